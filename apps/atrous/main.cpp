@@ -1,0 +1,38 @@
+// atrous: render noisy images with denoiser buffers, denoise them, compare against references.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+
+#include "atrous/error.h"
+#include "commands.h"
+
+int main(int argc, char** argv) {
+    CLI::App app{"atrous: Monte Carlo path tracing and fast wavelet denoising (EAW, SURE, SVGF)"};
+    app.require_subcommand(1);
+    app.set_version_flag("--version", "atrous 0.1.0");
+    atrous::cli::addRenderCommand(app);
+    atrous::cli::addDenoiseCommand(app);
+    atrous::cli::addCompareCommand(app);
+    atrous::cli::addBenchCommand(app);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        // Bad flags are bad input: one line, exit code 2.
+        std::fprintf(stderr, "atrous: error: %s (see --help)\n", e.what());
+        return 2;
+    } catch (const atrous::InputError& e) {
+        std::fprintf(stderr, "atrous: error: %s\n", e.what());
+        return 2;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "atrous: error: %s\n", e.what());
+        return 2;
+    }
+    return 0;
+}

@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# Installs what atrous needs on a fresh Debian 12 machine: the C++ libraries from Debian's
+# packages (only those missing), and, when the Python side exists, a local venv in .venv.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+PKGS=(build-essential cmake pkg-config
+      libembree-dev libtbb-dev libopenexr-dev libcli11-dev libtinyobjloader-dev libstb-dev
+      nlohmann-json3-dev libgtest-dev libbenchmark-dev)
+
+missing=()
+for p in "${PKGS[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}"
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+if [ -f python/requirements.txt ]; then
+  if [ ! -x .venv/bin/python ]; then
+    echo "setup: creating .venv"
+    python3 -m venv .venv
+  fi
+  stamp=.venv/.requirements.stamp
+  if [ ! -f "$stamp" ] || ! cmp -s python/requirements.txt "$stamp"; then
+    .venv/bin/python -m pip install -q --upgrade pip
+    .venv/bin/python -m pip install -q -r python/requirements.txt
+    cp python/requirements.txt "$stamp"
+  fi
+fi

@@ -1,0 +1,47 @@
+#include "atrous/device.h"
+
+#include <fstream>
+#include <string>
+#include <thread>
+
+#include <tbb/info.h>
+
+#include "atrous/error.h"
+#include "core/memory.h"
+
+namespace atrous {
+
+bool cudaAvailable() { return cudaCompiled() && detail::cudaDevicePresent(); }
+
+const char* deviceToString(Device d) { return d == Device::Cuda ? "cuda" : "cpu"; }
+
+Device parseDevice(const std::string& name) {
+    if (name == "cpu") return Device::Cpu;
+    if (name == "auto") return cudaAvailable() ? Device::Cuda : Device::Cpu;
+    if (name == "cuda") {
+        if (!cudaCompiled())
+            throw InputError("--device cuda: this build of atrous has no CUDA backend (nvcc was not found at build time)");
+        if (!detail::cudaDevicePresent()) throw InputError("--device cuda: no CUDA-capable GPU is available");
+        return Device::Cuda;
+    }
+    throw InputError("unknown device '" + name + "' (expected cpu, cuda or auto)");
+}
+
+static std::string cpuModel() {
+    std::ifstream in("/proc/cpuinfo");
+    std::string line;
+    while (std::getline(in, line)) {
+        if (line.rfind("model name", 0) == 0) {
+            auto pos = line.find(':');
+            if (pos != std::string::npos) return line.substr(pos + 2);
+        }
+    }
+    return "unknown CPU";
+}
+
+std::string deviceName(Device d) {
+    if (d == Device::Cuda) return detail::cudaDeviceName();
+    return cpuModel() + " (" + std::to_string(tbb::info::default_concurrency()) + " threads)";
+}
+
+}  // namespace atrous

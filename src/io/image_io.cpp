@@ -1,0 +1,266 @@
+#include "io/image_io.h"
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <stb_image.h>
+#include <stb_image_write.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include "atrous/error.h"
+
+namespace fs = std::filesystem;
+
+namespace atrous::io {
+
+std::string extensionOf(const std::string& path) {
+    std::string ext = fs::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return ext;
+}
+
+static void requireFile(const std::string& path) {
+    std::error_code ec;
+    if (!fs::exists(path, ec)) throw InputError(path + ": file not found");
+    if (fs::is_directory(path, ec)) throw InputError(path + ": is a directory, not an image file");
+    std::ifstream probe(path, std::ios::binary);
+    if (!probe) throw InputError(path + ": cannot open for reading (" + std::strerror(errno) + ")");
+}
+
+// ---------------------------------------------------------------------------------------- EXR
+
+static Image readExr(const std::string& path) {
+    try {
+        Imf::InputFile file(path.c_str());
+        const Imath::Box2i dw = file.header().dataWindow();
+        const long w = long(dw.max.x) - dw.min.x + 1, h = long(dw.max.y) - dw.min.y + 1;
+        if (w <= 0 || h <= 0 || w > kMaxImageDim || h > kMaxImageDim)
+            throw InputError(path + ": unsupported image size " + std::to_string(w) + "x" + std::to_string(h));
+        const Imf::ChannelList& channels = file.header().channels();
+        std::vector<std::string> names;
+        for (auto it = channels.begin(); it != channels.end(); ++it) names.push_back(it.name());
+        auto has = [&](const char* n) { return channels.findChannel(n) != nullptr; };
+        std::string src[3];
+        if (has("R") && has("G") && has("B")) {
+            src[0] = "R", src[1] = "G", src[2] = "B";
+        } else if (has("Y")) {
+            src[0] = src[1] = src[2] = "Y";
+        } else if (names.size() == 1) {
+            src[0] = src[1] = src[2] = names[0];
+        } else {
+            std::string list;
+            for (auto& n : names) list += (list.empty() ? "" : ",") + n;
+            throw InputError(path + ": expected R,G,B (or Y, or a single) channels, found " +
+                             (list.empty() ? std::string("none") : list));
+        }
+        Image img(int(w), int(h), 3);
+        Imf::FrameBuffer fb;
+        const size_t xs = sizeof(float), ys = sizeof(float) * size_t(w);
+        for (int c = 0; c < 3; ++c) {
+            // Point the slice's origin so that data-window pixel (min.x, min.y) lands at (0, 0).
+            char* base = reinterpret_cast<char*>(img.view().channel(c)) - dw.min.x * long(xs) - dw.min.y * long(ys);
+            if (c > 0 && src[c] == src[0]) continue;  // grey: filled below
+            fb.insert(src[c].c_str(), Imf::Slice(Imf::FLOAT, base, xs, ys, 1, 1, 0.0));
+        }
+        file.setFrameBuffer(fb);
+        file.readPixels(dw.min.y, dw.max.y);
+        if (src[1] == src[0]) {
+            std::copy(img.data(), img.data() + img.plane(), img.data() + img.plane());
+            std::copy(img.data(), img.data() + img.plane(), img.data() + 2 * img.plane());
+        }
+        return img;
+    } catch (const InputError&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw InputError(path + ": cannot read EXR (" + e.what() + ")");
+    }
+}
+
+void writeExr(const std::string& path, const Image& img) {
+    if (img.device() != Device::Cpu) throw InputError(path + ": writeExr needs a host image");
+    if (img.channels() != 1 && img.channels() != 3)
+        throw InputError(path + ": can only write 1- or 3-channel images, got " + std::to_string(img.channels()));
+    writeFileAtomically(path, [&](const std::string& tmp) {
+        try {
+            Imf::Header header(img.width(), img.height());
+            header.compression() = Imf::ZIP_COMPRESSION;
+            const char* names[3] = {"R", "G", "B"};
+            for (auto n : names) header.channels().insert(n, Imf::Channel(Imf::FLOAT));
+            Imf::OutputFile file(tmp.c_str(), header);
+            Imf::FrameBuffer fb;
+            const size_t xs = sizeof(float), ys = sizeof(float) * size_t(img.width());
+            for (int c = 0; c < 3; ++c) {
+                const float* plane = img.view().channel(img.channels() == 3 ? c : 0);
+                fb.insert(names[c], Imf::Slice(Imf::FLOAT, (char*)plane, xs, ys));
+            }
+            file.setFrameBuffer(fb);
+            file.writePixels(img.height());
+        } catch (const std::exception& e) {
+            throw RuntimeError(path + ": cannot write EXR (" + e.what() + ")");
+        }
+    });
+}
+
+// ---------------------------------------------------------------------------------------- PFM
+
+static Image readPfm(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::string magic;
+    long w = 0, h = 0;
+    double scale = 0;
+    in >> magic >> w >> h >> scale;
+    if (!in || (magic != "PF" && magic != "Pf"))
+        throw InputError(path + ": not a PFM file (bad header)");
+    if (w <= 0 || h <= 0 || w > kMaxImageDim || h > kMaxImageDim)
+        throw InputError(path + ": unsupported PFM size " + std::to_string(w) + "x" + std::to_string(h));
+    if (scale == 0 || !std::isfinite(scale)) throw InputError(path + ": PFM scale must be a non-zero number");
+    in.get();  // the single whitespace byte after the scale
+    const int nc = magic == "PF" ? 3 : 1;
+    std::vector<float> raw(size_t(w) * size_t(h) * nc);
+    in.read(reinterpret_cast<char*>(raw.data()), std::streamsize(raw.size() * sizeof(float)));
+    if (size_t(in.gcount()) != raw.size() * sizeof(float))
+        throw InputError(path + ": truncated PFM (expected " + std::to_string(raw.size() * sizeof(float)) +
+                         " bytes of pixels, found " + std::to_string(in.gcount()) + ")");
+    const bool fileLittle = scale < 0;
+    const uint16_t probe = 1;
+    const bool hostLittle = *reinterpret_cast<const uint8_t*>(&probe) == 1;
+    if (fileLittle != hostLittle) {
+        for (float& f : raw) {
+            uint32_t u;
+            std::memcpy(&u, &f, 4);
+            u = __builtin_bswap32(u);
+            std::memcpy(&f, &u, 4);
+        }
+    }
+    Image img(int(w), int(h), 3);
+    for (long y = 0; y < h; ++y) {
+        const long srcRow = h - 1 - y;  // PFM rows run bottom to top
+        for (long x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c) img(int(x), int(y), c) = raw[(size_t(srcRow) * w + x) * nc + (nc == 3 ? c : 0)];
+    }
+    return img;
+}
+
+void writePfm(const std::string& path, const Image& img) {
+    if (img.device() != Device::Cpu) throw InputError(path + ": writePfm needs a host image");
+    writeFileAtomically(path, [&](const std::string& tmp) {
+        std::ofstream out(tmp, std::ios::binary);
+        if (!out) throw RuntimeError(tmp + ": cannot open for writing");
+        const int w = img.width(), h = img.height();
+        out << "PF\n" << w << " " << h << "\n-1.0\n";
+        std::vector<float> row(size_t(w) * 3);
+        for (int y = h - 1; y >= 0; --y) {
+            for (int x = 0; x < w; ++x)
+                for (int c = 0; c < 3; ++c) row[size_t(x) * 3 + c] = img(x, y, img.channels() == 3 ? c : 0);
+            out.write(reinterpret_cast<const char*>(row.data()), std::streamsize(row.size() * sizeof(float)));
+        }
+        if (!out) throw RuntimeError(path + ": write failed");
+    });
+}
+
+// ---------------------------------------------------------------------------------- PNG & co.
+
+static float srgbEncode(float v) {
+    v = std::min(std::max(v, 0.0f), 1.0f);
+    return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+}
+
+void writePng(const std::string& path, const Image& img, float exposure) {
+    if (img.device() != Device::Cpu) throw InputError(path + ": writePng needs a host image");
+    const int w = img.width(), h = img.height();
+    std::vector<unsigned char> px(size_t(w) * h * 3);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c) {
+                float v = img(x, y, img.channels() == 3 ? c : 0) * exposure;
+                if (!std::isfinite(v)) v = 0.0f;
+                px[(size_t(y) * w + x) * 3 + c] = (unsigned char)std::lround(srgbEncode(v) * 255.0f);
+            }
+    writeFileAtomically(path, [&](const std::string& tmp) {
+        if (!stbi_write_png(tmp.c_str(), w, h, 3, px.data(), w * 3)) throw RuntimeError(path + ": cannot write PNG");
+    });
+}
+
+static Image readStb(const std::string& path) {
+    int w = 0, h = 0, n = 0;
+    // stbi_loadf converts 8-bit sRGB to linear (gamma 2.2) and reads Radiance .hdr as is.
+    float* data = stbi_loadf(path.c_str(), &w, &h, &n, 3);
+    if (!data) throw InputError(path + ": cannot read image (" + stbi_failure_reason() + ")");
+    Image img;
+    try {
+        img = Image(w, h, 3);
+    } catch (...) {
+        stbi_image_free(data);
+        throw;
+    }
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c) img(x, y, c) = data[(size_t(y) * w + x) * 3 + c];
+    stbi_image_free(data);
+    return img;
+}
+
+Image readImage(const std::string& path) {
+    requireFile(path);
+    const std::string ext = extensionOf(path);
+    if (ext == ".exr") return readExr(path);
+    if (ext == ".pfm") return readPfm(path);
+    if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".hdr" || ext == ".bmp" || ext == ".tga")
+        return readStb(path);
+    throw InputError(path + ": unsupported image format '" + ext + "' (expected .exr, .pfm, .png, .jpg or .hdr)");
+}
+
+void writeImage(const std::string& path, const Image& img) {
+    const std::string ext = extensionOf(path);
+    if (ext == ".exr") return writeExr(path, img);
+    if (ext == ".pfm") return writePfm(path, img);
+    if (ext == ".png") return writePng(path, img);
+    throw InputError(path + ": unsupported output format '" + ext + "' (expected .exr, .pfm or .png)");
+}
+
+// ------------------------------------------------------------------------------------ helpers
+
+void ensureWritableDirectory(const std::string& dir) {
+    std::error_code ec;
+    if (fs::exists(dir, ec)) {
+        if (!fs::is_directory(dir, ec)) throw InputError(dir + ": exists and is not a directory");
+    } else if (!fs::create_directories(dir, ec) || ec) {
+        throw InputError(dir + ": cannot create output directory (" + ec.message() + ")");
+    }
+    if (access(dir.c_str(), W_OK | X_OK) != 0) throw InputError(dir + ": output directory is not writable");
+}
+
+void writeFileAtomically(const std::string& path, const std::function<void(const std::string&)>& writer) {
+    fs::path target(path);
+    fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec)) throw InputError(path + ": output directory " + dir.string() + " does not exist");
+    if (access(dir.c_str(), W_OK | X_OK) != 0) throw InputError(path + ": output directory is not writable");
+    // Keep the extension last so libraries that look at it (stb, OpenEXR) still see it.
+    std::string tmp = (dir / ("." + target.stem().string() + ".tmp" + std::to_string(getpid()) + target.extension().string())).string();
+    try {
+        writer(tmp);
+    } catch (...) {
+        fs::remove(tmp, ec);
+        throw;
+    }
+    fs::rename(tmp, target, ec);
+    if (ec) {
+        fs::remove(tmp, ec);
+        throw RuntimeError(path + ": cannot rename temporary file into place (" + ec.message() + ")");
+    }
+}
+
+}  // namespace atrous::io

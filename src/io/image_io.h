@@ -1,0 +1,37 @@
+// Image files: OpenEXR (float RGB), PFM (the format Intel Open Image Denoise's tools use), and
+// PNG/JPEG/HDR through stb. Every writer goes through writeFileAtomically, so a failure never
+// leaves half a file under the final name.
+#pragma once
+#include <functional>
+#include <string>
+
+#include "atrous/image.h"
+
+namespace atrous::io {
+
+// Reads an image file as a 3-channel planar host Image (linear RGB). EXR needs R,G,B channels
+// (A is ignored), or Y, or exactly one channel (grey, repeated into R,G,B); PFM may be colour or
+// grey; 8-bit formats are converted from sRGB to linear. Throws InputError naming the file and the
+// problem for a missing, unreadable, truncated or oddly-shaped file.
+Image readImage(const std::string& path);
+
+// Writes `img` (1 or 3 channels on the host) by the file's extension: .exr (32-bit float R,G,B,
+// ZIP compressed), .pfm, or .png (tonemapped preview: exposure, clamp, sRGB). Atomic.
+void writeImage(const std::string& path, const Image& img);
+void writeExr(const std::string& path, const Image& img);
+void writePfm(const std::string& path, const Image& img);
+// 8-bit sRGB preview of linear HDR: out = srgb(clamp(exposure * v, 0, 1)).
+void writePng(const std::string& path, const Image& img, float exposure = 1.0f);
+
+// Calls writer(tmpPath) with a temporary name beside `path`, then renames it to `path`. If the
+// writer throws, the temporary file is removed and the exception passes on. Throws InputError when
+// the directory cannot be written.
+void writeFileAtomically(const std::string& path, const std::function<void(const std::string&)>& writer);
+
+// Throws InputError unless `dir` exists (or can be created) and a file can be created in it.
+void ensureWritableDirectory(const std::string& dir);
+
+// Lower-case extension with the dot (".exr"), or "" when there is none.
+std::string extensionOf(const std::string& path);
+
+}  // namespace atrous::io

@@ -1,0 +1,89 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "atrous/error.h"
+#include "io/image_io.h"
+#include "test_util.h"
+
+using namespace atrous;
+using atrous::test::TempDir;
+
+static Image ramp(int w, int h) {
+    Image img(w, h, 3);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c) img(x, y, c) = 0.1f * x + 10.0f * y + 100.0f * c + 0.125f;
+    return img;
+}
+
+static void expectSame(const Image& a, const Image& b) {
+    ASSERT_EQ(a.width(), b.width());
+    ASSERT_EQ(a.height(), b.height());
+    ASSERT_EQ(a.channels(), b.channels());
+    for (size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a.data()[i], b.data()[i]) << "at " << i;
+}
+
+TEST(ImageIo, ExrRoundTripIsExact) {
+    TempDir dir;
+    Image img = ramp(13, 7);
+    io::writeImage(dir / "a.exr", img);
+    expectSame(img, io::readImage(dir / "a.exr"));
+}
+
+TEST(ImageIo, PfmRoundTripIsExactAndRowOrderIsTopDown) {
+    TempDir dir;
+    Image img = ramp(9, 4);
+    io::writeImage(dir / "a.pfm", img);
+    expectSame(img, io::readImage(dir / "a.pfm"));
+    // The first pixel row stored in the file is the bottom row of the image.
+    std::ifstream in(dir / "a.pfm", std::ios::binary);
+    std::string magic;
+    int w, h;
+    float scale;
+    in >> magic >> w >> h >> scale;
+    in.get();
+    float first;
+    in.read(reinterpret_cast<char*>(&first), 4);
+    EXPECT_EQ(first, img(0, 3, 0));
+}
+
+TEST(ImageIo, PngPreviewIsWritten) {
+    TempDir dir;
+    io::writeImage(dir / "a.png", ramp(8, 8));
+    Image back = io::readImage(dir / "a.png");
+    EXPECT_EQ(back.width(), 8);
+    EXPECT_EQ(atrous::test::countEntries(dir.str()), 1);  // no temporary left behind
+}
+
+TEST(ImageIo, BadFilesGiveInputErrorsNamingTheFile) {
+    TempDir dir;
+    EXPECT_THROW(io::readImage(dir / "missing.exr"), InputError);
+    {
+        std::ofstream(dir / "garbage.exr") << "this is not an exr file";
+    }
+    try {
+        io::readImage(dir / "garbage.exr");
+        FAIL();
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("garbage.exr"), std::string::npos);
+    }
+    // A truncated EXR: the first half of a valid file.
+    io::writeImage(dir / "full.exr", ramp(64, 64));
+    std::ifstream in(dir / "full.exr", std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), {});
+    std::ofstream(dir / "trunc.exr", std::ios::binary).write(bytes.data(), std::streamsize(bytes.size() / 2));
+    EXPECT_THROW(io::readImage(dir / "trunc.exr"), InputError);
+    // A truncated PFM.
+    std::ofstream(dir / "trunc.pfm", std::ios::binary) << "PF\n4 4\n-1.0\n" << std::string(10, 'x');
+    EXPECT_THROW(io::readImage(dir / "trunc.pfm"), InputError);
+    EXPECT_THROW(io::readImage(dir / "a.xyz"), InputError);
+}
+
+TEST(ImageIo, FailedWriteLeavesNothing) {
+    TempDir dir;
+    EXPECT_THROW(io::writeImage(dir / "nodir/a.exr", ramp(4, 4)), InputError);
+    EXPECT_THROW(io::writeImage(dir / "a.bmp", ramp(4, 4)), InputError);
+    EXPECT_EQ(atrous::test::countEntries(dir.str()), 0);
+}

@@ -1,0 +1,66 @@
+// Helpers shared by the GoogleTest files: temporary directories and running the CLI.
+#pragma once
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <random>
+#include <string>
+
+namespace atrous::test {
+
+// A fresh directory under the system temp dir, removed when the object dies.
+class TempDir {
+public:
+    TempDir() {
+        std::random_device rd;
+        auto base = std::filesystem::temp_directory_path();
+        for (;;) {
+            mPath = base / ("atrous_test_" + std::to_string(getpid()) + "_" + std::to_string(rd()));
+            if (std::filesystem::create_directories(mPath)) break;
+        }
+    }
+    ~TempDir() {
+        std::error_code ec;
+        std::filesystem::permissions(mPath, std::filesystem::perms::owner_all, std::filesystem::perm_options::add, ec);
+        std::filesystem::remove_all(mPath, ec);
+    }
+    std::string str() const { return mPath.string(); }
+    std::string operator/(const std::string& name) const { return (mPath / name).string(); }
+    const std::filesystem::path& path() const { return mPath; }
+
+private:
+    std::filesystem::path mPath;
+};
+
+struct CliResult {
+    int exitCode = -1;
+    std::string output;  // stdout and stderr together
+};
+
+// Runs `build/atrous <args>` through the shell and captures its output and exit code.
+inline CliResult runCli(const std::string& args) {
+    std::string cmd = std::string(ATROUS_CLI) + " " + args + " 2>&1";
+    CliResult r;
+    FILE* pipe = popen(cmd.c_str(), "r");
+    if (!pipe) return r;
+    std::array<char, 4096> buf;
+    size_t n;
+    while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) r.output.append(buf.data(), n);
+    int status = pclose(pipe);
+    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return r;
+}
+
+// Counts the entries of a directory (to check that a failed command wrote nothing).
+inline int countEntries(const std::string& dir) {
+    int n = 0;
+    std::error_code ec;
+    for (auto it = std::filesystem::directory_iterator(dir, ec); !ec && it != std::filesystem::directory_iterator(); ++it) ++n;
+    return n;
+}
+
+}  // namespace atrous::test
