@@ -17,6 +17,7 @@ demo: build
 
 test: build
 	@cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+	@JOBS=$(JOBS) ./scripts/python_test.sh
 
 bench: build
 	@./scripts/bench.sh $(BUILD)
