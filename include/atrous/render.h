@@ -1,0 +1,80 @@
+// Rendering API: a physically based CPU path tracer (Embree 3 intersection, TBB threads) that
+// writes the noisy colour together with the per-pixel buffers the denoisers use
+// (ALGORITHMS.md section 1, docs/rendering.md).
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "atrous/image.h"
+
+namespace atrous {
+
+namespace pt {
+struct SceneData;  // flat, GPU-friendly scene arrays (src/render/scene_data.h)
+}
+
+struct RenderSettings {
+    int width = 512;
+    int height = 512;
+    int spp = 16;        // samples per pixel, >= 1
+    uint32_t seed = 1;   // same seed -> bit-identical output, whatever the thread count
+    int maxDepth = 8;    // bounces: 0 = emitted light only, 1 = direct lighting, ...
+    int threads = 0;     // worker threads, 0 = all cores
+    // Next-event estimation with multiple importance sampling (power heuristic). false = BSDF
+    // sampling only (for tests; delta lights such as point lights then contribute nothing).
+    bool lightSampling = true;
+};
+
+// All buffers are 3-channel planar host images of width x height (ALGORITHMS.md section 1):
+//   color     mean radiance of the pixel's samples, linear HDR (W sr^-1 m^-2 per channel)
+//   variance  variance of that mean, per channel: (E[y^2] - E[y]^2) / (n - 1); 0 at spp = 1
+//   albedo    directional reflectance in [0,1] of the first non-delta surface (delta-bounce
+//             throughput multiplied in); background: environment radiance clamped to [0,1]
+//   normal    world-space unit shading normal of that surface; 0 for background
+//   position  world-space point of that surface; 0 for background
+//   depth     distance of the primary hit along the camera's forward axis, repeated in R,G,B;
+//             1e30 for background
+//   ids       R = mesh id, G = material id, B = 0; -1 for background
+struct RenderBuffers {
+    Image color, variance, albedo, normal, position, depth, ids;
+};
+
+// Depth written for pixels that see no surface (a finite stand-in for +inf).
+constexpr float kBackgroundDepth = 1e30f;
+
+// A scene ready to render: geometry, materials, lights and camera. Cheap to copy (shared,
+// immutable data).
+class Scene {
+public:
+    // One of builtinSceneNames(); throws InputError naming the unknown scene otherwise.
+    static Scene builtin(const std::string& name);
+    // A JSON scene file (docs/scenes.md); OBJ and texture paths are relative to the file.
+    // Throws InputError naming the file and the problem.
+    static Scene load(const std::string& path);
+    // JSON text; `baseDir` resolves relative paths, `sourceName` names the text in errors.
+    static Scene parse(const std::string& jsonText, const std::string& baseDir,
+                       const std::string& sourceName = "<scene json>");
+    // A path ending in .json or naming an existing file is loaded, anything else is a built-in.
+    static Scene loadByNameOrFile(const std::string& nameOrPath);
+
+    const std::string& name() const;
+    // Material id (as written into ids.G) of the material called `name`; -1 when there is none.
+    int materialId(const std::string& name) const;
+    // Mesh id (ids.R) of the object called `name`; -1 when there is none.
+    int meshId(const std::string& name) const;
+
+    const pt::SceneData& data() const { return *mData; }
+
+private:
+    std::shared_ptr<const pt::SceneData> mData;
+};
+
+const std::vector<std::string>& builtinSceneNames();
+
+// Renders `scene` on the CPU. Throws InputError for settings out of range (spp <= 0, width or
+// height <= 0 or > kMaxImageDim, maxDepth < 0, threads < 0).
+RenderBuffers render(const Scene& scene, const RenderSettings& settings);
+
+}  // namespace atrous

@@ -1,0 +1,230 @@
+// Unidirectional path tracing with next-event estimation and multiple importance sampling (power
+// heuristic), Russian roulette, and the denoiser features that follow delta bounces
+// (ALGORITHMS.md section 1). The per-pixel functor is a template on the intersector, so the CPU
+// backend plugs in Embree and a GPU backend its own BVH; everything here is host/device code with
+// no STL, no virtuals and no exceptions.
+//
+// A Tracer provides:
+//   bool intersect(Vec3 o, Vec3 d, float tmax, Hit& hit) const;   // nearest hit in (0, tmax)
+//   bool occluded(Vec3 o, Vec3 d, float tmax) const;              // any hit in (0, tmax)
+#pragma once
+#include "atrous/image.h"
+#include "core/math.h"
+#include "core/rng.h"
+#include "render/bsdf.h"
+#include "render/camera.h"
+#include "render/lights.h"
+#include "render/sampling.h"
+#include "render/scene_data.h"
+
+namespace atrous::pt {
+
+// Russian roulette starts after this many bounces (earlier paths carry most of the energy).
+constexpr int kRouletteStartBounce = 3;
+
+struct PathSample {
+    Vec3 radiance;
+    Vec3 albedo;       // feature albedo (delta throughput included)
+    Vec3 normal;       // feature normal (valid when featureHit)
+    Vec3 position;     // feature position (valid when featureHit)
+    float depth = -1;  // primary hit depth along the camera axis, < 0 when the camera ray escaped
+    int32_t mesh = -1, material = -1;
+    bool featureHit = false;
+};
+
+ATROUS_INLINE Vec3 clamp01(Vec3 v) {
+    return Vec3(clampf(v.x, 0.0f, 1.0f), clampf(v.y, 0.0f, 1.0f), clampf(v.z, 0.0f, 1.0f));
+}
+
+ATROUS_INLINE Bsdf makeBsdf(const SceneView& s, const Material& m, Vec2 uv, bool entering) {
+    Bsdf b;
+    b.type = m.type;
+    b.albedo = m.albedo;
+    if (m.texture >= 0) {
+        b.albedo = sampleTexture(s, m.texture, uv);
+    } else if (m.checker) {
+        int cx = int(floorf(uv.x * m.checkerScale)), cy = int(floorf(uv.y * m.checkerScale));
+        b.albedo = ((cx + cy) & 1) ? m.albedo2 : m.albedo;
+    }
+    b.alpha = clampf(m.roughness, 0.002f, 1.0f);
+    b.ior = m.ior;
+    b.entering = entering;
+    return b;
+}
+
+// The feature albedo of a non-delta surface: the Lambertian reflectance, a conductor's F0 and a
+// plastic's base colour (documented stand-ins for their directional albedo).
+ATROUS_INLINE Vec3 featureAlbedo(const Bsdf& b) { return clamp01(b.albedo); }
+
+ATROUS_INLINE Vec3 toLocal(Vec3 v, Vec3 t, Vec3 b, Vec3 n) { return Vec3(dot(v, t), dot(v, b), dot(v, n)); }
+ATROUS_INLINE Vec3 fromLocal(Vec3 v, Vec3 t, Vec3 b, Vec3 n) { return t * v.x + b * v.y + n * v.z; }
+
+template <class Tracer>
+ATROUS_HOST_DEVICE PathSample tracePath(const SceneView& s, const Tracer& tracer, Vec3 o, Vec3 d, Rng& rng,
+                                        int maxDepth, bool lightSampling) {
+    PathSample r;
+    Vec3 beta(1.0f);
+    Vec3 featureThroughput(1.0f);
+    bool following = true;  // still looking for the first non-delta surface (features)
+    bool specular = true;   // the last bounce was a delta one (or this is the camera ray)
+    float prevPdf = 0.0f;   // solid-angle pdf of the BSDF sample that made this ray
+    for (int bounce = 0;; ++bounce) {
+        Hit hit;
+        if (!tracer.intersect(o, d, kRayInfinity, hit)) {
+            Vec3 le = envRadiance(s, d);
+            float w = 1.0f;
+            if (!specular && lightSampling && s.env.lightIndex >= 0)
+                w = powerHeuristic(prevPdf, lightPmf(s, s.env.lightIndex) * envPdf(s, d));
+            r.radiance += beta * le * w;
+            if (following) r.albedo = featureThroughput * clamp01(le);
+            break;
+        }
+        SurfaceInteraction si = surfaceAt(s, hit, o, d);
+        const Material& m = s.materials[si.material];
+        Vec3 wo = -d;
+        bool front = dot(si.ng, wo) > 0.0f;
+        if (bounce == 0) r.depth = dot(si.p - s.camera.position, s.camera.forward);
+
+        if (front && maxComponent(m.emission) > 0.0f) {
+            float w = 1.0f;
+            if (!specular && lightSampling && si.light >= 0)
+                w = powerHeuristic(prevPdf, triangleLightPdf(s, si.light, si, d, hit.t));
+            r.radiance += beta * m.emission * w;
+        }
+
+        // Shade with the normals facing the incoming ray (two-sided surfaces); glass keeps
+        // `front` to know whether the ray enters or leaves.
+        Vec3 ng = front ? si.ng : -si.ng;
+        Vec3 ns = front ? si.ns : -si.ns;
+        Bsdf b = makeBsdf(s, m, si.uv, front);
+        bool delta = isDelta(m.type);
+        if (following && (!delta || bounce >= maxDepth)) {
+            r.albedo = featureThroughput * (delta ? clamp01(b.albedo) : featureAlbedo(b));
+            r.normal = ns;
+            r.position = si.p;
+            r.mesh = si.mesh;
+            r.material = si.material;
+            r.featureHit = true;
+            following = false;
+        }
+        if (bounce >= maxDepth) break;
+
+        Vec3 tt, bb;
+        makeBasis(ns, tt, bb);
+        Vec3 woL = toLocal(wo, tt, bb, ns);
+        if (woL.z <= 0.0f) break;  // shading normal disagrees with the geometry: give up the path
+
+        // Next-event estimation (not for delta BSDFs: a light sample has zero chance to match).
+        if (lightSampling && !delta && s.numLights > 0) {
+            float u0 = rng.next(), u1 = rng.next(), u2 = rng.next();
+            LightSample ls = sampleLight(s, si.p, u0, u1, u2);
+            if (ls.valid && dot(ls.wi, ng) > 0.0f) {
+                Vec3 wiL = toLocal(ls.wi, tt, bb, ns);
+                Vec3 f = bsdfEval(b, woL, wiL) * fabsf(wiL.z);
+                if (maxComponent(f) > 0.0f && maxComponent(ls.li) > 0.0f) {
+                    Vec3 origin = offsetRayOrigin(si.p, ng, ls.wi);
+                    float tmax = ls.dist < kRayInfinity ? ls.dist * (1.0f - 1e-3f) : kRayInfinity;
+                    if (!tracer.occluded(origin, ls.wi, tmax)) {
+                        float w = ls.delta ? 1.0f : powerHeuristic(ls.pdf, bsdfPdf(b, woL, wiL));
+                        r.radiance += beta * f * ls.li * (w / ls.pdf);
+                    }
+                }
+            }
+        }
+
+        float uLobe = rng.next(), u1 = rng.next(), u2 = rng.next();
+        BsdfSample bs = bsdfSample(b, woL, uLobe, u1, u2);
+        if (!bs.valid) break;
+        Vec3 wi = normalize(fromLocal(bs.wi, tt, bb, ns));
+        // A reflection must leave on the incoming side of the geometry, a refraction cross it;
+        // shading normals can break that, which would leak light through surfaces.
+        bool transmitted = bs.wi.z < 0.0f;
+        if ((dot(wi, ng) < 0.0f) != transmitted) break;
+        beta *= bs.weight;
+        if (following) featureThroughput *= bs.weight;  // only delta bounces get here
+        specular = bs.delta;
+        prevPdf = bs.pdf;
+        o = offsetRayOrigin(si.p, ng, wi);
+        d = wi;
+
+        if (bounce + 1 >= kRouletteStartBounce) {
+            float q = minf(0.95f, maxComponent(beta));
+            if (!(rng.next() < q)) break;
+            beta = beta / q;
+        }
+        if (!isFinite(beta)) break;
+    }
+    return r;
+}
+
+// Per-pixel outputs of the path tracer, one ImageView (3 channels) each.
+struct RenderTargets {
+    ImageView color, variance, albedo, normal, position, depth, ids;
+};
+
+// Renders all samples of pixel (x, y): the RNG stream of sample i is Rng(pixel, i, seed), so the
+// result is independent of thread count and scheduling.
+template <class Tracer>
+struct PathTraceKernel {
+    SceneView scene;
+    Tracer tracer;
+    RenderTargets out;
+    int width = 0, height = 0, spp = 1, maxDepth = 8;
+    uint32_t seed = 1;
+    bool lightSampling = true;
+    float backgroundDepth = 1e30f;
+
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        uint32_t pixel = uint32_t(y) * uint32_t(width) + uint32_t(x);
+        Vec3 mean(0.0f), m2(0.0f);  // Welford running mean and sum of squared deviations
+        Vec3 albedoSum(0.0f), normalSum(0.0f), positionSum(0.0f);
+        float depthSum = 0.0f;
+        int featureHits = 0, depthHits = 0;
+        int32_t mesh = -1, material = -1;
+        for (int i = 0; i < spp; ++i) {
+            Rng rng(pixel, uint32_t(i), seed);
+            float jx = rng.next(), jy = rng.next();
+            Vec3 dir = cameraRayDirection(scene.camera, float(x) + jx, float(y) + jy, width, height);
+            PathSample ps = tracePath(scene, tracer, scene.camera.position, dir, rng, maxDepth, lightSampling);
+            // A NaN/Inf sample (numerical accident) counts as black rather than poisoning the pixel.
+            Vec3 v = isFinite(ps.radiance) ? ps.radiance : Vec3(0.0f);
+            Vec3 delta = v - mean;
+            mean += delta / float(i + 1);
+            m2 += delta * (v - mean);
+            albedoSum += ps.albedo;
+            if (ps.featureHit) {
+                normalSum += ps.normal;
+                positionSum += ps.position;
+                ++featureHits;
+            }
+            if (ps.depth >= 0.0f) {
+                depthSum += ps.depth;
+                ++depthHits;
+            }
+            if (i == 0) {  // ids are not averaged: the first sample's
+                mesh = ps.mesh;
+                material = ps.material;
+            }
+        }
+        float n = float(spp);
+        // Variance of the mean: sample variance / n = (E[y^2] - E[y]^2) / (n - 1); unknown at n = 1.
+        Vec3 var = spp > 1 ? m2 / (n * (n - 1.0f)) : Vec3(0.0f);
+        Vec3 albedo = albedoSum / n;
+        Vec3 normal = featureHits > 0 ? normalize(normalSum) : Vec3(0.0f);
+        Vec3 position = featureHits > 0 ? positionSum / float(featureHits) : Vec3(0.0f);
+        float depth = depthHits > 0 ? depthSum / float(depthHits) : backgroundDepth;
+        for (int c = 0; c < 3; ++c) {
+            out.color(x, y, c) = mean[c];
+            out.variance(x, y, c) = maxf(0.0f, var[c]);
+            out.albedo(x, y, c) = albedo[c];
+            out.normal(x, y, c) = normal[c];
+            out.position(x, y, c) = position[c];
+            out.depth(x, y, c) = depth;
+        }
+        out.ids(x, y, 0) = float(mesh);
+        out.ids(x, y, 1) = float(material);
+        out.ids(x, y, 2) = mesh < 0 ? -1.0f : 0.0f;
+    }
+};
+
+}  // namespace atrous::pt
