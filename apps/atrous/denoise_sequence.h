@@ -1,0 +1,35 @@
+// `atrous denoise --method svgf|eaw|sure --sequence DIR --out OUTDIR`: denoises every frame of a
+// sequence directory (layout in src/io/sequence.h and docs/svgf.md). SVGF carries its history from
+// frame to frame; EAW and SURE denoise each frame on its own through atrous::denoise().
+#pragma once
+#include <string>
+
+#include "atrous/denoise.h"
+#include "atrous/device.h"
+#include "atrous/svgf.h"
+
+namespace atrous::cli {
+
+struct SequenceDenoiseArgs {
+    std::string method = "svgf";  // svgf | eaw | sure
+    std::string sequenceDir;
+    std::string outDir;
+    Device device = Device::Cpu;
+    SvgfParams svgf;              // used by --method svgf
+    DenoiseOptions frameOptions;  // used by eaw/sure (method and device are set from the fields above)
+    float exposure = 1.0f;        // of the PNG previews
+    bool preview = true;          // animated OUTDIR/preview.mp4 through ffmpeg when it is on PATH
+    bool quiet = false;           // no per-frame lines on stdout
+};
+
+// Checks the whole sequence first (every frame and buffer present, one size: nothing is written
+// otherwise), then writes OUTDIR/frame_NNNN.exr (linear HDR) and frame_NNNN.png (preview) per
+// input frame, and OUTDIR/preview.mp4 when ffmpeg is available (if not, it says so and skips).
+// Prints one line per frame (time, and MSE against reference.exr when the frame has one).
+// Throws InputError for bad input (the CLI turns it into exit code 2). Returns 0.
+int runSequenceDenoise(const SequenceDenoiseArgs& args);
+
+// Full path of an executable named `name` on PATH, or "" when there is none.
+std::string findOnPath(const std::string& name);
+
+}  // namespace atrous::cli

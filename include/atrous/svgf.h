@@ -1,0 +1,88 @@
+// Spatiotemporal variance-guided filtering (Schied et al. 2017, "SVGF"): a temporal accumulation
+// of 1-spp frames followed by an edge-avoiding à-trous wavelet filter whose luminance edge stop is
+// scaled by the estimated per-pixel standard deviation. See docs/svgf.md and ALGORITHMS.md §4.
+#pragma once
+#include <memory>
+
+#include "atrous/device.h"
+#include "atrous/image.h"
+
+namespace atrous {
+
+// Every knob of the filter. One struct feeds the CLI flags, the Python keywords and the kernels;
+// each field changes the output (tests/svgf_test.cpp checks that).
+struct SvgfParams {
+    // À-trous edge stops (paper's σ_l, σ_n, σ_z).
+    float sigmaL = 4.0f;    // luminance: exp(-|l_p - l_q| / (σ_l sqrt(g3x3(var_p)) + ε))
+    float sigmaN = 128.0f;  // normal: max(0, n_p·n_q)^σ_n
+    float sigmaZ = 1.0f;    // depth: exp(-|z_p - z_q| / (σ_z |∇z_p·(p - q)| + ε))
+    // Temporal accumulation: blend factor α = max(alpha, 1/historyLength) for colour and
+    // momentsAlpha likewise for the luminance moments. In (0, 1].
+    float alpha = 0.2f;
+    float momentsAlpha = 0.2f;
+    int historyCap = 32;   // history length saturates here (>= 1)
+    int levels = 5;        // à-trous levels, step 2^i (0..10; 0 = temporal accumulation only)
+    // Which à-trous level's output becomes next frame's colour history: 0 = after the first level
+    // (the paper), -1 = the unfiltered temporal accumulation. In [-1, levels - 1].
+    int feedbackTap = 0;
+    // Below this history length (frames) the variance comes from a 7x7 spatial bilateral estimate
+    // instead of the temporal moments (the paper: 4). >= 1.
+    int spatialVarianceFrames = 4;
+    // Reprojection consistency: a previous-frame tap is kept when its depth differs by at most
+    // reprojectDepthTolerance * (|dz/dx| + |dz/dy| + 0.01 z) (relative to the local depth gradient),
+    // its normal's cosine to the current one is at least reprojectNormalCos, and the mesh ids agree.
+    float reprojectDepthTolerance = 2.0f;
+    float reprojectNormalCos = 0.9f;
+    // Optional temporal anti-aliasing on the remodulated output: reprojected previous output,
+    // clamped to the current 3x3 neighbourhood's colour box, blended with weight taaAlpha.
+    bool taa = false;
+    float taaAlpha = 0.1f;
+};
+
+// Throws InputError naming the field when a parameter is out of range.
+void validateSvgfParams(const SvgfParams& p);
+
+// One frame's buffers, each a planar Image of the colour's size on the host or on the denoiser's
+// device. Only `color` is required; a missing buffer takes a neutral default (albedo 1, normal
+// +z, depth 1, id 0, motion 0, emission 0). Non-finite values anywhere are treated as missing for
+// that pixel (a non-finite colour is no sample; non-finite motion means "no history").
+struct SvgfFrame {
+    const Image* color = nullptr;     // 1 spp radiance, linear HDR, 3 channels
+    const Image* albedo = nullptr;    // 3 channels, [0, 1]; demodulation divides by max(albedo, 1e-3)
+    const Image* normal = nullptr;    // world-space unit normal, 3 channels (0 = background)
+    const Image* depth = nullptr;     // view depth in channel 0 (>= 1e29 = background, e.g. 1e30)
+    const Image* ids = nullptr;       // mesh id in channel 0, -1 for background
+    const Image* motion = nullptr;    // channel 0 = dx, channel 1 = dy in pixels, previous - current
+    const Image* emission = nullptr;  // optional: emitted radiance at the primary hit, 3 channels
+};
+
+namespace detail {
+class SvgfBackend;
+}
+
+// Keeps the history across frames. Feed frames in order; reset() (or a change of image size)
+// starts a new history. Not thread-safe: one denoiser per stream of frames.
+class SvgfDenoiser {
+public:
+    // Throws InputError for bad params or an unusable device.
+    explicit SvgfDenoiser(const SvgfParams& params = {}, Device device = Device::Cpu);
+    ~SvgfDenoiser();
+    SvgfDenoiser(SvgfDenoiser&&) noexcept;
+    SvgfDenoiser& operator=(SvgfDenoiser&&) noexcept;
+
+    // Denoises one frame and returns the 3-channel linear HDR result on the host. Throws InputError
+    // when `color` is missing or a buffer's size or channel count does not match the colour's.
+    Image denoiseFrame(const SvgfFrame& frame);
+    // Forgets all history (next frame is treated as the first).
+    void reset();
+
+    const SvgfParams& params() const { return mParams; }
+    Device device() const { return mDevice; }
+
+private:
+    SvgfParams mParams;
+    Device mDevice = Device::Cpu;
+    std::unique_ptr<detail::SvgfBackend> mImpl;
+};
+
+}  // namespace atrous

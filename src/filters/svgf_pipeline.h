@@ -1,0 +1,221 @@
+// The SVGF per-frame driver, written once as a template on the executor (CpuExec from
+// core/parallel.h, CudaExec from cuda/cuda_exec.cuh) so both backends run the same stage functors
+// in the same order. SvgfState owns every buffer on the executor's device: the history carried
+// from frame to frame and this frame's temporaries (allocated once per image size).
+#pragma once
+#include <memory>
+#include <string>
+#include <utility>
+
+#include "atrous/error.h"
+#include "atrous/svgf.h"
+#include "filters/svgf_accumulate.h"
+#include "filters/svgf_atrous.h"
+#include "filters/svgf_demodulate.h"
+#include "filters/svgf_gbuffer.h"
+#include "filters/svgf_remodulate.h"
+#include "filters/svgf_reproject.h"
+#include "filters/svgf_taa.h"
+#include "filters/svgf_variance.h"
+
+namespace atrous::detail {
+
+// Type-erased backend behind SvgfDenoiser (virtuals here, never inside a functor).
+class SvgfBackend {
+public:
+    virtual ~SvgfBackend() = default;
+    virtual Image denoiseFrame(const SvgfFrame& frame) = 0;
+    virtual void reset() = 0;
+};
+
+std::unique_ptr<SvgfBackend> makeSvgfCpuBackend(const SvgfParams& params);
+// Defined in src/cuda/cuda_svgf.cu on CUDA builds; throws InputError otherwise.
+std::unique_ptr<SvgfBackend> makeSvgfCudaBackend(const SvgfParams& params);
+
+}  // namespace atrous::detail
+
+namespace atrous::svgf {
+
+// Checks the frame's buffers (colour present; every given buffer of the colour's size with enough
+// channels) and returns nothing; throws InputError naming the buffer and the problem.
+void checkFrame(const SvgfFrame& frame);
+
+struct SvgfState {
+    int width = 0, height = 0;
+    bool havePrevious = false;  // history buffers hold a previous frame
+    bool haveTaa = false;       // taaHistory holds a previous output
+    int frames = 0;             // frames since the last reset
+
+    // Carried across frames: accumulated illumination after the feedback tap, luminance moments,
+    // history length, the previous frame's sanitised features, and the TAA output.
+    Image histIllum, histMoments, histLength, prevDepth, prevNormal, prevIds, taaHistory;
+    // This frame.
+    Image illum, valid, depth, normal, ids, motion, depthGrad;
+    Image reprojIllum, reprojMoments, reprojLength;
+    Image accIllum, accMoments, accLength, variance;
+    Image levelIllum[2], levelVariance[2], nextHistIllum;
+    Image output, taaOutput;
+    const Image* result = nullptr;  // output or taaHistory after the last run
+
+    void allocate(int w, int h, Device d) {
+        width = w;
+        height = h;
+        havePrevious = haveTaa = false;
+        frames = 0;
+        auto make = [&](int c) { return Image(w, h, c, d); };
+        histIllum = make(3), histMoments = make(2), histLength = make(1);
+        prevDepth = make(1), prevNormal = make(3), prevIds = make(1), taaHistory = make(3);
+        illum = make(3), valid = make(1), depth = make(1), normal = make(3), ids = make(1), motion = make(2);
+        depthGrad = make(2);
+        reprojIllum = make(3), reprojMoments = make(2), reprojLength = make(1);
+        accIllum = make(3), accMoments = make(2), accLength = make(1), variance = make(1);
+        for (int i = 0; i < 2; ++i) levelIllum[i] = make(3), levelVariance[i] = make(1);
+        nextHistIllum = make(3);
+        output = make(3), taaOutput = make(3);
+        result = nullptr;
+    }
+};
+
+template <class Exec>
+class SvgfPipeline {
+public:
+    explicit SvgfPipeline(const SvgfParams& params, Exec exec = Exec{}) : mParams(params), mExec(exec) {
+        validateSvgfParams(params);
+    }
+
+    void reset() {
+        mState.havePrevious = mState.haveTaa = false;
+        mState.frames = 0;
+    }
+
+    // Runs every stage on `frame`; the result is left in *state().result on the executor's device.
+    void run(const SvgfFrame& frame) {
+        checkFrame(frame);
+        const Device dev = mExec.device();
+        const int w = frame.color->width(), h = frame.color->height();
+        if (w != mState.width || h != mState.height || mState.illum.device() != dev || mState.illum.empty())
+            mState.allocate(w, h, dev);  // a new size starts a new history
+        SvgfState& s = mState;
+
+        // Inputs not yet on the executor's device are copied there for this frame.
+        Image holders[7];
+        const Image* inputs[7] = {frame.color, frame.albedo, frame.normal, frame.depth, frame.ids, frame.motion, frame.emission};
+        ImageView views[7];
+        for (int i = 0; i < 7; ++i) {
+            if (!inputs[i]) continue;
+            if (inputs[i]->device() == dev) {
+                views[i] = inputs[i]->view();
+            } else {
+                holders[i] = inputs[i]->to(dev);
+                views[i] = holders[i].view();
+            }
+        }
+        const ImageView color = views[0], albedo = views[1], normalIn = views[2], depthIn = views[3], idsIn = views[4],
+                        motionIn = views[5], emission = views[6];
+
+        mExec.forEachPixel(w, h, Demodulate{color, albedo, emission, s.illum.view(), s.valid.view()});
+        mExec.forEachPixel(w, h, SanitizeGbuffer{depthIn, normalIn, idsIn, motionIn, s.depth.view(), s.normal.view(),
+                                                 s.ids.view(), s.motion.view()});
+        mExec.forEachPixel(w, h, DepthGradient{s.depth.view(), s.depthGrad.view()});
+
+        Reproject rp;
+        rp.depthTolerance = mParams.reprojectDepthTolerance;
+        rp.normalCos = mParams.reprojectNormalCos;
+        rp.havePrevious = s.havePrevious;
+        rp.motion = s.motion.view(), rp.depth = s.depth.view(), rp.normal = s.normal.view(), rp.ids = s.ids.view();
+        rp.depthGrad = s.depthGrad.view();
+        rp.prevIllum = s.histIllum.view(), rp.prevMoments = s.histMoments.view(), rp.prevLength = s.histLength.view();
+        rp.prevDepth = s.prevDepth.view(), rp.prevNormal = s.prevNormal.view(), rp.prevIds = s.prevIds.view();
+        rp.outIllum = s.reprojIllum.view(), rp.outMoments = s.reprojMoments.view(), rp.outLength = s.reprojLength.view();
+        mExec.forEachPixel(w, h, rp);
+
+        Accumulate acc;
+        acc.alpha = mParams.alpha;
+        acc.momentsAlpha = mParams.momentsAlpha;
+        acc.historyCap = float(mParams.historyCap);
+        acc.illum = s.illum.view(), acc.valid = s.valid.view();
+        acc.histIllum = s.reprojIllum.view(), acc.histMoments = s.reprojMoments.view(), acc.histLength = s.reprojLength.view();
+        acc.outIllum = s.accIllum.view(), acc.outMoments = s.accMoments.view(), acc.outLength = s.accLength.view();
+        mExec.forEachPixel(w, h, acc);
+
+        Variance var;
+        var.spatialFrames = float(mParams.spatialVarianceFrames);
+        var.sigmaN = mParams.sigmaN;
+        var.sigmaZ = mParams.sigmaZ;
+        var.moments = s.accMoments.view(), var.length = s.accLength.view();
+        var.depth = s.depth.view(), var.normal = s.normal.view(), var.depthGrad = s.depthGrad.view();
+        var.variance = s.variance.view();
+        mExec.forEachPixel(w, h, var);
+
+        // À-trous levels, ping-ponging between two buffers; the level at the feedback tap writes
+        // straight into next frame's colour history instead (no copy).
+        ImageView inIllum = s.accIllum.view(), inVar = s.variance.view();
+        for (int level = 0; level < mParams.levels; ++level) {
+            Atrous at;
+            at.sigmaL = mParams.sigmaL, at.sigmaN = mParams.sigmaN, at.sigmaZ = mParams.sigmaZ;
+            at.step = 1 << level;
+            at.illum = inIllum, at.variance = inVar, at.length = s.accLength.view();
+            at.depth = s.depth.view(), at.normal = s.normal.view(), at.depthGrad = s.depthGrad.view();
+            at.outIllum = level == mParams.feedbackTap ? s.nextHistIllum.view() : s.levelIllum[level & 1].view();
+            at.outVariance = s.levelVariance[level & 1].view();
+            mExec.forEachPixel(w, h, at);
+            inIllum = at.outIllum;
+            inVar = at.outVariance;
+        }
+
+        mExec.forEachPixel(w, h, Remodulate{inIllum, albedo, emission, s.output.view()});
+        s.result = &s.output;
+        if (mParams.taa) {
+            Taa taa;
+            taa.alpha = mParams.taaAlpha;
+            taa.havePrevious = s.haveTaa;
+            taa.current = s.output.view(), taa.motion = s.motion.view(), taa.history = s.taaHistory.view();
+            taa.out = s.taaOutput.view();
+            mExec.forEachPixel(w, h, taa);
+            std::swap(s.taaHistory, s.taaOutput);
+            s.haveTaa = true;
+            s.result = &s.taaHistory;
+        }
+
+        // This frame becomes the history. Swaps move ownership only; nothing is copied.
+        if (mParams.feedbackTap < 0)
+            std::swap(s.histIllum, s.accIllum);
+        else
+            std::swap(s.histIllum, s.nextHistIllum);
+        std::swap(s.histMoments, s.accMoments);
+        std::swap(s.histLength, s.accLength);
+        std::swap(s.prevDepth, s.depth);
+        std::swap(s.prevNormal, s.normal);
+        std::swap(s.prevIds, s.ids);
+        s.havePrevious = true;
+        ++s.frames;
+        mExec.synchronize();  // the holders die at the end of this scope
+    }
+
+    // run() and a copy of the result on the host.
+    Image denoiseFrame(const SvgfFrame& frame) {
+        run(frame);
+        return mState.result->to(Device::Cpu);
+    }
+
+    SvgfState& state() { return mState; }
+    const SvgfParams& params() const { return mParams; }
+
+private:
+    SvgfParams mParams;
+    Exec mExec;
+    SvgfState mState;
+};
+
+template <class Exec>
+class SvgfBackendImpl final : public detail::SvgfBackend {
+public:
+    explicit SvgfBackendImpl(const SvgfParams& p) : mPipeline(p) {}
+    Image denoiseFrame(const SvgfFrame& frame) override { return mPipeline.denoiseFrame(frame); }
+    void reset() override { mPipeline.reset(); }
+
+private:
+    SvgfPipeline<Exec> mPipeline;
+};
+
+}  // namespace atrous::svgf

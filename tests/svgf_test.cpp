@@ -1,0 +1,619 @@
+// SVGF: stage functors, the per-frame driver, sequence I/O and the sequence denoise command, on
+// synthetic sequences generated here (a tilted, gently curved textured ground plane, a strip of
+// sky, and a textured box that slides right, approaches the camera and turns a little each frame).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "atrous/error.h"
+#include "atrous/svgf.h"
+#include "core/parallel.h"
+#include "filters/svgf_pipeline.h"
+#include "io/image_io.h"
+#include "io/sequence.h"
+#include "test_util.h"
+
+// The sequence command lives in the CLI's sources, which are not part of atrous_lib; compile its
+// translation unit into this test so it can be tested as a function.
+#include "../apps/atrous/denoise_sequence.cpp"
+
+using namespace atrous;
+
+namespace {
+
+struct SceneOptions {
+    int width = 64, height = 48;
+    float boxSpeed = 4.0f;       // pixels per frame, to the right
+    float boxApproach = 0.03f;   // depth change per frame (towards the camera)
+    float boxTurn = 0.05f;       // radians per frame about the vertical axis
+    float noiseSigma = 0.0f;     // Gaussian noise on the colour, same value in R, G, B
+    bool withBox = true;
+    bool flat = false;           // a fronto-parallel constant plane, albedo 1, illumination 1
+    unsigned seed = 1;
+};
+
+struct SynthFrame {
+    Image color, albedo, normal, depth, ids, motion, truth;
+    SvgfFrame frame() const {
+        SvgfFrame f;
+        f.color = &color;
+        f.albedo = &albedo;
+        f.normal = &normal;
+        f.depth = &depth;
+        f.ids = &ids;
+        f.motion = &motion;
+        return f;
+    }
+};
+
+constexpr int kSkyRows = 4;
+
+int boxX0(const SceneOptions& o, int t) { return o.width / 4 + int(o.boxSpeed * float(t)); }
+int boxY0(const SceneOptions& o) { return o.height / 3; }
+int boxSize(const SceneOptions& o) { return o.width / 4; }
+
+SynthFrame makeFrame(const SceneOptions& o, int t) {
+    const int w = o.width, h = o.height;
+    SynthFrame f{Image(w, h, 3), Image(w, h, 3), Image(w, h, 3), Image(w, h, 3),
+                 Image(w, h, 3), Image(w, h, 3), Image(w, h, 3)};
+    std::mt19937 rng(o.seed * 7919u + unsigned(t));
+    std::normal_distribution<float> gauss(0.0f, 1.0f);
+    const int bx = boxX0(o, t), by = boxY0(o), bs = boxSize(o);
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            float a[3], n[3], z, id, mx = 0.0f, e;
+            bool inBox = o.withBox && x >= bx && x < bx + bs && y >= by && y < by + bs;
+            if (o.flat) {
+                a[0] = a[1] = a[2] = 1.0f;
+                n[0] = 0, n[1] = 0, n[2] = 1;
+                z = 5.0f, id = 0.0f, e = 1.0f;
+            } else if (inBox) {
+                int lx = x - bx, ly = y - by;  // texture moves with the box
+                float c = ((lx / 4 + ly / 4) % 2) ? 0.7f : 0.3f;
+                a[0] = c, a[1] = 0.5f, a[2] = 1.0f - c;
+                float th = o.boxTurn * float(t);
+                n[0] = std::sin(th), n[1] = 0.0f, n[2] = std::cos(th);
+                z = 3.0f - o.boxApproach * float(t);
+                id = 1.0f;
+                mx = -o.boxSpeed;
+                e = 2.0f;
+            } else if (y < kSkyRows) {
+                a[0] = a[1] = a[2] = 1.0f;
+                n[0] = n[1] = n[2] = 0.0f;
+                z = 1e30f, id = -1.0f, e = 0.5f;
+            } else {
+                float c = ((x / 8 + y / 8) % 2) ? 0.8f : 0.2f;
+                a[0] = c, a[1] = 0.6f, a[2] = 0.5f;
+                float nx = 0.3f * std::sin(float(x) / 7.0f);
+                float len = std::sqrt(nx * nx + 0.36f + 0.64f);
+                n[0] = nx / len, n[1] = 0.6f / len, n[2] = 0.8f / len;
+                z = 4.0f + 0.05f * float(y);
+                id = 0.0f;
+                e = 1.0f + 0.5f * std::sin(float(x) / 10.0f);
+            }
+            float noise = o.noiseSigma * gauss(rng);
+            for (int c = 0; c < 3; ++c) {
+                f.albedo(x, y, c) = a[c];
+                f.normal(x, y, c) = n[c];
+                f.depth(x, y, c) = z;
+                f.ids(x, y, c) = id;
+                f.truth(x, y, c) = a[c] * e;
+                f.color(x, y, c) = a[c] * e + noise;
+            }
+            f.motion(x, y, 0) = mx;
+        }
+    }
+    return f;
+}
+
+double mse(const Image& a, const Image& b) {
+    double s = 0;
+    for (size_t i = 0; i < a.size(); ++i) s += double(a.data()[i] - b.data()[i]) * double(a.data()[i] - b.data()[i]);
+    return s / double(a.size());
+}
+
+bool allFinite(const Image& img) {
+    for (size_t i = 0; i < img.size(); ++i)
+        if (!std::isfinite(img.data()[i])) return false;
+    return true;
+}
+
+float maxAbsDiff(const Image& a, const Image& b) {
+    float m = 0;
+    for (size_t i = 0; i < a.size(); ++i) m = std::max(m, std::fabs(a.data()[i] - b.data()[i]));
+    return m;
+}
+
+// Runs `frames` frames of the scene through a fresh denoiser; returns the last output.
+Image runSequence(const SvgfParams& p, const SceneOptions& o, int frames) {
+    SvgfDenoiser d(p);
+    Image out;
+    for (int t = 0; t < frames; ++t) out = d.denoiseFrame(makeFrame(o, t).frame());
+    return out;
+}
+
+}  // namespace
+
+// ---- reprojection -------------------------------------------------------------------------------
+
+struct ReprojectFixture {
+    int w = 32, h = 16;
+    Image motion{w, h, 2}, depth{w, h, 1}, normal{w, h, 3}, ids{w, h, 1}, grad{w, h, 2};
+    Image prevIllum{w, h, 3}, prevMoments{w, h, 2}, prevLength{w, h, 1}, prevDepth{w, h, 1}, prevNormal{w, h, 3},
+        prevIds{w, h, 1};
+    Image outIllum{w, h, 3}, outMoments{w, h, 2}, outLength{w, h, 1};
+
+    static float texture(int x, int y, int c) { return std::sin(0.7f * x + 0.3f * c) + 0.25f * float(y) + float(c); }
+
+    ReprojectFixture() {
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                depth(x, y, 0) = prevDepth(x, y, 0) = 5.0f;
+                normal(x, y, 2) = prevNormal(x, y, 2) = 1.0f;
+                for (int c = 0; c < 3; ++c) prevIllum(x, y, c) = texture(x, y, c);
+                prevMoments(x, y, 0) = texture(x, y, 0);
+                prevMoments(x, y, 1) = 2.0f * texture(x, y, 1);
+                prevLength(x, y, 0) = 3.0f;
+            }
+    }
+
+    void run(float mx, float my) {
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) motion(x, y, 0) = mx, motion(x, y, 1) = my;
+        svgf::Reproject r;
+        r.havePrevious = true;
+        r.motion = motion.view(), r.depth = depth.view(), r.normal = normal.view(), r.ids = ids.view();
+        r.depthGrad = grad.view();
+        r.prevIllum = prevIllum.view(), r.prevMoments = prevMoments.view(), r.prevLength = prevLength.view();
+        r.prevDepth = prevDepth.view(), r.prevNormal = prevNormal.view(), r.prevIds = prevIds.view();
+        r.outIllum = outIllum.view(), r.outMoments = outMoments.view(), r.outLength = outLength.view();
+        CpuExec().forEachPixel(w, h, r);
+    }
+};
+
+TEST(SvgfReproject, IntegerMotionCopiesTheShiftedPreviousFrameExactly) {
+    ReprojectFixture f;
+    f.run(-2.0f, 1.0f);  // previous - current: the content moved 2 px right and 1 px up
+    for (int y = 0; y < f.h - 1; ++y)
+        for (int x = 2; x < f.w; ++x) {
+            for (int c = 0; c < 3; ++c) ASSERT_EQ(f.outIllum(x, y, c), ReprojectFixture::texture(x - 2, y + 1, c));
+            ASSERT_EQ(f.outMoments(x, y, 0), f.prevMoments(x - 2, y + 1, 0));
+            ASSERT_EQ(f.outMoments(x, y, 1), f.prevMoments(x - 2, y + 1, 1));
+            ASSERT_EQ(f.outLength(x, y, 0), 3.0f);
+        }
+}
+
+TEST(SvgfReproject, HalfPixelMotionGivesTheBilinearValue) {
+    ReprojectFixture f;
+    f.run(-1.5f, 0.5f);
+    for (int y = 0; y < f.h - 1; ++y)
+        for (int x = 2; x < f.w; ++x)
+            for (int c = 0; c < 3; ++c) {
+                float expect = 0.25f * (ReprojectFixture::texture(x - 2, y, c) + ReprojectFixture::texture(x - 1, y, c) +
+                                        ReprojectFixture::texture(x - 2, y + 1, c) + ReprojectFixture::texture(x - 1, y + 1, c));
+                // Four float products and a normalisation: a few ulps of values up to ~7.
+                ASSERT_NEAR(f.outIllum(x, y, c), expect, 1e-5f) << x << "," << y;
+            }
+}
+
+TEST(SvgfReproject, InconsistentTapsAreDroppedAndTheFallbackSearchRecovers) {
+    ReprojectFixture f;
+    // Column 10 of the previous frame belongs to another mesh: a half-pixel footprint over columns
+    // 9 and 10 keeps only column 9 (renormalised bilinear weight).
+    for (int y = 0; y < f.h; ++y) f.prevIds(10, y, 0) = 7.0f;
+    f.run(-0.5f, 0.0f);
+    EXPECT_EQ(f.outIllum(9 + 1, 5, 0), ReprojectFixture::texture(9, 5, 0));  // x = 10 reads 9.5
+    // Everything in the footprint is another mesh -> 3x3 search finds the neighbours.
+    for (int y = 0; y < f.h; ++y) f.prevIds(9, y, 0) = 7.0f;
+    f.run(0.0f, 0.0f);
+    EXPECT_EQ(f.outLength(9, 5, 0), 3.0f);  // found a consistent neighbour (column 8)
+    EXPECT_NEAR(f.outIllum(9, 5, 0),
+                (ReprojectFixture::texture(8, 4, 0) + ReprojectFixture::texture(8, 5, 0) + ReprojectFixture::texture(8, 6, 0)) / 3.0f,
+                1e-5f);
+}
+
+TEST(SvgfReproject, MotionOutsideTheImageOrNonFiniteResetsTheHistory) {
+    ReprojectFixture f;
+    for (float m : {-1e4f, 40.0f, 1e20f, std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+        f.run(m, 0.0f);
+        for (int y = 0; y < f.h; ++y)
+            for (int x = 0; x < f.w; ++x) ASSERT_EQ(f.outLength(x, y, 0), 0.0f) << "motion " << m;
+    }
+}
+
+// ---- history length through the whole driver ----------------------------------------------------
+
+TEST(SvgfHistory, DisoccludedPixelsResetAndConsistentPixelsIncrement) {
+    SceneOptions o;  // noiseless, box slides 4 px per frame
+    svgf::SvgfPipeline<CpuExec> pipe(SvgfParams{});
+    for (int t = 0; t < 3; ++t) {
+        pipe.run(makeFrame(o, t).frame());
+        const Image& len = pipe.state().histLength;  // this frame's accumulated history length
+        // Ground far from the box: t + 1 frames, exactly (bilinear weight 1 on a static pixel).
+        EXPECT_EQ(len(2, o.height - 2, 0), float(t + 1));
+        // Inside the moving box (consistent reprojection along its motion): t + 1.
+        EXPECT_EQ(len(boxX0(o, t) + 5, boxY0(o) + 5, 0), float(t + 1));
+        // Sky: background matches background.
+        EXPECT_EQ(len(5, 1, 0), float(t + 1));
+    }
+    // Ground the box uncovered in the last frame: columns x0(1) .. x0(2)-1. The first column can
+    // borrow history from its left neighbour (itself uncovered one frame earlier, so length 1 or
+    // 2) through the 3x3 search; the others are reset.
+    const Image& len = pipe.state().histLength;
+    for (int x = boxX0(o, 1) + 1; x < boxX0(o, 2); ++x)
+        for (int y = boxY0(o) + 1; y < boxY0(o) + boxSize(o) - 1; ++y) EXPECT_EQ(len(x, y, 0), 1.0f) << x << "," << y;
+    EXPECT_GT(len(boxX0(o, 1), boxY0(o) + 5, 0), 1.0f);
+}
+
+// ---- convergence --------------------------------------------------------------------------------
+
+TEST(SvgfConvergence, StaticNoisySceneApproachesTheTruth) {
+    SceneOptions o;
+    o.withBox = false;
+    o.noiseSigma = 0.3f;
+    SvgfDenoiser d;
+    std::vector<double> err;
+    double inputMse = 0;
+    for (int t = 0; t < 10; ++t) {
+        SynthFrame f = makeFrame(o, t);
+        Image out = d.denoiseFrame(f.frame());
+        err.push_back(mse(out, f.truth));
+        inputMse = mse(f.color, f.truth);
+    }
+    for (size_t i = 0; i < err.size(); ++i) std::printf("frame %zu: MSE %.5f\n", i, err[i]);
+    // Measured (64x48, σ = 0.3, input MSE ~0.09): 0.0034 after one frame, 0.0012 after three,
+    // ~0.0010 from then on (α = 0.2 caps the temporal gain). The bounds leave ~1.6x headroom.
+    EXPECT_LT(err[2], 0.6 * err[0]);
+    EXPECT_LT(err.back(), 0.5 * err.front());
+    EXPECT_LT(err.back(), 0.02 * inputMse);
+}
+
+// ---- variance -----------------------------------------------------------------------------------
+
+TEST(SvgfVariance, TemporalEstimateMatchesTheNoiseVariance) {
+    SceneOptions o;
+    o.flat = true;
+    o.withBox = false;
+    o.noiseSigma = 0.1f;
+    const float sigma2 = o.noiseSigma * o.noiseSigma;  // grey noise: luminance variance = σ²
+    SvgfParams p;
+    svgf::SvgfPipeline<CpuExec> pipe(p);
+    for (int t = 0; t < 40; ++t) pipe.run(makeFrame(o, t).frame());
+    const Image& v = pipe.state().variance;
+    double mean = 0;
+    for (size_t i = 0; i < v.size(); ++i) mean += v.data()[i];
+    mean /= double(v.size());
+    // An exponential moving average with weight a has E[μ2 - μ1²] = σ² (1 - a / (2 - a)).
+    const double a = p.momentsAlpha, expected = sigma2 * (1.0 - a / (2.0 - a));
+    // 3072 pixels, each estimate averaging ~9 effective frames: the mean's relative standard error
+    // is about 1%; 4% is four of those.
+    EXPECT_NEAR(mean / expected, 1.0, 0.04) << "mean variance " << mean << " expected " << expected;
+}
+
+TEST(SvgfVariance, SpatialEstimateIsUsedWhileTheHistoryIsShort) {
+    SceneOptions o;
+    o.flat = true;
+    o.withBox = false;
+    o.noiseSigma = 0.1f;
+    const double sigma2 = double(o.noiseSigma) * o.noiseSigma;
+    auto meanVariance = [&](const SvgfParams& p) {
+        svgf::SvgfPipeline<CpuExec> pipe(p);
+        pipe.run(makeFrame(o, 0).frame());
+        const Image& v = pipe.state().variance;
+        double m = 0;
+        for (size_t i = 0; i < v.size(); ++i) m += v.data()[i];
+        return m / double(v.size());
+    };
+    // History 1 < 4: the 7x7 spatial estimate, (49 - 1)/49 σ² in expectation on this flat plane
+    // (fewer taps at the border); ±6% covers the sampling error of 3072 correlated estimates.
+    EXPECT_NEAR(meanVariance(SvgfParams{}) / sigma2, 48.0 / 49.0, 0.06);
+    // Forcing the temporal estimate at history 1 gives μ2 - μ1² = l² - l² = 0.
+    SvgfParams temporal;
+    temporal.spatialVarianceFrames = 1;
+    EXPECT_LT(meanVariance(temporal), 1e-6 * sigma2);
+}
+
+// ---- bad input ----------------------------------------------------------------------------------
+
+TEST(SvgfRobustness, NanInputsAndWildMotionGiveFiniteOutput) {
+    SceneOptions o;
+    o.noiseSigma = 0.1f;
+    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+    svgf::SvgfPipeline<CpuExec> pipe(SvgfParams{});
+    Image emission(o.width, o.height, 3);
+    for (int t = 0; t < 4; ++t) {
+        SynthFrame f = makeFrame(o, t);
+        for (int i = 0; i < 40; ++i) {
+            int x = (i * 37 + t * 11) % o.width, y = (i * 17 + t * 5) % o.height;
+            Image* bufs[] = {&f.color, &f.albedo, &f.normal, &f.depth, &f.ids, &f.motion, &emission};
+            Image& b = *bufs[i % 7];
+            b(x, y, i % 2) = (i % 3) ? nan : -inf;
+        }
+        f.color(3, 20, 0) = inf;
+        f.motion(10, 30, 0) = 1e20f;   // far outside
+        f.motion(11, 30, 1) = -3e4f;   // outside
+        f.motion(12, 30, 0) = 200.0f;  // outside
+        SvgfFrame in = f.frame();
+        in.emission = &emission;
+        pipe.run(in);
+        ASSERT_TRUE(allFinite(*pipe.state().result)) << "frame " << t;
+        for (const Image* img : {&pipe.state().histIllum, &pipe.state().histMoments, &pipe.state().variance})
+            ASSERT_TRUE(allFinite(*img));
+        if (t > 0) {
+            // Documented rule: motion that leaves the image is a disocclusion (history reset).
+            EXPECT_EQ(pipe.state().histLength(10, 30, 0), 1.0f);
+            EXPECT_EQ(pipe.state().histLength(11, 30, 0), 1.0f);
+            EXPECT_EQ(pipe.state().histLength(12, 30, 0), 1.0f);
+        }
+    }
+    // A pixel whose first colour sample is NaN is filled in by the spatial filter, not left black.
+    SceneOptions clean;
+    SynthFrame f = makeFrame(clean, 0);
+    f.color(2, 40, 0) = f.color(2, 40, 1) = f.color(2, 40, 2) = nan;
+    SvgfDenoiser d;
+    Image out = d.denoiseFrame(f.frame());
+    EXPECT_TRUE(allFinite(out));
+    EXPECT_NEAR(out(2, 40, 1), f.truth(2, 40, 1), 0.1f * f.truth(2, 40, 1));
+}
+
+TEST(SvgfRobustness, BadFramesAndParamsAreInputErrors) {
+    Image c(8, 8, 3), small(4, 8, 3), grey(8, 8, 1);
+    SvgfDenoiser d;
+    EXPECT_THROW(d.denoiseFrame(SvgfFrame{}), InputError);
+    SvgfFrame f;
+    f.color = &c;
+    f.albedo = &small;
+    try {
+        d.denoiseFrame(f);
+        FAIL() << "expected InputError";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("albedo"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("4x8"), std::string::npos) << e.what();
+    }
+    f.albedo = nullptr;
+    f.motion = &grey;  // needs 2 channels
+    EXPECT_THROW(d.denoiseFrame(f), InputError);
+    f.motion = nullptr;
+    EXPECT_NO_THROW(d.denoiseFrame(f));  // colour alone is enough
+
+    auto bad = [](const std::function<void(SvgfParams&)>& change) {
+        SvgfParams p;
+        change(p);
+        EXPECT_THROW(SvgfDenoiser{p}, InputError);
+    };
+    bad([](SvgfParams& p) { p.sigmaL = 0; });
+    bad([](SvgfParams& p) { p.sigmaN = -1; });
+    bad([](SvgfParams& p) { p.sigmaZ = std::nanf(""); });
+    bad([](SvgfParams& p) { p.alpha = 0; });
+    bad([](SvgfParams& p) { p.momentsAlpha = 1.5f; });
+    bad([](SvgfParams& p) { p.historyCap = 0; });
+    bad([](SvgfParams& p) { p.levels = 11; });
+    bad([](SvgfParams& p) { p.feedbackTap = 5; });
+    bad([](SvgfParams& p) { p.spatialVarianceFrames = 0; });
+    bad([](SvgfParams& p) { p.reprojectDepthTolerance = -1; });
+    bad([](SvgfParams& p) { p.reprojectNormalCos = 2; });
+    bad([](SvgfParams& p) { p.taaAlpha = 0; });
+    if (!cudaAvailable()) EXPECT_THROW(SvgfDenoiser(SvgfParams{}, Device::Cuda), InputError);
+}
+
+TEST(SvgfRobustness, ResetAndSizeChangeStartANewHistory) {
+    SceneOptions o;
+    o.noiseSigma = 0.2f;
+    SvgfDenoiser d;
+    Image first = d.denoiseFrame(makeFrame(o, 0).frame());
+    d.denoiseFrame(makeFrame(o, 1).frame());
+    d.reset();
+    Image again = d.denoiseFrame(makeFrame(o, 0).frame());
+    EXPECT_EQ(maxAbsDiff(first, again), 0.0f);  // deterministic, and no history leaked
+    SceneOptions big = o;
+    big.width = 80;
+    Image other = d.denoiseFrame(makeFrame(big, 0).frame());
+    EXPECT_EQ(other.width(), 80);
+    SvgfDenoiser fresh;
+    EXPECT_EQ(maxAbsDiff(other, fresh.denoiseFrame(makeFrame(big, 0).frame())), 0.0f);
+}
+
+// ---- every parameter matters ------------------------------------------------------------------
+
+TEST(SvgfParamsTest, EveryFieldChangesTheOutput) {
+    SceneOptions o;
+    o.noiseSigma = 0.2f;
+    const int frames = 6;
+    const Image base = runSequence(SvgfParams{}, o, frames);
+    SvgfParams taaBase;
+    taaBase.taa = true;
+    const Image taaOut = runSequence(taaBase, o, frames);
+    struct Case {
+        const char* name;
+        std::function<void(SvgfParams&)> change;
+        const Image* reference;
+    };
+    std::vector<Case> cases = {
+        {"sigmaL", [](SvgfParams& p) { p.sigmaL = 1.0f; }, &base},
+        {"sigmaN", [](SvgfParams& p) { p.sigmaN = 4.0f; }, &base},
+        {"sigmaZ", [](SvgfParams& p) { p.sigmaZ = 8.0f; }, &base},
+        {"alpha", [](SvgfParams& p) { p.alpha = 0.5f; }, &base},
+        {"momentsAlpha", [](SvgfParams& p) { p.momentsAlpha = 0.6f; }, &base},
+        {"historyCap", [](SvgfParams& p) { p.historyCap = 2; }, &base},
+        {"levels", [](SvgfParams& p) { p.levels = 3; }, &base},
+        {"feedbackTap", [](SvgfParams& p) { p.feedbackTap = 2; }, &base},
+        {"spatialVarianceFrames", [](SvgfParams& p) { p.spatialVarianceFrames = 1; }, &base},
+        {"reprojectDepthTolerance", [](SvgfParams& p) { p.reprojectDepthTolerance = 0.4f; }, &base},
+        {"reprojectNormalCos", [](SvgfParams& p) { p.reprojectNormalCos = 0.9999f; }, &base},
+        {"taa", [](SvgfParams& p) { p.taa = true; }, &base},
+        {"taaAlpha", [](SvgfParams& p) { p.taa = true, p.taaAlpha = 0.5f; }, &taaOut},
+    };
+    for (const auto& c : cases) {
+        SvgfParams p;
+        c.change(p);
+        Image out = runSequence(p, o, frames);
+        // Outputs are O(1); 1e-3 is far above float noise (the runs are deterministic anyway).
+        EXPECT_GT(maxAbsDiff(out, *c.reference), 1e-3f) << c.name << " did not change the output";
+    }
+}
+
+// ---- sequence I/O -------------------------------------------------------------------------------
+
+namespace {
+
+// Writes frames [first, first + count) of the scene as a sequence directory.
+void writeSequence(const std::string& dir, const SceneOptions& o, int count, int first = 0, bool reference = true) {
+    for (int t = 0; t < count; ++t) {
+        SynthFrame f = makeFrame(o, t);
+        std::string fd = dir + "/" + io::sequenceFrameName(first + t);
+        std::filesystem::create_directories(fd);
+        Image position(o.width, o.height, 3);
+        io::writeImage(fd + "/color.exr", f.color);
+        io::writeImage(fd + "/albedo.exr", f.albedo);
+        io::writeImage(fd + "/normal.exr", f.normal);
+        io::writeImage(fd + "/position.exr", position);
+        io::writeImage(fd + "/depth.exr", f.depth);
+        io::writeImage(fd + "/ids.exr", f.ids);
+        io::writeImage(fd + "/motion.exr", f.motion);
+        if (reference) io::writeImage(fd + "/reference.exr", f.truth);
+    }
+}
+
+std::string errorOf(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "(no InputError)";
+}
+
+}  // namespace
+
+TEST(SvgfSequence, ListsAndLoadsFramesInOrder) {
+    test::TempDir dir;
+    SceneOptions o;
+    o.width = 24, o.height = 16;
+    writeSequence(dir.str(), o, 3, 8);
+    std::filesystem::create_directories(dir / "not_a_frame");
+    auto frames = io::listSequenceFrames(dir.str());
+    ASSERT_EQ(frames.size(), 3u);
+    EXPECT_NE(frames[0].find("frame_0008"), std::string::npos);
+    EXPECT_NE(frames[2].find("frame_0010"), std::string::npos);
+    int w = 0, h = 0;
+    io::validateSequence(frames, w, h);
+    EXPECT_EQ(w, 24);
+    EXPECT_EQ(h, 16);
+    io::SequenceFrame f = io::loadSequenceFrame(frames[1]);
+    EXPECT_EQ(f.index, 9);
+    SynthFrame truth = makeFrame(o, 1);
+    EXPECT_EQ(maxAbsDiff(f.color, truth.color), 0.0f);
+    EXPECT_EQ(f.depth(0, 0, 0), 1e30f);
+    EXPECT_EQ(f.motion(boxX0(o, 1) + 1, boxY0(o) + 1, 0), -o.boxSpeed);
+    EXPECT_FALSE(f.reference.empty());
+    EXPECT_TRUE(f.emission.empty());
+}
+
+TEST(SvgfSequence, GapsMissingBuffersAndSizeMismatchesAreNamed) {
+    SceneOptions o;
+    o.width = 16, o.height = 12;
+    {
+        test::TempDir dir;
+        writeSequence(dir.str(), o, 1, 0);
+        writeSequence(dir.str(), o, 1, 2);
+        std::string msg = errorOf([&] { io::listSequenceFrames(dir.str()); });
+        EXPECT_NE(msg.find("frame_0001"), std::string::npos) << msg;
+    }
+    {
+        test::TempDir dir;
+        EXPECT_NE(errorOf([&] { io::listSequenceFrames(dir.str()); }).find("no frame"), std::string::npos);
+        EXPECT_NE(errorOf([&] { io::listSequenceFrames(dir / "absent"); }).find("absent"), std::string::npos);
+    }
+    {
+        test::TempDir dir;
+        writeSequence(dir.str(), o, 2);
+        std::filesystem::remove(dir / "frame_0001/motion.exr");
+        auto frames = io::listSequenceFrames(dir.str());
+        int w, h;
+        std::string msg = errorOf([&] { io::validateSequence(frames, w, h); });
+        EXPECT_NE(msg.find("frame_0001/motion.exr"), std::string::npos) << msg;
+        msg = errorOf([&] { io::loadSequenceFrame(frames[1]); });
+        EXPECT_NE(msg.find("frame_0001/motion.exr"), std::string::npos) << msg;
+    }
+    {
+        test::TempDir dir;
+        writeSequence(dir.str(), o, 1, 0);
+        SceneOptions big = o;
+        big.width = 20;
+        writeSequence(dir.str(), big, 1, 1);
+        auto frames = io::listSequenceFrames(dir.str());
+        int w, h;
+        std::string msg = errorOf([&] { io::validateSequence(frames, w, h); });
+        EXPECT_NE(msg.find("frame_0001/color.exr"), std::string::npos) << msg;
+        EXPECT_NE(msg.find("frame_0000/color.exr"), std::string::npos) << msg;
+        // Within one frame as well.
+        io::writeImage(dir / "frame_0000/ids.exr", Image(20, 12, 3));
+        msg = errorOf([&] { io::loadSequenceFrame(frames[0]); });
+        EXPECT_NE(msg.find("ids.exr"), std::string::npos) << msg;
+        EXPECT_NE(msg.find("color.exr"), std::string::npos) << msg;
+    }
+}
+
+TEST(SvgfSequence, DenoiseCommandWritesEveryFrameAndBeatsTheInput) {
+    test::TempDir dir;
+    SceneOptions o;
+    o.width = 48, o.height = 32;
+    o.noiseSigma = 0.2f;
+    writeSequence(dir / "seq", o, 4);
+    cli::SequenceDenoiseArgs args;
+    args.sequenceDir = dir / "seq";
+    args.outDir = dir / "out";
+    args.quiet = true;
+    EXPECT_EQ(cli::runSequenceDenoise(args), 0);
+    for (int t = 0; t < 4; ++t) {
+        std::string name = io::sequenceFrameName(t);
+        ASSERT_TRUE(std::filesystem::exists(dir / ("out/" + name + ".png")));
+        Image out = io::readImage(dir / ("out/" + name + ".exr"));
+        SynthFrame f = makeFrame(o, t);
+        ASSERT_TRUE(allFinite(out));
+        // The denoised frame is closer to the truth than the noisy input (measured ~5-20x).
+        EXPECT_LT(mse(out, f.truth), 0.5 * mse(f.color, f.truth)) << name;
+    }
+    if (cli::findOnPath("ffmpeg").empty())
+        EXPECT_FALSE(std::filesystem::exists(dir / "out/preview.mp4"));
+    else
+        EXPECT_TRUE(std::filesystem::exists(dir / "out/preview.mp4"));
+}
+
+TEST(SvgfSequence, PerFrameEawAlsoRuns) {
+    test::TempDir dir;
+    SceneOptions o;
+    o.width = 32, o.height = 24;
+    o.noiseSigma = 0.2f;
+    writeSequence(dir / "seq", o, 2);
+    cli::SequenceDenoiseArgs args;
+    args.method = "eaw";
+    args.sequenceDir = dir / "seq";
+    args.outDir = dir / "out";
+    args.quiet = true;
+    args.preview = false;
+    EXPECT_EQ(cli::runSequenceDenoise(args), 0);
+    EXPECT_TRUE(std::filesystem::exists(dir / "out/frame_0001.exr"));
+}
+
+TEST(SvgfSequence, BadSequencesWriteNothing) {
+    test::TempDir dir;
+    SceneOptions o;
+    o.width = 16, o.height = 12;
+    writeSequence(dir / "seq", o, 3);
+    std::filesystem::remove(dir / "seq/frame_0002/albedo.exr");
+    cli::SequenceDenoiseArgs args;
+    args.sequenceDir = dir / "seq";
+    args.outDir = dir / "out";
+    args.quiet = true;
+    std::string msg = errorOf([&] { cli::runSequenceDenoise(args); });
+    EXPECT_NE(msg.find("frame_0002/albedo.exr"), std::string::npos) << msg;
+    EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+    args.method = "median";
+    EXPECT_NE(errorOf([&] { cli::runSequenceDenoise(args); }).find("median"), std::string::npos);
+}
