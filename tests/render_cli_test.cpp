@@ -1,0 +1,118 @@
+// End-to-end tests of `atrous render`: the files it writes and every bad-input case (exit code 2,
+// one line naming the problem, nothing written).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "atrous/image.h"
+#include "io/image_io.h"
+#include "test_util.h"
+
+namespace atrous {
+namespace {
+
+namespace fs = std::filesystem;
+using test::countEntries;
+using test::runCli;
+using test::TempDir;
+
+int lines(const std::string& s) {
+    int n = 0;
+    for (char c : s) n += c == '\n';
+    return n;
+}
+
+TEST(RenderCli, WritesAllBuffersAndASummary) {
+    TempDir tmp;
+    auto r = runCli("render --scene cornell --width 24 --height 16 --spp 2 --seed 3 --max-depth 4 --threads 1 --out " + tmp.str());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_EQ(lines(r.output), 1) << r.output;
+    EXPECT_NE(r.output.find("24x16"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("samples/s"), std::string::npos) << r.output;
+    for (const char* f : {"color.exr", "variance.exr", "albedo.exr", "normal.exr", "position.exr", "depth.exr", "ids.exr", "color.png"})
+        EXPECT_TRUE(fs::exists(tmp / f)) << f;
+    EXPECT_EQ(countEntries(tmp.str()), 8);  // and no temporary files left behind
+    Image ids = io::readImage(tmp / "ids.exr");
+    EXPECT_EQ(ids.width(), 24);
+    EXPECT_EQ(ids.height(), 16);
+    Image depth = io::readImage(tmp / "depth.exr");
+    EXPECT_GT(depth(12, 8, 0), 0.0f);
+}
+
+TEST(RenderCli, HelpListsTheOptions) {
+    auto r = runCli("render --help");
+    EXPECT_EQ(r.exitCode, 0);
+    for (const char* opt : {"--scene", "--width", "--height", "--spp", "--seed", "--max-depth", "--threads", "--out", "--denoise"})
+        EXPECT_NE(r.output.find(opt), std::string::npos) << opt;
+}
+
+TEST(RenderCli, DenoiseWritesDenoisedImages) {
+    TempDir tmp;
+    auto r = runCli("render --scene cornell --width 32 --height 32 --spp 4 --denoise eaw,sure --out " + tmp.str());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    for (const char* f : {"denoised_eaw.exr", "denoised_sure.exr", "denoised_eaw.png", "denoised_sure.png"})
+        EXPECT_TRUE(fs::exists(tmp / f)) << f;
+}
+
+// Each case: exit code 2, exactly one line "atrous: error: ..." containing `expect`, and nothing
+// written (the output directory is not even created).
+void expectBadInput(const std::string& args, const std::string& expect, const TempDir& tmp) {
+    std::string out = tmp / "out";
+    auto r = runCli("render " + args + " --out " + out);
+    EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.output;
+    EXPECT_EQ(lines(r.output), 1) << r.output;
+    EXPECT_EQ(r.output.rfind("atrous: error:", 0), 0u) << r.output;
+    EXPECT_NE(r.output.find(expect), std::string::npos) << args << "\n" << r.output;
+    EXPECT_TRUE(!fs::exists(out) || countEntries(out) == 0) << args;
+}
+
+TEST(RenderCli, BadInputIsOneLineExitTwoNothingWritten) {
+    TempDir tmp;
+    std::string d = tmp.str();
+    std::ofstream(tmp / "malformed.json") << "{ \"camera\": ";
+    std::ofstream(tmp / "bad.obj") << "v 0 0 0\nf 1 2 3\n";
+    std::ofstream(tmp / "objscene.json")
+        << R"({"camera": {"position": [0,0,3], "lookAt": [0,0,0]}, "objects": [{"type": "mesh", "file": "bad.obj"}]})";
+    std::ofstream(tmp / "missingobj.json")
+        << R"({"camera": {"position": [0,0,3], "lookAt": [0,0,0]}, "objects": [{"type": "mesh", "file": "gone.obj"}]})";
+    std::ofstream(tmp / "tex.json")
+        << R"({"camera": {"position": [0,0,3], "lookAt": [0,0,0]}, "materials": {"m": {"texture": "gone.png"}}, "objects": []})";
+    std::ofstream(tmp / "badtex.png") << "this is not a png";
+    std::ofstream(tmp / "badtex.json")
+        << R"({"camera": {"position": [0,0,3], "lookAt": [0,0,0]}, "materials": {"m": {"texture": "badtex.png"}}, "objects": []})";
+    const std::string ok = " --width 8 --height 8 --spp 1";
+    expectBadInput("--scene " + d + "/nothere.json" + ok, "nothere.json", tmp);
+    expectBadInput("--scene " + d + "/malformed.json" + ok, "malformed.json", tmp);
+    expectBadInput("--scene " + d + "/objscene.json" + ok, "bad.obj", tmp);
+    expectBadInput("--scene " + d + "/missingobj.json" + ok, "gone.obj", tmp);
+    expectBadInput("--scene " + d + "/tex.json" + ok, "gone.png", tmp);
+    expectBadInput("--scene " + d + "/badtex.json" + ok, "badtex.png", tmp);
+    expectBadInput("--scene kitchen" + ok, "kitchen", tmp);
+    expectBadInput("--scene cornell --spp 0 --width 8 --height 8", "--spp", tmp);
+    expectBadInput("--scene cornell --spp -4 --width 8 --height 8", "--spp", tmp);
+    expectBadInput("--scene cornell --width 0 --height 8 --spp 1", "--width", tmp);
+    expectBadInput("--scene cornell --width 8 --height -1 --spp 1", "--height", tmp);
+    expectBadInput("--scene cornell --width 20000 --height 8 --spp 1", "--width", tmp);
+    expectBadInput("--scene cornell --width 8 --height 16385 --spp 1", "--height", tmp);
+    expectBadInput("--scene cornell --width 8 --height 8 --spp 1 --denoise blur", "blur", tmp);
+}
+
+TEST(RenderCli, UnwritableOutputDirectory) {
+    TempDir tmp;
+    std::ofstream(tmp / "blocker") << "a file, not a directory";
+    // An output path below a regular file can never be created (even by root, unlike chmod).
+    std::string out = tmp / "blocker/out";
+    auto r = runCli("render --scene cornell --width 8 --height 8 --spp 1 --out " + out);
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_EQ(lines(r.output), 1) << r.output;
+    EXPECT_NE(r.output.find("blocker"), std::string::npos) << r.output;
+    r = runCli("render --scene cornell --width 8 --height 8 --spp 1 --out " + (tmp / "blocker"));
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("not a directory"), std::string::npos) << r.output;
+    EXPECT_EQ(countEntries(tmp.str()), 1);  // still just the blocker
+}
+
+}  // namespace
+}  // namespace atrous
