@@ -118,6 +118,9 @@ struct RayPre {
 };
 
 ATROUS_INLINE float absf(float v) { return v < 0.0f ? -v : v; }
+// v[k] through selects, not an indexed load: a dynamically indexed local array would live in
+// slow local memory on the GPU.
+ATROUS_INLINE float comp(const float v[3], int k) { return k == 0 ? v[0] : (k == 1 ? v[1] : v[2]); }
 
 ATROUS_INLINE RayPre prepare(const BvhRay& ray) {
     RayPre p;
@@ -135,7 +138,7 @@ ATROUS_INLINE RayPre prepare(const BvhRay& ray) {
     int kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
     int kx = kz + 1 == 3 ? 0 : kz + 1;
     int ky = kx + 1 == 3 ? 0 : kx + 1;
-    if (d[kz] < 0.0f) {
+    if (comp(d, kz) < 0.0f) {
         int tmp = kx;
         kx = ky;
         ky = tmp;
@@ -143,9 +146,9 @@ ATROUS_INLINE RayPre prepare(const BvhRay& ray) {
     p.kx = kx;
     p.ky = ky;
     p.kz = kz;
-    p.sx = d[kx] / d[kz];
-    p.sy = d[ky] / d[kz];
-    p.sz = 1.0f / d[kz];
+    p.sx = comp(d, kx) / comp(d, kz);
+    p.sy = comp(d, ky) / comp(d, kz);
+    p.sz = 1.0f / comp(d, kz);
     return p;
 }
 
@@ -184,9 +187,9 @@ ATROUS_INLINE bool hitTriangle(const BvhPrim& p, const RayPre& r, float tmin, fl
     float b[3] = {p.b[0] - r.org[0], p.b[1] - r.org[1], p.b[2] - r.org[2]};
     float c[3] = {p.c[0] - r.org[0], p.c[1] - r.org[1], p.c[2] - r.org[2]};
     // Shear and scale the vertices into ray space (the ray becomes the +z axis).
-    float ax = fmaf(-r.sx, a[kz], a[kx]), ay = fmaf(-r.sy, a[kz], a[ky]);
-    float bx = fmaf(-r.sx, b[kz], b[kx]), by = fmaf(-r.sy, b[kz], b[ky]);
-    float cx = fmaf(-r.sx, c[kz], c[kx]), cy = fmaf(-r.sy, c[kz], c[ky]);
+    float ax = fmaf(-r.sx, comp(a, kz), comp(a, kx)), ay = fmaf(-r.sy, comp(a, kz), comp(a, ky));
+    float bx = fmaf(-r.sx, comp(b, kz), comp(b, kx)), by = fmaf(-r.sy, comp(b, kz), comp(b, ky));
+    float cx = fmaf(-r.sx, comp(c, kz), comp(c, kx)), cy = fmaf(-r.sy, comp(c, kz), comp(c, ky));
     // Scaled barycentrics (edge functions): U weights vertex a, V vertex b, W vertex c. The
     // sign must be exact, or a ray through a shared edge can see "outside" from both triangles
     // (the edge function of one triangle must be the exact negation of its neighbour's). The
@@ -199,7 +202,7 @@ ATROUS_INLINE bool hitTriangle(const BvhPrim& p, const RayPre& r, float tmin, fl
     if ((uu < 0.0f || vv < 0.0f || ww < 0.0f) && (uu > 0.0f || vv > 0.0f || ww > 0.0f)) return false;
     float det = uu + vv + ww;
     if (det == 0.0f) return false;  // degenerate in ray space (zero area or edge-on)
-    float az = r.sz * a[kz], bz = r.sz * b[kz], cz = r.sz * c[kz];
+    float az = r.sz * comp(a, kz), bz = r.sz * comp(b, kz), cz = r.sz * comp(c, kz);
     float tScaled = fmaf(uu, az, fmaf(vv, bz, ww * cz));
     float tt = tScaled / det;
     if (!(tt >= tmin && tt < tHit)) return false;

@@ -1,0 +1,58 @@
+// The path tracer over the flattened BVH (src/render/bvh.h) instead of Embree: the same per-pixel
+// functor (pt::PathTraceKernel, src/render/integrator.h) with pt::BvhTracer as its intersector.
+// renderBvhCuda is the GPU renderer; renderBvhCpu runs the very same code on TBB threads, which
+// lets the CPU test suite check the GPU path against the Embree renderer.
+#pragma once
+#include "atrous/image.h"
+#include "atrous/render.h"
+#include "render/bvh_tracer.h"
+#include "render/integrator.h"
+
+namespace atrous {
+
+// Same buffers, settings and determinism as atrous::render (include/atrous/render.h); the only
+// difference is the intersector. Throws InputError for settings out of range.
+RenderBuffers renderBvhCpu(const Scene& scene, const RenderSettings& settings);
+
+// The CUDA path tracer (src/cuda/cuda_render.cu): scene and BVH uploaded to the GPU, one thread
+// per pixel; buffers come back as host images. Throws InputError when the build has no CUDA
+// backend or no GPU is present (the message names --device cuda).
+RenderBuffers renderBvhCuda(const Scene& scene, const RenderSettings& settings);
+
+namespace detail {
+
+// Checks the settings as atrous::render does (flag names in the messages).
+void validateRenderSettings(const RenderSettings& s);
+
+inline RenderBuffers allocateRenderBuffers(int w, int h, Device device) {
+    RenderBuffers b;
+    b.color = Image(w, h, 3, device);
+    b.variance = Image(w, h, 3, device);
+    b.albedo = Image(w, h, 3, device);
+    b.normal = Image(w, h, 3, device);
+    b.position = Image(w, h, 3, device);
+    b.depth = Image(w, h, 3, device);
+    b.ids = Image(w, h, 3, device);
+    return b;
+}
+
+template <class Tracer>
+pt::PathTraceKernel<Tracer> makePathTraceKernel(const pt::SceneView& scene, const Tracer& tracer, RenderBuffers& b,
+                                                const RenderSettings& s) {
+    pt::PathTraceKernel<Tracer> k;
+    k.scene = scene;
+    k.tracer = tracer;
+    k.out = pt::RenderTargets{b.color.view(),    b.variance.view(), b.albedo.view(), b.normal.view(),
+                              b.position.view(), b.depth.view(),    b.ids.view()};
+    k.width = s.width;
+    k.height = s.height;
+    k.spp = s.spp;
+    k.maxDepth = s.maxDepth;
+    k.seed = s.seed;
+    k.lightSampling = s.lightSampling;
+    k.backgroundDepth = kBackgroundDepth;
+    return k;
+}
+
+}  // namespace detail
+}  // namespace atrous
