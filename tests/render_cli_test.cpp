@@ -97,6 +97,8 @@ TEST(RenderCli, BadInputIsOneLineExitTwoNothingWritten) {
     expectBadInput("--scene cornell --width 20000 --height 8 --spp 1", "--width", tmp);
     expectBadInput("--scene cornell --width 8 --height 16385 --spp 1", "--height", tmp);
     expectBadInput("--scene cornell --width 8 --height 8 --spp 1 --denoise blur", "blur", tmp);
+    expectBadInput("--scene cornell --width 8 --height 8 --spp 1 --max-depth -1", "--max-depth", tmp);
+    expectBadInput("--scene cornell --width 8 --height 8 --spp 1 --threads -1", "--threads", tmp);
 }
 
 TEST(RenderCli, UnwritableOutputDirectory) {

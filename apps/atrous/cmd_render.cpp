@@ -41,11 +41,7 @@ void run(const RenderArgs& a) {
     // Everything that can be checked before rendering is: settings, scene, methods, output dir.
     std::vector<DenoiseMethod> methods = parseMethods(a.denoise);
     const RenderSettings& s = a.settings;
-    if (s.width <= 0 || s.width > kMaxImageDim)
-        throw InputError("--width: " + std::to_string(s.width) + " is out of range (1.." + std::to_string(kMaxImageDim) + ")");
-    if (s.height <= 0 || s.height > kMaxImageDim)
-        throw InputError("--height: " + std::to_string(s.height) + " is out of range (1.." + std::to_string(kMaxImageDim) + ")");
-    if (s.spp <= 0) throw InputError("--spp: must be at least 1 (got " + std::to_string(s.spp) + ")");
+    validateRenderSettings(s);
     Scene scene = Scene::loadByNameOrFile(a.scene);
     io::ensureWritableDirectory(a.out);
 

@@ -73,8 +73,11 @@ private:
 
 const std::vector<std::string>& builtinSceneNames();
 
-// Renders `scene` on the CPU. Throws InputError for settings out of range (spp <= 0, width or
-// height <= 0 or > kMaxImageDim, maxDepth < 0, threads < 0).
+// Throws InputError naming the flag (--spp, --width, ...) for settings out of range: spp <= 0,
+// width or height <= 0 or > kMaxImageDim, maxDepth outside 0..1024, threads < 0.
+void validateRenderSettings(const RenderSettings& settings);
+
+// Renders `scene` on the CPU (validates the settings first).
 RenderBuffers render(const Scene& scene, const RenderSettings& settings);
 
 }  // namespace atrous

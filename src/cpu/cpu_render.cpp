@@ -192,7 +192,9 @@ struct EmbreeTracer {
     }
 };
 
-void validate(const RenderSettings& s) {
+}  // namespace
+
+void validateRenderSettings(const RenderSettings& s) {
     if (s.width <= 0 || s.width > kMaxImageDim)
         throw InputError("--width: " + std::to_string(s.width) + " is out of range (1.." + std::to_string(kMaxImageDim) + ")");
     if (s.height <= 0 || s.height > kMaxImageDim)
@@ -203,10 +205,8 @@ void validate(const RenderSettings& s) {
     if (s.threads < 0) throw InputError("--threads: must be 0 (all cores) or more (got " + std::to_string(s.threads) + ")");
 }
 
-}  // namespace
-
 RenderBuffers render(const Scene& scene, const RenderSettings& settings) {
-    validate(settings);
+    validateRenderSettings(settings);
     const SceneData& data = scene.data();
     RenderBuffers b;
     const int w = settings.width, h = settings.height;
