@@ -73,6 +73,10 @@ public:
     // Denoises one frame and returns the 3-channel linear HDR result on the host. Throws InputError
     // when `color` is missing or a buffer's size or channel count does not match the colour's.
     Image denoiseFrame(const SvgfFrame& frame);
+    // The same, but the result stays on the denoiser's device, owned by the denoiser and valid
+    // until the next call (no copy back to the host: for GPU pipelines and benchmarks). The
+    // device's work is finished when it returns.
+    const Image& denoiseFrameOnDevice(const SvgfFrame& frame);
     // Forgets all history (next frame is treated as the first).
     void reset();
 

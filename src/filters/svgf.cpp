@@ -95,6 +95,8 @@ SvgfDenoiser& SvgfDenoiser::operator=(SvgfDenoiser&&) noexcept = default;
 
 Image SvgfDenoiser::denoiseFrame(const SvgfFrame& frame) { return mImpl->denoiseFrame(frame); }
 
+const Image& SvgfDenoiser::denoiseFrameOnDevice(const SvgfFrame& frame) { return mImpl->denoiseFrameOnDevice(frame); }
+
 void SvgfDenoiser::reset() { mImpl->reset(); }
 
 }  // namespace atrous

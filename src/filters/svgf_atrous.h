@@ -44,7 +44,8 @@ struct Atrous {
         Vec3 np = readVec3(normal, x, y);
         float gx = depthGrad(x, y, 0), gy = depthGrad(x, y, 1);
         // ε keeps the stop finite where the variance is exactly 0 (then only equal luminance passes).
-        float lumDenom = sigmaL * sqrtf(maxf(prefilteredVariance(x, y), 0.0f)) + 1e-10f;
+        // ε keeps the stop finite where the variance is exactly 0 (then only equal luminance passes).
+        float invLumDenom = 1.0f / (sigmaL * sqrtf(maxf(prefilteredVariance(x, y), 0.0f)) + 1e-10f);
 
         Vec3 sumC(0.0f);
         float sumV = 0.0f, sumW = 0.0f;
@@ -56,17 +57,17 @@ struct Atrous {
                 int qx = x + i * step;
                 if (qx < 0 || qx >= w) continue;
                 if (length(qx, qy, 0) <= 0.0f) continue;  // empty pixel: contributes nothing
-                Vec3 cq = readVec3(illum, qx, qy);
-                float lw;
-                if (i == 0 && j == 0) {
-                    lw = 0.0f;
-                } else {
+                float lw = 0.0f;
+                if (i != 0 || j != 0) {
                     float dx = float(i * step), dy = float(j * step);
-                    lw = -fabsf(lp - luminance(cq)) / lumDenom +
-                         depthLogWeight(zp, depth(qx, qy, 0), gx, gy, dx, dy, sigmaZ) +
+                    // Geometry first: across an edge the tap is dropped without touching its colour.
+                    lw = depthLogWeight(zp, depth(qx, qy, 0), gx, gy, dx, dy, sigmaZ) +
                          normalLogWeight(np, readVec3(normal, qx, qy), sigmaN);
+                    if (lw < -40.0f) continue;  // weight < 4e-18 of the centre's
                 }
-                float wq = hy * b3Tap(i) * expf(lw);
+                Vec3 cq = readVec3(illum, qx, qy);
+                lw -= fabsf(lp - luminance(cq)) * invLumDenom;
+                float wq = hy * b3Tap(i) * fastExp(lw);
                 sumC += wq * cq;
                 sumV += wq * wq * variance(qx, qy, 0);
                 sumW += wq;

@@ -25,6 +25,7 @@ class SvgfBackend {
 public:
     virtual ~SvgfBackend() = default;
     virtual Image denoiseFrame(const SvgfFrame& frame) = 0;
+    virtual const Image& denoiseFrameOnDevice(const SvgfFrame& frame) = 0;
     virtual void reset() = 0;
 };
 
@@ -212,6 +213,10 @@ class SvgfBackendImpl final : public detail::SvgfBackend {
 public:
     explicit SvgfBackendImpl(const SvgfParams& p) : mPipeline(p) {}
     Image denoiseFrame(const SvgfFrame& frame) override { return mPipeline.denoiseFrame(frame); }
+    const Image& denoiseFrameOnDevice(const SvgfFrame& frame) override {
+        mPipeline.run(frame);
+        return *mPipeline.state().result;
+    }
     void reset() override { mPipeline.reset(); }
 
 private:

@@ -38,7 +38,7 @@ struct Variance {
                 if (length(qx, qy, 0) <= 0.0f) continue;  // no information there
                 float lw = depthLogWeight(zp, depth(qx, qy, 0), gx, gy, float(i), float(j), sigmaZ) +
                            normalLogWeight(np, readVec3(normal, qx, qy), sigmaN);
-                float w = expf(lw);
+                float w = fastExp(lw);
                 sumW += w;
                 s0 += w * moments(qx, qy, 0);
                 s1 += w * moments(qx, qy, 1);

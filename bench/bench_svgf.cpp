@@ -1,0 +1,119 @@
+// SVGF benchmark: the whole per-frame pipeline (demodulate, G-buffer, reprojection, accumulation,
+// variance, 5 à-trous levels, remodulation) on a synthetic 1-spp-like animated sequence, at
+// 512x512 and 1920x1080. Inputs are prepared on the device beforehand and the result stays there,
+// so the figure is the filter alone. Prints JSON: median (and min) milliseconds per frame over
+// many frames after a warm-up long enough for the histories to fill.
+//
+//   build/bench/bench_svgf [--device cpu|cuda] [--runs N] [--warmup N] [--taa]
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "atrous/device.h"
+#include "atrous/error.h"
+#include "atrous/svgf.h"
+#include "core/timer.h"
+
+using namespace atrous;
+
+namespace {
+
+struct Frame {
+    Image color, albedo, normal, depth, ids, motion;
+};
+
+// A textured ground plane receding in depth under a camera that pans 1.5 px per frame, a sky strip,
+// and a box moving the other way: every stage (bilinear reprojection, disocclusion, edges) works.
+Frame makeFrame(int w, int h, int t, Device device) {
+    Frame f{Image(w, h, 3), Image(w, h, 3), Image(w, h, 3), Image(w, h, 3), Image(w, h, 3), Image(w, h, 3)};
+    std::mt19937 rng(1234u + unsigned(t));
+    std::exponential_distribution<float> spp1(1.0f);  // 1-spp-like: heavy-tailed, mean 1
+    const float pan = 1.5f * float(t);
+    const int bx = w / 3 - 2 * t, by = h / 3, bs = h / 4;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            bool sky = y < h / 8;
+            bool box = x >= bx && x < bx + bs && y >= by && y < by + bs;
+            float u = float(x) + pan;
+            float a = box ? 0.6f : (((int(u) / 16 + y / 16) % 2) ? 0.8f : 0.3f);
+            float e = sky ? 2.0f : (box ? 1.5f : 1.0f + 0.5f * std::sin(u / 40.0f));
+            float z = sky ? 1e30f : (box ? 2.0f : 3.0f + 10.0f * float(y) / float(h));
+            float noise = spp1(rng);
+            for (int c = 0; c < 3; ++c) {
+                f.albedo(x, y, c) = sky ? 1.0f : a;
+                f.color(x, y, c) = (sky ? 1.0f : a) * e * noise;
+                f.depth(x, y, c) = z;
+                f.ids(x, y, c) = sky ? -1.0f : (box ? 1.0f : 0.0f);
+            }
+            f.normal(x, y, 0) = 0.0f;
+            f.normal(x, y, 1) = sky ? 0.0f : (box ? 0.0f : 0.8f);
+            f.normal(x, y, 2) = sky ? 0.0f : (box ? 1.0f : 0.6f);
+            f.motion(x, y, 0) = box ? 2.0f : 1.5f;  // previous - current
+        }
+    if (device != Device::Cpu)
+        f = Frame{f.color.to(device), f.albedo.to(device), f.normal.to(device), f.depth.to(device), f.ids.to(device),
+                  f.motion.to(device)};
+    return f;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    int runs = 15, warmup = 6;
+    std::string deviceName_ = "cpu";
+    bool taa = false;
+    for (int i = 1; i < argc; ++i) {
+        if (!std::strcmp(argv[i], "--runs") && i + 1 < argc)
+            runs = std::atoi(argv[++i]);
+        else if (!std::strcmp(argv[i], "--warmup") && i + 1 < argc)
+            warmup = std::atoi(argv[++i]);
+        else if (!std::strcmp(argv[i], "--device") && i + 1 < argc)
+            deviceName_ = argv[++i];
+        else if (!std::strcmp(argv[i], "--taa"))
+            taa = true;
+        else {
+            std::fprintf(stderr, "usage: bench_svgf [--device cpu|cuda] [--runs N] [--warmup N] [--taa]\n");
+            return 2;
+        }
+    }
+    try {
+        const Device device = parseDevice(deviceName_);
+        SvgfParams params;
+        params.taa = taa;
+        nlohmann::json out;
+        out["benchmark"] = "svgf";
+        out["device"] = deviceName(device);
+        out["backend"] = deviceToString(device);
+        out["params"] = {{"levels", params.levels}, {"taa", params.taa}, {"feedbackTap", params.feedbackTap}};
+        out["what"] = "whole SVGF pipeline per frame, inputs and output on the device";
+        const int sizes[2][2] = {{512, 512}, {1920, 1080}};
+        for (const auto& sz : sizes) {
+            const int w = sz[0], h = sz[1];
+            std::vector<Frame> frames;
+            for (int t = 0; t < 4; ++t) frames.push_back(makeFrame(w, h, t, device));
+            SvgfDenoiser denoiser(params, device);
+            std::vector<double> ms;
+            for (int i = 0; i < warmup + runs; ++i) {
+                const Frame& f = frames[i % frames.size()];
+                SvgfFrame in;
+                in.color = &f.color, in.albedo = &f.albedo, in.normal = &f.normal;
+                in.depth = &f.depth, in.ids = &f.ids, in.motion = &f.motion;
+                Timer timer;
+                denoiser.denoiseFrameOnDevice(in);  // synchronises before returning
+                if (i >= warmup) ms.push_back(timer.ms());
+            }
+            double mn = *std::min_element(ms.begin(), ms.end());
+            out["results"].push_back({{"width", w}, {"height", h}, {"runs", runs}, {"warmup", warmup},
+                                      {"ms_median", median(ms)}, {"ms_min", mn}});
+        }
+        std::printf("%s\n", out.dump(2).c_str());
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "bench_svgf: error: %s\n", e.what());
+        return 2;
+    }
+    return 0;
+}
