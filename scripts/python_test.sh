@@ -5,7 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 [ -f python/src/bindings.cpp ] || exit 0  # the Python package is not there yet
-PY=.venv/bin/python
+PY="$PWD/.venv/bin/python"
 JOBS=${JOBS:-$(nproc)}
 CMAKE_BUILD_PARALLEL_LEVEL=$JOBS "$PY" -m pip install -q --no-build-isolation \
   -Ccmake.define.ATROUS_ENABLE_CUDA=${ATROUS_PY_CUDA:-OFF} .

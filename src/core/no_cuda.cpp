@@ -3,6 +3,7 @@
 #include "atrous/device.h"
 #include "atrous/error.h"
 #include "core/memory.h"
+#include "core/strided.h"
 
 namespace atrous {
 
@@ -18,6 +19,8 @@ void cudaCopy(void*, Device, const void*, Device, size_t) { noCuda(); }
 void cudaFillFloats(float*, float, size_t) { noCuda(); }
 bool cudaDevicePresent() { return false; }
 std::string cudaDeviceName() { return "none (no CUDA backend)"; }
+void cudaGatherStrided(const GatherStrided&, int, int) { noCuda(); }
+void cudaScatterInterleaved(const ScatterInterleaved&, int, int) { noCuda(); }
 
 }  // namespace detail
 }  // namespace atrous

@@ -1,0 +1,247 @@
+"""atrous: Monte Carlo path tracing and fast wavelet denoising.
+
+    import atrous
+    bufs = atrous.render("cornell", width=256, height=256, spp=16)
+    clean = atrous.denoise(bufs["color"], albedo=bufs["albedo"], normal=bufs["normal"],
+                           position=bufs["position"], variance=bufs["variance"], method="sure")
+
+Arrays are H x W x 3 (features may also be H x W or H x W x 1, repeated into 3 channels), linear
+HDR. The array rule:
+
+* numpy arrays of float32 are used as they are, with any strides (non-contiguous views, negative
+  strides): atrous copies them into its own planar layout anyway;
+* other floating-point dtypes (float16, float64) are converted to float32;
+* anything else (integers, booleans, complex, objects) is rejected with ValueError;
+* CUDA arrays (PyTorch tensors, CuPy arrays, anything with ``__dlpack__`` on a CUDA device) must be
+  float32; on a CUDA build they are denoised on their GPU without a host round trip, and the result
+  comes back as the same kind of array on the same device.
+
+Errors from the library arrive as ValueError (bad input: shapes, sizes, parameters, files) or
+RuntimeError (everything else). NaN and Inf in the colour are treated as missing samples; the
+output is always finite.
+"""
+from __future__ import annotations
+
+from typing import Any, Dict, Optional
+
+import numpy as np
+
+from . import _core
+
+__all__ = [
+    "denoise",
+    "render",
+    "metrics",
+    "Svgf",
+    "builtin_scenes",
+    "cuda_available",
+    "METHODS",
+]
+
+__version__ = "0.1.0"
+
+METHODS = ("eaw", "sure")
+
+
+def builtin_scenes() -> list:
+    """Names of the built-in scenes accepted by :func:`render`."""
+    return list(_core.builtin_scenes())
+
+
+def cuda_available() -> bool:
+    """True when this build has the CUDA backend and a GPU is present."""
+    return bool(_core.cuda_available())
+
+
+def _framework(x: Any) -> str:
+    mod = type(x).__module__.split(".")[0]
+    if mod == "torch":
+        return "torch"
+    if mod == "cupy":
+        return "cupy"
+    return "numpy"
+
+
+def _is_cuda(x: Any) -> bool:
+    dev = getattr(x, "__dlpack_device__", None)
+    if dev is None or isinstance(x, np.ndarray):
+        return False
+    try:
+        return int(dev()[0]) == 2  # kDLCUDA
+    except Exception:
+        return False
+
+
+def _prepare(x: Any, name: str, allow_gray: bool = True, channels: tuple = (3,)) -> Any:
+    """Applies the array rule of the module docstring; returns something _core accepts."""
+    if x is None:
+        return None
+    if _is_cuda(x):
+        dtype = str(getattr(x, "dtype", ""))
+        if not dtype.endswith("float32"):
+            raise ValueError(f"{name}: CUDA arrays must be float32, got {dtype}")
+        arr = x
+        shape = tuple(arr.shape)
+    else:
+        if _framework(x) == "torch":
+            x = x.detach().cpu().numpy()
+        elif _framework(x) == "cupy":  # pragma: no cover - cupy on host is not a thing
+            x = x.get()
+        arr = np.asarray(x)
+        if arr.dtype.kind != "f":
+            raise ValueError(f"{name}: expected a floating-point array, got dtype {arr.dtype}")
+        if arr.dtype != np.float32:
+            arr = arr.astype(np.float32)
+        shape = arr.shape
+    if len(shape) == 2 and allow_gray:
+        pass
+    elif len(shape) == 3 and (shape[2] in channels or (allow_gray and shape[2] == 1)):
+        pass
+    else:
+        ch = " or ".join(f"(H, W, {k})" for k in channels)
+        want = f"{ch}, (H, W, 1) or (H, W)" if allow_gray else ch
+        raise ValueError(f"{name}: expected shape {want}, got {tuple(shape)}")
+    if shape[0] == 0 or shape[1] == 0:
+        raise ValueError(f"{name}: empty image {tuple(shape)}")
+    return arr
+
+
+def _wrap_like(result: Any, like: Any) -> Any:
+    """Returns a _core result as the same kind of array as the input `like`."""
+    if isinstance(result, np.ndarray):
+        if _framework(like) == "torch":
+            import torch
+
+            return torch.from_numpy(result)
+        return result
+    fw = _framework(like)
+    if fw == "torch":
+        import torch
+
+        return torch.from_dlpack(result)
+    if fw == "cupy":
+        import cupy
+
+        return cupy.from_dlpack(result)
+    return result
+
+
+def denoise(
+    color: Any,
+    *,
+    albedo: Any = None,
+    normal: Any = None,
+    position: Any = None,
+    depth: Any = None,
+    variance: Any = None,
+    ids: Any = None,
+    method: str = "sure",
+    device: str = "auto",
+    **params: Any,
+) -> Any:
+    """Denoises a Monte Carlo rendering with EAW or SURE-based À-Trous.
+
+    color: H x W x 3 mean radiance (linear HDR). variance: the variance of that mean per channel
+    (not the sample variance); without it the noise is estimated from the image. albedo, normal
+    (world-space, unit), position (world-space), depth (view depth), ids (R mesh id, G material id,
+    -1 background): optional features; a missing one simply has no edge stop.
+
+    method: "eaw" or "sure". device: "auto" (the arrays' device: CUDA arrays on the GPU, numpy on
+    the CPU), "cpu" or "cuda" (numpy inputs are then copied to the GPU and back).
+
+    params: the filter parameters, named as the CLI flags with '_' for '-': levels, sigma_color,
+    color_scale, color_level_factor, sigma_normal, normal_step_scale, sigma_position,
+    position_scale, sigma_depth, use_ids, sure_mode ("discrete" | "james-stein"), sure_candidates,
+    sure_window, correlated_variance, firefly, firefly_k, demodulate, albedo_epsilon
+    (docs/denoising.md gives their meaning and defaults).
+
+    Returns the denoised H x W x 3 float32 image as the same kind of array as `color`.
+    """
+    if method not in METHODS:
+        raise ValueError(f"unknown method '{method}' (expected one of {', '.join(METHODS)})")
+    if device not in ("auto", "cpu", "cuda"):
+        raise ValueError(f"unknown device '{device}' (expected auto, cpu or cuda)")
+    c = _prepare(color, "color", allow_gray=False)
+    bufs = {
+        name: _prepare(val, name)
+        for name, val in (("albedo", albedo), ("normal", normal), ("position", position),
+                          ("depth", depth), ("variance", variance), ("ids", ids))
+    }
+    on_gpu = _is_cuda(c)
+    if device == "cuda" and not on_gpu:
+        if not cuda_available():
+            raise ValueError("device='cuda': no usable CUDA backend or GPU in this build")
+        return _denoise_numpy_on_gpu(c, bufs, method, params)
+    if device == "cpu" and on_gpu:
+        raise ValueError("device='cpu' with CUDA arrays: move them to the host first")
+    for name, b in bufs.items():
+        if b is not None and _is_cuda(b) != on_gpu:
+            raise ValueError(f"{name}: lives on a different device than color")
+    out = _core.denoise(c, bufs["albedo"], bufs["normal"], bufs["position"], bufs["depth"],
+                        bufs["variance"], bufs["ids"], method, dict(params))
+    return _wrap_like(out, color)
+
+
+def _denoise_numpy_on_gpu(c, bufs, method, params):  # pragma: no cover - needs a GPU
+    import cupy
+
+    up = {k: (None if v is None else cupy.asarray(v)) for k, v in bufs.items()}
+    out = _core.denoise(cupy.asarray(c), up["albedo"], up["normal"], up["position"], up["depth"],
+                        up["variance"], up["ids"], method, dict(params))
+    return cupy.asnumpy(cupy.from_dlpack(out))
+
+
+def render(
+    scene: str,
+    *,
+    width: int = 512,
+    height: int = 512,
+    spp: int = 16,
+    seed: int = 1,
+    max_depth: int = 8,
+    threads: int = 0,
+) -> Dict[str, np.ndarray]:
+    """Path-traces `scene` (a built-in name or a JSON scene file) on the CPU.
+
+    Returns a dict of H x W x 3 float32 arrays: color, variance (of the mean), albedo, normal,
+    position, depth, ids (docs/rendering.md). Same seed, same pixels, whatever the thread count.
+    """
+    for name, v in (("width", width), ("height", height), ("spp", spp)):
+        if not isinstance(v, (int, np.integer)) or isinstance(v, bool):
+            raise ValueError(f"{name} must be an integer, got {v!r}")
+    return dict(_core.render(str(scene), int(width), int(height), int(spp), int(seed), int(max_depth),
+                             int(threads)))
+
+
+def metrics(image: Any, reference: Any) -> Dict[str, float]:
+    """MSE, relMSE, PSNR (tonemapped) and SSIM of `image` against `reference` (ALGORITHMS.md 5)."""
+    return dict(_core.metrics(_prepare(image, "image", allow_gray=False),
+                              _prepare(reference, "reference", allow_gray=False)))
+
+
+class Svgf:
+    """Spatiotemporal variance-guided filtering of a stream of 1-spp frames (keeps history).
+
+    params: sigma_l, sigma_n, sigma_z, alpha, moments_alpha, history_cap, levels, feedback_tap,
+    spatial_variance_frames, reproject_depth_tolerance, reproject_normal_cos, taa, taa_alpha.
+    """
+
+    def __init__(self, device: str = "cpu", **params: Any) -> None:
+        self._impl = _core.Svgf(device, dict(params))
+
+    def denoise_frame(self, color: Any, *, albedo: Any = None, normal: Any = None, depth: Any = None,
+                      ids: Any = None, motion: Any = None, emission: Any = None) -> Any:
+        """Denoises the next frame; motion is (dx, dy) in pixels, previous - current."""
+        c = _prepare(color, "color", allow_gray=False)
+        b = [_prepare(v, n, channels=(2, 3) if n == "motion" else (3,))
+             for n, v in (("albedo", albedo), ("normal", normal), ("depth", depth), ("ids", ids),
+                          ("motion", motion), ("emission", emission))]
+        return _wrap_like(self._impl.denoise_frame(c, *b), color)
+
+    def reset(self) -> None:
+        """Forgets the history: the next frame starts a new sequence."""
+        self._impl.reset()
+
+    @property
+    def device(self) -> str:
+        return self._impl.device

@@ -1,0 +1,277 @@
+// atrous._core: the nanobind layer under the Python package (python/atrous/__init__.py holds the
+// documented API and the argument rules). Arrays cross as H x W x C float32 with any strides, on
+// the host or (CUDA builds) on the GPU; results are returned as new C-contiguous arrays on the
+// same device. Library errors arrive in Python as ValueError (InputError) or RuntimeError.
+#include <nanobind/nanobind.h>
+#include <nanobind/ndarray.h>
+#include <nanobind/stl/string.h>
+#include <nanobind/stl/vector.h>
+#include <nanobind/stl/unordered_map.h>
+
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "atrous/denoise.h"
+#include "atrous/device.h"
+#include "atrous/error.h"
+#include "atrous/interop.h"
+#include "atrous/metrics.h"
+#include "atrous/render.h"
+#include "atrous/svgf.h"
+
+namespace nb = nanobind;
+using namespace atrous;
+
+namespace {
+
+using Array = nb::ndarray<nb::ro>;  // any dtype, shape, strides and device: checked below
+
+Device deviceOf(const Array& a, const char* what) {
+    if (a.device_type() == nb::device::cpu::value) return Device::Cpu;
+    if (a.device_type() == nb::device::cuda::value) {
+        if (!cudaAvailable())
+            throw InputError(std::string(what) + ": a CUDA array was given but this build of atrous has no usable CUDA backend");
+        return Device::Cuda;
+    }
+    throw InputError(std::string(what) + ": arrays must live on the CPU or a CUDA device");
+}
+
+// Copies a H x W x C (or H x W) float32 array into a planar Image on the array's device.
+Image toImage(const Array& a, const char* what, int channels = 3) {
+    if (a.dtype() != nb::dtype<float>())
+        throw InputError(std::string(what) + ": expected float32 data");
+    if (a.ndim() != 2 && a.ndim() != 3)
+        throw InputError(std::string(what) + ": expected an array of shape (H, W, 3), got " + std::to_string(a.ndim()) + " dimensions");
+    StridedArray s;
+    s.data = static_cast<const float*>(a.data());
+    s.height = int(a.shape(0));
+    s.width = int(a.shape(1));
+    s.channels = a.ndim() == 3 ? int(a.shape(2)) : 1;
+    s.strideY = a.stride(0);
+    s.strideX = a.stride(1);
+    s.strideC = a.ndim() == 3 ? a.stride(2) : 0;
+    s.device = deviceOf(a, what);
+    if (a.shape(0) == 0 || a.shape(1) == 0) throw InputError(std::string(what) + ": empty array");
+    return imageFromStrided(s, channels, what);
+}
+
+// Hands an Image to Python as a C-contiguous H x W x C float32 array on the image's device.
+nb::object fromImage(Image&& img) {
+    const Device dev = img.device();
+    Image* inter = new Image(img.width(), img.height(), img.channels(), dev);  // holds H x W x C floats
+    imageToInterleaved(img, inter->data());
+    nb::capsule owner(inter, [](void* p) noexcept { delete static_cast<Image*>(p); });
+    const size_t shape[3] = {size_t(img.height()), size_t(img.width()), size_t(img.channels())};
+    const int devType = dev == Device::Cuda ? nb::device::cuda::value : nb::device::cpu::value;
+    if (dev == Device::Cpu) {
+        nb::ndarray<nb::numpy, float> arr(inter->data(), 3, shape, owner);
+        return arr.cast();
+    }
+    nb::ndarray<float> arr(inter->data(), 3, shape, owner, nullptr, nb::dtype<float>(), devType, 0);
+    return arr.cast();
+}
+
+struct Buffers {
+    std::vector<std::unique_ptr<Image>> owned;
+    // `anyChannels`: keep the array's own channel count (motion vectors have 2).
+    const Image* add(const nb::handle& obj, const char* what, const Image& color, bool anyChannels = false) {
+        if (obj.is_none()) return nullptr;
+        Array a = nb::cast<Array>(obj);
+        const int channels = anyChannels && a.ndim() == 3 ? int(a.shape(2)) : 3;
+        owned.push_back(std::make_unique<Image>(toImage(a, what, channels)));
+        const Image& img = *owned.back();
+        if (!img.view().sameSize(color.view()))
+            throw InputError(std::string(what) + ": size " + std::to_string(img.width()) + "x" + std::to_string(img.height()) +
+                             " differs from the color's " + std::to_string(color.width()) + "x" + std::to_string(color.height()));
+        if (img.device() != color.device())
+            throw InputError(std::string(what) + ": lives on a different device than color");
+        return &img;
+    }
+};
+
+template <class T>
+T as(const nb::handle& v, const std::string& key) {
+    try {
+        return nb::cast<T>(v);
+    } catch (const std::exception&) {
+        throw InputError("parameter '" + key + "' has the wrong type");
+    }
+}
+
+// The Python keyword names of every denoise parameter (the CLI's flag names with '_' for '-').
+void applyDenoiseParam(DenoiseOptions& o, const std::string& k, const nb::handle& v) {
+    EawParams& e = o.eaw;
+    if (k == "levels") e.levels = as<int>(v, k);
+    else if (k == "sigma_color") e.sigmaColor = as<float>(v, k);
+    else if (k == "color_scale") e.colorScale = as<float>(v, k);
+    else if (k == "color_level_factor") e.colorLevelFactor = as<float>(v, k);
+    else if (k == "sigma_normal") e.sigmaNormal = as<float>(v, k);
+    else if (k == "normal_step_scale") e.normalStepScale = as<bool>(v, k);
+    else if (k == "sigma_position") e.sigmaPosition = as<float>(v, k);
+    else if (k == "position_scale") e.positionScale = as<float>(v, k);
+    else if (k == "sigma_depth") e.sigmaDepth = as<float>(v, k);
+    else if (k == "use_ids") e.useIds = as<bool>(v, k);
+    else if (k == "sure_mode") {
+        std::string m = as<std::string>(v, k);
+        if (m == "discrete") o.sure.mode = SureMode::Discrete;
+        else if (m == "james-stein" || m == "james_stein") o.sure.mode = SureMode::JamesStein;
+        else throw InputError("parameter 'sure_mode' must be 'discrete' or 'james-stein', got '" + m + "'");
+    } else if (k == "sure_candidates") o.sure.candidates = as<std::vector<float>>(v, k);
+    else if (k == "sure_window") o.sure.windowRadius = as<int>(v, k);
+    else if (k == "correlated_variance") o.sure.correlatedVariance = as<bool>(v, k);
+    else if (k == "firefly") o.firefly.enabled = as<bool>(v, k);
+    else if (k == "firefly_k") o.firefly.k = as<float>(v, k);
+    else if (k == "demodulate") o.demodulate = as<bool>(v, k);
+    else if (k == "albedo_epsilon") o.albedoEpsilon = as<float>(v, k);
+    else throw InputError("unknown denoise parameter '" + k + "'");
+}
+
+nb::object pyDenoise(const Array& color, nb::handle albedo, nb::handle normal, nb::handle position, nb::handle depth,
+                     nb::handle variance, nb::handle ids, const std::string& method, nb::dict params) {
+    Image c = toImage(color, "color");
+    Buffers b;
+    DenoiseInputs in;
+    in.color = &c;
+    in.albedo = b.add(albedo, "albedo", c);
+    in.normal = b.add(normal, "normal", c);
+    in.position = b.add(position, "position", c);
+    in.depth = b.add(depth, "depth", c);
+    in.variance = b.add(variance, "variance", c);
+    in.ids = b.add(ids, "ids", c);
+    DenoiseOptions o;
+    o.method = parseDenoiseMethod(method);
+    o.device = c.device();
+    for (auto [k, v] : params) applyDenoiseParam(o, nb::cast<std::string>(k), v);
+    Image out;
+    {
+        nb::gil_scoped_release release;
+        out = denoise(in, o);
+    }
+    if (out.device() != c.device()) out = out.to(c.device());
+    return fromImage(std::move(out));
+}
+
+void applySvgfParam(SvgfParams& p, const std::string& k, const nb::handle& v) {
+    if (k == "sigma_l") p.sigmaL = as<float>(v, k);
+    else if (k == "sigma_n") p.sigmaN = as<float>(v, k);
+    else if (k == "sigma_z") p.sigmaZ = as<float>(v, k);
+    else if (k == "alpha") p.alpha = as<float>(v, k);
+    else if (k == "moments_alpha") p.momentsAlpha = as<float>(v, k);
+    else if (k == "history_cap") p.historyCap = as<int>(v, k);
+    else if (k == "levels") p.levels = as<int>(v, k);
+    else if (k == "feedback_tap") p.feedbackTap = as<int>(v, k);
+    else if (k == "spatial_variance_frames") p.spatialVarianceFrames = as<int>(v, k);
+    else if (k == "reproject_depth_tolerance") p.reprojectDepthTolerance = as<float>(v, k);
+    else if (k == "reproject_normal_cos") p.reprojectNormalCos = as<float>(v, k);
+    else if (k == "taa") p.taa = as<bool>(v, k);
+    else if (k == "taa_alpha") p.taaAlpha = as<float>(v, k);
+    else throw InputError("unknown SVGF parameter '" + k + "'");
+}
+
+class PySvgf {
+public:
+    PySvgf(const std::string& device, nb::dict params) {
+        SvgfParams p;
+        for (auto [k, v] : params) applySvgfParam(p, nb::cast<std::string>(k), v);
+        mDenoiser = std::make_unique<SvgfDenoiser>(p, parseDevice(device));
+    }
+    nb::object denoiseFrame(const Array& color, nb::handle albedo, nb::handle normal, nb::handle depth, nb::handle ids,
+                            nb::handle motion, nb::handle emission) {
+        Image c = toImage(color, "color");
+        Buffers b;
+        SvgfFrame f;
+        f.color = &c;
+        f.albedo = b.add(albedo, "albedo", c);
+        f.normal = b.add(normal, "normal", c);
+        f.depth = b.add(depth, "depth", c);
+        f.ids = b.add(ids, "ids", c);
+        f.motion = b.add(motion, "motion", c, true);
+        f.emission = b.add(emission, "emission", c);
+        Image out;
+        {
+            nb::gil_scoped_release release;
+            if (c.device() == mDenoiser->device() && c.device() == Device::Cuda)
+                out = mDenoiser->denoiseFrameOnDevice(f).clone();
+            else
+                out = mDenoiser->denoiseFrame(f);
+        }
+        if (out.device() != c.device()) out = out.to(c.device());
+        return fromImage(std::move(out));
+    }
+    void reset() { mDenoiser->reset(); }
+    std::string device() const { return deviceToString(mDenoiser->device()); }
+
+private:
+    std::unique_ptr<SvgfDenoiser> mDenoiser;
+};
+
+nb::dict pyRender(const std::string& scene, int width, int height, int spp, uint32_t seed, int maxDepth, int threads) {
+    Scene s = Scene::loadByNameOrFile(scene);
+    RenderSettings rs;
+    rs.width = width;
+    rs.height = height;
+    rs.spp = spp;
+    rs.seed = seed;
+    rs.maxDepth = maxDepth;
+    rs.threads = threads;
+    RenderBuffers b;
+    {
+        nb::gil_scoped_release release;
+        b = render(s, rs);
+    }
+    nb::dict d;
+    d["color"] = fromImage(std::move(b.color));
+    d["variance"] = fromImage(std::move(b.variance));
+    d["albedo"] = fromImage(std::move(b.albedo));
+    d["normal"] = fromImage(std::move(b.normal));
+    d["position"] = fromImage(std::move(b.position));
+    d["depth"] = fromImage(std::move(b.depth));
+    d["ids"] = fromImage(std::move(b.ids));
+    return d;
+}
+
+nb::dict pyMetrics(const Array& image, const Array& reference) {
+    Image a = toImage(image, "image"), r = toImage(reference, "reference");
+    if (a.device() != Device::Cpu) a = a.to(Device::Cpu);
+    if (r.device() != Device::Cpu) r = r.to(Device::Cpu);
+    ImageMetrics m = computeMetrics(a, r);
+    nb::dict d;
+    d["mse"] = m.mse;
+    d["relmse"] = m.relMse;
+    d["psnr"] = m.psnr;
+    d["ssim"] = m.ssim;
+    return d;
+}
+
+}  // namespace
+
+NB_MODULE(_core, m) {
+    m.doc() = "atrous native core (use the `atrous` package, not this module)";
+    nb::register_exception_translator([](const std::exception_ptr& p, void*) {
+        try {
+            std::rethrow_exception(p);
+        } catch (const InputError& e) {
+            PyErr_SetString(PyExc_ValueError, e.what());
+        } catch (const atrous::RuntimeError& e) {
+            PyErr_SetString(PyExc_RuntimeError, e.what());
+        }
+    });
+    m.def("denoise", &pyDenoise, nb::arg("color"), nb::arg("albedo").none(), nb::arg("normal").none(),
+          nb::arg("position").none(), nb::arg("depth").none(), nb::arg("variance").none(), nb::arg("ids").none(),
+          nb::arg("method"), nb::arg("params"));
+    m.def("render", &pyRender, nb::arg("scene"), nb::arg("width"), nb::arg("height"), nb::arg("spp"), nb::arg("seed"),
+          nb::arg("max_depth"), nb::arg("threads"));
+    m.def("metrics", &pyMetrics, nb::arg("image"), nb::arg("reference"));
+    m.def("builtin_scenes", [] { return builtinSceneNames(); });
+    m.def("cuda_available", &cudaAvailable);
+    m.def("cuda_compiled", &cudaCompiled);
+    m.def("device_name", [](const std::string& d) { return deviceName(parseDevice(d)); });
+    nb::class_<PySvgf>(m, "Svgf")
+        .def(nb::init<const std::string&, nb::dict>(), nb::arg("device"), nb::arg("params"))
+        .def("denoise_frame", &PySvgf::denoiseFrame, nb::arg("color"), nb::arg("albedo").none(), nb::arg("normal").none(),
+             nb::arg("depth").none(), nb::arg("ids").none(), nb::arg("motion").none(), nb::arg("emission").none())
+        .def("reset", &PySvgf::reset)
+        .def_prop_ro("device", &PySvgf::device);
+}
