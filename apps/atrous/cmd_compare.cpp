@@ -1,12 +1,78 @@
-// Placeholder until the compare subcommand lands (replaced by its own commit).
-#include "commands.h"
+// `atrous compare`: MSE, relMSE, tonemapped PSNR and SSIM of images against a reference.
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
 #include "atrous/error.h"
+#include "atrous/metrics.h"
+#include "commands.h"
+#include "io/image_io.h"
 
 namespace atrous::cli {
 
+namespace {
+
+struct CompareArgs {
+    std::string ref, errorMaps;
+    std::vector<std::string> images;
+    bool json = false;
+};
+
+void run(const CompareArgs& a) {
+    if (a.images.empty()) throw InputError("compare: give at least one image to compare with --ref");
+    if (!a.errorMaps.empty()) io::ensureWritableDirectory(a.errorMaps);
+    Image ref = io::readImage(a.ref);
+    std::vector<ImageMetrics> ms;
+    std::vector<Image> imgs;
+    for (const auto& p : a.images) {
+        imgs.push_back(io::readImage(p));
+        try {
+            ms.push_back(computeMetrics(imgs.back(), ref));
+        } catch (const InputError& e) {
+            throw InputError("'" + p + "' vs reference '" + a.ref + "': " + e.what());
+        }
+    }
+    if (!a.errorMaps.empty()) {
+        for (size_t i = 0; i < imgs.size(); ++i) {
+            const std::string stem = std::filesystem::path(a.images[i]).stem().string();
+            io::writeImage((std::filesystem::path(a.errorMaps) / (stem + "_se.exr")).string(), squaredErrorMap(imgs[i], ref));
+            io::writeImage((std::filesystem::path(a.errorMaps) / (stem + "_relse.exr")).string(),
+                           relativeErrorMap(imgs[i], ref));
+        }
+    }
+    if (a.json) {
+        nlohmann::json j;
+        j["reference"] = a.ref;
+        j["images"] = nlohmann::json::array();
+        for (size_t i = 0; i < ms.size(); ++i)
+            j["images"].push_back({{"path", a.images[i]},
+                                   {"mse", ms[i].mse},
+                                   {"relmse", ms[i].relMse},
+                                   {"psnr", ms[i].psnr},
+                                   {"ssim", ms[i].ssim}});
+        std::printf("%s\n", j.dump(2).c_str());
+    } else {
+        std::printf("%-40s %14s %14s %10s %8s\n", "image", "MSE", "relMSE", "PSNR(dB)", "SSIM");
+        for (size_t i = 0; i < ms.size(); ++i)
+            std::printf("%-40s %14.6g %14.6g %10.3f %8.4f\n", a.images[i].c_str(), ms[i].mse, ms[i].relMse, ms[i].psnr,
+                        ms[i].ssim);
+    }
+}
+
+}  // namespace
+
 void addCompareCommand(CLI::App& app) {
-    auto* cmd = app.add_subcommand("compare", "(not built yet)");
-    cmd->callback([] { throw InputError("'compare' is not built yet"); });
+    auto a = std::make_shared<CompareArgs>();
+    auto* cmd = app.add_subcommand("compare", "Compare images against a reference (MSE, relMSE, PSNR, SSIM)");
+    cmd->add_option("--ref", a->ref, "Reference image (EXR/PFM)")->required();
+    cmd->add_option("images", a->images, "Images to compare");
+    cmd->add_flag("--json", a->json, "Print JSON");
+    cmd->add_option("--error-maps", a->errorMaps, "Write <name>_se.exr and <name>_relse.exr error maps into DIR");
+    cmd->callback([a] { run(*a); });
 }
 
 }  // namespace atrous::cli

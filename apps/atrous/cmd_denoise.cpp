@@ -1,12 +1,166 @@
-// Placeholder until the denoise subcommand lands (replaced by its own commit).
-#include "commands.h"
+// `atrous denoise`: EAW or SURE-À-Trous on a render directory or on individual EXR/PFM buffers.
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include "atrous/denoise.h"
 #include "atrous/error.h"
+#include "commands.h"
+#include "core/timer.h"
+#include "io/image_io.h"
 
 namespace atrous::cli {
 
+namespace {
+
+struct DenoiseArgs {
+    std::string inDir, color, albedo, normal, position, depth, variance, ids, out;
+    std::string method = "sure", device = "cpu", sureMode = "discrete", sureCandidates;
+    bool normalStepScale = false, noIds = false, noCorrelated = false, noFirefly = false, noDemodulate = false;
+    DenoiseOptions opt;
+};
+
+std::vector<float> parseFloatList(const std::string& s, const char* flag) {
+    std::vector<float> v;
+    std::stringstream ss(s);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        try {
+            size_t used = 0;
+            v.push_back(std::stof(item, &used));
+            if (used != item.size()) throw std::invalid_argument(item);
+        } catch (const std::exception&) {
+            throw InputError(std::string(flag) + ": '" + item + "' is not a number");
+        }
+    }
+    return v;
+}
+
+void run(DenoiseArgs& a) {
+    DenoiseOptions& o = a.opt;
+    o.method = parseDenoiseMethod(a.method);
+    if (a.sureMode == "discrete")
+        o.sure.mode = SureMode::Discrete;
+    else if (a.sureMode == "james-stein")
+        o.sure.mode = SureMode::JamesStein;
+    else
+        throw InputError("--sure-mode: unknown mode '" + a.sureMode + "' (expected discrete or james-stein)");
+    if (!a.sureCandidates.empty()) o.sure.candidates = parseFloatList(a.sureCandidates, "--sure-candidates");
+    o.eaw.normalStepScale = a.normalStepScale;
+    o.eaw.useIds = !a.noIds;
+    o.sure.correlatedVariance = !a.noCorrelated;
+    o.firefly.enabled = !a.noFirefly;
+    o.demodulate = !a.noDemodulate;
+    validateDenoiseOptions(o);
+    o.device = parseDevice(a.device);
+    const std::string ext = io::extensionOf(a.out);
+    if (ext != ".exr" && ext != ".pfm" && ext != ".png")
+        throw InputError("--out '" + a.out + "': unsupported extension (use .exr, .pfm or .png)");
+    if (a.inDir.empty() == a.color.empty()) throw InputError("give exactly one of --in RENDER_DIR or --color FILE");
+
+    // Buffer paths: --in DIR takes the renderer's file names where present; explicit flags win.
+    auto pick = [&](const std::string& flag, const char* name) -> std::string {
+        if (!flag.empty()) return flag;
+        if (a.inDir.empty()) return "";
+        const std::string p = (std::filesystem::path(a.inDir) / name).string();
+        return std::filesystem::exists(p) ? p : "";
+    };
+    std::string colorPath = a.color;
+    if (!a.inDir.empty()) {
+        if (!std::filesystem::is_directory(a.inDir)) throw InputError("--in '" + a.inDir + "': not a directory");
+        colorPath = (std::filesystem::path(a.inDir) / "color.exr").string();
+        if (!std::filesystem::exists(colorPath)) throw InputError("--in '" + a.inDir + "': no color.exr in it");
+    }
+    Image color = io::readImage(colorPath);
+    std::unique_ptr<Image> bufs[6];
+    const std::string paths[6] = {pick(a.variance, "variance.exr"), pick(a.albedo, "albedo.exr"),
+                                  pick(a.normal, "normal.exr"),     pick(a.position, "position.exr"),
+                                  pick(a.depth, "depth.exr"),       pick(a.ids, "ids.exr")};
+    const char* names[6] = {"variance", "albedo", "normal", "position", "depth", "ids"};
+    for (int i = 0; i < 6; ++i) {
+        if (paths[i].empty()) continue;
+        bufs[i] = std::make_unique<Image>(io::readImage(paths[i]));
+        if (bufs[i]->width() != color.width() || bufs[i]->height() != color.height())
+            throw InputError(std::string(names[i]) + " buffer '" + paths[i] + "' is " + std::to_string(bufs[i]->width()) +
+                             "x" + std::to_string(bufs[i]->height()) + " but the color '" + colorPath + "' is " +
+                             std::to_string(color.width()) + "x" + std::to_string(color.height()));
+    }
+    DenoiseInputs in;
+    in.color = &color;
+    in.variance = bufs[0].get();
+    in.albedo = bufs[1].get();
+    in.normal = bufs[2].get();
+    in.position = bufs[3].get();
+    in.depth = bufs[4].get();
+    in.ids = bufs[5].get();
+    DenoiseReport rep;
+    o.report = &rep;
+    Timer t;
+    Image out;
+    try {
+        out = denoise(in, o);
+    } catch (const InputError& e) {
+        // Name the buffer's file: library messages name the buffer ("variance buffer has ...").
+        std::string msg = e.what();
+        for (int i = 0; i < 6; ++i)
+            if (!paths[i].empty() && msg.rfind(names[i], 0) == 0) msg = "'" + paths[i] + "': " + msg;
+        throw InputError(msg);
+    }
+    const double ms = t.ms();
+    io::writeImage(a.out, out);
+    std::printf("denoise: method %s on %s, %dx%d, buffers used: %s\n", denoiseMethodName(o.method),
+                deviceToString(o.device), color.width(), color.height(), rep.buffersUsed.c_str());
+    if (rep.noiseEstimated)
+        std::printf("denoise: no variance buffer: noise estimated from the image (Donoho MAD), sigma = %.4g %.4g %.4g\n",
+                    rep.noiseSigma[0], rep.noiseSigma[1], rep.noiseSigma[2]);
+    if (rep.nonFinitePixels > 0)
+        std::printf("denoise: %d pixels had NaN/Inf colour, treated as missing\n", rep.nonFinitePixels);
+    if (o.firefly.enabled)
+        std::printf("denoise: fireflies clamped: %d pixels, mean luminance %.6g -> %.6g\n", rep.firefliesClamped,
+                    rep.meanLuminanceIn, rep.meanLuminanceAfterFirefly);
+    std::printf("denoise: filter %.2f ms, total %.2f ms, wrote %s\n", rep.milliseconds, ms, a.out.c_str());
+}
+
+}  // namespace
+
 void addDenoiseCommand(CLI::App& app) {
-    auto* cmd = app.add_subcommand("denoise", "(not built yet)");
-    cmd->callback([] { throw InputError("'denoise' is not built yet"); });
+    auto a = std::make_shared<DenoiseArgs>();
+    auto* cmd = app.add_subcommand("denoise", "Denoise a render with EAW or SURE-based a-trous wavelets");
+    cmd->add_option("--in", a->inDir, "Render directory (color.exr, variance.exr, albedo.exr, normal.exr, ...)");
+    cmd->add_option("--color", a->color, "Noisy colour (EXR/PFM)");
+    cmd->add_option("--variance", a->variance, "Per-channel variance of the pixel mean");
+    cmd->add_option("--albedo", a->albedo, "Albedo buffer");
+    cmd->add_option("--normal", a->normal, "World-space normal buffer");
+    cmd->add_option("--position", a->position, "World-space position buffer");
+    cmd->add_option("--depth", a->depth, "View depth buffer");
+    cmd->add_option("--ids", a->ids, "Mesh id (R) / material id (G) buffer");
+    cmd->add_option("--out", a->out, "Output file (.exr, .pfm or .png)")->required();
+    cmd->add_option("--method", a->method, "eaw | sure")->capture_default_str();
+    cmd->add_option("--device", a->device, "cpu | cuda | auto")->capture_default_str();
+    EawParams& e = a->opt.eaw;
+    cmd->add_option("--levels", e.levels, "A-trous levels (1..10)")->capture_default_str();
+    cmd->add_option("--sigma-color", e.sigmaColor, "Raw sigma_c (0 = automatic from the variance)")->capture_default_str();
+    cmd->add_option("--color-scale", e.colorScale, "k_c of the automatic sigma_c")->capture_default_str();
+    cmd->add_option("--color-level-factor", e.colorLevelFactor, "sigma_c,i = sigma_c * factor^i")->capture_default_str();
+    cmd->add_option("--sigma-normal", e.sigmaNormal, "sigma_n (0 = no normal stop)")->capture_default_str();
+    cmd->add_flag("--normal-step-scale", a->normalStepScale, "Divide the normal distance by step^2 (paper GLSL)");
+    cmd->add_option("--sigma-position", e.sigmaPosition, "Raw sigma_x (0 = automatic from the pixel footprint)")
+        ->capture_default_str();
+    cmd->add_option("--position-scale", e.positionScale, "k_x of the automatic sigma_x")->capture_default_str();
+    cmd->add_option("--sigma-depth", e.sigmaDepth, "sigma_z on relative depth (0 = off)")->capture_default_str();
+    cmd->add_flag("--no-ids", a->noIds, "Ignore the ids buffer");
+    cmd->add_option("--sure-mode", a->sureMode, "discrete | james-stein")->capture_default_str();
+    cmd->add_option("--sure-candidates", a->sureCandidates, "Comma-separated fractions (default 0,0.2,0.4,0.6,0.8,1)");
+    cmd->add_option("--sure-window", a->opt.sure.windowRadius, "SURE window radius r ((2r+1)^2 window)")
+        ->capture_default_str();
+    cmd->add_flag("--no-correlated-variance", a->noCorrelated, "Plain independence propagation of the variance");
+    cmd->add_flag("--no-firefly", a->noFirefly, "Disable firefly suppression");
+    cmd->add_option("--firefly-k", a->opt.firefly.k, "Firefly bound: k local standard deviations")->capture_default_str();
+    cmd->add_flag("--no-demodulate", a->noDemodulate, "Do not divide by the albedo");
+    cmd->add_option("--albedo-epsilon", a->opt.albedoEpsilon, "Demodulation floor")->capture_default_str();
+    cmd->callback([a] { run(*a); });
 }
 
 }  // namespace atrous::cli

@@ -1,8 +1,10 @@
 // Denoising API: EAW (Dammertz et al. 2010) and SURE-based À-Trous (Kim, Moon, Yoon 2016).
-// OWNER: the denoiser work (issue 3) extends this header; the names below are used by the render
-// command (`atrous render --denoise eaw,sure`) and must keep working.
+// The names below are used by the render command (`atrous render --denoise eaw,sure`), the CLI
+// (`atrous denoise`) and the benchmarks. The math is ALGORITHMS.md sections 2, 3, 3a; the
+// parameters and how their defaults are derived are documented in docs/denoising.md.
 #pragma once
 #include <string>
+#include <vector>
 
 #include "atrous/device.h"
 #include "atrous/image.h"
@@ -23,15 +25,84 @@ struct DenoiseInputs {
     const Image* ids = nullptr;       // R = mesh id, G = material id, -1 for background
 };
 
+// Edge-avoiding à-trous cascade (ALGORITHMS.md 2). Also the cascade that SURE runs on.
+// Edge-stopping weight of a tap: w = exp(-(Δc²/σ_c,i² + Δn²/σ_n,i² + Δx²/σ_x² + (Δz/(σ_z z))² + ids)).
+struct EawParams {
+    int levels = 5;  // 1..10; five levels reach ±62 pixels
+    // σ_c. 0 = automatic: σ_c² at a tap pair is colorScale² · (V(p) + V(q)), V = 3×3-prefiltered
+    // sum over channels of the variance buffer (or of the estimated noise). > 0 = the paper's raw
+    // constant σ_c (GLSL c_phi = σ_c²).
+    float sigmaColor = 0.0f;
+    float colorScale = 2.0f;        // k_c of the automatic σ_c (> 0)
+    float colorLevelFactor = 0.5f;  // σ_c,i = σ_c · factor^i (paper: halved per level), (0, 1]
+    // σ_n on |n(p) - n(q)| (unit normals). 0 disables the normal stop. GLSL n_phi = σ_n².
+    float sigmaNormal = 0.5f;
+    // Divide the normal distance by the squared step width 2^(2i), as the paper's GLSL does.
+    bool normalStepScale = false;
+    // σ_x. 0 = automatic: σ_x at a tap is positionScale · (pixel offset of the tap) · (world-space
+    // size of a pixel at p, from the position buffer), so flat surfaces pass at any depth and any
+    // level. > 0 = the paper's raw constant σ_x (GLSL p_phi = σ_x²), the same at every level.
+    float sigmaPosition = 0.0f;
+    float positionScale = 1.0f;  // k_x of the automatic σ_x (> 0)
+    // σ_z on the relative depth difference (z_p - z_q) / z_p; 0 disables the depth stop (default:
+    // position already covers it).
+    float sigmaDepth = 0.0f;
+    bool useIds = true;  // weight 0 across mesh or material id changes when an ids buffer is given
+};
+
+enum class SureMode { Discrete, JamesStein };
+
+// SURE-based choice of the fraction s_i(p) of each detail d_i kept (ALGORITHMS.md 3).
+struct SureParams {
+    SureMode mode = SureMode::Discrete;
+    std::vector<float> candidates = {0.0f, 0.2f, 0.4f, 0.6f, 0.8f, 1.0f};  // 1..8 values in [0,1]
+    int windowRadius = 3;  // the SURE window is (2r+1)², 1..10
+    // Correct the propagated variance v_i for the correlation the independence assumption ignores
+    // (per-level factors computed exactly for the unweighted B3 cascade on white noise).
+    bool correlatedVariance = true;
+};
+
+// Firefly suppression before either filter (ALGORITHMS.md 3a): a pixel whose luminance exceeds
+// m + k·sqrt(s² + v) (m, s² the mean and variance of its 3×3 neighbours' luminance without the
+// brightest one, v their mean luminance variance) is scaled down to that bound.
+struct FireflyParams {
+    bool enabled = true;
+    float k = 4.0f;  // > 0
+};
+
+struct DenoiseReport;
+
 struct DenoiseOptions {
     DenoiseMethod method = DenoiseMethod::Sure;
     Device device = Device::Cpu;
-    // Filter parameters are added by the denoiser work (EawParams, SureParams, firefly, ...).
+    EawParams eaw;
+    SureParams sure;
+    FireflyParams firefly;
+    // Albedo demodulation (when an albedo buffer is given): filter color / max(albedo, ε) with
+    // variance / max(albedo, ε)², then multiply the result by max(albedo, ε).
+    bool demodulate = true;
+    float albedoEpsilon = 1e-3f;  // > 0
+    DenoiseReport* report = nullptr;  // optional: filled with what the run did
+};
+
+// What a denoise() call did, for the CLI and for measurements.
+struct DenoiseReport {
+    bool noiseEstimated = false;  // no variance buffer: noise estimated by Donoho's MAD
+    float noiseSigma[3] = {0, 0, 0};  // the estimated per-channel standard deviation
+    int nonFinitePixels = 0;          // colour samples that were NaN/Inf (treated as missing)
+    int firefliesClamped = 0;
+    double meanLuminanceIn = 0;        // mean luminance of the (finite) input colour
+    double meanLuminanceAfterFirefly = 0;  // ... after firefly suppression
+    std::string buffersUsed;           // e.g. "color,variance,normal,position"
+    double milliseconds = 0;           // filter time (excluding validation)
 };
 
 // Denoises inputs.color and returns a 3-channel host image of the same size. Throws InputError
 // for mismatched sizes, missing colour, negative variance or parameters out of range.
 Image denoise(const DenoiseInputs& inputs, const DenoiseOptions& options);
+
+// Throws InputError naming the parameter when one is out of range.
+void validateDenoiseOptions(const DenoiseOptions& options);
 
 DenoiseMethod parseDenoiseMethod(const std::string& name);  // "eaw" | "sure"; InputError otherwise
 const char* denoiseMethodName(DenoiseMethod m);

@@ -1,0 +1,27 @@
+// Image-quality metrics against a reference (ALGORITHMS.md 5). All inputs are linear HDR RGB
+// host images of the same size; non-finite pixels count as errors (they are replaced by 0 before
+// comparing, so a NaN in the image shows up as a large error instead of poisoning the mean).
+#pragma once
+#include "atrous/image.h"
+
+namespace atrous {
+
+struct ImageMetrics {
+    double mse = 0;     // mean over pixels and channels of (x - r)², linear HDR
+    double relMse = 0;  // mean of (x - r)² / (r² + 0.01)
+    double psnr = 0;    // dB, on tonemapped images: x/(1+x), then ^(1/2.2), clamped to [0,1]
+    double ssim = 0;    // on the tonemapped luminance, 11×11 Gaussian window σ = 1.5
+};
+
+// Throws InputError when the sizes differ or an image is empty.
+ImageMetrics computeMetrics(const Image& image, const Image& reference);
+
+// Tonemap used by PSNR/SSIM: clamp(pow(x/(1+x), 1/2.2), 0, 1) (x < 0 → 0).
+float tonemapForMetrics(float x);
+
+// Per-pixel error maps (3-channel host images, the value repeated in R,G,B): squared error
+// averaged over channels, and relative squared error.
+Image squaredErrorMap(const Image& image, const Image& reference);
+Image relativeErrorMap(const Image& image, const Image& reference);
+
+}  // namespace atrous

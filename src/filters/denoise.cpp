@@ -1,0 +1,236 @@
+// The denoise() entry point: validates the inputs and parameters, estimates the noise when no
+// variance buffer is given, and runs the driver (denoise_driver.h) on the CPU or, through
+// src/cuda/cuda_denoise.cu, on the GPU.
+#include "atrous/denoise.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "atrous/error.h"
+#include "core/parallel.h"
+#include "core/timer.h"
+#include "filters/denoise_driver.h"
+#include "filters/denoise_internal.h"
+
+namespace atrous {
+
+DenoiseMethod parseDenoiseMethod(const std::string& name) {
+    if (name == "eaw") return DenoiseMethod::Eaw;
+    if (name == "sure") return DenoiseMethod::Sure;
+    throw InputError("unknown denoise method '" + name + "' (expected eaw or sure)");
+}
+
+const char* denoiseMethodName(DenoiseMethod m) { return m == DenoiseMethod::Eaw ? "eaw" : "sure"; }
+
+static void requireRange(bool ok, const std::string& what) {
+    if (!ok) throw InputError("parameter out of range: " + what);
+}
+
+void validateDenoiseOptions(const DenoiseOptions& o) {
+    const EawParams& e = o.eaw;
+    requireRange(e.levels >= 1 && e.levels <= filters::kMaxLevels, "levels must be in 1..10");
+    requireRange(std::isfinite(e.sigmaColor) && e.sigmaColor >= 0, "sigma-color must be >= 0 (0 = automatic)");
+    requireRange(std::isfinite(e.colorScale) && e.colorScale > 0, "color-scale must be > 0");
+    requireRange(std::isfinite(e.colorLevelFactor) && e.colorLevelFactor > 0 && e.colorLevelFactor <= 1,
+                 "color-level-factor must be in (0, 1]");
+    requireRange(std::isfinite(e.sigmaNormal) && e.sigmaNormal >= 0, "sigma-normal must be >= 0 (0 = off)");
+    requireRange(std::isfinite(e.sigmaPosition) && e.sigmaPosition >= 0, "sigma-position must be >= 0 (0 = automatic)");
+    requireRange(std::isfinite(e.positionScale) && e.positionScale > 0, "position-scale must be > 0");
+    requireRange(std::isfinite(e.sigmaDepth) && e.sigmaDepth >= 0, "sigma-depth must be >= 0 (0 = off)");
+    const SureParams& s = o.sure;
+    requireRange(s.windowRadius >= 1 && s.windowRadius <= 10, "sure-window must be in 1..10");
+    requireRange(!s.candidates.empty() && int(s.candidates.size()) <= filters::kMaxSureCandidates,
+                 "sure-candidates must list 1..8 values");
+    for (float c : s.candidates) requireRange(std::isfinite(c) && c >= 0 && c <= 1, "sure-candidates must be in [0, 1]");
+    requireRange(std::isfinite(o.firefly.k) && o.firefly.k > 0, "firefly-k must be > 0");
+    requireRange(std::isfinite(o.albedoEpsilon) && o.albedoEpsilon > 0, "albedo-epsilon must be > 0");
+}
+
+namespace filters {
+
+// Donoho's estimator on the finest detail of the unweighted B3 à-trous: σ_d = median|d_0| / 0.6745;
+// for white noise var(d_0) = σ² (1 + Σh² - 2 h(0)) (see sureDetailVarianceFactors), so
+// σ = σ_d / sqrt(0.7900...). Per channel, over finite pixels.
+void estimateNoiseSigma(const Image& color, float sigma[3]) {
+    const int w = color.width(), h = color.height();
+    const double sumH2 = (70.0 / 256.0) * (70.0 / 256.0), h0 = (6 / 16.0) * (6 / 16.0);
+    const double detailVar = 1.0 + sumH2 - 2.0 * h0;
+    for (int c = 0; c < 3; ++c) {
+        std::vector<float> d;
+        d.reserve(size_t(w) * h);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const float v = color(x, y, c);
+                if (!std::isfinite(v)) continue;
+                double s = 0, ws = 0;
+                bool ok = true;
+                for (int qy = -2; qy <= 2 && ok; ++qy)
+                    for (int qx = -2; qx <= 2; ++qx) {
+                        const float u = color(clampIdx(x + qx, w - 1), clampIdx(y + qy, h - 1), c);
+                        if (!std::isfinite(u)) {
+                            ok = false;
+                            break;
+                        }
+                        s += double(b3(qx) * b3(qy)) * u;
+                        ws += b3(qx) * b3(qy);
+                    }
+                if (ok) d.push_back(std::fabs(float(v - s / ws)));
+            }
+        if (d.empty()) {
+            sigma[c] = 0;
+            continue;
+        }
+        auto mid = d.begin() + d.size() / 2;
+        std::nth_element(d.begin(), mid, d.end());
+        sigma[c] = float(double(*mid) / 0.6745 / std::sqrt(detailVar));
+    }
+}
+
+static void checkBuffer(const Image* img, const Image& color, const char* name) {
+    if (!img) return;
+    if (img->empty()) throw InputError(std::string(name) + " buffer is empty");
+    if (img->width() != color.width() || img->height() != color.height())
+        throw InputError(std::string(name) + " buffer is " + std::to_string(img->width()) + "x" +
+                         std::to_string(img->height()) + " but the color is " + std::to_string(color.width()) + "x" +
+                         std::to_string(color.height()));
+    if (img->channels() < 3) throw InputError(std::string(name) + " buffer needs 3 channels");
+}
+
+PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, DenoiseReport& rep) {
+    if (!in.color || in.color->empty()) throw InputError("no color buffer given");
+    const Image& color = *in.color;
+    if (color.channels() < 3) throw InputError("color buffer needs 3 channels");
+    checkBuffer(in.variance, color, "variance");
+    checkBuffer(in.albedo, color, "albedo");
+    checkBuffer(in.normal, color, "normal");
+    checkBuffer(in.position, color, "position");
+    checkBuffer(in.depth, color, "depth");
+    checkBuffer(in.ids, color, "ids");
+    validateDenoiseOptions(o);
+    PreparedInputs p;
+    const Image colorHost = color.device() == Device::Cpu ? Image() : color.to(Device::Cpu);
+    const Image& ch = color.device() == Device::Cpu ? color : colorHost;
+    rep.nonFinitePixels = 0;
+    for (size_t i = 0; i < ch.plane(); ++i) {
+        if (!std::isfinite(ch.data()[i]) || !std::isfinite(ch.data()[i + ch.plane()]) ||
+            !std::isfinite(ch.data()[i + 2 * ch.plane()]))
+            ++rep.nonFinitePixels;
+    }
+    std::string used = "color";
+    if (in.variance) {
+        const Image varHost = in.variance->device() == Device::Cpu ? Image() : in.variance->to(Device::Cpu);
+        const Image& vh = in.variance->device() == Device::Cpu ? *in.variance : varHost;
+        for (size_t i = 0; i < 3 * vh.plane(); ++i)
+            if (vh.data()[i] < 0) {
+                const size_t px = i % vh.plane();
+                throw InputError("variance buffer has a negative value (" + std::to_string(vh.data()[i]) + ") at pixel (" +
+                                 std::to_string(px % vh.width()) + ", " + std::to_string(px / vh.width()) + ")");
+            }
+        used += ",variance";
+        rep.noiseEstimated = false;
+    } else {
+        // No variance: Donoho's MAD estimate, constant over the image.
+        estimateNoiseSigma(ch, rep.noiseSigma);
+        rep.noiseEstimated = true;
+        p.estimatedVariance = Image(color.width(), color.height(), 3, Device::Cpu);
+        for (int c = 0; c < 3; ++c) {
+            const float v = rep.noiseSigma[c] * rep.noiseSigma[c];
+            std::fill(p.estimatedVariance.data() + c * p.estimatedVariance.plane(),
+                      p.estimatedVariance.data() + (c + 1) * p.estimatedVariance.plane(), v);
+        }
+    }
+    if (in.albedo) used += o.demodulate ? ",albedo" : ",albedo(unused: demodulation off)";
+    if (in.normal) used += ",normal";
+    if (in.position) used += ",position";
+    if (in.depth) used += o.eaw.sigmaDepth > 0 ? ",depth" : ",depth(unused: sigma-depth 0)";
+    if (in.ids) used += o.eaw.useIds ? ",ids" : ",ids(unused)";
+    rep.buffersUsed = used;
+    return p;
+}
+
+DriverConfig makeConfig(const DenoiseOptions& o) {
+    DriverConfig cfg;
+    cfg.method = o.method;
+    cfg.eaw = o.eaw;
+    cfg.sure = o.sure;
+    cfg.firefly = o.firefly;
+    cfg.demodulate = o.demodulate;
+    cfg.albedoEpsilon = o.albedoEpsilon;
+    return cfg;
+}
+
+static ImageView viewOf(const Image* img) { return img ? img->view() : ImageView{}; }
+
+static double meanLuminance(const Image& img) {
+    double s = 0;
+    size_t n = 0;
+    for (size_t i = 0; i < img.plane(); ++i) {
+        const float l = lum(img.data()[i], img.data()[i + img.plane()], img.data()[i + 2 * img.plane()]);
+        if (std::isfinite(l)) {
+            s += l;
+            ++n;
+        }
+    }
+    return n ? s / double(n) : 0.0;
+}
+
+Image denoiseCpu(const DenoiseInputs& in, const DenoiseOptions& o, const PreparedInputs& prep, DenoiseReport& rep,
+                 DriverDebug* debug) {
+    const int w = in.color->width(), h = in.color->height();
+    DriverInputs di;
+    di.color = in.color->view();
+    di.variance = in.variance ? in.variance->view() : prep.estimatedVariance.view();
+    di.albedo = viewOf(in.albedo);
+    di.normal = viewOf(in.normal);
+    di.position = viewOf(in.position);
+    di.depth = viewOf(in.depth);
+    di.ids = viewOf(in.ids);
+    Image out(w, h, 3, Device::Cpu), after(w, h, 3, Device::Cpu), flag(w, h, 1, Device::Cpu);
+    DriverOutputs dout;
+    dout.out = out.view();
+    dout.afterFirefly = after.view();
+    dout.fireflyFlag = flag.view();
+    if (debug && !debug->sureS.empty()) dout.sureS = debug->sureS.view();
+    Timer t;
+    runDenoise(CpuExec{}, di, makeConfig(o), dout);
+    rep.milliseconds = t.ms();
+    rep.meanLuminanceIn = meanLuminance(*in.color);
+    rep.meanLuminanceAfterFirefly = meanLuminance(after);
+    int clamped = 0;
+    for (size_t i = 0; i < flag.plane(); ++i) clamped += flag.data()[i] > 0.5f;
+    rep.firefliesClamped = clamped;
+    return out;
+}
+
+}  // namespace filters
+
+Image denoise(const DenoiseInputs& inputs, const DenoiseOptions& options) {
+    DenoiseReport local;
+    DenoiseReport& rep = options.report ? *options.report : local;
+    rep = DenoiseReport{};
+    filters::PreparedInputs prep = filters::prepareInputs(inputs, options, rep);
+    if (options.device == Device::Cuda) {
+        if (!cudaCompiled()) throw InputError("--device cuda: this build of atrous has no CUDA backend");
+        if (!cudaAvailable()) throw InputError("--device cuda: no CUDA-capable GPU is available");
+        return filters::denoiseCuda(inputs, options, prep, rep);
+    }
+    for (const Image* img : {inputs.color, inputs.variance, inputs.albedo, inputs.normal, inputs.position,
+                             inputs.depth, inputs.ids})
+        if (img && img->device() != Device::Cpu) {
+            // Host path with device inputs: bring them over (rare; the CLI always passes host images).
+            throw InputError("denoise on the CPU needs host images (got a CUDA image)");
+        }
+    return filters::denoiseCpu(inputs, options, prep, rep, nullptr);
+}
+
+}  // namespace atrous
+
+#if !defined(ATROUS_HAVE_CUDA)
+namespace atrous::filters {
+Image denoiseCuda(const DenoiseInputs&, const DenoiseOptions&, const PreparedInputs&, DenoiseReport&) {
+    throw InputError("--device cuda: this build of atrous has no CUDA backend");
+}
+}  // namespace atrous::filters
+#endif

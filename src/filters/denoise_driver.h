@@ -1,0 +1,188 @@
+// The level-loop driver of EAW and SURE, written once as a template on the executor (CpuExec in
+// src/filters/denoise.cpp, CudaExec in src/cuda/cuda_denoise.cu). Inputs and outputs are views on
+// the executor's device; temporaries are allocated there.
+#pragma once
+#include <cmath>
+#include <vector>
+
+#include "atrous/denoise.h"
+#include "atrous/image.h"
+#include "filters/eaw.h"
+#include "filters/prepass.h"
+#include "filters/sure.h"
+
+namespace atrous::filters {
+
+constexpr int kMaxLevels = 10;
+// Exponent added per unit squared id difference: ids are integers, so a differing id gives a
+// weight below e^-87 (the clamp of expNeg), i.e. 0 for all purposes.
+constexpr float kIdPenalty = 1e4f;
+
+struct DriverInputs {
+    ImageView color, variance;  // variance always valid (a constant estimate when none was given)
+    ImageView albedo, normal, position, depth, ids;  // invalid when absent
+};
+
+struct DriverOutputs {
+    ImageView out;           // 3 channels, required
+    ImageView afterFirefly;  // optional: c_0 after sanitising and firefly suppression (3 ch)
+    ImageView fireflyFlag;   // optional: 1 where a firefly was clamped (1 ch)
+    ImageView sureS;         // optional: s_i per level (levels channels)
+};
+
+struct DriverConfig {
+    DenoiseMethod method = DenoiseMethod::Sure;
+    EawParams eaw;
+    SureParams sure;
+    FireflyParams firefly;
+    bool demodulate = true;
+    float albedoEpsilon = 1e-3f;
+};
+
+// α_i = true var(d_i) / independence-propagated var(d_i) for the unweighted B3 cascade on white
+// noise. The 2D kernels are separable (K = k ⊗ k), so Σ K² = (Σ k²)² and
+// Σ (K_i - K_{i+1})² = (Σ k_i²)² + (Σ k_{i+1}²)² - 2 (Σ k_i k_{i+1})², computed from 1D kernels.
+inline void sureDetailVarianceFactors(int levels, float* alpha) {
+    const int reach = 4 * ((1 << levels) - 1) + 1;
+    const int n = 2 * reach + 1, c = reach;
+    std::vector<double> k(n, 0.0), next(n);
+    k[c] = 1.0;
+    const double h[5] = {1 / 16.0, 4 / 16.0, 6 / 16.0, 4 / 16.0, 1 / 16.0};
+    const double sumH2 = (70.0 / 256.0) * (70.0 / 256.0);  // Σ h² of the 2D kernel
+    const double h0 = (6 / 16.0) * (6 / 16.0);              // a_p of the 2D kernel
+    double indVar = 1.0;                                     // independence var(c_i)
+    for (int i = 0; i < levels; ++i) {
+        const int step = 1 << i;
+        for (int j = 0; j < n; ++j) {
+            double s = 0;
+            for (int q = -2; q <= 2; ++q) {
+                const int jj = j + q * step;
+                if (jj >= 0 && jj < n) s += h[q + 2] * k[jj];
+            }
+            next[j] = s;
+        }
+        double a = 0, b = 0, ab = 0;
+        for (int j = 0; j < n; ++j) {
+            a += k[j] * k[j];
+            b += next[j] * next[j];
+            ab += k[j] * next[j];
+        }
+        const double trueVar = a * a + b * b - 2.0 * ab * ab;
+        const double indNext = indVar * sumH2;
+        const double ind = indVar + indNext - 2.0 * h0 * indVar;
+        alpha[i] = float(trueVar / ind);
+        indVar = indNext;
+        k.swap(next);
+    }
+}
+
+template <class Exec>
+void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cfg, const DriverOutputs& out) {
+    const int w = in.color.width, h = in.color.height;
+    const Device dev = exec.device();
+    const bool sure = cfg.method == DenoiseMethod::Sure;
+    const int levels = cfg.eaw.levels;
+
+    // 1. Non-finite samples and features.
+    Image c0(w, h, 3, dev), v0(w, h, 3, dev);
+    exec.forEachPixel(w, h, SanitizeColor{in.color, in.variance, c0.view(), v0.view()});
+    Image normal(w, h, 3, dev), position(w, h, 3, dev), depth(w, h, 1, dev), ids(w, h, 2, dev);
+    if (in.normal.valid()) exec.forEachPixel(w, h, SanitizeFeature{in.normal, normal.view()});
+    if (in.position.valid()) exec.forEachPixel(w, h, SanitizeFeature{in.position, position.view()});
+    if (in.depth.valid()) exec.forEachPixel(w, h, SanitizeFeature{in.depth, depth.view()});
+    if (in.ids.valid()) exec.forEachPixel(w, h, SanitizeFeature{in.ids, ids.view()});
+
+    // 2. Fireflies (before demodulation: the outlier is in radiance).
+    Image cA(w, h, 3, dev), vA(w, h, 3, dev);
+    if (cfg.firefly.enabled) {
+        exec.forEachPixel(w, h, FireflyClamp{cfg.firefly.k, c0.view(), v0.view(), cA.view(), vA.view(), out.fireflyFlag});
+    } else {
+        cA.copyFrom(c0);
+        vA.copyFrom(v0);
+    }
+    if (out.afterFirefly.valid()) {
+        exec.forEachPixel(w, h, SanitizeFeature{cA.view(), out.afterFirefly});
+    }
+
+    // 3. Albedo demodulation.
+    ImageView albedo = cfg.demodulate ? in.albedo : ImageView{};
+    Image albedoClean;
+    if (albedo.valid()) {
+        albedoClean = Image(w, h, 3, dev);
+        exec.forEachPixel(w, h, SanitizeFeature{albedo, albedoClean.view()});
+        albedo = albedoClean.view();
+        exec.forEachPixel(w, h, Demodulate{cfg.albedoEpsilon, albedo, cA.view(), vA.view()});
+    }
+
+    // 4. Per-pixel scales of the automatic σ_c and σ_x.
+    Image S(w, h, 1, dev), invX(w, h, 1, dev), invZ(w, h, 1, dev);
+    exec.forEachPixel(w, h, ColorScale{cfg.eaw.sigmaColor, cfg.eaw.colorScale * cfg.eaw.colorScale, vA.view(), S.view()});
+    exec.forEachPixel(w, h, Footprint{in.position.valid() ? 1 : 0, cfg.eaw.sigmaPosition,
+                                      cfg.eaw.positionScale * cfg.eaw.positionScale, position.view(), depth.view(),
+                                      invX.view(), invZ.view()});
+
+    // 5. The cascade. SURE also propagates the variance and keeps Σ s_i d_i in `acc`.
+    Image cB(w, h, 3, dev);
+    Image vB, detail, boxH, acc;
+    float alpha[kMaxLevels];
+    for (int i = 0; i < kMaxLevels; ++i) alpha[i] = 1.0f;
+    SureChoiceParams choice;
+    if (sure) {
+        vB = Image(w, h, 3, dev);
+        detail = Image(w, h, 2, dev);
+        boxH = Image(w, h, 2, dev);
+        acc = Image(w, h, 3, dev);
+        if (cfg.sure.correlatedVariance) sureDetailVarianceFactors(levels, alpha);
+        choice.radius = cfg.sure.windowRadius;
+        choice.jamesStein = cfg.sure.mode == SureMode::JamesStein ? 1 : 0;
+        choice.count = int(cfg.sure.candidates.size());
+        for (int k = 0; k < choice.count && k < kMaxSureCandidates; ++k) choice.candidates[k] = cfg.sure.candidates[k];
+    }
+    Image* cur = &cA;
+    Image* nxt = &cB;
+    Image* vcur = &vA;
+    Image* vnxt = &vB;
+    const float invSigmaN2 = cfg.eaw.sigmaNormal > 0 && in.normal.valid() ? 1.0f / (cfg.eaw.sigmaNormal * cfg.eaw.sigmaNormal) : 0.0f;
+    for (int i = 0; i < levels; ++i) {
+        EawLevelParams lp;
+        lp.step = 1 << i;
+        lp.colorMul = std::pow(cfg.eaw.colorLevelFactor, 2.0f * float(i));
+        lp.invNormal = cfg.eaw.normalStepScale ? invSigmaN2 / float(lp.step * lp.step) : invSigmaN2;
+        lp.autoPosition = cfg.eaw.sigmaPosition > 0 ? 0 : 1;
+        lp.invDepth = cfg.eaw.sigmaDepth > 0 && in.depth.valid() ? 1.0f / (cfg.eaw.sigmaDepth * cfg.eaw.sigmaDepth) : 0.0f;
+        lp.idPenalty = cfg.eaw.useIds && in.ids.valid() ? kIdPenalty : 0.0f;
+        lp.propagate = sure ? 1 : 0;
+        lp.detailVarScale = alpha[i];
+        EawLevel f;
+        f.p = lp;
+        f.cIn = cur->view();
+        f.cOut = nxt->view();
+        if (sure) {
+            f.vIn = vcur->view();
+            f.vOut = vnxt->view();
+            f.detail = detail.view();
+        }
+        f.S = S.view();
+        f.normal = normal.view();
+        f.position = position.view();
+        f.invX = invX.view();
+        f.depth = depth.view();
+        f.invZ = invZ.view();
+        f.ids = ids.view();
+        runEawLevel(exec, f);
+        if (sure) {
+            exec.forEachPixel(w, h, SureBoxH{choice.radius, detail.view(), boxH.view()});
+            ImageView sOut;
+            if (out.sureS.valid()) sOut = ImageView{out.sureS.channel(i), w, h, 1};
+            exec.forEachPixel(w, h, SureChoose{choice, boxH.view(), cur->view(), nxt->view(), acc.view(), sOut});
+            std::swap(vcur, vnxt);
+        }
+        std::swap(cur, nxt);
+    }
+
+    // 6. out = (c_N + Σ s_i d_i) · albedo.
+    exec.forEachPixel(w, h, Recombine{cfg.albedoEpsilon, cur->view(), sure ? acc.view() : ImageView{}, albedo, out.out});
+    exec.synchronize();
+}
+
+}  // namespace atrous::filters

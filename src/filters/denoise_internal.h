@@ -1,0 +1,29 @@
+// Internal pieces of denoise() shared by the CPU path (denoise.cpp), the CUDA path
+// (src/cuda/cuda_denoise.cu) and the white-box tests.
+#pragma once
+#include "atrous/denoise.h"
+#include "atrous/image.h"
+#include "filters/denoise_driver.h"
+
+namespace atrous::filters {
+
+struct PreparedInputs {
+    Image estimatedVariance;  // constant σ² per channel when no variance buffer was given
+};
+
+// Optional extra outputs for tests.
+struct DriverDebug {
+    Image sureS;  // host image with `levels` channels: receives s_i(p)
+};
+
+// Validates sizes, channels, negative variance and parameters (InputError), counts non-finite
+// colour pixels and estimates the noise when there is no variance buffer.
+PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, DenoiseReport& rep);
+DriverConfig makeConfig(const DenoiseOptions& o);
+// Per-channel noise standard deviation by Donoho's MAD of the finest B3 detail.
+void estimateNoiseSigma(const Image& color, float sigma[3]);
+Image denoiseCpu(const DenoiseInputs& in, const DenoiseOptions& o, const PreparedInputs& prep, DenoiseReport& rep,
+                 DriverDebug* debug);
+Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const PreparedInputs& prep, DenoiseReport& rep);
+
+}  // namespace atrous::filters

@@ -1,0 +1,120 @@
+// Metrics of ALGORITHMS.md 5 (MSE, relMSE, tonemapped PSNR, SSIM of tonemapped luminance).
+#include "atrous/metrics.h"
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "atrous/error.h"
+
+namespace atrous {
+
+namespace {
+
+float finiteOr0(float v) { return std::isfinite(v) ? v : 0.0f; }
+
+void checkPair(const Image& a, const Image& r) {
+    if (a.empty() || r.empty()) throw InputError("cannot compare an empty image");
+    if (a.width() != r.width() || a.height() != r.height())
+        throw InputError("image is " + std::to_string(a.width()) + "x" + std::to_string(a.height()) +
+                         " but the reference is " + std::to_string(r.width()) + "x" + std::to_string(r.height()));
+    if (a.channels() < 3 || r.channels() < 3) throw InputError("images to compare need 3 channels");
+}
+
+// Separable 11-tap Gaussian (σ = 1.5) blur with clamped borders.
+std::vector<double> blur(const std::vector<double>& in, int w, int h) {
+    double g[11], s = 0;
+    for (int i = 0; i < 11; ++i) {
+        g[i] = std::exp(-double((i - 5) * (i - 5)) / (2 * 1.5 * 1.5));
+        s += g[i];
+    }
+    for (double& v : g) v /= s;
+    std::vector<double> tmp(in.size()), out(in.size());
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            double a = 0;
+            for (int i = -5; i <= 5; ++i) a += g[i + 5] * in[size_t(y) * w + std::min(std::max(x + i, 0), w - 1)];
+            tmp[size_t(y) * w + x] = a;
+        }
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            double a = 0;
+            for (int i = -5; i <= 5; ++i) a += g[i + 5] * tmp[size_t(std::min(std::max(y + i, 0), h - 1)) * w + x];
+            out[size_t(y) * w + x] = a;
+        }
+    return out;
+}
+
+}  // namespace
+
+float tonemapForMetrics(float x) {
+    x = finiteOr0(x);
+    if (x <= 0) return 0.0f;
+    float t = std::pow(x / (1.0f + x), 1.0f / 2.2f);
+    return t < 0 ? 0 : (t > 1 ? 1 : t);
+}
+
+ImageMetrics computeMetrics(const Image& a, const Image& r) {
+    checkPair(a, r);
+    const int w = a.width(), h = a.height();
+    const size_t plane = a.plane();
+    ImageMetrics m;
+    double se = 0, rel = 0, tse = 0;
+    for (int c = 0; c < 3; ++c)
+        for (size_t i = 0; i < plane; ++i) {
+            const double x = finiteOr0(a.data()[c * plane + i]), ref = finiteOr0(r.data()[c * plane + i]);
+            const double d = x - ref;
+            se += d * d;
+            rel += d * d / (ref * ref + 0.01);
+            const double td = double(tonemapForMetrics(float(x))) - tonemapForMetrics(float(ref));
+            tse += td * td;
+        }
+    const double n = 3.0 * double(plane);
+    m.mse = se / n;
+    m.relMse = rel / n;
+    const double tmse = tse / n;
+    m.psnr = tmse > 0 ? 10.0 * std::log10(1.0 / tmse) : 100.0;  // identical images: capped at 100 dB
+    // SSIM (Wang et al. 2004) on tonemapped luminance, dynamic range L = 1.
+    std::vector<double> X(plane), Y(plane), XX(plane), YY(plane), XY(plane);
+    for (size_t i = 0; i < plane; ++i) {
+        const double lx = 0.2126 * tonemapForMetrics(a.data()[i]) + 0.7152 * tonemapForMetrics(a.data()[plane + i]) +
+                          0.0722 * tonemapForMetrics(a.data()[2 * plane + i]);
+        const double ly = 0.2126 * tonemapForMetrics(r.data()[i]) + 0.7152 * tonemapForMetrics(r.data()[plane + i]) +
+                          0.0722 * tonemapForMetrics(r.data()[2 * plane + i]);
+        X[i] = lx;
+        Y[i] = ly;
+        XX[i] = lx * lx;
+        YY[i] = ly * ly;
+        XY[i] = lx * ly;
+    }
+    const auto mx = blur(X, w, h), my = blur(Y, w, h), mxx = blur(XX, w, h), myy = blur(YY, w, h), mxy = blur(XY, w, h);
+    const double c1 = 0.01 * 0.01, c2 = 0.03 * 0.03;
+    double ssim = 0;
+    for (size_t i = 0; i < plane; ++i) {
+        const double sx = mxx[i] - mx[i] * mx[i], sy = myy[i] - my[i] * my[i], sxy = mxy[i] - mx[i] * my[i];
+        ssim += ((2 * mx[i] * my[i] + c1) * (2 * sxy + c2)) / ((mx[i] * mx[i] + my[i] * my[i] + c1) * (sx + sy + c2));
+    }
+    m.ssim = ssim / double(plane);
+    return m;
+}
+
+static Image errorMap(const Image& a, const Image& r, bool relative) {
+    checkPair(a, r);
+    Image out(a.width(), a.height(), 3, Device::Cpu);
+    const size_t plane = a.plane();
+    for (size_t i = 0; i < plane; ++i) {
+        double e = 0;
+        for (int c = 0; c < 3; ++c) {
+            const double x = finiteOr0(a.data()[c * plane + i]), ref = finiteOr0(r.data()[c * plane + i]);
+            const double d2 = (x - ref) * (x - ref);
+            e += relative ? d2 / (ref * ref + 0.01) : d2;
+        }
+        for (int c = 0; c < 3; ++c) out.data()[c * plane + i] = float(e / 3.0);
+    }
+    return out;
+}
+
+Image squaredErrorMap(const Image& a, const Image& r) { return errorMap(a, r, false); }
+Image relativeErrorMap(const Image& a, const Image& r) { return errorMap(a, r, true); }
+
+}  // namespace atrous

@@ -1,0 +1,185 @@
+// Per-pixel passes that prepare the cascade's inputs (shared by CPU and CUDA): non-finite
+// samples, fireflies (ALGORITHMS.md 3a), albedo demodulation, the colour scale of the automatic
+// σ_c, the pixel footprint of the automatic σ_x, and the final recombination.
+#pragma once
+#include "atrous/image.h"
+#include "filters/filter_math.h"
+
+namespace atrous::filters {
+
+// Largest magnitude a feature keeps; squares of differences then stay finite in float.
+constexpr float kFeatureClamp = 1e18f;
+
+// NaN/Inf colour or variance samples are missing data: replaced by the mean of the finite values
+// of the same channel in the 5×5 neighbourhood (0 when there are none), so they never spread.
+struct SanitizeColor {
+    ImageView colorIn, varIn;    // user buffers (varIn may be a constant estimate)
+    ImageView colorOut, varOut;  // c_0, var(c_0)
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        for (int c = 0; c < 3; ++c) {
+            colorOut(x, y, c) = fix(colorIn, x, y, c);
+            varOut(x, y, c) = fix(varIn, x, y, c);
+        }
+    }
+    ATROUS_HOST_DEVICE static float fix(const ImageView& v, int x, int y, int c) {
+        const float a = v(x, y, c);
+        if (finite(a)) return a;
+        float s = 0;
+        int n = 0;
+        for (int dy = -2; dy <= 2; ++dy)
+            for (int dx = -2; dx <= 2; ++dx) {
+                const int xx = x + dx, yy = y + dy;
+                if (xx < 0 || yy < 0 || xx >= v.width || yy >= v.height) continue;
+                const float b = v(xx, yy, c);
+                if (finite(b)) {
+                    s += b;
+                    ++n;
+                }
+            }
+        return n > 0 ? s / float(n) : 0.0f;
+    }
+};
+
+// Copies a feature buffer, mapping non-finite values to 0 and clamping to ±kFeatureClamp.
+struct SanitizeFeature {
+    ImageView in, out;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        for (int c = 0; c < out.channels; ++c) {
+            const float a = in(x, y, c);
+            out(x, y, c) = finite(a) ? fminf(fmaxf(a, -kFeatureClamp), kFeatureClamp) : 0.0f;
+        }
+    }
+};
+
+// Firefly suppression: L(p) above m + k·sqrt(s² + v̄) is scaled down to that bound, where m and s²
+// are the mean and variance of the 3×3 neighbours' luminance without the brightest neighbour (so
+// a two-pixel firefly does not vouch for itself) and v̄ is their mean luminance variance (the
+// noise the renderer reported there). The pixel's own variance is not used: a firefly inflates
+// it. The variance is scaled by the same factor squared.
+struct FireflyClamp {
+    float k = 4.0f;
+    ImageView cIn, vIn, cOut, vOut;
+    ImageView flag;  // 1 channel: 1 where clamped (for the report), may be invalid
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        const int w = cIn.width, h = cIn.height;
+        float l[8], lv[8];
+        int n = 0;
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                if (dx == 0 && dy == 0) continue;
+                const int xx = clampIdx(x + dx, w - 1), yy = clampIdx(y + dy, h - 1);
+                l[n] = lum(cIn(xx, yy, 0), cIn(xx, yy, 1), cIn(xx, yy, 2));
+                lv[n] = lum(lum(1, 0, 0) * vIn(xx, yy, 0), lum(0, 1, 0) * vIn(xx, yy, 1), lum(0, 0, 1) * vIn(xx, yy, 2));
+                ++n;
+            }
+        int imax = 0;
+        for (int i = 1; i < 8; ++i)
+            if (l[i] > l[imax]) imax = i;
+        float m = 0, m2 = 0, vm = 0;
+        for (int i = 0; i < 8; ++i) {
+            if (i == imax) continue;
+            m += l[i];
+            m2 += l[i] * l[i];
+            vm += lv[i];
+        }
+        m /= 7.0f;
+        vm /= 7.0f;
+        const float s2 = fmaxf(m2 / 7.0f - m * m, 0.0f);
+        const float bound = fmaxf(m, 0.0f) + k * sqrtf(s2 + fmaxf(vm, 0.0f));
+        const float L = lum(cIn(x, y, 0), cIn(x, y, 1), cIn(x, y, 2));
+        const bool clamp = L > bound && L > 0.0f;
+        const float scale = clamp ? bound / L : 1.0f;
+        for (int c = 0; c < 3; ++c) {
+            cOut(x, y, c) = cIn(x, y, c) * scale;
+            vOut(x, y, c) = vIn(x, y, c) * scale * scale;
+        }
+        if (flag.valid()) flag(x, y, 0) = clamp ? 1.0f : 0.0f;
+    }
+};
+
+// c / max(albedo, ε), var / max(albedo, ε)² (in place).
+struct Demodulate {
+    float eps;
+    ImageView albedo, color, var;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        for (int c = 0; c < 3; ++c) {
+            const float a = fmaxf(albedo(x, y, c), eps);
+            const float ia = 1.0f / a;
+            color(x, y, c) *= ia;
+            var(x, y, c) *= ia * ia;
+        }
+    }
+};
+
+// Per-pixel colour scale S of the automatic σ_c: k_c² · (3×3 [1 2 1]² / 16 prefilter of the
+// channel-summed variance) — prefiltered because a few-sample variance estimate is itself noisy.
+// With a raw σ_c, S = σ_c²/2 so that S(p) + S(q) = σ_c².
+struct ColorScale {
+    float rawSigma = 0;  // > 0: the paper's constant σ_c
+    float k2 = 1;
+    ImageView var, S;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        if (rawSigma > 0) {
+            S(x, y, 0) = 0.5f * rawSigma * rawSigma;
+            return;
+        }
+        float s = 0;
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const int xx = clampIdx(x + dx, var.width - 1), yy = clampIdx(y + dy, var.height - 1);
+                const float wt = (dx == 0 ? 2.0f : 1.0f) * (dy == 0 ? 2.0f : 1.0f) * (1.0f / 16.0f);
+                s += wt * (var(xx, yy, 0) + var(xx, yy, 1) + var(xx, yy, 2));
+            }
+        S(x, y, 0) = k2 * s;
+    }
+};
+
+// invX = 1/σ_x² per pixel and invZ = 1/z. Automatic σ_x: k_x · F(p), F the world-space size of a
+// pixel at p: per axis the smaller of the forward and backward position differences (the smaller,
+// so a silhouette next to p does not inflate it), then the larger of the two axes (so a surface
+// seen at a grazing angle still passes along its long axis). The tap's pixel offset multiplies
+// σ_x later (eawPositionTapScale).
+struct Footprint {
+    int hasPosition = 0;
+    float rawSigma = 0;  // > 0: constant σ_x
+    float k2 = 1;
+    ImageView position, depth, invX, invZ;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        invZ(x, y, 0) = 1.0f / fmaxf(fabsf(depth(x, y, 0)), 1e-6f);
+        if (!hasPosition) {
+            invX(x, y, 0) = 0.0f;
+            return;
+        }
+        if (rawSigma > 0) {
+            invX(x, y, 0) = 1.0f / (rawSigma * rawSigma);
+            return;
+        }
+        const int w = position.width, h = position.height;
+        const float fx = fminf(dist2(x, y, clampIdx(x + 1, w - 1), y), dist2(x, y, clampIdx(x - 1, w - 1), y));
+        const float fy = fminf(dist2(x, y, x, clampIdx(y + 1, h - 1)), dist2(x, y, x, clampIdx(y - 1, h - 1)));
+        const float f2 = fmaxf(fx, fy);
+        // 1e-20 keeps the inverse finite (1e20) on degenerate footprints (e.g. background).
+        invX(x, y, 0) = 1.0f / (k2 * f2 + 1e-20f);
+    }
+    ATROUS_HOST_DEVICE float dist2(int x0, int y0, int x1, int y1) const {
+        if (x0 == x1 && y0 == y1) return 3.0e38f;  // image border: use the other side only
+        return sq(position(x0, y0, 0) - position(x1, y1, 0)) + sq(position(x0, y0, 1) - position(x1, y1, 1)) +
+               sq(position(x0, y0, 2) - position(x1, y1, 2));
+    }
+};
+
+// out = (c_N + Σ s_i d_i) · max(albedo, ε) (albedo invalid: no remodulation).
+struct Recombine {
+    float eps;
+    ImageView cN, detailSum, albedo, out;  // detailSum may be invalid (EAW)
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        for (int c = 0; c < 3; ++c) {
+            float v = cN(x, y, c);
+            if (detailSum.valid()) v += detailSum(x, y, c);
+            if (albedo.valid()) v *= fmaxf(albedo(x, y, c), eps);
+            out(x, y, c) = v;
+        }
+    }
+};
+
+}  // namespace atrous::filters
