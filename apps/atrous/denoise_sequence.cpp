@@ -52,7 +52,7 @@ void writeAnimatedPreview(const std::string& outDir, int firstIndex, bool quiet)
     // Even dimensions for yuv420p; 24 frames per second.
     std::string cmd = shellQuote(ffmpeg) + " -nostdin -y -loglevel error -framerate 24 -start_number " +
                       std::to_string(firstIndex) + " -i " + shellQuote((fs::path(outDir) / "frame_%04d.png").string()) +
-                      " -vf pad=ceil(iw/2)*2:ceil(ih/2)*2 -pix_fmt yuv420p -f mp4 " + shellQuote(tmpPath);
+                      " -vf " + shellQuote("pad=ceil(iw/2)*2:ceil(ih/2)*2") + " -pix_fmt yuv420p -f mp4 " + shellQuote(tmpPath);
     int rc = std::system(cmd.c_str());
     std::error_code ec;
     if (rc != 0) {

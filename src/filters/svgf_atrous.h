@@ -44,7 +44,6 @@ struct Atrous {
         Vec3 np = readVec3(normal, x, y);
         float gx = depthGrad(x, y, 0), gy = depthGrad(x, y, 1);
         // ε keeps the stop finite where the variance is exactly 0 (then only equal luminance passes).
-        // ε keeps the stop finite where the variance is exactly 0 (then only equal luminance passes).
         float invLumDenom = 1.0f / (sigmaL * sqrtf(maxf(prefilteredVariance(x, y), 0.0f)) + 1e-10f);
 
         Vec3 sumC(0.0f);
