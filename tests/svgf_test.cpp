@@ -585,6 +585,30 @@ TEST(SvgfSequence, DenoiseCommandWritesEveryFrameAndBeatsTheInput) {
         EXPECT_TRUE(std::filesystem::exists(dir / "out/preview.mp4"));
 }
 
+TEST(SvgfSequence, EveryParamHasAFlag) {
+    SvgfParams p;
+    CLI::App app;
+    cli::addSvgfOptions(app, p);
+    const char* argv[] = {"x", "--svgf-sigma-l", "2", "--svgf-sigma-n", "64", "--svgf-sigma-z", "3", "--svgf-alpha", "0.3",
+                          "--svgf-moments-alpha", "0.4", "--svgf-history-cap", "16", "--svgf-levels", "4",
+                          "--svgf-feedback-tap", "1", "--svgf-spatial-variance-frames", "2", "--svgf-depth-tolerance", "5",
+                          "--svgf-normal-cos", "0.5", "--taa", "--taa-alpha", "0.25"};
+    app.parse(int(sizeof(argv) / sizeof(argv[0])), argv);
+    EXPECT_EQ(p.sigmaL, 2.0f);
+    EXPECT_EQ(p.sigmaN, 64.0f);
+    EXPECT_EQ(p.sigmaZ, 3.0f);
+    EXPECT_EQ(p.alpha, 0.3f);
+    EXPECT_EQ(p.momentsAlpha, 0.4f);
+    EXPECT_EQ(p.historyCap, 16);
+    EXPECT_EQ(p.levels, 4);
+    EXPECT_EQ(p.feedbackTap, 1);
+    EXPECT_EQ(p.spatialVarianceFrames, 2);
+    EXPECT_EQ(p.reprojectDepthTolerance, 5.0f);
+    EXPECT_EQ(p.reprojectNormalCos, 0.5f);
+    EXPECT_TRUE(p.taa);
+    EXPECT_EQ(p.taaAlpha, 0.25f);
+}
+
 TEST(SvgfSequence, PerFrameEawAlsoRuns) {
     test::TempDir dir;
     SceneOptions o;

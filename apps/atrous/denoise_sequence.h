@@ -2,6 +2,8 @@
 // sequence directory (layout in src/io/sequence.h and docs/svgf.md). SVGF carries its history from
 // frame to frame; EAW and SURE denoise each frame on its own through atrous::denoise().
 #pragma once
+#include <CLI/CLI.hpp>
+
 #include <string>
 
 #include "atrous/denoise.h"
@@ -28,6 +30,13 @@ struct SequenceDenoiseArgs {
 // Prints one line per frame (time, and MSE against reference.exr when the frame has one).
 // Throws InputError for bad input (the CLI turns it into exit code 2). Returns 0.
 int runSequenceDenoise(const SequenceDenoiseArgs& args);
+
+// Registers one flag per SvgfParams field on `cmd` (--svgf-sigma-l, --svgf-sigma-n, --svgf-sigma-z,
+// --svgf-alpha, --svgf-moments-alpha, --svgf-history-cap, --svgf-levels, --svgf-feedback-tap,
+// --svgf-spatial-variance-frames, --svgf-depth-tolerance, --svgf-normal-cos, --taa, --taa-alpha),
+// writing into `params`; the defaults shown are the struct's. Ranges are checked later by
+// validateSvgfParams (InputError naming the field).
+void addSvgfOptions(CLI::App& cmd, SvgfParams& params);
 
 // Full path of an executable named `name` on PATH, or "" when there is none.
 std::string findOnPath(const std::string& name);
