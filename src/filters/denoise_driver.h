@@ -15,7 +15,7 @@ namespace atrous::filters {
 
 constexpr int kMaxLevels = 10;
 // Exponent added per unit squared id difference: ids are integers, so a differing id gives a
-// weight below e^-87 (the clamp of expNeg), i.e. 0 for all purposes.
+// weight of exactly 0 (expNeg returns 0 below -80).
 constexpr float kIdPenalty = 1e4f;
 
 struct DriverInputs {

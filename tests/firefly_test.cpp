@@ -1,0 +1,114 @@
+// Firefly suppression (ALGORITHMS.md 3a) and non-finite samples: fireflies are brought down to
+// the local bound, ordinary noise is left alone, NaN/Inf never reach the output.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "atrous/denoise.h"
+#include "denoise_test_util.h"
+
+using namespace atrous;
+using namespace atrous::test;
+
+namespace {
+
+// Flat grey 0.5 with Gaussian noise σ = 0.05 and a matching variance buffer (σ² per channel).
+struct Flat {
+    Image color, var;
+    Flat(int w, int h, unsigned seed) : color(w, h, 3), var(w, h, 3) {
+        std::mt19937 rng(seed);
+        std::normal_distribution<float> g(0.0f, 0.05f);
+        for (size_t i = 0; i < color.size(); ++i) color.data()[i] = 0.5f + g(rng);
+        var.fill(0.05f * 0.05f);
+    }
+    DenoiseInputs inputs() const {
+        DenoiseInputs in;
+        in.color = &color;
+        in.variance = &var;
+        return in;
+    }
+};
+
+}  // namespace
+
+TEST(Firefly, ClampsAnOutlierAndLeavesNoiseAlone) {
+    Flat f(64, 64, 1);
+    for (int c = 0; c < 3; ++c) f.color(30, 20, c) = 500.0f;  // one firefly
+    DenoiseReport rep;
+    DenoiseOptions o;
+    o.method = DenoiseMethod::Eaw;
+    o.report = &rep;
+    Image out = denoise(f.inputs(), o);
+    // Gaussian noise exceeds 4 local σ with probability ~3e-5 per pixel: of 4096 pixels, the
+    // firefly plus at most a handful.
+    EXPECT_GE(rep.firefliesClamped, 1);
+    EXPECT_LE(rep.firefliesClamped, 5);
+    // The firefly's energy is removed: without suppression it would add 500·1/4096 = 0.12 to the
+    // mean luminance; with it the mean stays within 0.005 of 0.5.
+    EXPECT_NEAR(rep.meanLuminanceAfterFirefly, 0.5, 0.005);
+    EXPECT_GT(rep.meanLuminanceIn, 0.6);
+    // And the output around it is not a blotch: every pixel within 0.2 of the flat level.
+    for (size_t i = 0; i < out.size(); ++i) ASSERT_NEAR(out.data()[i], 0.5f, 0.2f);
+    // Without suppression the blotch is there.
+    o.firefly.enabled = false;
+    Image raw = denoise(f.inputs(), o);
+    EXPECT_GT(raw(30, 20, 0), 2.0f);
+}
+
+TEST(Firefly, ParametersChangeTheOutput) {
+    Flat f(48, 48, 2);
+    for (int c = 0; c < 3; ++c) f.color(10, 10, c) = 50.0f;
+    DenoiseOptions base;
+    const Image ref = denoise(f.inputs(), base);
+    DenoiseOptions off = base;
+    off.firefly.enabled = false;
+    EXPECT_GT(maxAbsDiff(denoise(f.inputs(), off), ref), 1e-3);
+    DenoiseOptions k = base;
+    k.firefly.k = 1.0f;  // clamps ordinary noise too
+    EXPECT_GT(maxAbsDiff(denoise(f.inputs(), k), ref), 1e-4);
+}
+
+TEST(Firefly, TwoPixelClusterIsClamped) {
+    // The brightest neighbour is left out of the local statistics, so a firefly next to another
+    // one does not vouch for it.
+    Flat f(32, 32, 3);
+    for (int c = 0; c < 3; ++c) {
+        f.color(10, 10, c) = 200.0f;
+        f.color(11, 10, c) = 150.0f;
+    }
+    DenoiseReport rep;
+    DenoiseOptions o;
+    o.report = &rep;
+    denoise(f.inputs(), o);
+    EXPECT_NEAR(rep.meanLuminanceAfterFirefly, 0.5, 0.01);
+}
+
+TEST(NonFinite, NanAndInfNeverSpread) {
+    SyntheticScene s = makeScene(40, 40, 0.3f, 4);
+    s.noisy(5, 5, 0) = NAN;
+    s.noisy(20, 20, 1) = INFINITY;
+    s.noisy(21, 20, 2) = -INFINITY;
+    for (int x = 30; x < 40; ++x)
+        for (int c = 0; c < 3; ++c) s.noisy(x, 39, c) = NAN;  // a run of missing pixels at the edge
+    s.variance(7, 7, 0) = NAN;
+    s.normal(8, 8, 0) = NAN;
+    s.position(9, 9, 2) = INFINITY;
+    s.depth(3, 3, 0) = INFINITY;
+    for (auto m : {DenoiseMethod::Eaw, DenoiseMethod::Sure}) {
+        for (bool estimate : {false, true}) {
+            DenoiseInputs in = s.inputs();
+            if (estimate) in.variance = nullptr;
+            DenoiseReport rep;
+            DenoiseOptions o;
+            o.method = m;
+            o.report = &rep;
+            Image out = denoise(in, o);
+            EXPECT_TRUE(allFinite(out)) << denoiseMethodName(m);
+            EXPECT_EQ(rep.nonFinitePixels, 13);
+            // Missing pixels are filled from their neighbourhood: close to the truth there.
+            EXPECT_NEAR(out(5, 5, 0), s.truth(5, 5, 0), 0.3f);
+            EXPECT_NEAR(out(20, 20, 1), s.truth(20, 20, 1), 0.3f);
+        }
+    }
+}
