@@ -87,9 +87,14 @@ def load_oidn() -> Tuple[Optional[Callable], str]:
 
 def _atrous_method(name: str) -> Callable:
     def run(b: Dict[str, np.ndarray]) -> np.ndarray:
+        # At 1 spp the renderer cannot estimate a variance and writes zeros; a zero variance
+        # would tell the filters the input is clean, so they estimate the noise themselves.
+        var = b.get("variance")
+        if var is not None and not np.any(var > 0):
+            var = None
         return atrous.denoise(b["color"], albedo=b.get("albedo"), normal=b.get("normal"),
                               position=b.get("position"), depth=b.get("depth"),
-                              variance=b.get("variance"), ids=b.get("ids"), method=name)
+                              variance=var, ids=b.get("ids"), method=name)
     return run
 
 
@@ -264,8 +269,9 @@ def run_eval(cfg: EvalConfig) -> Dict[str, Any]:
         if not seq_dir:
             seq_dir = str(out / "static_sequence")
             _log(f"writing a {cfg.static_sequence}-frame static-camera sequence of {cfg.sequence_scene} to {seq_dir}")
+            seq_ref = renders.get(cfg.sequence_scene, w, h, cfg.ref_spp, cfg.ref_seed)[0]["color"]
             seq.write_static_sequence(seq_dir, cfg.sequence_scene, cfg.static_sequence, w, h,
-                                      ref_spp=cfg.ref_spp, seed=cfg.seed)
+                                      ref_spp=cfg.ref_spp, seed=cfg.seed, reference=seq_ref)
         sequence = seq.evaluate_sequence(seq_dir, methods, log=_log)
         if not cfg.sequence:
             sequence["note"] = (f"synthesised by --static-sequence: scene {cfg.sequence_scene}, static camera "

@@ -52,12 +52,14 @@ def load_frame(frame_dir: Path) -> Dict[str, np.ndarray]:
 
 
 def write_static_sequence(seq_dir: str, scene: str, frames: int, width: int, height: int,
-                          ref_spp: int = 256, seed: int = 1) -> None:
+                          ref_spp: int = 256, seed: int = 1, reference: Optional[np.ndarray] = None) -> None:
     """A static-camera sequence from the renderer: `frames` 1-spp frames with their own seeds,
-    motion 0, one shared reference (ref_spp samples, another seed) in every frame."""
+    motion 0, one shared reference (ref_spp samples, another seed, or `reference`) in every frame."""
     d = Path(seq_dir)
     d.mkdir(parents=True, exist_ok=True)
-    ref = atrous.render(scene, width=width, height=height, spp=ref_spp, seed=1000003)["color"]
+    ref = reference
+    if ref is None:
+        ref = atrous.render(scene, width=width, height=height, spp=ref_spp, seed=1000003)["color"]
     for i in range(frames):
         b = atrous.render(scene, width=width, height=height, spp=1, seed=seed + 7919 * i)
         f = d / f"frame_{i:04d}"
