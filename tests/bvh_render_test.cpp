@@ -64,10 +64,13 @@ Diff compare(const RenderBuffers& a, const RenderBuffers& b) {
 
 }  // namespace
 
-// Every built-in scene: the BVH renderer agrees with the Embree renderer.
+// Every built-in scene and the example JSON scene (OBJ mesh): the BVH renderer agrees with the
+// Embree renderer.
 TEST(BvhRender, MatchesEmbreeRendererOnBuiltinScenes) {
-    for (const std::string& name : builtinSceneNames()) {
-        Scene scene = Scene::builtin(name);
+    std::vector<std::string> names = builtinSceneNames();
+    names.push_back(std::string(ATROUS_SOURCE_DIR) + "/scenes/example.json");
+    for (const std::string& name : names) {
+        Scene scene = Scene::loadByNameOrFile(name);
         RenderSettings s = small(48, 36, 16);
         RenderBuffers embree = render(scene, s);
         RenderBuffers bvh = renderBvhCpu(scene, s);

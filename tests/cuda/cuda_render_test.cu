@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "atrous/device.h"
 #include "atrous/render.h"
@@ -30,8 +31,10 @@ RenderSettings small(int w, int h, int spp) {
 
 TEST(CudaRender, MatchesCpuWithinNoiseOnBuiltinScenes) {
     if (!cudaAvailable()) GTEST_SKIP() << "no CUDA device";
-    for (const std::string& name : builtinSceneNames()) {
-        Scene scene = Scene::builtin(name);
+    std::vector<std::string> names = builtinSceneNames();
+    names.push_back(std::string(ATROUS_SOURCE_DIR) + "/scenes/example.json");  // OBJ mesh, textures
+    for (const std::string& name : names) {
+        Scene scene = Scene::loadByNameOrFile(name);
         RenderSettings s = small(64, 48, 32);
         RenderBuffers cpu = renderBvhCpu(scene, s);
         RenderBuffers gpu = renderBvhCuda(scene, s);
