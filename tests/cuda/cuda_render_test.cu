@@ -32,7 +32,7 @@ RenderSettings small(int w, int h, int spp) {
 TEST(CudaRender, MatchesCpuWithinNoiseOnBuiltinScenes) {
     if (!cudaAvailable()) GTEST_SKIP() << "no CUDA device";
     std::vector<std::string> names = builtinSceneNames();
-    names.push_back(std::string(ATROUS_SOURCE_DIR) + "/scenes/example.json");  // OBJ mesh, textures
+    names.push_back(std::string(ATROUS_SOURCE_DIR) + "/scenes/example.json");  // OBJ mesh
     for (const std::string& name : names) {
         Scene scene = Scene::loadByNameOrFile(name);
         RenderSettings s = small(64, 48, 32);
