@@ -6,7 +6,7 @@ cd "$(dirname "$0")/.."
 
 PKGS=(build-essential cmake pkg-config
       libembree-dev libtbb-dev libopenexr-dev libcli11-dev libtinyobjloader-dev libstb-dev
-      nlohmann-json3-dev libgtest-dev libbenchmark-dev)
+      nlohmann-json3-dev libgtest-dev libbenchmark-dev libglfw3-dev libimgui-dev xvfb ffmpeg)
 
 missing=()
 for p in "${PKGS[@]}"; do

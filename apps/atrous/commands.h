@@ -10,5 +10,6 @@ void addRenderCommand(CLI::App& app);
 void addDenoiseCommand(CLI::App& app);
 void addCompareCommand(CLI::App& app);
 void addBenchCommand(CLI::App& app);
+void addViewCommand(CLI::App& app);
 
 }  // namespace atrous::cli

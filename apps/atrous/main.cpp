@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
     atrous::cli::addDenoiseCommand(app);
     atrous::cli::addCompareCommand(app);
     atrous::cli::addBenchCommand(app);
+    atrous::cli::addViewCommand(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,164 @@
+// The viewer's frame pipeline without any windowing: progressive path tracing with a movable
+// camera, accumulation of the buffers over frames, screen-space motion vectors for SVGF, the
+// denoisers of the two comparison slots, and the debug buffers (per-level detail, SURE's s_i).
+// Kept apart from the GLFW/ImGui code so its logic reads (and could be tested) on its own.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "atrous/denoise.h"
+#include "atrous/image.h"
+#include "atrous/render.h"
+#include "atrous/svgf.h"
+#include "render/bvh_build.h"
+#include "render/scene_data.h"
+
+namespace atrous::view {
+
+enum class Method { None = 0, Eaw = 1, Sure = 2, Svgf = 3 };
+const char* methodName(Method m);
+Method parseMethod(const std::string& name);  // none | eaw | sure | svgf; InputError otherwise
+
+// Everything the user can change between frames.
+struct PipelineSettings {
+    int sppPerFrame = 1;
+    bool accumulate = true;  // EAW/SURE/none filter the running mean over frames
+    int maxDepth = 8;
+    Method methodA = Method::Eaw;
+    Method methodB = Method::None;
+    bool split = false;  // compute slot B too (split-screen comparison)
+    // Shared by EAW and SURE (SURE runs on the EAW cascade).
+    EawParams eaw;
+    SureParams sure;
+    FireflyParams firefly;
+    bool demodulate = true;
+    float albedoEpsilon = 1e-3f;
+    SvgfParams svgf;
+    // SVGF on camera motion: true = feed reprojection motion vectors computed from the depth buffer
+    // and the previous camera (history survives the move); false = reset the history instead.
+    bool svgfMotionVectors = true;
+    // Debug buffers, computed only when asked for (they cost extra filter runs).
+    int detailLevel = -1;  // >= 0: compute d_i for this level
+    bool sureFractions = false;  // capture SURE's s_i(p) (CPU only)
+};
+
+// Milliseconds spent in each stage of the last step().
+struct StageTimes {
+    double render = 0, accumulate = 0, motion = 0, denoiseA = 0, denoiseB = 0, debug = 0;
+};
+
+// One slot's result.
+struct SlotResult {
+    Method method = Method::None;
+    Image image;          // 3-channel linear HDR (the noisy input for Method::None)
+    std::string error;    // non-empty when the filter refused its parameters (image = input then)
+    double filterMs = 0;  // as the denoiser reported it (EAW/SURE) or measured (SVGF)
+};
+
+class ViewPipeline {
+public:
+    // `device` Cpu renders with the shared BVH traversal on TBB threads (camera freely movable);
+    // Cuda renders with renderBvhCuda (scene camera only; see docs/viewer.md).
+    ViewPipeline(const Scene& scene, int width, int height, Device device, uint32_t seed);
+    ~ViewPipeline();
+
+    int width() const { return mWidth; }
+    int height() const { return mHeight; }
+    Device device() const { return mDevice; }
+    bool cameraMovable() const { return mDevice == Device::Cpu; }
+    const pt::Camera& camera() const { return mCamera; }
+    const pt::Camera& sceneCamera() const { return mSceneCamera; }
+    // World-space bounds of the scene (for the orbit pivot and movement speed).
+    Vec3 sceneCenter() const { return mSceneCenter; }
+    float sceneRadius() const { return mSceneRadius; }
+
+    // Moves the camera: accumulation restarts; SVGF gets motion vectors (or a reset).
+    void setCamera(const pt::Camera& c);
+    // Drops the accumulated frames (and SVGF histories).
+    void resetAccumulation();
+
+    // Renders one frame, accumulates it and runs the slots' filters. Throws InputError only for
+    // settings the renderer rejects; filter parameter errors land in SlotResult::error.
+    void step(const PipelineSettings& s);
+
+    int framesAccumulated() const { return mFrames; }
+    int samplesPerPixel() const { return mFrames * mSppAccumulated; }
+    const StageTimes& times() const { return mTimes; }
+
+    // The buffers the filters saw in the last step (accumulated ones when accumulating).
+    const Image& color() const { return mColor; }
+    const Image& variance() const { return mVariance; }
+    bool varianceValid() const { return mVarianceValid; }  // false at 1 sample per pixel
+    const Image& albedo() const { return mAlbedo; }
+    const Image& normal() const { return mNormal; }
+    const Image& position() const { return mPosition; }
+    const Image& depth() const { return mDepth; }
+    const Image& ids() const { return mIds; }
+    const Image& motion() const { return mMotion; }  // x = dx, y = dy (previous - current), pixels
+    const SlotResult& slot(int i) const { return mSlots[i]; }
+    // d_i = (EAW with i levels) - (EAW with i + 1 levels), remodulated by the albedo; empty
+    // unless PipelineSettings::detailLevel asked for it.
+    const Image& detail() const { return mDetail; }
+    int detailLevel() const { return mDetailLevelShown; }
+    // SURE's s_i(p), one channel per level; empty unless asked for and a slot runs SURE on the CPU.
+    const Image& sureFractions() const { return mSureS; }
+
+    // Writes every buffer (EXR, linear) into `dir` (created when missing); returns the file names.
+    std::vector<std::string> saveBuffers(const std::string& dir) const;
+
+private:
+    void renderFrame(const PipelineSettings& s);
+    void accumulateFrame(bool accumulate);
+    void computeMotion();
+    void computeEmission();
+    void runSlot(int i, Method m, const PipelineSettings& s);
+    DenoiseOptions denoiseOptions(Method m, const PipelineSettings& s) const;
+
+    Scene mScene;
+    int mWidth, mHeight;
+    Device mDevice;
+    uint32_t mSeed;
+    pt::Camera mSceneCamera, mCamera, mPrevCamera;
+    bool mCameraMoved = false;
+    Vec3 mSceneCenter;
+    float mSceneRadius = 1.0f;
+    std::unique_ptr<BvhData> mBvh;  // CPU rendering
+    uint64_t mFrameIndex = 0;       // seeds: every frame draws fresh samples
+
+    RenderBuffers mFrame;  // this frame's render
+    // Running sums (double: thousands of frames without cancellation trouble).
+    std::vector<double> mSumX, mSumX2, mSumM2, mSumAlbedo, mSumNormal, mSumPosition, mSumDepth;
+    std::vector<int> mFeatureHits, mDepthHits;
+    int mFrames = 0, mSppAccumulated = 0;
+    bool mAccumulating = false;
+
+    Image mColor, mVariance, mAlbedo, mNormal, mPosition, mDepth, mIds, mMotion, mEmission;
+    bool mVarianceValid = false;
+    SlotResult mSlots[2];
+    std::unique_ptr<SvgfDenoiser> mSvgf[2];
+    SvgfParams mSvgfParams[2];
+    bool mSvgfResetPending = false;
+    Image mDetail, mSureS;
+    int mDetailLevelShown = -1;
+    StageTimes mTimes;
+};
+
+// A pinhole camera that orbits a pivot: yaw about world +y, pitch about the camera's right axis.
+struct OrbitCamera {
+    Vec3 target;
+    float distance = 1.0f;
+    float yaw = 0.0f, pitch = 0.0f;  // radians
+    float tanHalfFov = 0.4f;
+
+    // Starts from `c`, orbiting the point `pivotDistance` in front of it.
+    static OrbitCamera fromCamera(const pt::Camera& c, float pivotDistance);
+    pt::Camera camera() const;
+    void orbit(float dYaw, float dPitch);
+    // Moves target and eye together along the camera's right/up/forward axes (world units).
+    void pan(const pt::Camera& c, float right, float up, float forward);
+    void zoom(float factor);  // distance *= factor
+};
+
+}  // namespace atrous::view

@@ -1,0 +1,23 @@
+# The interactive viewer (`atrous view`), included from the top-level CMakeLists.txt after the
+# `atrous` executable is defined. Built only when GLFW, OpenGL and imgui (with its GLFW and
+# OpenGL 3 backends, as Debian's libimgui-dev ships them) are found; otherwise `atrous view`
+# exists and says how to get it.
+option(ATROUS_BUILD_VIEWER "Build the interactive viewer when GLFW, OpenGL and imgui are found" ON)
+set(ATROUS_HAVE_VIEWER OFF)
+if(ATROUS_BUILD_VIEWER)
+  find_package(glfw3 QUIET)
+  set(OpenGL_GL_PREFERENCE GLVND)
+  find_package(OpenGL QUIET)
+  pkg_check_modules(IMGUI QUIET IMPORTED_TARGET imgui)
+  if(glfw3_FOUND AND OpenGL_FOUND AND IMGUI_FOUND)
+    set(ATROUS_HAVE_VIEWER ON)
+  endif()
+endif()
+message(STATUS "atrous: viewer ${ATROUS_HAVE_VIEWER}")
+if(ATROUS_HAVE_VIEWER)
+  file(GLOB ATROUS_VIEW_SOURCES CONFIGURE_DEPENDS ${CMAKE_CURRENT_LIST_DIR}/*.cpp)
+  target_sources(atrous PRIVATE ${ATROUS_VIEW_SOURCES})
+  target_include_directories(atrous PRIVATE ${CMAKE_CURRENT_LIST_DIR}/..)
+  target_compile_definitions(atrous PRIVATE ATROUS_HAVE_VIEWER=1)
+  target_link_libraries(atrous PRIVATE PkgConfig::IMGUI glfw OpenGL::GL ${CMAKE_DL_LIBS})
+endif()

@@ -1,0 +1,686 @@
+// `atrous view`: GLFW window + OpenGL 3.3 core + Dear ImGui over the frame pipeline
+// (view_pipeline.h). The image is tonemapped on the host and uploaded with glTexSubImage2D; ImGui
+// draws it as a textured quad, so the viewer needs only GL 1.1 entry points of its own (ImGui's
+// OpenGL 3 backend loads the rest).
+#include "view/viewer.h"
+
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "atrous/device.h"
+#include "atrous/error.h"
+#include "atrous/render.h"
+#include "core/timer.h"
+#include "io/image_io.h"
+#include "view/view_pipeline.h"
+
+namespace atrous::view {
+namespace {
+
+constexpr float kPanelWidth = 360.0f;
+
+enum class BufferView {
+    Result, Noisy, Variance, Albedo, Normal, Position, Depth, MeshIds, MaterialIds, Motion, Detail, SureFractions
+};
+const char* const kViewNames[] = {"result (denoised)", "color (noisy input)", "variance (std dev)", "albedo",
+                                  "normal", "position", "depth", "mesh ids", "material ids",
+                                  "motion vectors (SVGF)", "detail d_i (per level)", "SURE fractions s_i"};
+const char* const kViewFlags[] = {"result", "color", "variance", "albedo", "normal", "position", "depth",
+                                  "mesh-ids", "material-ids", "motion", "detail", "sure-s"};
+constexpr int kViewCount = int(sizeof(kViewNames) / sizeof(kViewNames[0]));
+const char* const kMethodNames[] = {"none", "eaw", "sure", "svgf"};
+
+BufferView parseBufferView(const std::string& s) {
+    for (int i = 0; i < kViewCount; ++i)
+        if (s == kViewFlags[i]) return BufferView(i);
+    std::string all;
+    for (int i = 0; i < kViewCount; ++i) all += std::string(i ? ", " : "") + kViewFlags[i];
+    throw InputError("--buffer: unknown view \"" + s + "\" (expected one of " + all + ")");
+}
+
+// ---- host tonemapping into RGBA8 ----
+
+struct SrgbLut {
+    unsigned char enc[4096];  // linear [0,1] -> 8-bit sRGB
+    float dec[256];           // 8-bit sRGB -> linear
+    SrgbLut() {
+        for (int i = 0; i < 4096; ++i) {
+            const float v = float(i) / 4095.0f;
+            const float s = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+            enc[i] = (unsigned char)std::lround(std::clamp(s, 0.0f, 1.0f) * 255.0f);
+        }
+        for (int i = 0; i < 256; ++i) {
+            const float s = float(i) / 255.0f;
+            dec[i] = s <= 0.04045f ? s / 12.92f : std::pow((s + 0.055f) / 1.055f, 2.4f);
+        }
+    }
+    unsigned char operator()(float v) const {
+        if (!(v > 0.0f)) return 0;  // also NaN
+        if (v >= 1.0f) return 255;
+        return enc[int(v * 4095.0f + 0.5f)];
+    }
+};
+const SrgbLut& lut() {
+    static const SrgbLut l;
+    return l;
+}
+
+// 99th percentile of f over the pixels (robust display scale), at least `floor`.
+template <class F>
+float percentile99(size_t n, F f, float floor) {
+    std::vector<float> v;
+    v.reserve(n);
+    for (size_t i = 0; i < n; ++i) {
+        const float x = f(i);
+        if (std::isfinite(x)) v.push_back(x);
+    }
+    if (v.empty()) return floor;
+    const size_t k = std::min(v.size() - 1, size_t(0.99 * double(v.size())));
+    std::nth_element(v.begin(), v.begin() + k, v.end());
+    return std::max(v[k], floor);
+}
+
+void idColor(float id, unsigned char* px) {
+    if (!(id >= 0.0f)) {
+        px[0] = px[1] = px[2] = 0;
+        return;
+    }
+    uint32_t h = uint32_t(id) * 2654435761u + 0x9E3779B9u;
+    h ^= h >> 15;
+    h *= 0x85EBCA6Bu;
+    h ^= h >> 13;
+    px[0] = (unsigned char)(64 + (h & 0xBF));
+    px[1] = (unsigned char)(64 + ((h >> 8) & 0xBF));
+    px[2] = (unsigned char)(64 + ((h >> 16) & 0xBF));
+}
+
+// Writes columns [x0, x1) of the display image for `view`. Returns a note for the UI when the view
+// has nothing to show.
+std::string tonemap(const ViewPipeline& pl, BufferView view, const Image* result, float exposure, int level, int x0,
+                    int x1, std::vector<unsigned char>& rgba) {
+    const int w = pl.width(), h = pl.height();
+    const size_t plane = size_t(w) * h;
+    const SrgbLut& L = lut();
+    auto px = [&](int x, int y) { return &rgba[(size_t(y) * w + x) * 4]; };
+    auto fill = [&](auto f) {
+        for (int y = 0; y < h; ++y)
+            for (int x = x0; x < x1; ++x) {
+                unsigned char* p = px(x, y);
+                f(size_t(y) * w + x, p);
+                p[3] = 255;
+            }
+    };
+    auto srgb3 = [&](const Image& img, float scale) {
+        const float* d = img.data();
+        fill([&](size_t i, unsigned char* p) {
+            for (int c = 0; c < 3; ++c) p[c] = L(d[c * plane + i] * scale);
+        });
+    };
+    auto lin3 = [&](const Image& img, float offset, float scale) {  // linear mapping, no sRGB curve
+        const float* d = img.data();
+        fill([&](size_t i, unsigned char* p) {
+            for (int c = 0; c < 3; ++c) {
+                const float v = (d[c * plane + i] - offset) * scale;
+                p[c] = std::isfinite(v) ? (unsigned char)std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f) : 0;
+            }
+        });
+    };
+    auto blank = [&](const std::string& why) {
+        fill([&](size_t, unsigned char* p) { p[0] = p[1] = p[2] = 24; });
+        return why;
+    };
+    switch (view) {
+        case BufferView::Result:
+            if (!result || result->empty()) return blank("no result yet");
+            srgb3(*result, exposure);
+            return "";
+        case BufferView::Noisy: srgb3(pl.color(), exposure); return "";
+        case BufferView::Variance: {
+            if (!pl.varianceValid()) return blank("variance: unknown at 1 sample per pixel (accumulate more frames)");
+            const float* v = pl.variance().data();
+            const float s = percentile99(plane, [&](size_t i) { return std::sqrt(std::max(0.0f, v[i] + v[plane + i] + v[2 * plane + i])); }, 1e-12f);
+            fill([&](size_t i, unsigned char* p) {
+                for (int c = 0; c < 3; ++c) p[c] = L(std::sqrt(std::max(0.0f, v[c * plane + i])) / s);
+            });
+            return "";
+        }
+        case BufferView::Albedo: srgb3(pl.albedo(), 1.0f); return "";
+        case BufferView::Normal: lin3(pl.normal(), -1.0f, 0.5f); return "";
+        case BufferView::Position: {
+            const float* d = pl.position().data();
+            const float* n = pl.normal().data();
+            float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
+            for (size_t i = 0; i < plane; ++i)
+                if (n[i] != 0 || n[plane + i] != 0 || n[2 * plane + i] != 0)
+                    for (int c = 0; c < 3; ++c) {
+                        lo[c] = std::min(lo[c], d[c * plane + i]);
+                        hi[c] = std::max(hi[c], d[c * plane + i]);
+                    }
+            fill([&](size_t i, unsigned char* p) {
+                for (int c = 0; c < 3; ++c) {
+                    const float r = hi[c] > lo[c] ? (d[c * plane + i] - lo[c]) / (hi[c] - lo[c]) : 0.0f;
+                    p[c] = (unsigned char)std::lround(std::clamp(r, 0.0f, 1.0f) * 255.0f);
+                }
+            });
+            return "";
+        }
+        case BufferView::Depth: {
+            const float* d = pl.depth().data();
+            float lo = 1e30f, hi = 0.0f;
+            for (size_t i = 0; i < plane; ++i)
+                if (d[i] < 0.1f * kBackgroundDepth) {
+                    lo = std::min(lo, d[i]);
+                    hi = std::max(hi, d[i]);
+                }
+            fill([&](size_t i, unsigned char* p) {
+                const bool bg = !(d[i] < 0.1f * kBackgroundDepth);
+                const float r = bg ? 0.0f : (hi > lo ? 1.0f - 0.85f * (d[i] - lo) / (hi - lo) : 1.0f);
+                p[0] = p[1] = p[2] = (unsigned char)std::lround(r * 255.0f);
+            });
+            return "";
+        }
+        case BufferView::MeshIds:
+        case BufferView::MaterialIds: {
+            const float* d = pl.ids().data() + (view == BufferView::MaterialIds ? plane : 0);
+            fill([&](size_t i, unsigned char* p) { idColor(d[i], p); });
+            return "";
+        }
+        case BufferView::Motion: {
+            const float* m = pl.motion().data();
+            const float s = percentile99(plane, [&](size_t i) { return std::max(std::fabs(m[i]), std::fabs(m[plane + i])); }, 0.5f);
+            fill([&](size_t i, unsigned char* p) {
+                if (!std::isfinite(m[i]) || !std::isfinite(m[plane + i])) {
+                    p[0] = 255, p[1] = 0, p[2] = 255;  // no history
+                    return;
+                }
+                p[0] = (unsigned char)std::lround(std::clamp(0.5f + 0.5f * m[i] / s, 0.0f, 1.0f) * 255.0f);
+                p[1] = (unsigned char)std::lround(std::clamp(0.5f + 0.5f * m[plane + i] / s, 0.0f, 1.0f) * 255.0f);
+                p[2] = 128;
+            });
+            return "";
+        }
+        case BufferView::Detail: {
+            if (pl.detail().empty()) return blank("detail: choose a level below the EAW level count");
+            const float* d = pl.detail().data();
+            const float s = percentile99(plane, [&](size_t i) { return std::fabs(d[i]) + std::fabs(d[plane + i]) + std::fabs(d[2 * plane + i]); }, 1e-12f);
+            fill([&](size_t i, unsigned char* p) {  // signed: mid grey = 0
+                for (int c = 0; c < 3; ++c)
+                    p[c] = (unsigned char)std::lround(std::clamp(0.5f + 0.5f * d[c * plane + i] / s, 0.0f, 1.0f) * 255.0f);
+            });
+            return "";
+        }
+        case BufferView::SureFractions: {
+            const Image& s = pl.sureFractions();
+            if (s.empty() || level >= s.channels()) return blank("SURE fractions: pick SURE as a method (CPU only)");
+            const float* d = s.data() + size_t(level) * plane;
+            fill([&](size_t i, unsigned char* p) {
+                p[0] = p[1] = p[2] = (unsigned char)std::lround(std::clamp(d[i], 0.0f, 1.0f) * 255.0f);
+            });
+            return "";
+        }
+    }
+    return "";
+}
+
+// ---- window framebuffer -> PNG ----
+
+void saveFramebuffer(const std::string& path, int fbw, int fbh) {
+    std::vector<unsigned char> px(size_t(fbw) * fbh * 4);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadBuffer(GL_BACK);
+    glReadPixels(0, 0, fbw, fbh, GL_RGBA, GL_UNSIGNED_BYTE, px.data());
+    // writePng encodes linear -> sRGB; decode the 8-bit sRGB values first (the round trip is exact
+    // at 8 bits) so the saved file is the framebuffer.
+    Image img(fbw, fbh, 3);
+    const SrgbLut& L = lut();
+    for (int y = 0; y < fbh; ++y)
+        for (int x = 0; x < fbw; ++x) {
+            const unsigned char* p = &px[(size_t(fbh - 1 - y) * fbw + x) * 4];  // GL rows are bottom-up
+            for (int c = 0; c < 3; ++c) img(x, y, c) = L.dec[p[c]];
+        }
+    io::writePng(path, img, 1.0f);
+}
+
+std::string glfwErrorText;
+void glfwErrorCallback(int code, const char* description) {
+    glfwErrorText = std::string(description ? description : "unknown") + " (GLFW error " + std::to_string(code) + ")";
+}
+
+struct GlfwSession {
+    GLFWwindow* window = nullptr;
+    bool imgui = false;
+    GLuint texture = 0;
+    ~GlfwSession() {
+        if (texture) glDeleteTextures(1, &texture);
+        if (imgui) {
+            ImGui_ImplOpenGL3_Shutdown();
+            ImGui_ImplGlfw_Shutdown();
+            ImGui::DestroyContext();
+        }
+        if (window) glfwDestroyWindow(window);
+        glfwTerminate();
+    }
+};
+
+struct Json {
+    std::ostringstream s;
+    bool first = true;
+    void key(const char* k) {
+        s << (first ? "" : ", ") << '"' << k << "\": ";
+        first = false;
+    }
+    void num(const char* k, double v) {
+        key(k);
+        s << v;
+    }
+    void str(const char* k, const std::string& v) {
+        key(k);
+        s << '"' << v << '"';
+    }
+};
+
+bool comboMethod(const char* label, Method& m) {
+    int i = int(m);
+    const bool changed = ImGui::Combo(label, &i, kMethodNames, 4);
+    m = Method(i);
+    return changed;
+}
+
+}  // namespace
+
+void runViewer(const ViewerOptions& opt) {
+    // Everything that can be checked before a window opens is checked first.
+    const Device device = parseDevice(opt.device);  // "cuda" without a GPU: InputError
+    PipelineSettings ps;
+    ps.methodA = parseMethod(opt.method);
+    ps.split = !opt.compare.empty();
+    if (ps.split) ps.methodB = parseMethod(opt.compare);
+    ps.sppPerFrame = opt.spp;
+    ps.maxDepth = opt.maxDepth;
+    ps.accumulate = !opt.noAccumulate;
+    BufferView view = parseBufferView(opt.bufferView);
+    if (opt.frames < 0) throw InputError("--frames: must be 0 (interactive) or more");
+    if (!opt.screenshot.empty()) {
+        if (opt.frames == 0) throw InputError("--screenshot needs --frames N (headless mode)");
+        if (io::extensionOf(opt.screenshot) != ".png") throw InputError("--screenshot: " + opt.screenshot + " must end in .png");
+        const std::filesystem::path parent = std::filesystem::path(opt.screenshot).parent_path();
+        io::ensureWritableDirectory(parent.empty() ? "." : parent.string());
+    }
+    if (!opt.dumpDir.empty()) {
+        if (opt.frames == 0) throw InputError("--dump needs --frames N (headless mode)");
+        io::ensureWritableDirectory(opt.dumpDir);
+    }
+    if (!(opt.exposure > 0.0f)) throw InputError("--exposure: must be > 0");
+    {
+        RenderSettings rs;
+        rs.width = opt.width;
+        rs.height = opt.height;
+        rs.spp = opt.spp;
+        rs.maxDepth = opt.maxDepth;
+        validateRenderSettings(rs);  // names --width/--height/--spp/--max-depth
+    }
+    Scene scene = Scene::loadByNameOrFile(opt.scene);  // InputError naming the scene or file
+    const bool headless = opt.frames > 0;
+
+    // ---- window ----
+    glfwSetErrorCallback(glfwErrorCallback);
+    GlfwSession session;
+    if (!glfwInit())
+        throw InputError("view: cannot open a window: " + glfwErrorText +
+                         ". No display? Run it under a virtual X server: xvfb-run -a atrous view ... --frames N "
+                         "--screenshot out.png (headless mode)");
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+    glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+    glfwWindowHint(GLFW_RESIZABLE, headless ? GLFW_FALSE : GLFW_TRUE);
+    const int winW = opt.hideUi ? opt.width : opt.width + int(kPanelWidth);
+    const int winH = opt.hideUi ? opt.height : std::max(opt.height, 720);
+    session.window = glfwCreateWindow(winW, winH, ("atrous view: " + scene.name()).c_str(), nullptr, nullptr);
+    if (!session.window)
+        throw InputError("view: cannot create an OpenGL 3.3 core context: " + glfwErrorText +
+                         " (try xvfb-run -a, or LIBGL_ALWAYS_SOFTWARE=1 for Mesa's software renderer)");
+    GLFWwindow* win = session.window;
+    glfwMakeContextCurrent(win);
+    glfwSwapInterval(headless ? 0 : 1);
+
+    IMGUI_CHECKVERSION();
+    ImGui::CreateContext();
+    ImGuiIO& io = ImGui::GetIO();
+    io.IniFilename = nullptr;  // no imgui.ini litter in the working directory
+    ImGui::StyleColorsDark();
+    if (!ImGui_ImplGlfw_InitForOpenGL(win, true) || !ImGui_ImplOpenGL3_Init("#version 330 core")) {
+        ImGui::DestroyContext();
+        throw InputError("view: cannot initialise Dear ImGui's OpenGL 3 backend");
+    }
+    session.imgui = true;
+
+    ViewPipeline pl(scene, opt.width, opt.height, device, opt.seed);
+    const int w = opt.width, h = opt.height;
+    glGenTextures(1, &session.texture);
+    glBindTexture(GL_TEXTURE_2D, session.texture);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+    std::vector<unsigned char> rgba(size_t(w) * h * 4, 0);
+
+    // ---- state ----
+    float exposure = opt.exposure;
+    float splitPos = 0.5f;
+    int level = 0;
+    bool paused = false;
+    bool uiVisible = !opt.hideUi;
+    float moveSpeed = 0.5f;  // scene radii per second
+    OrbitCamera orbit = OrbitCamera::fromCamera(pl.camera(), std::max(0.1f * pl.sceneRadius(),
+                                                                      dot(pl.sceneCenter() - pl.camera().position, pl.camera().forward)));
+    std::string status, viewNote;
+    char candidatesText[128] = "0,0.2,0.4,0.6,0.8,1";
+    int snapCounter = 0;
+    bool dragging[3] = {false, false, false};
+    std::vector<double> frameMs, renderMs, accMs, motionMs, denAMs, denBMs, debugMs, displayMs;
+    Timer frameTimer, lastFrame;
+    double displayTime = 0;
+
+    for (int frame = 0; !glfwWindowShouldClose(win); ++frame) {
+        frameTimer.reset();
+        glfwPollEvents();
+        const float dt = float(std::min(0.1, lastFrame.seconds()));
+        lastFrame.reset();
+
+        // ---- camera input (only where ImGui does not want the mouse/keyboard) ----
+        int fbw = 0, fbh = 0;
+        glfwGetFramebufferSize(win, &fbw, &fbh);
+        const float areaW = uiVisible ? std::max(1.0f, float(fbw) - kPanelWidth) : float(fbw);
+        const float areaH = float(fbh);
+        const float scale = std::min(areaW / float(w), areaH / float(h));
+        const float imgW = float(w) * scale, imgH = float(h) * scale;
+        const float imgX = 0.5f * (areaW - imgW), imgY = 0.5f * (areaH - imgH);
+        bool moved = false;
+        if (!headless && pl.cameraMovable()) {
+            const pt::Camera cam = orbit.camera();
+            for (int b = 0; b < 3; ++b) {
+                if (ImGui::IsMouseClicked(b) && !io.WantCaptureMouse) dragging[b] = true;
+                if (!io.MouseDown[b]) dragging[b] = false;
+            }
+            const ImVec2 d = io.MouseDelta;
+            if (dragging[0] && (d.x != 0 || d.y != 0)) {  // left: orbit
+                orbit.orbit(-d.x * 0.01f, d.y * 0.01f);
+                moved = true;
+            }
+            if ((dragging[1] || dragging[2]) && (d.x != 0 || d.y != 0)) {  // right / middle: pan
+                const float k = 2.0f * orbit.distance * orbit.tanHalfFov / std::max(1.0f, imgH);
+                orbit.pan(cam, -d.x * k, d.y * k, 0.0f);
+                moved = true;
+            }
+            if (!io.WantCaptureMouse && io.MouseWheel != 0.0f) {  // wheel: zoom
+                orbit.zoom(std::pow(0.9f, io.MouseWheel));
+                moved = true;
+            }
+            if (!io.WantCaptureKeyboard) {
+                const float step = moveSpeed * pl.sceneRadius() * dt;
+                float f = 0, r = 0, u = 0;
+                if (glfwGetKey(win, GLFW_KEY_W) == GLFW_PRESS) f += step;
+                if (glfwGetKey(win, GLFW_KEY_S) == GLFW_PRESS) f -= step;
+                if (glfwGetKey(win, GLFW_KEY_D) == GLFW_PRESS) r += step;
+                if (glfwGetKey(win, GLFW_KEY_A) == GLFW_PRESS) r -= step;
+                if (glfwGetKey(win, GLFW_KEY_E) == GLFW_PRESS) u += step;
+                if (glfwGetKey(win, GLFW_KEY_Q) == GLFW_PRESS) u -= step;
+                if (f != 0 || r != 0 || u != 0) {
+                    orbit.pan(cam, r, u, f);
+                    moved = true;
+                }
+            }
+            if (moved) pl.setCamera(orbit.camera());
+        }
+        bool snapshot = ImGui::IsKeyPressed(GLFW_KEY_F12, false) ||
+                        (!io.WantCaptureKeyboard && ImGui::IsKeyPressed(GLFW_KEY_P, false));
+        if (!io.WantCaptureKeyboard && ImGui::IsKeyPressed(GLFW_KEY_TAB, false)) uiVisible = !uiVisible;
+        if (!io.WantCaptureKeyboard && ImGui::IsKeyPressed(GLFW_KEY_ESCAPE, false)) glfwSetWindowShouldClose(win, 1);
+
+        // ---- render, accumulate, denoise ----
+        ps.detailLevel = view == BufferView::Detail ? level : -1;
+        ps.sureFractions = view == BufferView::SureFractions;
+        const bool doStep = !paused || moved || frame == 0;
+        if (doStep) pl.step(ps);
+
+        // ---- display image ----
+        Timer dispTimer;
+        {  // every frame: exposure and the view can change while paused
+            const SlotResult& a = pl.slot(0);
+            const SlotResult& b = pl.slot(1);
+            if (view == BufferView::Result && ps.split) {
+                const int xs = std::clamp(int(std::lround(splitPos * float(w))), 0, w);
+                viewNote = tonemap(pl, view, &a.image, exposure, level, 0, xs, rgba);
+                tonemap(pl, view, &b.image, exposure, level, xs, w, rgba);
+            } else {
+                viewNote = tonemap(pl, view, &a.image, exposure, level, 0, w, rgba);
+            }
+            glBindTexture(GL_TEXTURE_2D, session.texture);
+            glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+        }
+        displayTime = dispTimer.ms();
+
+        // ---- UI ----
+        ImGui_ImplOpenGL3_NewFrame();
+        ImGui_ImplGlfw_NewFrame();
+        ImGui::NewFrame();
+        ImDrawList* bg = ImGui::GetBackgroundDrawList();
+        bg->AddImage((ImTextureID)(intptr_t)session.texture, ImVec2(imgX, imgY), ImVec2(imgX + imgW, imgY + imgH));
+        if (view == BufferView::Result && ps.split) {
+            const float xs = imgX + splitPos * imgW;
+            bg->AddLine(ImVec2(xs, imgY), ImVec2(xs, imgY + imgH), IM_COL32(255, 255, 255, 200), 1.0f);
+            if (uiVisible) {
+                bg->AddText(ImVec2(imgX + 6, imgY + 4), IM_COL32(255, 255, 255, 230), methodName(ps.methodA));
+                bg->AddText(ImVec2(xs + 6, imgY + 4), IM_COL32(255, 255, 255, 230), methodName(ps.methodB));
+            }
+        }
+        bool resetCamera = false;
+        if (uiVisible) {
+            ImGui::SetNextWindowPos(ImVec2(float(fbw) - kPanelWidth, 0), ImGuiCond_Always);
+            ImGui::SetNextWindowSize(ImVec2(kPanelWidth, float(fbh)), ImGuiCond_Always);
+            ImGui::Begin("atrous view", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+            const StageTimes& t = pl.times();
+            const double lastMs = frameMs.empty() ? 0.0 : frameMs.back();
+            ImGui::Text("%s  %dx%d  %s", scene.name().c_str(), w, h, deviceToString(device));
+            ImGui::Text("frame %d   %d spp   %.1f ms (%.1f fps)", frame, pl.samplesPerPixel(), lastMs,
+                        lastMs > 0 ? 1000.0 / lastMs : 0.0);
+            ImGui::Text("render %.1f  accum %.1f  motion %.1f ms", t.render, t.accumulate, t.motion);
+            ImGui::Text("filter A %.1f (%s %.1f)  B %.1f ms", t.denoiseA, methodName(pl.slot(0).method),
+                        pl.slot(0).filterMs, t.denoiseB);
+            ImGui::Text("debug views %.1f  display %.1f ms", t.debug, displayTime);
+            ImGui::Separator();
+            if (ImGui::SliderInt("spp / frame", &ps.sppPerFrame, 1, 64)) pl.resetAccumulation();
+            if (ImGui::SliderInt("max depth", &ps.maxDepth, 0, 32)) pl.resetAccumulation();
+            if (ImGui::Checkbox("accumulate", &ps.accumulate)) pl.resetAccumulation();
+            ImGui::SameLine();
+            ImGui::Checkbox("pause", &paused);
+            ImGui::SameLine();
+            if (ImGui::Button("restart")) pl.resetAccumulation();
+            ImGui::SliderFloat("exposure", &exposure, 0.05f, 16.0f, "%.2f", ImGuiSliderFlags_Logarithmic);
+            if (pl.cameraMovable()) {
+                ImGui::SliderFloat("move speed", &moveSpeed, 0.05f, 4.0f, "%.2f", ImGuiSliderFlags_Logarithmic);
+                if (ImGui::Button("reset camera")) resetCamera = true;
+                ImGui::SameLine();
+                ImGui::TextDisabled("LMB orbit, RMB/MMB pan, wheel zoom, WASD QE");
+            } else {
+                ImGui::TextDisabled("camera fixed (CUDA renderer has no camera hook)");
+            }
+            ImGui::Separator();
+            comboMethod("method A", ps.methodA);
+            ImGui::Checkbox("split screen", &ps.split);
+            if (ps.split) {
+                comboMethod("method B", ps.methodB);
+                ImGui::SliderFloat("split", &splitPos, 0.0f, 1.0f);
+            }
+            int v = int(view);
+            ImGui::Combo("buffer", &v, kViewNames, kViewCount);
+            view = BufferView(v);
+            if (view == BufferView::Detail || view == BufferView::SureFractions)
+                ImGui::SliderInt("level i", &level, 0, std::max(0, ps.eaw.levels - 1));
+            if (!viewNote.empty()) ImGui::TextWrapped("%s", viewNote.c_str());
+            for (int i = 0; i < 2; ++i)
+                if (!pl.slot(i).error.empty())
+                    ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s: %s", i ? "B" : "A", pl.slot(i).error.c_str());
+            if (ImGui::CollapsingHeader("EAW (also SURE's cascade)", ImGuiTreeNodeFlags_DefaultOpen)) {
+                EawParams& e = ps.eaw;
+                ImGui::SliderInt("levels", &e.levels, 1, 10);
+                ImGui::DragFloat("sigma color (0=auto)", &e.sigmaColor, 0.01f, 0.0f, 100.0f);
+                ImGui::DragFloat("color scale k_c", &e.colorScale, 0.02f, 0.01f, 20.0f);
+                ImGui::SliderFloat("color level factor", &e.colorLevelFactor, 0.05f, 1.0f);
+                ImGui::DragFloat("sigma normal (0=off)", &e.sigmaNormal, 0.01f, 0.0f, 10.0f);
+                ImGui::Checkbox("normal / step^2", &e.normalStepScale);
+                ImGui::DragFloat("sigma position (0=auto)", &e.sigmaPosition, 0.01f, 0.0f, 100.0f);
+                ImGui::DragFloat("position scale k_x", &e.positionScale, 0.02f, 0.01f, 20.0f);
+                ImGui::DragFloat("sigma depth (0=off)", &e.sigmaDepth, 0.005f, 0.0f, 10.0f);
+                ImGui::Checkbox("id edge stop", &e.useIds);
+            }
+            if (ImGui::CollapsingHeader("SURE")) {
+                int mode = int(ps.sure.mode);
+                const char* modes[] = {"discrete", "james-stein"};
+                ImGui::Combo("mode", &mode, modes, 2);
+                ps.sure.mode = SureMode(mode);
+                if (ImGui::InputText("candidates", candidatesText, sizeof(candidatesText))) {
+                    std::vector<float> c;
+                    std::stringstream ss(candidatesText);
+                    std::string item;
+                    bool ok = true;
+                    while (std::getline(ss, item, ',')) {
+                        try {
+                            c.push_back(std::stof(item));
+                        } catch (...) {
+                            ok = false;
+                        }
+                    }
+                    if (ok && !c.empty()) ps.sure.candidates = c;  // range errors surface as the slot's error
+                }
+                ImGui::SliderInt("window radius", &ps.sure.windowRadius, 1, 10);
+                ImGui::Checkbox("correlated variance", &ps.sure.correlatedVariance);
+            }
+            if (ImGui::CollapsingHeader("Firefly / demodulation")) {
+                ImGui::Checkbox("firefly suppression", &ps.firefly.enabled);
+                ImGui::DragFloat("firefly k", &ps.firefly.k, 0.05f, 0.1f, 50.0f);
+                ImGui::Checkbox("demodulate albedo", &ps.demodulate);
+                ImGui::DragFloat("albedo epsilon", &ps.albedoEpsilon, 1e-4f, 1e-6f, 1.0f, "%.5f");
+            }
+            if (ImGui::CollapsingHeader("SVGF")) {
+                SvgfParams& p = ps.svgf;
+                ImGui::DragFloat("sigma_l", &p.sigmaL, 0.05f, 0.0f, 100.0f);
+                ImGui::DragFloat("sigma_n", &p.sigmaN, 1.0f, 0.0f, 1024.0f);
+                ImGui::DragFloat("sigma_z", &p.sigmaZ, 0.02f, 0.0f, 100.0f);
+                ImGui::SliderFloat("alpha", &p.alpha, 0.01f, 1.0f);
+                ImGui::SliderFloat("moments alpha", &p.momentsAlpha, 0.01f, 1.0f);
+                ImGui::SliderInt("history cap", &p.historyCap, 1, 256);
+                ImGui::SliderInt("svgf levels", &p.levels, 0, 10);
+                ImGui::SliderInt("feedback tap", &p.feedbackTap, -1, std::max(-1, p.levels - 1));
+                ImGui::SliderInt("spatial variance frames", &p.spatialVarianceFrames, 1, 32);
+                ImGui::DragFloat("reproject depth tol", &p.reprojectDepthTolerance, 0.05f, 0.0f, 100.0f);
+                ImGui::SliderFloat("reproject normal cos", &p.reprojectNormalCos, -1.0f, 1.0f);
+                ImGui::Checkbox("TAA", &p.taa);
+                ImGui::SliderFloat("TAA alpha", &p.taaAlpha, 0.01f, 1.0f);
+                ImGui::Checkbox("motion vectors on camera move", &ps.svgfMotionVectors);
+                ImGui::TextDisabled(ps.svgfMotionVectors ? "(history reprojected)" : "(history reset on move)");
+            }
+            ImGui::Separator();
+            if (ImGui::Button("save snapshot (F12 / P)")) snapshot = true;
+            ImGui::TextDisabled("to %s/snap_NNNN/", opt.outDir.c_str());
+            if (!status.empty()) ImGui::TextWrapped("%s", status.c_str());
+            ImGui::TextDisabled("Tab hides this panel, Esc quits");
+            ImGui::End();
+        }
+        if (resetCamera) {
+            orbit = OrbitCamera::fromCamera(pl.sceneCamera(), std::max(0.1f * pl.sceneRadius(),
+                                                                       dot(pl.sceneCenter() - pl.sceneCamera().position,
+                                                                           pl.sceneCamera().forward)));
+            pl.setCamera(pl.sceneCamera());
+        }
+        ImGui::Render();
+        glViewport(0, 0, fbw, fbh);
+        glClearColor(0.08f, 0.08f, 0.09f, 1.0f);
+        glClear(GL_COLOR_BUFFER_BIT);
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+
+        const bool last = headless && frame + 1 >= opt.frames;
+        if (snapshot) {
+            try {
+                char name[32];
+                std::snprintf(name, sizeof(name), "snap_%04d", ++snapCounter);
+                const std::string dir = (std::filesystem::path(opt.outDir) / name).string();
+                std::vector<std::string> files = pl.saveBuffers(dir);
+                saveFramebuffer((std::filesystem::path(dir) / "screenshot.png").string(), fbw, fbh);
+                status = "saved " + dir + " (" + std::to_string(files.size() + 1) + " files)";
+            } catch (const std::exception& e) {
+                status = std::string("snapshot failed: ") + e.what();
+            }
+            std::fprintf(stderr, "atrous view: %s\n", status.c_str());
+        }
+        if (last) {
+            if (!opt.screenshot.empty()) saveFramebuffer(opt.screenshot, fbw, fbh);
+            if (!opt.dumpDir.empty()) pl.saveBuffers(opt.dumpDir);
+        }
+        glfwSwapBuffers(win);
+
+        frameMs.push_back(frameTimer.ms());
+        const StageTimes& t = pl.times();
+        renderMs.push_back(t.render);
+        accMs.push_back(t.accumulate);
+        motionMs.push_back(t.motion);
+        denAMs.push_back(t.denoiseA);
+        denBMs.push_back(t.denoiseB);
+        debugMs.push_back(t.debug);
+        displayMs.push_back(displayTime);
+        if (last) break;
+    }
+
+    if (opt.benchmark || headless) {
+        // The first frame (BVH already built, but first allocations, ImGui font atlas upload) is a
+        // warm-up and left out when there are more.
+        const size_t skip = frameMs.size() > 1 ? 1 : 0;
+        auto tail = [&](const std::vector<double>& v) { return std::vector<double>(v.begin() + skip, v.end()); };
+        const std::vector<double> f = tail(frameMs);
+        double mean = 0;
+        for (double x : f) mean += x;
+        mean = f.empty() ? 0 : mean / double(f.size());
+        const double med = median(f);
+        Json j;
+        j.str("benchmark", "view");
+        j.str("scene", scene.name());
+        j.num("width", w);
+        j.num("height", h);
+        j.str("method", methodName(ps.methodA));
+        j.str("compare", ps.split ? methodName(ps.methodB) : "");
+        j.num("spp_per_frame", ps.sppPerFrame);
+        j.num("accumulate", ps.accumulate ? 1 : 0);
+        j.num("frames", double(f.size()));
+        j.num("warmup_frames", double(skip));
+        j.num("frame_ms_mean", mean);
+        j.num("frame_ms_median", med);
+        j.num("fps", med > 0 ? 1000.0 / med : 0.0);
+        j.num("render_ms", median(tail(renderMs)));
+        j.num("accumulate_ms", median(tail(accMs)));
+        j.num("motion_ms", median(tail(motionMs)));
+        j.num("denoise_a_ms", median(tail(denAMs)));
+        j.num("denoise_b_ms", median(tail(denBMs)));
+        j.num("debug_ms", median(tail(debugMs)));
+        j.num("display_ms", median(tail(displayMs)));
+        j.str("device", deviceName(device));
+        std::printf("{%s}\n", j.s.str().c_str());
+        std::fflush(stdout);
+    }
+}
+
+}  // namespace atrous::view

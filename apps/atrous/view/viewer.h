@@ -1,0 +1,34 @@
+// `atrous view`: the interactive viewer (GLFW window, OpenGL 3.3 core, Dear ImGui). Built only
+// when GLFW, OpenGL and imgui are found (ATROUS_HAVE_VIEWER); docs/viewer.md.
+#pragma once
+#include <cstdint>
+#include <string>
+
+namespace atrous::view {
+
+struct ViewerOptions {
+    std::string scene = "cornell";
+    std::string device = "cpu";
+    int width = 512, height = 512;  // rendered image size
+    int spp = 1;                    // samples per pixel per frame
+    int maxDepth = 8;
+    uint32_t seed = 1;
+    std::string method = "eaw";     // slot A: none | eaw | sure | svgf
+    std::string compare;            // slot B for the split screen (empty: no split)
+    bool noAccumulate = false;
+    std::string bufferView = "result";  // initial buffer view (see docs/viewer.md)
+    float exposure = 1.0f;
+    // Headless: render this many frames, save --screenshot (window framebuffer) and exit.
+    int frames = 0;
+    std::string screenshot;
+    std::string dumpDir;  // headless: also write every buffer (EXR) here at the end
+    std::string outDir = "atrous_view";  // F12 / P snapshots go to OUT/snap_NNNN/
+    bool hideUi = false;  // no control panel: the window is exactly width x height
+    bool benchmark = false;  // print a JSON line with frame and stage timings at exit
+};
+
+// Opens the window and runs until it is closed (or --frames are done). Throws InputError for bad
+// flags, an unknown scene, no display or no OpenGL 3.3 context (the CLI exits 2).
+void runViewer(const ViewerOptions& options);
+
+}  // namespace atrous::view
