@@ -99,6 +99,36 @@ TEST(SceneJson, TextureAndMaterialOverride) {
     EXPECT_EQ(s.data().materials[s.materialId("t")].texture, 0);
 }
 
+TEST(SceneJson, MtlMaterialsTexturesAndSky) {
+    test::TempDir tmp;
+    Image tex(2, 2, 3);
+    tex.fill(0.5f);
+    io::writeImage(tmp / "kd.exr", tex);
+    writeText(tmp / "m.mtl", "newmtl lamp\nKd 0 0 0\nKe 5 5 5\nnewmtl chrome\nKs 0.9 0.9 0.9\nillum 3\n"
+                             "newmtl tex\nKd 1 1 1\nmap_Kd kd.exr\nnewmtl glass\nNi 1.33\nillum 7\n");
+    writeText(tmp / "m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n"
+                             "usemtl lamp\nf 1 2 3\nusemtl chrome\nf 2 4 3\nusemtl tex\nf 1 3 2\nusemtl glass\nf 3 4 2\n");
+    writeText(tmp / "s.json", R"({"camera": {"position": [0,0,3], "lookAt": [0,0,0]},
+      "objects": [{"type": "mesh", "file": "m.obj"}],
+      "lights": [{"type": "sky", "sunDirection": [0, 1, 0.2], "sunRadius": 2}]})");
+    Scene s = Scene::load(tmp / "s.json");
+    const auto& d = s.data();
+    auto mat = [&](const char* name) { return d.materials.at(s.materialId(name)); };
+    EXPECT_EQ(mat("lamp").emission.x, 5.0f);
+    EXPECT_EQ(mat("chrome").type, pt::MaterialType::Mirror);
+    EXPECT_GE(mat("tex").texture, 0);
+    EXPECT_EQ(mat("glass").type, pt::MaterialType::Dielectric);
+    EXPECT_NEAR(mat("glass").ior, 1.33f, 1e-6f);
+    EXPECT_EQ(d.triLight[0], 0);  // the emissive triangle is an area light
+    EXPECT_EQ(d.env.type, pt::EnvType::Map);
+    EXPECT_EQ(d.lights.size(), 2u);  // area light + sky
+
+    // A texture named by the MTL that is missing is reported with its path.
+    writeText(tmp / "m.mtl", "newmtl tex\nKd 1 1 1\nmap_Kd missing_kd.png\n");
+    std::string msg = errorOf([&] { Scene::load(tmp / "s.json"); });
+    EXPECT_NE(msg.find("missing_kd.png"), std::string::npos) << msg;
+}
+
 struct BadScene {
     const char* json;
     const char* expect;  // substring of the error message
