@@ -31,7 +31,7 @@
 // Host/device parity. Every product that feeds a sum is written as an explicit fmaf, and nothing
 // else in these functions can be contracted, so gcc (which contracts a*b+c freely under
 // -std=gnu++17) and nvcc round identically: the CPU and CUDA traversals return bit-identical hits
-// (tests/cuda/bvh_test.cu checks it). Keep that rule when editing.
+// (tests/cuda/cuda_bvh_test.cu checks it). Keep that rule when editing.
 //
 // A hit's t is in units of the ray direction (directions need not be unit length), and
 // tmin <= t < tmax. u, v are the barycentrics of vertices 1 and 2 (Embree's convention:
@@ -194,7 +194,7 @@ ATROUS_INLINE bool hitTriangle(const BvhPrim& p, const RayPre& r, float tmin, fl
     // sign must be exact, or a ray through a shared edge can see "outside" from both triangles
     // (the edge function of one triangle must be the exact negation of its neighbour's). The
     // paper gets that from two rounded products; a compiler that fuses one of them into an FMA
-    // (gcc and nvcc both do by default) breaks it. Kahan's difference of products is accurate
+    // (gcc targeting FMA hardware and nvcc both do by default) breaks it. Kahan's difference of products is accurate
     // to 2 ulp, so its sign is exact, and it is written with explicit FMAs nothing can re-fuse.
     float uu = differenceOfProducts(cx, by, cy, bx);
     float vv = differenceOfProducts(ax, cy, ay, cx);
