@@ -194,8 +194,8 @@ ATROUS_INLINE bool hitTriangle(const BvhPrim& p, const RayPre& r, float tmin, fl
     // sign must be exact, or a ray through a shared edge can see "outside" from both triangles
     // (the edge function of one triangle must be the exact negation of its neighbour's). The
     // paper gets that from two rounded products; a compiler that fuses one of them into an FMA
-    // (gcc targeting FMA hardware and nvcc both do by default) breaks it. Kahan's difference of products is accurate
-    // to 2 ulp, so its sign is exact, and it is written with explicit FMAs nothing can re-fuse.
+    // (gcc targeting FMA hardware and nvcc both do by default) breaks it. Kahan's difference of
+    // products is accurate to 2 ulp, so its sign is exact, and its explicit FMAs cannot re-fuse.
     float uu = differenceOfProducts(cx, by, cy, bx);
     float vv = differenceOfProducts(ax, cy, ay, cx);
     float ww = differenceOfProducts(bx, ay, by, ax);
