@@ -34,7 +34,12 @@ struct Flat {
 
 TEST(Firefly, ClampsAnOutlierAndLeavesNoiseAlone) {
     Flat f(64, 64, 1);
-    for (int c = 0; c < 3; ++c) f.color(30, 20, c) = 500.0f;  // one firefly
+    // One firefly: one huge sample among n raises the mean by E and reports a variance of the
+    // mean of about E² (what the renderer's variance buffer holds for it).
+    for (int c = 0; c < 3; ++c) {
+        f.color(30, 20, c) = 500.0f;
+        f.var(30, 20, c) = 500.0f * 500.0f;
+    }
     DenoiseReport rep;
     DenoiseOptions o;
     o.method = DenoiseMethod::Eaw;
@@ -58,7 +63,10 @@ TEST(Firefly, ClampsAnOutlierAndLeavesNoiseAlone) {
 
 TEST(Firefly, ParametersChangeTheOutput) {
     Flat f(48, 48, 2);
-    for (int c = 0; c < 3; ++c) f.color(10, 10, c) = 50.0f;
+    for (int c = 0; c < 3; ++c) {
+        f.color(10, 10, c) = 50.0f;
+        f.var(10, 10, c) = 50.0f * 50.0f;
+    }
     DenoiseOptions base;
     const Image ref = denoise(f.inputs(), base);
     DenoiseOptions off = base;
@@ -76,12 +84,30 @@ TEST(Firefly, TwoPixelClusterIsClamped) {
     for (int c = 0; c < 3; ++c) {
         f.color(10, 10, c) = 200.0f;
         f.color(11, 10, c) = 150.0f;
+        f.var(10, 10, c) = 200.0f * 200.0f;
+        f.var(11, 10, c) = 150.0f * 150.0f;
     }
     DenoiseReport rep;
     DenoiseOptions o;
     o.report = &rep;
     denoise(f.inputs(), o);
     EXPECT_NEAR(rep.meanLuminanceAfterFirefly, 0.5, 0.01);
+}
+
+TEST(Firefly, BrightPixelWithLowOwnVarianceIsSignal) {
+    // The sun seen directly: very bright, but its own standard deviation (here 10% of its excess)
+    // says most samples agree, so it is kept (ALGORITHMS.md 3a: only implausible pixels).
+    Flat f(32, 32, 5);
+    for (int c = 0; c < 3; ++c) {
+        f.color(16, 16, c) = 1000.0f;
+        f.var(16, 16, c) = 100.0f * 100.0f;
+    }
+    DenoiseReport rep;
+    DenoiseOptions o;
+    o.report = &rep;
+    denoise(f.inputs(), o);
+    EXPECT_EQ(rep.firefliesClamped, 0);
+    EXPECT_NEAR(rep.meanLuminanceAfterFirefly, rep.meanLuminanceIn, 1e-6);
 }
 
 TEST(NonFinite, NanAndInfNeverSpread) {

@@ -33,7 +33,7 @@ struct EawParams {
     // sum over channels of the variance buffer (or of the estimated noise). > 0 = the paper's raw
     // constant σ_c (GLSL c_phi = σ_c²).
     float sigmaColor = 0.0f;
-    float colorScale = 2.0f;        // k_c of the automatic σ_c (> 0)
+    float colorScale = 6.0f;        // k_c of the automatic σ_c (> 0)
     float colorLevelFactor = 0.5f;  // σ_c,i = σ_c · factor^i (paper: halved per level), (0, 1]
     // σ_n on |n(p) - n(q)| (unit normals). 0 disables the normal stop. GLSL n_phi = σ_n².
     float sigmaNormal = 0.5f;

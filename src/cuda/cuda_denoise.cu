@@ -30,7 +30,9 @@ Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const Prepar
     dout.afterFirefly = after.view();
     dout.fireflyFlag = flag.view();
     Timer t;
-    runDenoise(CudaExec{}, di, makeConfig(o), dout);
+    DriverConfig cfg = makeConfig(o);
+    cfg.varianceGiven = in.variance != nullptr;
+    runDenoise(CudaExec{}, di, cfg, dout);
     rep.milliseconds = t.ms();
     Image hostAfter = after.to(Device::Cpu), hostFlag = flag.to(Device::Cpu);
     double s0 = 0, s1 = 0;

@@ -194,7 +194,9 @@ Image denoiseCpu(const DenoiseInputs& in, const DenoiseOptions& o, const Prepare
     dout.fireflyFlag = flag.view();
     if (debug && !debug->sureS.empty()) dout.sureS = debug->sureS.view();
     Timer t;
-    runDenoise(CpuExec{}, di, makeConfig(o), dout);
+    DriverConfig cfg = makeConfig(o);
+    cfg.varianceGiven = in.variance != nullptr;
+    runDenoise(CpuExec{}, di, cfg, dout);
     rep.milliseconds = t.ms();
     rep.meanLuminanceIn = meanLuminance(*in.color);
     rep.meanLuminanceAfterFirefly = meanLuminance(after);

@@ -37,6 +37,7 @@ struct DriverConfig {
     FireflyParams firefly;
     bool demodulate = true;
     float albedoEpsilon = 1e-3f;
+    bool varianceGiven = true;  // false: the variance is a constant estimate
 };
 
 // α_i = true var(d_i) / independence-propagated var(d_i) for the unweighted B3 cascade on white
@@ -95,13 +96,14 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     // 2. Fireflies (before demodulation: the outlier is in radiance).
     Image cA(w, h, 3, dev), vA(w, h, 3, dev);
     if (cfg.firefly.enabled) {
-        exec.forEachPixel(w, h, FireflyClamp{cfg.firefly.k, c0.view(), v0.view(), cA.view(), vA.view(), out.fireflyFlag});
+        exec.forEachPixel(w, h, FireflyClamp{cfg.firefly.k, cfg.varianceGiven ? 1 : 0, c0.view(), v0.view(), cA.view(),
+                                             vA.view(), out.fireflyFlag});
     } else {
         cA.copyFrom(c0);
         vA.copyFrom(v0);
     }
     if (out.afterFirefly.valid()) {
-        exec.forEachPixel(w, h, SanitizeFeature{cA.view(), out.afterFirefly});
+        exec.forEachPixel(w, h, Copy3{cA.view(), out.afterFirefly});
     }
 
     // 3. Albedo demodulation.

@@ -14,7 +14,7 @@ namespace atrous::filters {
 // Per-level constants, derived on the host from EawParams (denoise_driver.h).
 struct EawLevelParams {
     int step = 1;               // 2^i: tap spacing of level i
-    float colorMul = 1.0f;      // factor^(2i): σ_c,i² = colorMul · (S(p) + S(q))
+    float colorMul = 1.0f;      // factor^(2i): σ_c,i² = colorMul · 2 min(S(p), S(q))
     float colorEps = 1e-12f;    // keeps σ_c,i² > 0 where the variance is exactly 0
     float invNormal = 0.0f;     // 1/σ_n² (÷ step² with normalStepScale); 0 = no normal stop
     int autoPosition = 1;       // 1: σ_x scales with the tap's pixel offset (invX = 1/(k_x F)²)
@@ -31,7 +31,10 @@ struct EawLevelParams {
 //   dzRel = (z_p - z_q)/z_p, did2 = squared mesh + material id difference.
 ATROUS_INLINE float eawExponent(const EawLevelParams& P, float dc2, float Sp, float Sq, float dn2, float dx2,
                                 float invXp, float posTap, float dzRel, float did2) {
-    return dc2 / (P.colorMul * (Sp + Sq) + P.colorEps) + dn2 * P.invNormal + dx2 * invXp * posTap +
+    // σ_c² of the pair: 2·min(S(p), S(q)) (symmetric, so the filter stays mean-preserving, and
+    // a quiet pixel never takes in a noisy bright neighbour: with S(p) + S(q) the sun seen
+    // directly leaked into the sky around it). min written as (a + b - |a - b|)/2 so it vectorises.
+    return dc2 / (P.colorMul * (Sp + Sq - fabsf(Sp - Sq)) + P.colorEps) + dn2 * P.invNormal + dx2 * invXp * posTap +
            dzRel * dzRel * P.invDepth + did2 * P.idPenalty;
 }
 

@@ -41,23 +41,45 @@ struct SanitizeColor {
 };
 
 // Copies a feature buffer, mapping non-finite values to 0 and clamping to ±kFeatureClamp.
+// (Selects instead of fminf/fmaxf, which do not vectorise under strict IEEE flags.)
+ATROUS_INLINE float sanitizeFeature(float a) {
+    float b = a < -kFeatureClamp ? -kFeatureClamp : a;
+    b = b > kFeatureClamp ? kFeatureClamp : b;
+    return finite(a) ? b : 0.0f;
+}
 struct SanitizeFeature {
     ImageView in, out;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        for (int c = 0; c < out.channels; ++c) {
-            const float a = in(x, y, c);
-            out(x, y, c) = finite(a) ? fminf(fmaxf(a, -kFeatureClamp), kFeatureClamp) : 0.0f;
-        }
+        if (out.channels >= 1) out(x, y, 0) = sanitizeFeature(in(x, y, 0));
+        if (out.channels >= 2) out(x, y, 1) = sanitizeFeature(in(x, y, 1));
+        if (out.channels >= 3) out(x, y, 2) = sanitizeFeature(in(x, y, 2));
+    }
+};
+
+// Plain 3-channel copy.
+struct Copy3 {
+    ImageView in, out;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        out(x, y, 0) = in(x, y, 0);
+        out(x, y, 1) = in(x, y, 1);
+        out(x, y, 2) = in(x, y, 2);
     }
 };
 
 // Firefly suppression: L(p) above m + k·sqrt(s² + v̄) is scaled down to that bound, where m and s²
 // are the mean and variance of the 3×3 neighbours' luminance without the brightest neighbour (so
 // a two-pixel firefly does not vouch for itself) and v̄ is their mean luminance variance (the
-// noise the renderer reported there). The pixel's own variance is not used: a firefly inflates
-// it. The variance is scaled by the same factor squared.
+// noise the renderer reported there). The variance is scaled by the same factor squared.
+// A firefly is a rare huge sample, so it also inflates its own pixel's variance: a mean raised by
+// E through one outlier among n samples has a standard deviation of about E (j outliers: about
+// E/sqrt(j)). A bright pixel whose own standard deviation is below half its excess over m (the
+// sun seen directly, partly covering the pixel: ~0.2) is signal, not a firefly, and is kept. With an estimated (constant)
+// variance this test is off (ownVariance = 0).
+constexpr float kFireflyOwnStd = 0.5f;  // see FireflyClamp: ~3 or fewer samples carry the excess
+
 struct FireflyClamp {
     float k = 4.0f;
+    int ownVariance = 1;
     ImageView cIn, vIn, cOut, vOut;
     ImageView flag;  // 1 channel: 1 where clamped (for the report), may be invalid
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
@@ -87,7 +109,9 @@ struct FireflyClamp {
         const float s2 = fmaxf(m2 / 7.0f - m * m, 0.0f);
         const float bound = fmaxf(m, 0.0f) + k * sqrtf(s2 + fmaxf(vm, 0.0f));
         const float L = lum(cIn(x, y, 0), cIn(x, y, 1), cIn(x, y, 2));
-        const bool clamp = L > bound && L > 0.0f;
+        const float ownStd = sqrtf(lum(lum(1, 0, 0) * vIn(x, y, 0), lum(0, 1, 0) * vIn(x, y, 1), lum(0, 0, 1) * vIn(x, y, 2)));
+        const bool noisy = !ownVariance || ownStd > kFireflyOwnStd * (L - m);
+        const bool clamp = L > bound && L > 0.0f && noisy;
         const float scale = clamp ? bound / L : 1.0f;
         for (int c = 0; c < 3; ++c) {
             cOut(x, y, c) = cIn(x, y, c) * scale;
@@ -112,8 +136,10 @@ struct Demodulate {
 };
 
 // Per-pixel colour scale S of the automatic σ_c: k_c² · (3×3 [1 2 1]² / 16 prefilter of the
-// channel-summed variance) — prefiltered because a few-sample variance estimate is itself noisy.
-// With a raw σ_c, S = σ_c²/2 so that S(p) + S(q) = σ_c².
+// channel-summed variance, without its largest neighbour, renormalised) — prefiltered because a
+// few-sample variance estimate is itself noisy, and without the largest neighbour so that one
+// very noisy bright pixel (the sun seen directly) does not raise the scale of the quiet pixels
+// around it. With a raw σ_c, S = σ_c²/2 so that 2 min(S(p), S(q)) = σ_c².
 struct ColorScale {
     float rawSigma = 0;  // > 0: the paper's constant σ_c
     float k2 = 1;
@@ -123,14 +149,19 @@ struct ColorScale {
             S(x, y, 0) = 0.5f * rawSigma * rawSigma;
             return;
         }
-        float s = 0;
+        float s = 0, vmax = -1, wmax = 0;
         for (int dy = -1; dy <= 1; ++dy)
             for (int dx = -1; dx <= 1; ++dx) {
                 const int xx = clampIdx(x + dx, var.width - 1), yy = clampIdx(y + dy, var.height - 1);
                 const float wt = (dx == 0 ? 2.0f : 1.0f) * (dy == 0 ? 2.0f : 1.0f) * (1.0f / 16.0f);
-                s += wt * (var(xx, yy, 0) + var(xx, yy, 1) + var(xx, yy, 2));
+                const float v = var(xx, yy, 0) + var(xx, yy, 1) + var(xx, yy, 2);
+                s += wt * v;
+                if ((dx != 0 || dy != 0) && v > vmax) {
+                    vmax = v;
+                    wmax = wt;
+                }
             }
-        S(x, y, 0) = k2 * s;
+        S(x, y, 0) = k2 * (s - wmax * vmax) / (1.0f - wmax);
     }
 };
 
