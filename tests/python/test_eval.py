@@ -68,11 +68,13 @@ def test_quick_denoisers_beat_noisy(quick):
 def test_quick_report_embeds_images_and_plots(quick):
     cfg, out, _, js = quick
     html = (out / "report.html").read_text()
-    # Crops: reference + every method per scene x spp, FLIP maps per method, one thumbnail per
-    # scene, and the plots: all inline, nothing refers to an outside file.
+    # Per scene a thumbnail and the reference crop, per scene x spp a crop and a FLIP map per
+    # method, and the plots: all inline, nothing refers to an outside file. The reference crop is
+    # embedded once per scene and copied into each spp row by a script (data-ref).
     n_methods = len(js["methods"])
-    min_images = len(cfg.scenes) * (1 + len(cfg.spp) * (1 + 2 * n_methods))
+    min_images = len(cfg.scenes) * (2 + len(cfg.spp) * 2 * n_methods) + 4
     assert html.count("data:image/png;base64,") >= min_images
+    assert html.count("data-ref=") == len(cfg.scenes) * len(cfg.spp)
     assert "src='http" not in html and 'src="http' not in html
     for name in ("quality_vs_spp", "equal_time", "runtime_vs_resolution", "quality_per_ms"):
         f = out / js["plots"][name]

@@ -266,13 +266,21 @@ def run_eval(cfg: EvalConfig) -> Dict[str, Any]:
     if cfg.sequence or cfg.static_sequence:
         from . import sequence as seq
         seq_dir = cfg.sequence
+        tmp_seq = None
         if not seq_dir:
-            seq_dir = str(out / "static_sequence")
+            # Uncompressed 1-spp EXRs (~0.8 MB a buffer at 256x256): written to a temporary
+            # directory and removed once evaluated.
+            import tempfile
+            tmp_seq = tempfile.TemporaryDirectory(prefix="atrous-static-seq-")
+            seq_dir = tmp_seq.name
             _log(f"writing a {cfg.static_sequence}-frame static-camera sequence of {cfg.sequence_scene} to {seq_dir}")
             seq_ref = renders.get(cfg.sequence_scene, w, h, cfg.ref_spp, cfg.ref_seed)[0]["color"]
             seq.write_static_sequence(seq_dir, cfg.sequence_scene, cfg.static_sequence, w, h,
                                       ref_spp=cfg.ref_spp, seed=cfg.seed, reference=seq_ref)
         sequence = seq.evaluate_sequence(seq_dir, methods, log=_log)
+        if tmp_seq is not None:
+            tmp_seq.cleanup()
+            sequence["dir"] = "(temporary static sequence)"
         if not cfg.sequence:
             sequence["note"] = (f"synthesised by --static-sequence: scene {cfg.sequence_scene}, static camera "
                                 "(motion 0), each frame 1 spp with its own seed, one shared reference; SVGF's "

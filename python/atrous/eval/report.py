@@ -74,6 +74,12 @@ def summarise(data: Dict[str, Any]) -> Dict[str, Any]:
                 f"best atrous filter's relMSE is {_geomean(ratios):.2f}x OIDN's (geometric mean; range "
                 f"{min(ratios):.2f}x to {max(ratios):.2f}x), and OIDN's PSNR is "
                 f"{np.mean([v['psnr_diff_db'] for v in versus]):+.2f} dB higher on average.")
+            losses = [v for v in versus if v["relmse_ratio"] and v["relmse_ratio"] < 1]
+            if losses:
+                findings.append(
+                    "atrous has the lower relMSE in: " + ", ".join(
+                        f"{v['scene']} {v['spp']} spp ({v['best_atrous']} {1 / v['relmse_ratio']:.1f}x lower)"
+                        for v in losses) + ".")
             sp = [v["speedup"] for v in versus if v["speedup"]]
             if sp:
                 g = _geomean(sp)
@@ -111,8 +117,14 @@ def _plt():
     return plt
 
 
+def _null_formatter():
+    from matplotlib.ticker import NullFormatter
+
+    return NullFormatter()
+
+
 def _grid(n: int):
-    cols = min(n, 4)
+    cols = 2 if n in (2, 4) else min(n, 3)
     rows = (n + cols - 1) // cols
     return rows, cols
 
@@ -173,6 +185,7 @@ def write_plots(data: Dict[str, Any], out: Path) -> Dict[str, str]:
                     ax.plot(*zip(*p), "s-", color=COLORS.get(m), label=f"{m} (render + denoise)")
             ax.set_xscale("log")
             ax.set_yscale("log")
+            ax.xaxis.set_minor_formatter(_null_formatter())
             ax.set_title(sc)
             ax.set_xlabel("render + denoise time (ms)")
             ax.set_ylabel("relMSE")
@@ -260,12 +273,17 @@ def tonemap(img: np.ndarray) -> np.ndarray:
     return (np.clip((x / (1.0 + x)) ** (1.0 / 2.2), 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
 
 
-def png_bytes(rgb8: np.ndarray) -> bytes:
+def png_bytes(rgb8: np.ndarray, palette: int = 0) -> bytes:
+    """PNG of an 8-bit RGB array; palette > 0 quantises to that many colours (for the smooth
+    colour-mapped error maps, about a third of the size)."""
     buf = io.BytesIO()
     try:
         from PIL import Image
 
-        Image.fromarray(rgb8).save(buf, format="PNG", optimize=True)
+        im = Image.fromarray(rgb8)
+        if palette:
+            im = im.quantize(palette)
+        im.save(buf, format="PNG", optimize=True)
     except ImportError:  # matplotlib always has a PNG writer
         import matplotlib.image as mpimg
 
@@ -273,8 +291,15 @@ def png_bytes(rgb8: np.ndarray) -> bytes:
     return buf.getvalue()
 
 
-def data_uri(rgb8: np.ndarray) -> str:
-    return "data:image/png;base64," + base64.b64encode(png_bytes(rgb8)).decode("ascii")
+def data_uri(rgb8: np.ndarray, palette: int = 0) -> str:
+    return "data:image/png;base64," + base64.b64encode(png_bytes(rgb8, palette)).decode("ascii")
+
+
+def _half(rgb8: np.ndarray) -> np.ndarray:
+    """2x2 box downsampling (the full-frame thumbnails are only there to locate the crop)."""
+    h, w = (rgb8.shape[0] // 2) * 2, (rgb8.shape[1] // 2) * 2
+    x = rgb8[:h, :w].astype(np.float32)
+    return ((x[0::2, 0::2] + x[1::2, 0::2] + x[0::2, 1::2] + x[1::2, 1::2]) / 4 + 0.5).astype(np.uint8)
 
 
 def choose_crop(ref: np.ndarray, size: int) -> tuple:
@@ -443,12 +468,18 @@ def write_html(data: Dict[str, Any], images: Dict[str, Dict[str, Any]], path: Pa
         h, w = ref.shape[:2]
         cs = max(16, min(h, w) // 2)
         y, x = choose_crop(ref, cs)
+        thumb = _boxed(tonemap(ref), y, x, cs)
+        if min(h, w) > 192:
+            thumb = _half(thumb)
+        ref_id = f"ref-{len(parts)}"
         parts.append(f"<h3>{html.escape(sc)}</h3><div class='strip'><figure>"
-                     f"<img src='{data_uri(_boxed(tonemap(ref), y, x, cs))}'><figcaption>reference "
-                     f"{cfg['ref_spp']} spp (full)</figcaption></figure></div>")
+                     f"<img src='{data_uri(thumb)}'><figcaption>reference "
+                     f"{cfg['ref_spp']} spp (full frame)</figcaption></figure><figure>"
+                     f"<img id='{ref_id}' src='{data_uri(tonemap(ref[y:y + cs, x:x + cs]))}'>"
+                     f"<figcaption>reference crop</figcaption></figure></div>")
         for spp, per in im["spp"].items():
             res = {r["method"]: r for r in data["results"] if r["scene"] == sc and r["spp"] == spp}
-            crops = [("reference", tonemap(ref[y:y + cs, x:x + cs]), "")]
+            crops = [("reference", None, ref_id)]
             maps = []
             for m in methods:
                 if m not in per:
@@ -459,13 +490,16 @@ def write_html(data: Dict[str, Any], images: Dict[str, Dict[str, Any]], path: Pa
                 if fm is not None:
                     maps.append((m, (np.clip(fm[y:y + cs, x:x + cs], 0, 1) * 255 + 0.5).astype(np.uint8),
                                  f"FLIP {_fmt(res[m].get('flip'), 4)}"))
-            parts.append(f"<p><b>{spp} spp</b></p><div class='strip'>" + "".join(
-                f"<figure><img src='{data_uri(a)}'><figcaption>{html.escape(n)} {c}</figcaption></figure>"
-                for n, a, c in crops) + "</div>")
+
+            def fig(n, a, c, palette=0):
+                if a is None:  # the scene's reference crop, copied in by the script at the end
+                    return f"<figure><img data-ref='{c}'><figcaption>{html.escape(n)}</figcaption></figure>"
+                return (f"<figure><img src='{data_uri(a, palette)}'><figcaption>{html.escape(n)} {c}"
+                        "</figcaption></figure>")
+            parts.append(f"<p><b>{spp} spp</b></p><div class='strip'>" + "".join(fig(*t) for t in crops) + "</div>")
             if maps:
                 parts.append("<div class='strip'><figure style='width:202px'></figure>" + "".join(
-                    f"<figure><img src='{data_uri(a)}'><figcaption>{html.escape(n)} {c}</figcaption></figure>"
-                    for n, a, c in maps) + "</div>")
+                    fig(n, a, c, palette=64) for n, a, c in maps) + "</div>")
 
     et = data.get("equal_time") or []
     if et:
@@ -509,6 +543,9 @@ def write_html(data: Dict[str, Any], images: Dict[str, Dict[str, Any]], path: Pa
             parts.append(_plot_img(out_dir / plots["sequence"]))
     else:
         parts.append("<p>No sequence was evaluated (see the notes above).</p>")
+    # Each reference crop is embedded once; this copies it into every row that shows it.
+    parts.append("<script>document.querySelectorAll('img[data-ref]').forEach(function(i){"
+                 "i.src=document.getElementById(i.dataset.ref).src;});</script>")
     parts.append(f"<p style='color:#888'>elapsed {data.get('elapsed_s', 0):.1f} s; raw numbers in "
                  "results.json.</p></body></html>")
     tmp = Path(str(path) + ".tmp")
