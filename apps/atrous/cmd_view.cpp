@@ -35,6 +35,7 @@ void addViewCommand(CLI::App& app) {
     cmd->add_option("--screenshot", o.screenshot, "Headless: PNG of the window's framebuffer after the last frame");
     cmd->add_option("--dump", o.dumpDir, "Headless: directory for every buffer (EXR) after the last frame");
     cmd->add_option("--out", o.outDir, "Directory of the F12 / P snapshots")->capture_default_str();
+    cmd->add_option("--orbit", o.orbitDegPerFrame, "Turntable: orbit the camera by this many degrees per frame");
     cmd->add_flag("--hide-ui", o.hideUi, "No control panel: the window is exactly --width x --height");
     cmd->add_flag("--benchmark", o.benchmark, "Print a JSON line of frame and stage timings at exit");
     cmd->callback([opt] { view::runViewer(*opt); });

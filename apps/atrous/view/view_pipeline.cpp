@@ -3,6 +3,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/blocked_range2d.h>
+#include <sys/resource.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -59,6 +60,13 @@ constexpr float kPi = 3.14159265358979f;
 
 }  // namespace
 
+double processCpuMs() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return (double(u.ru_utime.tv_sec) + double(u.ru_stime.tv_sec)) * 1e3 +
+           (double(u.ru_utime.tv_usec) + double(u.ru_stime.tv_usec)) * 1e-3;
+}
+
 // ---- orbit camera ----
 
 OrbitCamera OrbitCamera::fromCamera(const pt::Camera& c, float pivotDistance) {
@@ -114,8 +122,9 @@ ViewPipeline::ViewPipeline(const Scene& scene, int width, int height, Device dev
     }
     mFrame = detail::allocateRenderBuffers(width, height, Device::Cpu);
     const size_t n = size_t(width) * height;
-    for (auto* v : {&mSumX, &mSumX2, &mSumM2, &mSumAlbedo, &mSumNormal, &mSumPosition}) v->assign(3 * n, 0.0);
-    mSumDepth.assign(n, 0.0);
+    for (auto* v : {&mSumX, &mSumX2, &mSumM2}) v->assign(3 * n, 0.0);
+    for (auto* v : {&mSumAlbedo, &mSumNormal, &mSumPosition}) v->assign(3 * n, 0.0f);
+    mSumDepth.assign(n, 0.0f);
     mFeatureHits.assign(n, 0);
     mDepthHits.assign(n, 0);
     for (Image* img : {&mColor, &mVariance, &mAlbedo, &mNormal, &mPosition, &mDepth, &mIds, &mMotion, &mEmission})
@@ -167,71 +176,91 @@ void ViewPipeline::accumulateFrame(bool accumulate) {
     const int w = mWidth;
     const size_t plane = size_t(w) * mHeight;
     const bool restart = !accumulate || !mAccumulating;
-    if (restart) {
-        mFrames = 0;
-        mIds.copyFrom(mFrame.ids);  // ids are not averaged (as the renderer: the first sample's)
-    }
     mAccumulating = accumulate;
-    ++mFrames;
+    if (restart) {
+        // One frame: its buffers are the filters' input as they are (the renderer already averaged
+        // the frame's samples). The sums are seeded only when later frames will add to them.
+        mFrames = 1;
+        mColor.copyFrom(mFrame.color);
+        mVariance.copyFrom(mFrame.variance);
+        mAlbedo.copyFrom(mFrame.albedo);
+        mNormal.copyFrom(mFrame.normal);
+        mPosition.copyFrom(mFrame.position);
+        mDepth.copyFrom(mFrame.depth);
+        mIds.copyFrom(mFrame.ids);  // ids are never averaged (as the renderer: the first sample's)
+        mVarianceValid = mSppAccumulated > 1;
+        if (!accumulate) return;
+    } else {
+        ++mFrames;
+    }
     const int N = mFrames;
     const double spp = double(mSppAccumulated);
-    forRows(mHeight, [&](int y) {
+    const double invN = 1.0 / N;
+    const double n = double(N) * spp;
+    const double invVar = n > 1 ? 1.0 / (n * (n - 1.0)) : 0.0;
+    const bool withinFrame = mSppAccumulated > 1;  // at 1 spp a frame has no own variance
+    const float* fc = mFrame.color.data();
+    const float* fv = mFrame.variance.data();
+    const float* fa = mFrame.albedo.data();
+    const float* fn = mFrame.normal.data();
+    const float* fp = mFrame.position.data();
+    const float* fd = mFrame.depth.data();
+    auto rows = [&](int y) {
         for (int x = 0; x < w; ++x) {
             const size_t p = size_t(y) * w + x;
+            const bool featureHit = fn[p] != 0.0f || fn[plane + p] != 0.0f || fn[2 * plane + p] != 0.0f;
+            const bool depthHit = fd[p] < 0.1f * kBackgroundDepth;
             if (restart) {
+                mFeatureHits[p] = featureHit;
+                mDepthHits[p] = depthHit;
+                mSumDepth[p] = depthHit ? fd[p] : 0.0f;
                 for (int c = 0; c < 3; ++c) {
-                    mSumX[c * plane + p] = mSumX2[c * plane + p] = mSumM2[c * plane + p] = 0.0;
-                    mSumAlbedo[c * plane + p] = mSumNormal[c * plane + p] = mSumPosition[c * plane + p] = 0.0;
+                    const size_t i = c * plane + p;
+                    const double v = fc[i];
+                    mSumX[i] = v;
+                    mSumX2[i] = v * v;
+                    if (withinFrame) mSumM2[i] = double(fv[i]) * spp * (spp - 1.0);
+                    mSumAlbedo[i] = fa[i];
+                    mSumNormal[i] = featureHit ? fn[i] : 0.0f;
+                    mSumPosition[i] = featureHit ? fp[i] : 0.0f;
                 }
-                mSumDepth[p] = 0.0;
-                mFeatureHits[p] = mDepthHits[p] = 0;
+                continue;  // outputs already copied
             }
-            const float* nrm = mFrame.normal.data();
-            const bool featureHit = nrm[p] != 0.0f || nrm[plane + p] != 0.0f || nrm[2 * plane + p] != 0.0f;
-            const float d = mFrame.depth.data()[p];
-            const bool depthHit = d < 0.1f * kBackgroundDepth;
-            mFeatureHits[p] += featureHit;
-            mDepthHits[p] += depthHit;
-            if (depthHit) mSumDepth[p] += d;
+            const int fh = mFeatureHits[p] += featureHit;
+            const int dh = mDepthHits[p] += depthHit;
+            if (depthHit) mSumDepth[p] += fd[p];
+            const float depth = dh ? mSumDepth[p] / float(dh) : kBackgroundDepth;
+            const float invFh = fh ? 1.0f / float(fh) : 0.0f;
+            float nrm[3];
             for (int c = 0; c < 3; ++c) {
                 const size_t i = c * plane + p;
-                const double x_ = mFrame.color.data()[i];
-                mSumX[i] += x_;
-                mSumX2[i] += x_ * x_;
-                // The frame's own sum of squared deviations: variance of its mean · s (s - 1).
-                mSumM2[i] += double(mFrame.variance.data()[i]) * spp * (spp - 1.0);
-                mSumAlbedo[i] += mFrame.albedo.data()[i];
-                if (featureHit) {
-                    mSumNormal[i] += mFrame.normal.data()[i];
-                    mSumPosition[i] += mFrame.position.data()[i];
-                }
-            }
-            // Finalise: mean colour, variance of the mean pooled over all N·s samples
-            // (M2 = Σ M2_k + s Σ (x_k - x̄)², var = M2 / (n (n - 1))), averaged features.
-            const double n = double(N) * spp;
-            double nx = 0, ny = 0, nz = 0;
-            for (int c = 0; c < 3; ++c) {
-                const size_t i = c * plane + p;
-                const double mean = mSumX[i] / N;
+                const double v = fc[i];
+                const double sx = mSumX[i] += v;
+                const double sx2 = mSumX2[i] += v * v;
+                // Each frame's own sum of squared deviations: the variance of its mean · s (s - 1).
+                const double sm2 = withinFrame ? (mSumM2[i] += double(fv[i]) * spp * (spp - 1.0)) : 0.0;
+                // Variance of the mean pooled over all n = N·s samples:
+                // M2 = Σ M2_k + s Σ (x_k - x̄)²,  var = M2 / (n (n - 1)).
+                const double mean = sx * invN;
+                const double m2 = sm2 + spp * std::max(0.0, sx2 - sx * mean);
                 mColor.data()[i] = float(mean);
-                const double between = std::max(0.0, mSumX2[i] - mSumX[i] * mean);
-                const double m2 = mSumM2[i] + spp * between;
-                mVariance.data()[i] = n > 1 ? float(m2 / (n * (n - 1.0))) : 0.0f;
-                mAlbedo.data()[i] = float(mSumAlbedo[i] / N);
-                const int fh = mFeatureHits[p];
-                mPosition.data()[i] = fh ? float(mSumPosition[i] / fh) : 0.0f;
-                const double nv = fh ? mSumNormal[i] / fh : 0.0;
-                (c == 0 ? nx : c == 1 ? ny : nz) = nv;
-                mDepth.data()[i] = mDepthHits[p] ? float(mSumDepth[p] / mDepthHits[p]) : kBackgroundDepth;
+                mVariance.data()[i] = float(m2 * invVar);
+                mAlbedo.data()[i] = (mSumAlbedo[i] += fa[i]) * float(invN);
+                if (featureHit) {
+                    mSumNormal[i] += fn[i];
+                    mSumPosition[i] += fp[i];
+                }
+                mPosition.data()[i] = mSumPosition[i] * invFh;
+                nrm[c] = mSumNormal[i] * invFh;
+                mDepth.data()[i] = depth;
             }
-            const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
-            const double inv = len > 0 ? 1.0 / len : 0.0;
-            mNormal.data()[p] = float(nx * inv);
-            mNormal.data()[plane + p] = float(ny * inv);
-            mNormal.data()[2 * plane + p] = float(nz * inv);
+            const float len = std::sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+            const float inv = len > 0 ? 1.0f / len : 0.0f;
+            for (int c = 0; c < 3; ++c) mNormal.data()[c * plane + p] = nrm[c] * inv;
         }
-    });
-    mVarianceValid = double(N) * spp > 1.0;
+    };
+    forRows(mHeight, rows);
+    mVarianceValid = n > 1.0;
 }
 
 void ViewPipeline::computeMotion() {
@@ -382,31 +411,34 @@ void ViewPipeline::step(const PipelineSettings& s) {
         mSppAccumulated = s.sppPerFrame;
     }
     Timer t;
+    double c = processCpuMs();
+    auto lap = [&](double& wall, double& cpu) {
+        wall = t.ms();
+        const double now = processCpuMs();
+        cpu = now - c;
+        c = now;
+        t.reset();
+    };
     renderFrame(s);
-    mTimes.render = t.ms();
+    lap(mTimes.render, mTimes.renderCpu);
 
-    t.reset();
     accumulateFrame(s.accumulate);
-    mTimes.accumulate = t.ms();
+    lap(mTimes.accumulate, mTimes.accumulateCpu);
 
     const bool svgf = s.methodA == Method::Svgf || (s.split && s.methodB == Method::Svgf);
-    t.reset();
     if (svgf) {
         computeMotion();
         computeEmission();
     }
-    mTimes.motion = t.ms();
+    lap(mTimes.motion, mTimes.motionCpu);
 
     if (!s.sureFractions) mSureS = Image();
-    t.reset();
     runSlot(0, s.methodA, s);
-    mTimes.denoiseA = t.ms();
-    t.reset();
+    lap(mTimes.denoiseA, mTimes.denoiseACpu);
     if (s.split) runSlot(1, s.methodB, s);
     else mSlots[1] = SlotResult{};
-    mTimes.denoiseB = t.ms();
+    lap(mTimes.denoiseB, mTimes.denoiseBCpu);
 
-    t.reset();
     mDetail = Image();
     mDetailLevelShown = -1;
     if (s.detailLevel >= 0 && s.detailLevel < s.eaw.levels) {
@@ -440,7 +472,7 @@ void ViewPipeline::step(const PipelineSettings& s) {
             mDetail = Image();
         }
     }
-    mTimes.debug = t.ms();
+    lap(mTimes.debug, mTimes.debugCpu);
 
     mPrevCamera = mCamera;
     mCameraMoved = false;

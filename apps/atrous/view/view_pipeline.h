@@ -44,10 +44,16 @@ struct PipelineSettings {
     bool sureFractions = false;  // capture SURE's s_i(p) (CPU only)
 };
 
-// Milliseconds spent in each stage of the last step().
+// Milliseconds spent in each stage of the last step(): wall clock, and CPU time of the whole process
+// (user + system over all threads, getrusage), which other tenants of a shared machine distort
+// much less.
 struct StageTimes {
     double render = 0, accumulate = 0, motion = 0, denoiseA = 0, denoiseB = 0, debug = 0;
+    double renderCpu = 0, accumulateCpu = 0, motionCpu = 0, denoiseACpu = 0, denoiseBCpu = 0, debugCpu = 0;
 };
+
+// Process CPU time (user + system, all threads) in milliseconds.
+double processCpuMs();
 
 // One slot's result.
 struct SlotResult {
@@ -128,8 +134,10 @@ private:
     uint64_t mFrameIndex = 0;       // seeds: every frame draws fresh samples
 
     RenderBuffers mFrame;  // this frame's render
-    // Running sums (double: thousands of frames without cancellation trouble).
-    std::vector<double> mSumX, mSumX2, mSumM2, mSumAlbedo, mSumNormal, mSumPosition, mSumDepth;
+    // Running sums of the colour moments (double: E[x²] - E[x]² over thousands of frames without
+    // cancellation trouble) and of the features (float: plain averages).
+    std::vector<double> mSumX, mSumX2, mSumM2;
+    std::vector<float> mSumAlbedo, mSumNormal, mSumPosition, mSumDepth;
     std::vector<int> mFeatureHits, mDepthHits;
     int mFrames = 0, mSppAccumulated = 0;
     bool mAccumulating = false;

@@ -17,6 +17,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "atrous/device.h"
@@ -393,11 +394,13 @@ void runViewer(const ViewerOptions& opt) {
     int snapCounter = 0;
     bool dragging[3] = {false, false, false};
     std::vector<double> frameMs, renderMs, accMs, motionMs, denAMs, denBMs, debugMs, displayMs;
+    std::vector<double> frameCpu, renderCpu, accCpu, motionCpu, denACpu, denBCpu, debugCpu;
     Timer frameTimer, lastFrame;
     double displayTime = 0;
 
     for (int frame = 0; !glfwWindowShouldClose(win); ++frame) {
         frameTimer.reset();
+        const double cpuStart = processCpuMs();
         glfwPollEvents();
         const float dt = float(std::min(0.1, lastFrame.seconds()));
         lastFrame.reset();
@@ -445,8 +448,12 @@ void runViewer(const ViewerOptions& opt) {
                     moved = true;
                 }
             }
-            if (moved) pl.setCamera(orbit.camera());
         }
+        if (opt.orbitDegPerFrame != 0.0f && pl.cameraMovable() && !paused && frame > 0) {
+            orbit.orbit(opt.orbitDegPerFrame * 3.14159265f / 180.0f, 0.0f);
+            moved = true;
+        }
+        if (moved) pl.setCamera(orbit.camera());
         bool snapshot = ImGui::IsKeyPressed(GLFW_KEY_F12, false) ||
                         (!io.WantCaptureKeyboard && ImGui::IsKeyPressed(GLFW_KEY_P, false));
         if (!io.WantCaptureKeyboard && ImGui::IsKeyPressed(GLFW_KEY_TAB, false)) uiVisible = !uiVisible;
@@ -494,10 +501,11 @@ void runViewer(const ViewerOptions& opt) {
             ImGui::SetNextWindowPos(ImVec2(float(fbw) - kPanelWidth, 0), ImGuiCond_Always);
             ImGui::SetNextWindowSize(ImVec2(kPanelWidth, float(fbh)), ImGuiCond_Always);
             ImGui::Begin("atrous view", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+            ImGui::PushItemWidth(150.0f);  // leaves the labels their room
             const StageTimes& t = pl.times();
             const double lastMs = frameMs.empty() ? 0.0 : frameMs.back();
             ImGui::Text("%s  %dx%d  %s", scene.name().c_str(), w, h, deviceToString(device));
-            ImGui::Text("frame %d   %d spp   %.1f ms (%.1f fps)", frame, pl.samplesPerPixel(), lastMs,
+            ImGui::Text("frame %d   %d spp   %.1f ms (%.1f fps)", frame + 1, pl.samplesPerPixel(), lastMs,
                         lastMs > 0 ? 1000.0 / lastMs : 0.0);
             ImGui::Text("render %.1f  accum %.1f  motion %.1f ms", t.render, t.accumulate, t.motion);
             ImGui::Text("filter A %.1f (%s %.1f)  B %.1f ms", t.denoiseA, methodName(pl.slot(0).method),
@@ -515,8 +523,7 @@ void runViewer(const ViewerOptions& opt) {
             if (pl.cameraMovable()) {
                 ImGui::SliderFloat("move speed", &moveSpeed, 0.05f, 4.0f, "%.2f", ImGuiSliderFlags_Logarithmic);
                 if (ImGui::Button("reset camera")) resetCamera = true;
-                ImGui::SameLine();
-                ImGui::TextDisabled("LMB orbit, RMB/MMB pan, wheel zoom, WASD QE");
+                ImGui::TextDisabled("drag: left orbit, right/middle pan\nwheel zoom, WASD move, Q/E down/up");
             } else {
                 ImGui::TextDisabled("camera fixed (CUDA renderer has no camera hook)");
             }
@@ -600,6 +607,7 @@ void runViewer(const ViewerOptions& opt) {
             ImGui::TextDisabled("to %s/snap_NNNN/", opt.outDir.c_str());
             if (!status.empty()) ImGui::TextWrapped("%s", status.c_str());
             ImGui::TextDisabled("Tab hides this panel, Esc quits");
+            ImGui::PopItemWidth();
             ImGui::End();
         }
         if (resetCamera) {
@@ -635,6 +643,13 @@ void runViewer(const ViewerOptions& opt) {
         glfwSwapBuffers(win);
 
         frameMs.push_back(frameTimer.ms());
+        frameCpu.push_back(processCpuMs() - cpuStart);
+        renderCpu.push_back(pl.times().renderCpu);
+        accCpu.push_back(pl.times().accumulateCpu);
+        motionCpu.push_back(pl.times().motionCpu);
+        denACpu.push_back(pl.times().denoiseACpu);
+        denBCpu.push_back(pl.times().denoiseBCpu);
+        debugCpu.push_back(pl.times().debugCpu);
         const StageTimes& t = pl.times();
         renderMs.push_back(t.render);
         accMs.push_back(t.accumulate);
@@ -677,6 +692,20 @@ void runViewer(const ViewerOptions& opt) {
         j.num("denoise_b_ms", median(tail(denBMs)));
         j.num("debug_ms", median(tail(debugMs)));
         j.num("display_ms", median(tail(displayMs)));
+        // CPU time (user + system, all threads) per frame: on a shared machine the wall-clock figures
+        // above depend on the other tenants; frame CPU time / cores bounds the frame time on an
+        // idle machine from below (exact when every stage keeps all cores busy).
+        j.num("cpu_ms_per_frame_median", median(tail(frameCpu)));
+        j.num("render_cpu_ms", median(tail(renderCpu)));
+        j.num("accumulate_cpu_ms", median(tail(accCpu)));
+        j.num("motion_cpu_ms", median(tail(motionCpu)));
+        j.num("denoise_a_cpu_ms", median(tail(denACpu)));
+        j.num("denoise_b_cpu_ms", median(tail(denBCpu)));
+        j.num("debug_cpu_ms", median(tail(debugCpu)));
+        const int cores = int(std::thread::hardware_concurrency());
+        j.num("hardware_threads", cores);
+        const double cpuMed = median(tail(frameCpu));
+        j.num("fps_idle_estimate", cpuMed > 0 ? 1000.0 * std::max(1, cores) / cpuMed : 0.0);
         j.str("device", deviceName(device));
         std::printf("{%s}\n", j.s.str().c_str());
         std::fflush(stdout);

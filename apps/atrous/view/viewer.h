@@ -23,6 +23,7 @@ struct ViewerOptions {
     std::string screenshot;
     std::string dumpDir;  // headless: also write every buffer (EXR) here at the end
     std::string outDir = "atrous_view";  // F12 / P snapshots go to OUT/snap_NNNN/
+    float orbitDegPerFrame = 0.0f;  // turntable: yaw the orbit camera by this much every frame
     bool hideUi = false;  // no control panel: the window is exactly width x height
     bool benchmark = false;  // print a JSON line with frame and stage timings at exit
 };
