@@ -57,7 +57,7 @@ private:
 }  // namespace
 
 RenderBuffers renderBvhCuda(const Scene& scene, const RenderSettings& settings) {
-    detail::validateRenderSettings(settings);
+    validateRenderSettings(settings);
     if (!cudaAvailable()) throw InputError("--device cuda: no CUDA device is available");
     const pt::SceneData& data = scene.data();
     BvhData bvh = pt::buildSceneBvh(data);

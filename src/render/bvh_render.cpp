@@ -1,33 +1,17 @@
-// CPU driver of the BVH path tracer (the GPU's code path on TBB threads), the settings check
-// shared with the CUDA driver, and the CUDA entry point's stand-in for builds without CUDA.
+// CPU driver of the BVH path tracer (the GPU's code path on TBB threads) and the CUDA entry
+// point's stand-in for builds without CUDA.
 #include "render/bvh_render.h"
 
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
-#include <string>
-
 #include "atrous/error.h"
 
 namespace atrous {
-namespace detail {
-
-void validateRenderSettings(const RenderSettings& s) {
-    if (s.width <= 0 || s.width > kMaxImageDim)
-        throw InputError("--width: " + std::to_string(s.width) + " is out of range (1.." + std::to_string(kMaxImageDim) + ")");
-    if (s.height <= 0 || s.height > kMaxImageDim)
-        throw InputError("--height: " + std::to_string(s.height) + " is out of range (1.." + std::to_string(kMaxImageDim) + ")");
-    if (s.spp <= 0) throw InputError("--spp: must be at least 1 (got " + std::to_string(s.spp) + ")");
-    if (s.maxDepth < 0 || s.maxDepth > 1024)
-        throw InputError("--max-depth: " + std::to_string(s.maxDepth) + " is out of range (0..1024)");
-    if (s.threads < 0) throw InputError("--threads: must be 0 (all cores) or more (got " + std::to_string(s.threads) + ")");
-}
-
-}  // namespace detail
 
 RenderBuffers renderBvhCpu(const Scene& scene, const RenderSettings& settings) {
-    detail::validateRenderSettings(settings);
+    validateRenderSettings(settings);  // include/atrous/render.h
     const pt::SceneData& data = scene.data();
     BvhData bvh = pt::buildSceneBvh(data);
     RenderBuffers b = detail::allocateRenderBuffers(settings.width, settings.height, Device::Cpu);
