@@ -422,7 +422,12 @@ void ViewPipeline::step(const PipelineSettings& s) {
     renderFrame(s);
     lap(mTimes.render, mTimes.renderCpu);
 
-    accumulateFrame(s.accumulate);
+    if (s.needAccumulated) {
+        accumulateFrame(s.accumulate);
+    } else {
+        mAccumulating = false;
+        mFrames = 1;
+    }
     lap(mTimes.accumulate, mTimes.accumulateCpu);
 
     const bool svgf = s.methodA == Method::Svgf || (s.split && s.methodB == Method::Svgf);

@@ -462,6 +462,11 @@ void runViewer(const ViewerOptions& opt) {
         // ---- render, accumulate, denoise ----
         ps.detailLevel = view == BufferView::Detail ? level : -1;
         ps.sureFractions = view == BufferView::SureFractions;
+        const bool lastFrame = headless && frame + 1 >= opt.frames;
+        auto onRunningMean = [](Method m) { return m != Method::Svgf; };
+        ps.needAccumulated = onRunningMean(ps.methodA) || (ps.split && onRunningMean(ps.methodB)) ||
+                             !(view == BufferView::Result || view == BufferView::Motion) || snapshot ||
+                             (lastFrame && !opt.dumpDir.empty());
         const bool doStep = !paused || moved || frame == 0;
         if (doStep) pl.step(ps);
 
