@@ -30,7 +30,7 @@ std::string errorOf(F f) {
 }
 
 TEST(SceneBuiltin, AllNamesBuildWithLightsAndGeometry) {
-    ASSERT_EQ(builtinSceneNames().size(), 4u);
+    ASSERT_EQ(builtinSceneNames().size(), 5u);  // cornell, cornell-point, cornell-spheres, sphere-env, cornell-moving
     for (const auto& name : builtinSceneNames()) {
         Scene s = Scene::builtin(name);
         const auto& d = s.data();

@@ -14,6 +14,7 @@
 #include "commands.h"
 #include "core/timer.h"
 #include "io/image_io.h"
+#include "io/sequence.h"
 
 namespace atrous::cli {
 namespace {
@@ -23,7 +24,76 @@ struct RenderArgs {
     std::string out;
     std::string denoise;
     RenderSettings settings;
+    // Animation (--frames): 0 = a still image as before.
+    int frames = 0;
+    bool framesGiven = false;
+    int referenceSpp = 0;
+    std::string cameraPath = "auto";
 };
+
+// Seeds of the noisy and reference renders of frame f: every frame gets its own noise (a temporal
+// filter must not see the same pattern twice) and the reference never shares a stream with it.
+uint32_t frameSeed(uint32_t seed, int f) { return seed + uint32_t(f); }
+uint32_t referenceSeed(uint32_t seed, int f) { return seed + 0x9E3779B9u + uint32_t(f) * 7919u; }
+
+void writeBuffers(const std::string& dir, const RenderBuffers& b) {
+    namespace fs = std::filesystem;
+    auto path = [&](const std::string& name) { return (fs::path(dir) / name).string(); };
+    io::writeImage(path("color.exr"), b.color);
+    io::writeImage(path("variance.exr"), b.variance);
+    io::writeImage(path("albedo.exr"), b.albedo);
+    io::writeImage(path("normal.exr"), b.normal);
+    io::writeImage(path("position.exr"), b.position);
+    io::writeImage(path("depth.exr"), b.depth);
+    io::writeImage(path("ids.exr"), b.ids);
+}
+
+// `atrous render --frames F`: DIR/frame_NNNN/ per frame (time t = f / max(F - 1, 1)) with the
+// usual buffers plus motion.exr and emission.exr, and reference.exr with --reference-spp.
+void runFrames(const RenderArgs& a) {
+    if (a.frames < 1) throw InputError("--frames: must be at least 1 (got " + std::to_string(a.frames) + ")");
+    if (a.frames > 100000) throw InputError("--frames: at most 100000 (got " + std::to_string(a.frames) + ")");
+    if (a.referenceSpp < 0) throw InputError("--reference-spp: must be at least 1 (got " + std::to_string(a.referenceSpp) + ")");
+    if (!a.denoise.empty()) throw InputError("--denoise: not with --frames (denoise the sequence with atrous denoise --sequence)");
+    const RenderSettings& s = a.settings;
+    validateRenderSettings(s);
+    RenderSettings ref = s;
+    ref.spp = a.referenceSpp > 0 ? a.referenceSpp : 1;
+    validateRenderSettings(ref);
+    CameraPath path = parseCameraPath(a.cameraPath);
+    Scene scene = Scene::loadByNameOrFile(a.scene);
+    (void)scene.atTime(0.0f, path);  // InputError now (keyframes missing), before anything is written
+    io::ensureWritableDirectory(a.out);
+
+    namespace fs = std::filesystem;
+    Timer total;
+    for (int f = 0; f < a.frames; ++f) {
+        const float t = frameTime(f, a.frames);
+        const float tPrev = f > 0 ? frameTime(f - 1, a.frames) : t;  // frame 0: no previous frame, motion 0
+        RenderSettings fs_ = s;
+        fs_.seed = frameSeed(s.seed, f);
+        Timer timer;
+        RenderBuffers b = renderFrame(scene, path, t, tPrev, fs_);
+        Image reference;
+        if (a.referenceSpp > 0) {
+            ref.seed = referenceSeed(s.seed, f);
+            reference = renderFrame(scene, path, t, t, ref).color;
+        }
+        double seconds = timer.seconds();
+        const std::string dir = (fs::path(a.out) / io::sequenceFrameName(f)).string();
+        io::ensureWritableDirectory(dir);
+        writeBuffers(dir, b);
+        io::writeImage((fs::path(dir) / "motion.exr").string(), b.motion);
+        io::writeImage((fs::path(dir) / "emission.exr").string(), b.emission);
+        if (!reference.empty()) io::writeImage((fs::path(dir) / "reference.exr").string(), reference);
+        io::writePng((fs::path(dir) / "color.png").string(), b.color);
+        std::printf("frame %d/%d (t = %.4f): %.3f s -> %s\n", f + 1, a.frames, t, seconds, dir.c_str());
+        std::fflush(stdout);
+    }
+    std::printf("rendered %s: %d frames, %dx%d, %d spp%s, %.3f s -> %s\n", scene.name().c_str(), a.frames, s.width,
+                s.height, s.spp, a.referenceSpp > 0 ? (", reference " + std::to_string(a.referenceSpp) + " spp").c_str() : "",
+                total.seconds(), a.out.c_str());
+}
 
 std::vector<DenoiseMethod> parseMethods(const std::string& list) {
     std::vector<DenoiseMethod> methods;
@@ -38,6 +108,9 @@ std::vector<DenoiseMethod> parseMethods(const std::string& list) {
 }
 
 void run(const RenderArgs& a) {
+    if (a.framesGiven) return runFrames(a);
+    if (a.referenceSpp != 0) throw InputError("--reference-spp: only with --frames");
+    if (a.cameraPath != "auto") throw InputError("--camera-path: only with --frames");
     // Everything that can be checked before rendering is: settings, scene, methods, output dir.
     std::vector<DenoiseMethod> methods = parseMethods(a.denoise);
     const RenderSettings& s = a.settings;
@@ -72,13 +145,7 @@ void run(const RenderArgs& a) {
     // All in memory: now write, each file atomically.
     namespace fs = std::filesystem;
     auto path = [&](const std::string& name) { return (fs::path(a.out) / name).string(); };
-    io::writeImage(path("color.exr"), b.color);
-    io::writeImage(path("variance.exr"), b.variance);
-    io::writeImage(path("albedo.exr"), b.albedo);
-    io::writeImage(path("normal.exr"), b.normal);
-    io::writeImage(path("position.exr"), b.position);
-    io::writeImage(path("depth.exr"), b.depth);
-    io::writeImage(path("ids.exr"), b.ids);
+    writeBuffers(a.out, b);
     io::writePng(path("color.png"), b.color);
     for (const auto& [name, img] : denoised) {
         io::writeImage(path("denoised_" + name + ".exr"), img);
@@ -108,7 +175,14 @@ void addRenderCommand(CLI::App& app) {
     cmd->add_option("--max-depth", args->settings.maxDepth, "Maximum bounces (1 = direct light only)")->capture_default_str();
     cmd->add_option("--threads", args->settings.threads, "Worker threads (0 = all cores)")->capture_default_str();
     cmd->add_option("--denoise", args->denoise, "Also denoise with these methods (comma list: eaw,sure)");
-    cmd->callback([args] { run(*args); });
+    auto* frames = cmd->add_option("--frames", args->frames,
+                                   "Render an animation of this many frames into OUT/frame_NNNN/ (time t = f / max(F-1, 1))");
+    cmd->add_option("--reference-spp", args->referenceSpp, "With --frames: also write reference.exr per frame at this spp (other seed)");
+    cmd->add_option("--camera-path", args->cameraPath, "With --frames: auto, static, orbit, dolly or keyframes")->capture_default_str();
+    cmd->callback([args, frames] {
+        args->framesGiven = frames->count() > 0;
+        run(*args);
+    });
 }
 
 }  // namespace atrous::cli

@@ -37,9 +37,26 @@ struct RenderSettings {
 //   depth     distance of the primary hit along the camera's forward axis, repeated in R,G,B;
 //             1e30 for background
 //   ids       R = mesh id, G = material id, B = 0; -1 for background
+//   motion    (animation frames only, renderFrame) R = dx, G = dy in pixels, B = 0: the primary
+//             hit's image position in the previous frame minus its position now (mean over the
+//             samples); background from the camera rotation alone; empty for render()
+//   emission  emitted radiance of the primary hit towards the camera (front faces of emitters),
+//             0 elsewhere and for background
 struct RenderBuffers {
     Image color, variance, albedo, normal, position, depth, ids;
+    Image motion, emission;
 };
+
+// Camera paths of animations (docs/scenes.md, "Animation"). Time t in [0, 1] spans the sequence.
+//   Static     the scene's camera at every t
+//   Orbit      turns about the vertical axis through the camera's target, -10..+10 degrees
+//   Dolly      moves towards the target by a quarter of the distance to it
+//   Keyframes  the scene's "camera.keyframes" (JSON scenes), Catmull-Rom interpolated
+//   Auto       Keyframes when the scene has keyframes, else Static
+enum class CameraPath { Auto, Static, Orbit, Dolly, Keyframes };
+
+// "auto", "static", "orbit", "dolly", "keyframes"; InputError naming --camera-path otherwise.
+CameraPath parseCameraPath(const std::string& name);
 
 // Depth written for pixels that see no surface (a finite stand-in for +inf).
 constexpr float kBackgroundDepth = 1e30f;
@@ -48,6 +65,9 @@ constexpr float kBackgroundDepth = 1e30f;
 // immutable data).
 class Scene {
 public:
+    Scene() = default;
+    explicit Scene(std::shared_ptr<const pt::SceneData> data) : mData(std::move(data)) {}
+
     // One of builtinSceneNames(); throws InputError naming the unknown scene otherwise.
     static Scene builtin(const std::string& name);
     // A JSON scene file (docs/scenes.md); OBJ and texture paths are relative to the file.
@@ -67,6 +87,14 @@ public:
 
     const pt::SceneData& data() const { return *mData; }
 
+    // Whether the scene has camera keyframes / objects with a "motion".
+    bool hasCameraKeyframes() const;
+    bool hasMovingObjects() const;
+    // The scene posed at animation time t in [0, 1]: camera on `path`, moving objects moved.
+    // Call it on the scene as loaded (InputError for a posed scene, or for Keyframes on a scene
+    // without keyframes).
+    Scene atTime(float t, CameraPath path) const;
+
 private:
     std::shared_ptr<const pt::SceneData> mData;
 };
@@ -77,7 +105,14 @@ const std::vector<std::string>& builtinSceneNames();
 // width or height <= 0 or > kMaxImageDim, maxDepth outside 0..1024, threads < 0.
 void validateRenderSettings(const RenderSettings& settings);
 
-// Renders `scene` on the CPU (validates the settings first).
+// Renders `scene` on the CPU (validates the settings first). motion stays empty; emission is filled.
 RenderBuffers render(const Scene& scene, const RenderSettings& settings);
+
+// Renders frame time t of the animated `scene` (as loaded) on the CPU, with motion vectors against
+// time tPrev (pass tPrev = t for a first frame: then every motion vector is 0 up to rounding).
+RenderBuffers renderFrame(const Scene& scene, CameraPath path, float t, float tPrev, const RenderSettings& settings);
+
+// Time of frame f of a sequence of `frames` frames: f / max(frames - 1, 1).
+inline float frameTime(int f, int frames) { return float(f) / float(frames > 1 ? frames - 1 : 1); }
 
 }  // namespace atrous

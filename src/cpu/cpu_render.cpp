@@ -13,6 +13,7 @@
 
 #include "atrous/error.h"
 #include "atrous/render.h"
+#include "render/animation.h"
 #include "render/integrator.h"
 #include "render/scene_data.h"
 
@@ -205,7 +206,10 @@ void validateRenderSettings(const RenderSettings& s) {
     if (s.threads < 0) throw InputError("--threads: must be 0 (all cores) or more (got " + std::to_string(s.threads) + ")");
 }
 
-RenderBuffers render(const Scene& scene, const RenderSettings& settings) {
+namespace {
+
+// `motion` == nullptr: a still image (no motion buffer).
+RenderBuffers renderImpl(const Scene& scene, const RenderSettings& settings, const pt::MotionReprojection* motion) {
     validateRenderSettings(settings);
     const SceneData& data = scene.data();
     RenderBuffers b;
@@ -217,13 +221,17 @@ RenderBuffers render(const Scene& scene, const RenderSettings& settings) {
     b.position = Image(w, h, 3);
     b.depth = Image(w, h, 3);
     b.ids = Image(w, h, 3);
+    b.emission = Image(w, h, 3);
+    if (motion) b.motion = Image(w, h, 3);
 
     EmbreeScene embree(data);
     pt::PathTraceKernel<EmbreeTracer> k;
     k.scene = data.view();
     k.tracer.scene = embree.handle();
     k.out = pt::RenderTargets{b.color.view(), b.variance.view(), b.albedo.view(), b.normal.view(),
-                                  b.position.view(), b.depth.view(), b.ids.view()};
+                                  b.position.view(), b.depth.view(), b.ids.view(),
+                                  b.motion.empty() ? ImageView{} : b.motion.view(), b.emission.view()};
+    if (motion) k.motion = *motion;
     k.width = w;
     k.height = h;
     k.spp = settings.spp;
@@ -246,6 +254,22 @@ RenderBuffers render(const Scene& scene, const RenderSettings& settings) {
         run();
     }
     return b;
+}
+
+}  // namespace
+
+RenderBuffers render(const Scene& scene, const RenderSettings& settings) { return renderImpl(scene, settings, nullptr); }
+
+RenderBuffers renderFrame(const Scene& scene, CameraPath path, float t, float tPrev, const RenderSettings& settings) {
+    validateRenderSettings(settings);
+    Scene posed = scene.atTime(t, path);
+    std::vector<float> toPrev = pt::meshToPrevious(scene.data(), t, tPrev);
+    pt::MotionReprojection m;
+    m.enabled = true;
+    m.previousCamera = pt::cameraAtTime(scene.data(), path, tPrev);
+    m.meshToPrevious = toPrev.data();
+    m.numMeshes = int32_t(scene.data().meshNames.size());
+    return renderImpl(posed, settings, &m);
 }
 
 }  // namespace atrous

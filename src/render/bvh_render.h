@@ -21,9 +21,6 @@ RenderBuffers renderBvhCuda(const Scene& scene, const RenderSettings& settings);
 
 namespace detail {
 
-// Checks the settings as atrous::render does (flag names in the messages).
-void validateRenderSettings(const RenderSettings& s);
-
 inline RenderBuffers allocateRenderBuffers(int w, int h, Device device) {
     RenderBuffers b;
     b.color = Image(w, h, 3, device);
@@ -33,6 +30,7 @@ inline RenderBuffers allocateRenderBuffers(int w, int h, Device device) {
     b.position = Image(w, h, 3, device);
     b.depth = Image(w, h, 3, device);
     b.ids = Image(w, h, 3, device);
+    b.emission = Image(w, h, 3, device);  // motion stays empty: still images only
     return b;
 }
 
@@ -43,7 +41,8 @@ pt::PathTraceKernel<Tracer> makePathTraceKernel(const pt::SceneView& scene, cons
     k.scene = scene;
     k.tracer = tracer;
     k.out = pt::RenderTargets{b.color.view(),    b.variance.view(), b.albedo.view(), b.normal.view(),
-                              b.position.view(), b.depth.view(),    b.ids.view()};
+                              b.position.view(), b.depth.view(),    b.ids.view(),
+                              ImageView{},       b.emission.view()};  // no motion buffer (still images)
     k.width = s.width;
     k.height = s.height;
     k.spp = s.spp;

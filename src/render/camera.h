@@ -25,4 +25,18 @@ ATROUS_INLINE Vec3 cameraRayDirection(const Camera& c, float px, float py, int w
     return normalize(c.forward + c.right * sx + c.up * sy);
 }
 
+// Inverse of cameraRayDirection: the image position (pixels) where the ray along `offset` (a point
+// minus the camera position, or a direction for points at infinity) crosses the image. False when
+// it is not in front of the camera.
+ATROUS_INLINE bool projectToImage(const Camera& c, Vec3 offset, int width, int height, float& px, float& py) {
+    float z = dot(offset, c.forward);
+    if (!(z > 1e-6f * length(offset))) return false;
+    float aspect = float(width) / float(height);
+    float sx = dot(offset, c.right) / (z * c.tanHalfFov * aspect);
+    float sy = dot(offset, c.up) / (z * c.tanHalfFov);
+    px = 0.5f * (sx + 1.0f) * float(width);
+    py = 0.5f * (1.0f - sy) * float(height);
+    return true;
+}
+
 }  // namespace atrous::pt

@@ -30,6 +30,12 @@ struct PathSample {
     float depth = -1;  // primary hit depth along the camera axis, < 0 when the camera ray escaped
     int32_t mesh = -1, material = -1;
     bool featureHit = false;
+    // The primary (camera-ray) hit, for motion vectors and the emission buffer: unlike the
+    // features above it does not follow delta bounces.
+    Vec3 primaryPosition;
+    Vec3 primaryEmission;  // emitted radiance towards the camera at the primary hit (front faces)
+    int32_t primaryMesh = -1;
+    bool primaryHit = false;
 };
 
 ATROUS_INLINE Vec3 clamp01(Vec3 v) {
@@ -83,7 +89,13 @@ ATROUS_HOST_DEVICE PathSample tracePath(const SceneView& s, const Tracer& tracer
         const Material& m = s.materials[si.material];
         Vec3 wo = -d;
         bool front = dot(si.ng, wo) > 0.0f;
-        if (bounce == 0) r.depth = dot(si.p - s.camera.position, s.camera.forward);
+        if (bounce == 0) {
+            r.depth = dot(si.p - s.camera.position, s.camera.forward);
+            r.primaryPosition = si.p;
+            r.primaryMesh = si.mesh;
+            r.primaryHit = true;
+            if (front) r.primaryEmission = m.emission;
+        }
 
         if (front && maxComponent(m.emission) > 0.0f) {
             float w = 1.0f;
@@ -158,8 +170,26 @@ ATROUS_HOST_DEVICE PathSample tracePath(const SceneView& s, const Tracer& tracer
 }
 
 // Per-pixel outputs of the path tracer, one ImageView (3 channels) each.
+// motion and emission are optional: a target with data == nullptr is not written.
 struct RenderTargets {
     ImageView color, variance, albedo, normal, position, depth, ids;
+    ImageView motion, emission;
+};
+
+// Offset written for a sample whose point was behind the previous camera: far off-screen, so a
+// temporal filter treats the pixel as disoccluded (finite, unlike NaN, so it never spreads).
+constexpr float kMotionOffscreen = -1.0e4f;
+
+// What the motion vectors reproject against (animation frames, src/render/animation.h).
+//   motion = (image position of the point in the previous frame) - (its image position now)
+// The previous position of a primary hit on mesh m is meshToPrevious[m] * p (a row-major 3x4
+// affine map, identity for static objects); background samples reproject their direction only
+// (camera rotation). meshToPrevious == nullptr means every object is static.
+struct MotionReprojection {
+    bool enabled = false;
+    Camera previousCamera;
+    const float* meshToPrevious = nullptr;  // 12 floats per mesh id (host memory: CPU renderer only)
+    int32_t numMeshes = 0;
 };
 
 // Renders all samples of pixel (x, y): the RNG stream of sample i is Rng(pixel, i, seed), so the
@@ -173,6 +203,26 @@ struct PathTraceKernel {
     uint32_t seed = 1;
     bool lightSampling = true;
     float backgroundDepth = 1e30f;
+    MotionReprojection motion;
+
+    // Screen-space motion of one camera sample at image position (sx, sy), previous - current.
+    ATROUS_HOST_DEVICE Vec3 sampleMotion(const PathSample& ps, Vec3 dir, float sx, float sy) const {
+        if (!motion.enabled) return Vec3(0.0f);
+        Vec3 offset = dir;  // background: direction only
+        if (ps.primaryHit) {
+            Vec3 p = ps.primaryPosition;
+            if (motion.meshToPrevious && ps.primaryMesh >= 0 && ps.primaryMesh < motion.numMeshes) {
+                const float* m = motion.meshToPrevious + 12 * ps.primaryMesh;
+                p = Vec3(m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3], m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
+                         m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]);
+            }
+            offset = p - motion.previousCamera.position;
+        }
+        float px = 0.0f, py = 0.0f;
+        if (!projectToImage(motion.previousCamera, offset, width, height, px, py))
+            return Vec3(kMotionOffscreen, kMotionOffscreen, 0.0f);
+        return Vec3(px - sx, py - sy, 0.0f);
+    }
 
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         uint32_t pixel = uint32_t(y) * uint32_t(width) + uint32_t(x);
@@ -181,6 +231,7 @@ struct PathTraceKernel {
         float depthSum = 0.0f;
         int featureHits = 0, depthHits = 0;
         int32_t mesh = -1, material = -1;
+        Vec3 motionSum(0.0f), emissionSum(0.0f);
         for (int i = 0; i < spp; ++i) {
             Rng rng(pixel, uint32_t(i), seed);
             float jx = rng.next(), jy = rng.next();
@@ -201,6 +252,8 @@ struct PathTraceKernel {
                 depthSum += ps.depth;
                 ++depthHits;
             }
+            if (out.motion.data) motionSum += sampleMotion(ps, dir, float(x) + jx, float(y) + jy);
+            emissionSum += ps.primaryEmission;
             if (i == 0) {  // ids are not averaged: the first sample's
                 mesh = ps.mesh;
                 material = ps.material;
@@ -220,6 +273,10 @@ struct PathTraceKernel {
             out.normal(x, y, c) = normal[c];
             out.position(x, y, c) = position[c];
             out.depth(x, y, c) = depth;
+        }
+        for (int c = 0; c < 3; ++c) {
+            if (out.motion.data) out.motion(x, y, c) = motionSum[c] / n;
+            if (out.emission.data) out.emission(x, y, c) = emissionSum[c] / n;
         }
         out.ids(x, y, 0) = float(mesh);
         out.ids(x, y, 1) = float(material);

@@ -101,6 +101,16 @@ public:
         d.env.texture = addTexture(img);
     }
     void setCamera(const Camera& c) { d.camera = c; }
+    // Look-at camera; the target is also what orbit and dolly paths turn about / move towards.
+    void setCamera(Vec3 eye, Vec3 target, Vec3 up, float fovDeg, Vec3 pathTarget) {
+        d.camera = makeLookAtCamera(eye, target, up, fovDeg);
+        d.cameraTarget = pathTarget;
+        d.cameraFovDeg = fovDeg;
+    }
+    void setMotion(int mesh, const MeshMotion& m) {
+        if (d.meshMotion.size() <= size_t(mesh)) d.meshMotion.resize(size_t(mesh) + 1);
+        d.meshMotion[size_t(mesh)] = m;
+    }
 
     std::shared_ptr<SceneData> finalize();
 
@@ -283,7 +293,8 @@ void addCornellRoom(SceneBuilder& b, bool areaLight, Vec3 lightRadiance, int flo
         b.addQuad(P(343, 548.7f, 227), P(343, 548.7f, 332), P(213, 548.7f, 332), P(213, 548.7f, 227), light,
                   b.addMesh("light"), Vec3(0, -1, 0));
     }
-    b.setCamera(makeLookAtCamera(P(278, 273, -800), P(278, 273, 0), Vec3(0, 1, 0), 39.3f));
+    // Paths turn about the middle of the box.
+    b.setCamera(P(278, 273, -800), P(278, 273, 0), Vec3(0, 1, 0), 39.3f, P(278, 273, 279.6f));
 }
 
 void addCornellBlocks(SceneBuilder& b) {
@@ -382,7 +393,26 @@ std::shared_ptr<SceneData> buildSphereEnv() {
     // Sun: 0.5 degree angular radius (a little larger than the real one so a 1024-wide map
     // resolves it), radiance ~2e4 (the sun's irradiance ~3x the sky's).
     b.setEnvMap(makeSkyMap(1024, 512, sun, 0.5f * kPi / 180.0f, Vec3(1.0f, 0.93f, 0.82f) * 20000.0f), 1.0f);
-    b.setCamera(makeLookAtCamera(Vec3(0.0f, 2.2f, 7.0f), Vec3(0.0f, 0.7f, 0.0f), Vec3(0, 1, 0), 38.0f));
+    b.setCamera(Vec3(0.0f, 2.2f, 7.0f), Vec3(0.0f, 0.7f, 0.0f), Vec3(0, 1, 0), 38.0f, Vec3(0.0f, 0.7f, 0.0f));
+    return b.finalize();
+}
+
+// The Cornell box with motion (for temporal denoisers): the short box turns 40 degrees about its
+// centre and a blue sphere floats from right to left above it over the sequence (t in [0, 1]).
+std::shared_ptr<SceneData> buildCornellMoving() {
+    SceneBuilder b("cornell-moving");
+    addCornellRoom(b, true, kCornellLight);
+    addCornellBlocks(b);
+    MeshMotion turn;
+    turn.rotateYDeg = 40.0f;
+    turn.pivot = Vec3(1.855f, 0.0f, 1.69f);  // the short box's footprint centre
+    b.setMotion(b.d.meshNames.size() - 2, turn);  // "short_box" (addCornellBlocks: short, then tall)
+    int blue = b.addMaterial("blue", diffuse(Vec3(0.1f, 0.2f, 0.7f)));
+    int sphere = b.addMesh("moving_sphere");
+    b.addSphere(Vec3(4.3f, 2.35f, 1.2f), 0.5f, blue, sphere);
+    MeshMotion slide;
+    slide.translate = Vec3(-3.0f, 0.0f, 0.0f);
+    b.setMotion(sphere, slide);
     return b.finalize();
 }
 
@@ -582,6 +612,50 @@ void loadObj(const JsonContext& c, SceneBuilder& b, const std::string& path, int
     if (triangles == 0) throw InputError(path + ": OBJ file contains no triangles");
 }
 
+// Centre of the bounding box of mesh `mesh` (triangles and spheres).
+Vec3 meshBoundsCentre(const SceneData& d, int mesh) {
+    Vec3 lo(1e30f), hi(-1e30f);
+    for (size_t t = 0; t < d.triMesh.size(); ++t)
+        if (d.triMesh[t] == mesh)
+            for (int k = 0; k < 3; ++k) {
+                lo = minv(lo, d.positions[d.indices[3 * t + k]]);
+                hi = maxv(hi, d.positions[d.indices[3 * t + k]]);
+            }
+    for (const Sphere& s : d.spheres)
+        if (s.mesh == mesh) {
+            lo = minv(lo, s.center - Vec3(s.radius));
+            hi = maxv(hi, s.center + Vec3(s.radius));
+        }
+    return lo.x <= hi.x ? (lo + hi) * 0.5f : Vec3(0.0f);
+}
+
+// "camera.keyframes": [{"t", "position", "target" (or "lookAt"), optional "up", "fov"}, ...] with
+// t strictly increasing; up and fov default to the camera's.
+std::vector<CameraKey> parseKeyframes(const JsonContext& c, const json& j, Vec3 up, float fov) {
+    if (!j.is_array() || j.empty()) fail(c, "camera.keyframes: must be a non-empty array of keyframe objects");
+    std::vector<CameraKey> keys;
+    for (size_t i = 0; i < j.size(); ++i) {
+        std::string where = "camera.keyframes[" + std::to_string(i) + "]";
+        const json& k = j[i];
+        if (!k.is_object()) fail(c, where + ": must be an object");
+        CameraKey key;
+        key.t = getFloat(c, k, "t", where, 0.0f, true);
+        key.position = getVec3(c, k, "position", where, Vec3(0.0f), true);
+        const char* targetKey = k.contains("target") ? "target" : "lookAt";
+        key.target = getVec3(c, k, targetKey, where, Vec3(0.0f), true);
+        key.up = getVec3(c, k, "up", where, up);
+        key.fovDeg = getFloat(c, k, "fov", where, fov);
+        if (!(key.fovDeg > 0.5f && key.fovDeg < 179.0f)) fail(c, where + ": \"fov\" must be in (0.5, 179) degrees");
+        Vec3 f = key.target - key.position;
+        if (length(f) <= 0.0f || length(cross(f, key.up)) <= 1e-6f * length(f) * length(key.up))
+            fail(c, where + ": \"target\" must differ from \"position\" and not be along \"up\"");
+        if (!keys.empty() && !(key.t > keys.back().t))
+            fail(c, where + ": \"t\" must be greater than the previous keyframe's (" + std::to_string(keys.back().t) + ")");
+        keys.push_back(key);
+    }
+    return keys;
+}
+
 std::shared_ptr<SceneData> parseJsonScene(const std::string& text, const JsonContext& c) {
     json root;
     try {
@@ -602,7 +676,8 @@ std::shared_ptr<SceneData> parseJsonScene(const std::string& text, const JsonCon
         if (!(fov > 0.5f && fov < 179.0f)) fail(c, "camera: \"fov\" must be in (0.5, 179) degrees");
         if (length(at - eye) <= 0.0f || length(cross(at - eye, up)) <= 1e-6f * length(at - eye) * length(up))
             fail(c, "camera: \"lookAt\" must differ from \"position\" and not be along \"up\"");
-        b.setCamera(makeLookAtCamera(eye, at, up, fov));
+        b.setCamera(eye, at, up, fov, at);
+        if (cam.contains("keyframes")) b.d.cameraKeys = parseKeyframes(c, cam.at("keyframes"), up, fov);
 
         // Materials.
         std::map<std::string, int> materials;
@@ -630,6 +705,7 @@ std::shared_ptr<SceneData> parseJsonScene(const std::string& text, const JsonCon
             if (!o.is_object()) fail(c, where + ": must be an object");
             std::string type = getString(c, o, "type", where);
             std::string name = o.contains("name") ? getString(c, o, "name", where) : type + std::to_string(index - 1);
+            const int meshCount = int(b.d.meshNames.size());
             if (type == "sphere") {
                 Vec3 center = getVec3(c, o, "center", where, Vec3(0.0f), true);
                 float radius = getFloat(c, o, "radius", where, 1.0f, true);
@@ -647,6 +723,20 @@ std::shared_ptr<SceneData> parseJsonScene(const std::string& text, const JsonCon
                 loadObj(c, b, file, materialRef(o, where, false), b.addMesh(name), parseTransform(c, o, where));
             } else {
                 fail(c, where + ": unknown object type \"" + type + "\" (sphere, quad, mesh)");
+            }
+            if (o.contains("motion")) {
+                const json& mj = o.at("motion");
+                if (!mj.is_object()) fail(c, where + ": \"motion\" must be an object");
+                for (auto it = mj.begin(); it != mj.end(); ++it)
+                    if (it.key() != "translate" && it.key() != "rotateY" && it.key() != "pivot")
+                        fail(c, where + ".motion: unknown key \"" + it.key() + "\" (translate, rotateY, pivot)");
+                MeshMotion m;
+                m.translate = getVec3(c, mj, "translate", where + ".motion", Vec3(0.0f));
+                m.rotateYDeg = getFloat(c, mj, "rotateY", where + ".motion", 0.0f);
+                // Default pivot: the centre of the object's bounding box.
+                m.pivot = mj.contains("pivot") ? getVec3(c, mj, "pivot", where + ".motion", Vec3(0.0f))
+                                                : meshBoundsCentre(b.d, meshCount);
+                b.setMotion(meshCount, m);
             }
         }
 
@@ -698,7 +788,7 @@ std::shared_ptr<SceneData> parseJsonScene(const std::string& text, const JsonCon
 // ---- public API ----
 
 const std::vector<std::string>& builtinSceneNames() {
-    static const std::vector<std::string> names = {"cornell", "cornell-point", "cornell-spheres", "sphere-env"};
+    static const std::vector<std::string> names = {"cornell", "cornell-point", "cornell-spheres", "sphere-env", "cornell-moving"};
     return names;
 }
 
@@ -708,6 +798,7 @@ Scene Scene::builtin(const std::string& name) {
     else if (name == "cornell-point") s.mData = pt::buildCornellPoint();
     else if (name == "cornell-spheres") s.mData = pt::buildCornellSpheres();
     else if (name == "sphere-env") s.mData = pt::buildSphereEnv();
+    else if (name == "cornell-moving") s.mData = pt::buildCornellMoving();
     else {
         std::string list;
         for (const auto& n : builtinSceneNames()) list += (list.empty() ? "" : ", ") + n;

@@ -103,6 +103,24 @@ struct SceneView {
     float sceneRadius = 1.0f;  // bounding-sphere radius (ray offsets)
 };
 
+// Animation (host only, src/render/animation.h). Time t runs over [0, 1] for the whole sequence.
+// A camera keyframe: pose at time t (smoothly interpolated between keys, Catmull-Rom).
+struct CameraKey {
+    float t = 0.0f;
+    Vec3 position, target;
+    Vec3 up = Vec3(0.0f, 1.0f, 0.0f);
+    float fovDeg = 40.0f;
+};
+
+// Rigid motion of one mesh, linear in t: at time t the rest geometry is rotated about the
+// vertical axis through `pivot` by rotateYDeg * t degrees, then translated by translate * t.
+struct MeshMotion {
+    Vec3 translate = Vec3(0.0f);
+    float rotateYDeg = 0.0f;
+    Vec3 pivot = Vec3(0.0f);
+    bool moving() const { return translate.x != 0.0f || translate.y != 0.0f || translate.z != 0.0f || rotateYDeg != 0.0f; }
+};
+
 // Host owner of the arrays (std::vector: host only; kernels see SceneView).
 struct SceneData {
     std::string name;
@@ -122,6 +140,13 @@ struct SceneData {
     Environment env;
     Camera camera;
     float sceneRadius = 1.0f;
+    // Animation: the rest pose above is time 0 of "static" paths; orbit and dolly paths start
+    // from `camera` and turn about / move towards `cameraTarget`.
+    Vec3 cameraTarget = Vec3(0.0f);
+    float cameraFovDeg = 40.0f;
+    std::vector<CameraKey> cameraKeys;    // empty = no keyframed path
+    std::vector<MeshMotion> meshMotion;   // per mesh id (may be shorter: missing = static)
+    bool posed = false;                   // true for a scene already moved to some time t
 
     SceneView view() const {
         SceneView v;
