@@ -24,16 +24,19 @@ using atrous::test::TempDir;
 namespace {
 
 bool viewerBuilt() {
-    static const bool built = runCli("view --help").output.find("--screenshot") != std::string::npos;
+    static const bool built =
+        runCli("view --help").output.find("--screenshot") != std::string::npos;
     return built;
 }
 
-bool haveXvfb() { return std::system("command -v xvfb-run > /dev/null 2>&1") == 0; }
+bool haveXvfb() {
+    return std::system("command -v xvfb-run > /dev/null 2>&1") == 0;
+}
 
 // runCli's shape, with the CLI started by xvfb-run inside a hard time limit.
 CliResult runUnderXvfb(const std::string& args) {
-    std::string cmd = "timeout -k 5 120 xvfb-run -a -s '-screen 0 1024x768x24' " + std::string(ATROUS_CLI) + " " +
-                      args + " 2>&1";
+    std::string cmd = "timeout -k 5 120 xvfb-run -a -s '-screen 0 1024x768x24' " +
+                      std::string(ATROUS_CLI) + " " + args + " 2>&1";
     CliResult r;
     FILE* pipe = popen(cmd.c_str(), "r");
     if (!pipe) return r;
@@ -45,10 +48,10 @@ CliResult runUnderXvfb(const std::string& args) {
     return r;
 }
 
-#define REQUIRE_VIEWER_AND_XVFB()                                                      \
-    do {                                                                               \
-        if (!viewerBuilt()) GTEST_SKIP() << "atrous built without the viewer";         \
-        if (!haveXvfb()) GTEST_SKIP() << "xvfb-run is not installed";                  \
+#define REQUIRE_VIEWER_AND_XVFB()                                              \
+    do {                                                                       \
+        if (!viewerBuilt()) GTEST_SKIP() << "atrous built without the viewer"; \
+        if (!haveXvfb()) GTEST_SKIP() << "xvfb-run is not installed";          \
     } while (0)
 
 double mse(const Image& a, const Image& b, int x0 = 0, int x1 = -1) {
@@ -136,11 +139,13 @@ TEST(ViewHeadless, DenoisedScreenshotIsCloserToTheReferenceThanTheNoisyOne) {
     REQUIRE_VIEWER_AND_XVFB();
     TempDir dir;
     // Reference: 16 accumulated frames of 16 spp = 256 spp (64x the 4-spp views below).
-    CliResult r = runUnderXvfb(std::string(kBase) + " --method none --frames 16 --spp 16 --seed 101 --screenshot " +
+    CliResult r = runUnderXvfb(std::string(kBase) +
+                               " --method none --frames 16 --spp 16 --seed 101 --screenshot " +
                                (dir / "ref.png"));
     ASSERT_EQ(r.exitCode, 0) << r.output;
     for (const char* m : {"none", "eaw", "svgf"}) {
-        r = runUnderXvfb(std::string(kBase) + " --method " + m + " --seed 3 --frames 4 --screenshot " + (dir / (std::string(m) + ".png")));
+        r = runUnderXvfb(std::string(kBase) + " --method " + m +
+                         " --seed 3 --frames 4 --screenshot " + (dir / (std::string(m) + ".png")));
         ASSERT_EQ(r.exitCode, 0) << m << ": " << r.output;
         // Headless runs print one JSON line of timings.
         EXPECT_NE(r.output.find("\"frame_ms_median\""), std::string::npos) << r.output;
@@ -157,10 +162,13 @@ TEST(ViewHeadless, DenoisedScreenshotIsCloserToTheReferenceThanTheNoisyOne) {
         EXPECT_GT(localVariance(*img), 1e-5);
     }
     const double mNoisy = mse(noisy, ref), mEaw = mse(eaw, ref), mSvgf = mse(svgf, ref);
-    const double lNoisy = localVariance(noisy), lEaw = localVariance(eaw), lSvgf = localVariance(svgf);
-    std::printf("vs 256-spp reference (display-linear): MSE noisy %.5f eaw %.5f svgf %.5f; local variance noisy %.5f "
-                "eaw %.5f svgf %.5f ref %.5f\n",
-                mNoisy, mEaw, mSvgf, lNoisy, lEaw, lSvgf, localVariance(ref));
+    const double lNoisy = localVariance(noisy), lEaw = localVariance(eaw),
+                 lSvgf = localVariance(svgf);
+    std::printf(
+        "vs 256-spp reference (display-linear): MSE noisy %.5f eaw %.5f svgf %.5f; local variance "
+        "noisy %.5f "
+        "eaw %.5f svgf %.5f ref %.5f\n",
+        mNoisy, mEaw, mSvgf, lNoisy, lEaw, lSvgf, localVariance(ref));
     // EAW on the 4-frame running mean: measured MSE ratio 0.60 (seeds fixed, so deterministic); the
     // bound leaves room for filter tuning but fails when the filter does nothing (ratio 1).
     EXPECT_LT(mEaw, 0.8 * mNoisy);
@@ -180,16 +188,17 @@ TEST(ViewHeadless, SplitScreenAndBufferDump) {
     REQUIRE_VIEWER_AND_XVFB();
     TempDir dir;
     const std::string dump = dir / "buffers";
-    CliResult r = runUnderXvfb(std::string(kBase) + " --method eaw --compare none --frames 3 --screenshot " +
-                               (dir / "split.png") + " --dump " + dump);
+    CliResult r =
+        runUnderXvfb(std::string(kBase) + " --method eaw --compare none --frames 3 --screenshot " +
+                     (dir / "split.png") + " --dump " + dump);
     ASSERT_EQ(r.exitCode, 0) << r.output;
     const Image s = atrous::io::readImage(dir / "split.png");
     ASSERT_EQ(s.width(), 128);
     // Left half EAW, right half noisy: the left is far smoother (noise dominates the local variance
     // at 3 spp; the box edges are present in both halves).
     EXPECT_LT(localVariance(s, 0, 60), 0.5 * localVariance(s, 68, 128));
-    for (const char* f : {"color.exr", "variance.exr", "albedo.exr", "normal.exr", "position.exr", "depth.exr", "ids.exr",
-                          "denoised_a_eaw.exr"})
+    for (const char* f : {"color.exr", "variance.exr", "albedo.exr", "normal.exr", "position.exr",
+                          "depth.exr", "ids.exr", "denoised_a_eaw.exr"})
         EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(dump) / f)) << f;
     const Image color = atrous::io::readImage((std::filesystem::path(dump) / "color.exr").string());
     EXPECT_EQ(color.width(), 128);
@@ -200,19 +209,26 @@ TEST(ViewHeadless, SureFractionsAndDetailBuffers) {
     REQUIRE_VIEWER_AND_XVFB();
     TempDir dir;
     const std::string d1 = dir / "sure", d2 = dir / "detail";
-    CliResult r = runUnderXvfb("view --scene cornell --width 64 --height 64 --hide-ui --method sure --buffer sure-s "
-                               "--frames 2 --dump " + d1);
+    CliResult r = runUnderXvfb(
+        "view --scene cornell --width 64 --height 64 --hide-ui --method sure --buffer sure-s "
+        "--frames 2 --dump " +
+        d1);
     ASSERT_EQ(r.exitCode, 0) << r.output;
     for (int l = 0; l < 5; ++l) {
-        const std::string f = (std::filesystem::path(d1) / ("sure_s_level" + std::to_string(l) + ".exr")).string();
+        const std::string f =
+            (std::filesystem::path(d1) / ("sure_s_level" + std::to_string(l) + ".exr")).string();
         ASSERT_TRUE(std::filesystem::exists(f)) << f;
         const Image s = atrous::io::readImage(f);
         float lo = 1e9f, hi = -1e9f;
-        for (size_t i = 0; i < s.size(); ++i) lo = std::min(lo, s.data()[i]), hi = std::max(hi, s.data()[i]);
+        for (size_t i = 0; i < s.size(); ++i)
+            lo = std::min(lo, s.data()[i]), hi = std::max(hi, s.data()[i]);
         EXPECT_GE(lo, 0.0f);  // fractions s_i in [0, 1]
         EXPECT_LE(hi, 1.0f);
     }
-    r = runUnderXvfb("view --scene cornell --width 64 --height 64 --hide-ui --method eaw --buffer detail --frames 2 --dump " + d2);
+    r = runUnderXvfb(
+        "view --scene cornell --width 64 --height 64 --hide-ui --method eaw --buffer detail "
+        "--frames 2 --dump " +
+        d2);
     ASSERT_EQ(r.exitCode, 0) << r.output;
     const std::string f = (std::filesystem::path(d2) / "detail_level0.exr").string();
     ASSERT_TRUE(std::filesystem::exists(f)) << f;
@@ -227,9 +243,14 @@ TEST(ViewHeadless, TurntableMovesTheCameraAndFeedsSvgfMotionVectors) {
     REQUIRE_VIEWER_AND_XVFB();
     TempDir dir;
     const std::string still = dir / "still", turn = dir / "turn";
-    CliResult r = runUnderXvfb("view --scene cornell --width 64 --height 64 --hide-ui --method svgf --frames 3 --dump " + still);
+    CliResult r = runUnderXvfb(
+        "view --scene cornell --width 64 --height 64 --hide-ui --method svgf --frames 3 --dump " +
+        still);
     ASSERT_EQ(r.exitCode, 0) << r.output;
-    r = runUnderXvfb("view --scene cornell --width 64 --height 64 --hide-ui --method svgf --orbit 10 --frames 3 --dump " + turn);
+    r = runUnderXvfb(
+        "view --scene cornell --width 64 --height 64 --hide-ui --method svgf --orbit 10 --frames 3 "
+        "--dump " +
+        turn);
     ASSERT_EQ(r.exitCode, 0) << r.output;
     auto load = [](const std::string& d, const char* f) {
         return atrous::io::readImage((std::filesystem::path(d) / f).string());
@@ -269,7 +290,10 @@ TEST(ViewHeadless, TurntableMovesTheCameraAndFeedsSvgfMotionVectors) {
     // about 50 pixels (a footprint of about 0.11 units, more on grazing walls): measured median
     // 0.12 with the motion, 0.44 without (p itself).
     const std::string prevDir = dir / "prev";
-    r = runUnderXvfb("view --scene cornell --width 64 --height 64 --hide-ui --method svgf --orbit 10 --frames 2 --dump " + prevDir);
+    r = runUnderXvfb(
+        "view --scene cornell --width 64 --height 64 --hide-ui --method svgf --orbit 10 --frames 2 "
+        "--dump " +
+        prevDir);
     ASSERT_EQ(r.exitCode, 0) << r.output;
     const Image pPrev = load(prevDir, "position.exr"), pCur = load(turn, "position.exr");
     std::vector<double> withMotion, without;
@@ -291,7 +315,8 @@ TEST(ViewHeadless, TurntableMovesTheCameraAndFeedsSvgfMotionVectors) {
         return v[v.size() / 2];
     };
     const double eMotion = med(withMotion), eStill = med(without);
-    std::printf("median world-space reprojection error: with motion %.4f, without %.4f\n", eMotion, eStill);
+    std::printf("median world-space reprojection error: with motion %.4f, without %.4f\n", eMotion,
+                eStill);
     EXPECT_LT(eMotion, 0.2);
     EXPECT_GT(eStill, 2.5 * eMotion);
 }

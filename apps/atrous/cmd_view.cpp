@@ -13,38 +13,52 @@ namespace atrous::cli {
 #if defined(ATROUS_HAVE_VIEWER)
 void addViewCommand(CLI::App& app) {
     auto opt = std::make_shared<view::ViewerOptions>();
-    CLI::App* cmd = app.add_subcommand(
-        "view", "Interactive viewer: progressive path tracing with live denoising (GLFW + OpenGL + Dear ImGui)");
+    CLI::App* cmd = app.add_subcommand("view",
+                                       "Interactive viewer: progressive path tracing with live "
+                                       "denoising (GLFW + OpenGL + Dear ImGui)");
     view::ViewerOptions& o = *opt;
-    cmd->add_option("--scene", o.scene, "Built-in scene name or JSON scene file")->capture_default_str();
+    cmd->add_option("--scene", o.scene, "Built-in scene name or JSON scene file")
+        ->capture_default_str();
     cmd->add_option("--device", o.device, "cpu | cuda | auto")->capture_default_str();
     cmd->add_option("--width", o.width, "Image width in pixels")->capture_default_str();
     cmd->add_option("--height", o.height, "Image height in pixels")->capture_default_str();
     cmd->add_option("--spp", o.spp, "Samples per pixel per frame")->capture_default_str();
     cmd->add_option("--max-depth", o.maxDepth, "Path bounces")->capture_default_str();
-    cmd->add_option("--seed", o.seed, "Base seed (frame k uses a seed derived from it)")->capture_default_str();
-    cmd->add_option("--method", o.method, "Denoiser of the main view: none | eaw | sure | svgf")->capture_default_str();
+    cmd->add_option("--seed", o.seed, "Base seed (frame k uses a seed derived from it)")
+        ->capture_default_str();
+    cmd->add_option("--method", o.method, "Denoiser of the main view: none | eaw | sure | svgf")
+        ->capture_default_str();
     cmd->add_option("--compare", o.compare, "Split screen: the method shown on the right half");
-    cmd->add_flag("--no-accumulate", o.noAccumulate, "Filter each frame on its own (no running mean)");
+    cmd->add_flag("--no-accumulate", o.noAccumulate,
+                  "Filter each frame on its own (no running mean)");
     cmd->add_option("--buffer", o.bufferView,
-                    "Initial buffer view: result, color, variance, albedo, normal, position, depth, mesh-ids, "
+                    "Initial buffer view: result, color, variance, albedo, normal, position, "
+                    "depth, mesh-ids, "
                     "material-ids, motion, detail, sure-s")
         ->capture_default_str();
-    cmd->add_option("--exposure", o.exposure, "Display exposure (linear scale)")->capture_default_str();
-    cmd->add_option("--frames", o.frames, "Headless: render N frames, save --screenshot/--dump, exit");
-    cmd->add_option("--screenshot", o.screenshot, "Headless: PNG of the window's framebuffer after the last frame");
-    cmd->add_option("--dump", o.dumpDir, "Headless: directory for every buffer (EXR) after the last frame");
+    cmd->add_option("--exposure", o.exposure, "Display exposure (linear scale)")
+        ->capture_default_str();
+    cmd->add_option("--frames", o.frames,
+                    "Headless: render N frames, save --screenshot/--dump, exit");
+    cmd->add_option("--screenshot", o.screenshot,
+                    "Headless: PNG of the window's framebuffer after the last frame");
+    cmd->add_option("--dump", o.dumpDir,
+                    "Headless: directory for every buffer (EXR) after the last frame");
     cmd->add_option("--out", o.outDir, "Directory of the F12 / P snapshots")->capture_default_str();
-    cmd->add_option("--orbit", o.orbitDegPerFrame, "Turntable: orbit the camera by this many degrees per frame");
-    cmd->add_flag("--hide-ui", o.hideUi, "No control panel: the window is exactly --width x --height");
-    cmd->add_flag("--benchmark", o.benchmark, "Print a JSON line of frame and stage timings at exit");
+    cmd->add_option("--orbit", o.orbitDegPerFrame,
+                    "Turntable: orbit the camera by this many degrees per frame");
+    cmd->add_flag("--hide-ui", o.hideUi,
+                  "No control panel: the window is exactly --width x --height");
+    cmd->add_flag("--benchmark", o.benchmark,
+                  "Print a JSON line of frame and stage timings at exit");
     cmd->callback([opt] { view::runViewer(*opt); });
 }
 #else
 void addViewCommand(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("view", "Interactive viewer (not in this build)");
     cmd->allow_extras();
-    cmd->callback([] { throw InputError("built without the viewer (install libglfw3-dev libimgui-dev)"); });
+    cmd->callback(
+        [] { throw InputError("built without the viewer (install libglfw3-dev libimgui-dev)"); });
 }
 #endif
 

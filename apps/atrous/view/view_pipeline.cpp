@@ -1,9 +1,9 @@
 // The viewer's frame pipeline (see view_pipeline.h).
 #include "view/view_pipeline.h"
 
+#include <sys/resource.h>
 #include <tbb/blocked_range.h>
 #include <tbb/blocked_range2d.h>
-#include <sys/resource.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -23,10 +23,14 @@ namespace atrous::view {
 
 const char* methodName(Method m) {
     switch (m) {
-        case Method::None: return "none";
-        case Method::Eaw: return "eaw";
-        case Method::Sure: return "sure";
-        case Method::Svgf: return "svgf";
+        case Method::None:
+            return "none";
+        case Method::Eaw:
+            return "eaw";
+        case Method::Sure:
+            return "sure";
+        case Method::Svgf:
+            return "svgf";
     }
     return "?";
 }
@@ -49,11 +53,13 @@ void forRows(int h, F f) {
 }
 
 bool sameSvgfParams(const SvgfParams& a, const SvgfParams& b) {
-    return a.sigmaL == b.sigmaL && a.sigmaN == b.sigmaN && a.sigmaZ == b.sigmaZ && a.alpha == b.alpha &&
-           a.momentsAlpha == b.momentsAlpha && a.historyCap == b.historyCap && a.levels == b.levels &&
-           a.feedbackTap == b.feedbackTap && a.spatialVarianceFrames == b.spatialVarianceFrames &&
-           a.reprojectDepthTolerance == b.reprojectDepthTolerance && a.reprojectNormalCos == b.reprojectNormalCos &&
-           a.taa == b.taa && a.taaAlpha == b.taaAlpha;
+    return a.sigmaL == b.sigmaL && a.sigmaN == b.sigmaN && a.sigmaZ == b.sigmaZ &&
+           a.alpha == b.alpha && a.momentsAlpha == b.momentsAlpha && a.historyCap == b.historyCap &&
+           a.levels == b.levels && a.feedbackTap == b.feedbackTap &&
+           a.spatialVarianceFrames == b.spatialVarianceFrames &&
+           a.reprojectDepthTolerance == b.reprojectDepthTolerance &&
+           a.reprojectNormalCos == b.reprojectNormalCos && a.taa == b.taa &&
+           a.taaAlpha == b.taaAlpha;
 }
 
 constexpr float kPi = 3.14159265358979f;
@@ -81,7 +87,8 @@ OrbitCamera OrbitCamera::fromCamera(const pt::Camera& c, float pivotDistance) {
 }
 
 pt::Camera OrbitCamera::camera() const {
-    const Vec3 off(std::cos(pitch) * std::sin(yaw), std::sin(pitch), std::cos(pitch) * std::cos(yaw));
+    const Vec3 off(std::cos(pitch) * std::sin(yaw), std::sin(pitch),
+                   std::cos(pitch) * std::cos(yaw));
     pt::Camera c = pt::makeLookAtCamera(target + off * distance, target, Vec3(0, 1, 0), 45.0f);
     c.tanHalfFov = tanHalfFov;
     return c;
@@ -98,7 +105,9 @@ void OrbitCamera::pan(const pt::Camera& c, float right, float up, float forward)
     target += c.right * right + c.up * up + c.forward * forward;
 }
 
-void OrbitCamera::zoom(float factor) { distance = std::clamp(distance * factor, 1e-3f, 1e6f); }
+void OrbitCamera::zoom(float factor) {
+    distance = std::clamp(distance * factor, 1e-3f, 1e6f);
+}
 
 // ---- pipeline ----
 
@@ -127,7 +136,8 @@ ViewPipeline::ViewPipeline(const Scene& scene, int width, int height, Device dev
     mSumDepth.assign(n, 0.0f);
     mFeatureHits.assign(n, 0);
     mDepthHits.assign(n, 0);
-    for (Image* img : {&mColor, &mVariance, &mAlbedo, &mNormal, &mPosition, &mDepth, &mIds, &mMotion, &mEmission})
+    for (Image* img : {&mColor, &mVariance, &mAlbedo, &mNormal, &mPosition, &mDepth, &mIds,
+                       &mMotion, &mEmission})
         *img = Image(width, height, 3);
 }
 
@@ -166,10 +176,11 @@ void ViewPipeline::renderFrame(const PipelineSettings& s) {
     pt::SceneView sv = data.view();
     sv.camera = mCamera;
     auto k = detail::makePathTraceKernel(sv, pt::makeBvhTracer(mBvh->view(), data), mFrame, rs);
-    tbb::parallel_for(tbb::blocked_range2d<int>(0, mHeight, 8, 0, mWidth, 8), [&](const tbb::blocked_range2d<int>& r) {
-        for (int y = r.rows().begin(); y < r.rows().end(); ++y)
-            for (int x = r.cols().begin(); x < r.cols().end(); ++x) k(x, y);
-    });
+    tbb::parallel_for(tbb::blocked_range2d<int>(0, mHeight, 8, 0, mWidth, 8),
+                      [&](const tbb::blocked_range2d<int>& r) {
+                          for (int y = r.rows().begin(); y < r.rows().end(); ++y)
+                              for (int x = r.cols().begin(); x < r.cols().end(); ++x) k(x, y);
+                      });
 }
 
 void ViewPipeline::accumulateFrame(bool accumulate) {
@@ -208,7 +219,8 @@ void ViewPipeline::accumulateFrame(bool accumulate) {
     auto rows = [&](int y) {
         for (int x = 0; x < w; ++x) {
             const size_t p = size_t(y) * w + x;
-            const bool featureHit = fn[p] != 0.0f || fn[plane + p] != 0.0f || fn[2 * plane + p] != 0.0f;
+            const bool featureHit =
+                fn[p] != 0.0f || fn[plane + p] != 0.0f || fn[2 * plane + p] != 0.0f;
             const bool depthHit = fd[p] < 0.1f * kBackgroundDepth;
             if (restart) {
                 mFeatureHits[p] = featureHit;
@@ -238,7 +250,8 @@ void ViewPipeline::accumulateFrame(bool accumulate) {
                 const double sx = mSumX[i] += v;
                 const double sx2 = mSumX2[i] += v * v;
                 // Each frame's own sum of squared deviations: the variance of its mean · s (s - 1).
-                const double sm2 = withinFrame ? (mSumM2[i] += double(fv[i]) * spp * (spp - 1.0)) : 0.0;
+                const double sm2 =
+                    withinFrame ? (mSumM2[i] += double(fv[i]) * spp * (spp - 1.0)) : 0.0;
                 // Variance of the mean pooled over all n = N·s samples:
                 // M2 = Σ M2_k + s Σ (x_k - x̄)²,  var = M2 / (n (n - 1)).
                 const double mean = sx * invN;
@@ -278,11 +291,13 @@ void ViewPipeline::computeMotion() {
             const size_t p = size_t(y) * w + x;
             float mx = 0.0f, my = 0.0f;
             if (moved) {
-                const Vec3 dir = pt::cameraRayDirection(cur, float(x) + 0.5f, float(y) + 0.5f, w, h);
+                const Vec3 dir =
+                    pt::cameraRayDirection(cur, float(x) + 0.5f, float(y) + 0.5f, w, h);
                 const float z = mFrame.depth.data()[p];
                 Vec3 v;  // from the previous eye towards the point
                 if (z < 0.1f * kBackgroundDepth) {
-                    const Vec3 hit = cur.position + dir * (z / std::max(dot(dir, cur.forward), 1e-6f));
+                    const Vec3 hit =
+                        cur.position + dir * (z / std::max(dot(dir, cur.forward), 1e-6f));
                     v = hit - prev.position;
                 } else {
                     v = dir;
@@ -293,7 +308,8 @@ void ViewPipeline::computeMotion() {
                 } else {
                     const float sx = dot(v, prev.right) / (zf * prev.tanHalfFov * aspect);
                     const float sy = dot(v, prev.up) / (zf * prev.tanHalfFov);
-                    const float px = (sx + 1.0f) * 0.5f * float(w), py = (1.0f - sy) * 0.5f * float(h);
+                    const float px = (sx + 1.0f) * 0.5f * float(w),
+                                py = (1.0f - sy) * 0.5f * float(h);
                     mx = px - (float(x) + 0.5f);
                     my = py - (float(y) + 0.5f);
                 }
@@ -440,8 +456,10 @@ void ViewPipeline::step(const PipelineSettings& s) {
     if (!s.sureFractions) mSureS = Image();
     runSlot(0, s.methodA, s);
     lap(mTimes.denoiseA, mTimes.denoiseACpu);
-    if (s.split) runSlot(1, s.methodB, s);
-    else mSlots[1] = SlotResult{};
+    if (s.split)
+        runSlot(1, s.methodB, s);
+    else
+        mSlots[1] = SlotResult{};
     lap(mTimes.denoiseB, mTimes.denoiseBCpu);
 
     mDetail = Image();
@@ -508,12 +526,14 @@ std::vector<std::string> ViewPipeline::saveBuffers(const std::string& dir) const
     for (int i = 0; i < 2; ++i) {
         const SlotResult& r = mSlots[i];
         if (r.image.empty() || r.method == Method::None) continue;
-        put(std::string(i == 0 ? "denoised_a_" : "denoised_b_") + methodName(r.method) + ".exr", r.image);
+        put(std::string(i == 0 ? "denoised_a_" : "denoised_b_") + methodName(r.method) + ".exr",
+            r.image);
     }
     if (!mDetail.empty()) put("detail_level" + std::to_string(mDetailLevelShown) + ".exr", mDetail);
     for (int l = 0; l < mSureS.channels(); ++l) {
         Image one(mWidth, mHeight, 1);
-        std::memcpy(one.data(), mSureS.data() + size_t(l) * mSureS.plane(), mSureS.plane() * sizeof(float));
+        std::memcpy(one.data(), mSureS.data() + size_t(l) * mSureS.plane(),
+                    mSureS.plane() * sizeof(float));
         put("sure_s_level" + std::to_string(l) + ".exr", one);
     }
     return names;

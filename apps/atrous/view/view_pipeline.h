@@ -44,16 +44,17 @@ struct PipelineSettings {
     // and the previous camera (history survives the move); false = reset the history instead.
     bool svgfMotionVectors = true;
     // Debug buffers, computed only when asked for (they cost extra filter runs).
-    int detailLevel = -1;  // >= 0: compute d_i for this level
+    int detailLevel = -1;        // >= 0: compute d_i for this level
     bool sureFractions = false;  // capture SURE's s_i(p) (CPU only)
 };
 
-// Milliseconds spent in each stage of the last step(): wall clock, and CPU time of the whole process
-// (user + system over all threads, getrusage), which other tenants of a shared machine distort
-// much less.
+// Milliseconds spent in each stage of the last step(): wall clock, and CPU time of the whole
+// process (user + system over all threads, getrusage), which other tenants of a shared machine
+// distort much less.
 struct StageTimes {
     double render = 0, accumulate = 0, motion = 0, denoiseA = 0, denoiseB = 0, debug = 0;
-    double renderCpu = 0, accumulateCpu = 0, motionCpu = 0, denoiseACpu = 0, denoiseBCpu = 0, debugCpu = 0;
+    double renderCpu = 0, accumulateCpu = 0, motionCpu = 0, denoiseACpu = 0, denoiseBCpu = 0,
+           debugCpu = 0;
 };
 
 // Process CPU time (user + system, all threads) in milliseconds.
@@ -68,7 +69,7 @@ struct SlotResult {
 };
 
 class ViewPipeline {
-public:
+  public:
     // `device` Cpu renders with the shared BVH traversal on TBB threads (camera freely movable);
     // Cuda renders with renderBvhCuda (scene camera only; see docs/viewer.md).
     ViewPipeline(const Scene& scene, int width, int height, Device device, uint32_t seed);
@@ -118,7 +119,7 @@ public:
     // Writes every buffer (EXR, linear) into `dir` (created when missing); returns the file names.
     std::vector<std::string> saveBuffers(const std::string& dir) const;
 
-private:
+  private:
     void renderFrame(const PipelineSettings& s);
     void accumulateFrame(bool accumulate);
     void computeMotion();

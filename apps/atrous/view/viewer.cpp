@@ -5,9 +5,9 @@
 #include "view/viewer.h"
 
 #include <GLFW/glfw3.h>
-#include <imgui.h>
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
 
 #include <algorithm>
 #include <cmath>
@@ -33,13 +33,34 @@ namespace {
 constexpr float kPanelWidth = 360.0f;
 
 enum class BufferView {
-    Result, Noisy, Variance, Albedo, Normal, Position, Depth, MeshIds, MaterialIds, Motion, Detail, SureFractions
+    Result,
+    Noisy,
+    Variance,
+    Albedo,
+    Normal,
+    Position,
+    Depth,
+    MeshIds,
+    MaterialIds,
+    Motion,
+    Detail,
+    SureFractions
 };
-const char* const kViewNames[] = {"result (denoised)", "color (noisy input)", "variance (std dev)", "albedo",
-                                  "normal", "position", "depth", "mesh ids", "material ids",
-                                  "motion vectors (SVGF)", "detail d_i (per level)", "SURE fractions s_i"};
-const char* const kViewFlags[] = {"result", "color", "variance", "albedo", "normal", "position", "depth",
-                                  "mesh-ids", "material-ids", "motion", "detail", "sure-s"};
+const char* const kViewNames[] = {"result (denoised)",
+                                  "color (noisy input)",
+                                  "variance (std dev)",
+                                  "albedo",
+                                  "normal",
+                                  "position",
+                                  "depth",
+                                  "mesh ids",
+                                  "material ids",
+                                  "motion vectors (SVGF)",
+                                  "detail d_i (per level)",
+                                  "SURE fractions s_i"};
+const char* const kViewFlags[] = {"result",       "color",    "variance", "albedo",
+                                  "normal",       "position", "depth",    "mesh-ids",
+                                  "material-ids", "motion",   "detail",   "sure-s"};
 constexpr int kViewCount = int(sizeof(kViewNames) / sizeof(kViewNames[0]));
 const char* const kMethodNames[] = {"none", "eaw", "sure", "svgf"};
 
@@ -59,7 +80,8 @@ struct SrgbLut {
     SrgbLut() {
         for (int i = 0; i < 4096; ++i) {
             const float v = float(i) / 4095.0f;
-            const float s = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+            const float s =
+                v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
             enc[i] = (unsigned char)std::lround(std::clamp(s, 0.0f, 1.0f) * 255.0f);
         }
         for (int i = 0; i < 256; ++i) {
@@ -109,8 +131,8 @@ void idColor(float id, unsigned char* px) {
 
 // Writes columns [x0, x1) of the display image for `view`. Returns a note for the UI when the view
 // has nothing to show.
-std::string tonemap(const ViewPipeline& pl, BufferView view, const Image* result, float exposure, int level, int x0,
-                    int x1, std::vector<unsigned char>& rgba) {
+std::string tonemap(const ViewPipeline& pl, BufferView view, const Image* result, float exposure,
+                    int level, int x0, int x1, std::vector<unsigned char>& rgba) {
     const int w = pl.width(), h = pl.height();
     const size_t plane = size_t(w) * h;
     const SrgbLut& L = lut();
@@ -134,7 +156,9 @@ std::string tonemap(const ViewPipeline& pl, BufferView view, const Image* result
         fill([&](size_t i, unsigned char* p) {
             for (int c = 0; c < 3; ++c) {
                 const float v = (d[c * plane + i] - offset) * scale;
-                p[c] = std::isfinite(v) ? (unsigned char)std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f) : 0;
+                p[c] = std::isfinite(v)
+                           ? (unsigned char)std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)
+                           : 0;
             }
         });
     };
@@ -147,18 +171,31 @@ std::string tonemap(const ViewPipeline& pl, BufferView view, const Image* result
             if (!result || result->empty()) return blank("no result yet");
             srgb3(*result, exposure);
             return "";
-        case BufferView::Noisy: srgb3(pl.color(), exposure); return "";
+        case BufferView::Noisy:
+            srgb3(pl.color(), exposure);
+            return "";
         case BufferView::Variance: {
-            if (!pl.varianceValid()) return blank("variance: unknown at 1 sample per pixel (accumulate more frames)");
+            if (!pl.varianceValid())
+                return blank("variance: unknown at 1 sample per pixel (accumulate more frames)");
             const float* v = pl.variance().data();
-            const float s = percentile99(plane, [&](size_t i) { return std::sqrt(std::max(0.0f, v[i] + v[plane + i] + v[2 * plane + i])); }, 1e-12f);
+            const float s = percentile99(
+                plane,
+                [&](size_t i) {
+                    return std::sqrt(std::max(0.0f, v[i] + v[plane + i] + v[2 * plane + i]));
+                },
+                1e-12f);
             fill([&](size_t i, unsigned char* p) {
-                for (int c = 0; c < 3; ++c) p[c] = L(std::sqrt(std::max(0.0f, v[c * plane + i])) / s);
+                for (int c = 0; c < 3; ++c)
+                    p[c] = L(std::sqrt(std::max(0.0f, v[c * plane + i])) / s);
             });
             return "";
         }
-        case BufferView::Albedo: srgb3(pl.albedo(), 1.0f); return "";
-        case BufferView::Normal: lin3(pl.normal(), -1.0f, 0.5f); return "";
+        case BufferView::Albedo:
+            srgb3(pl.albedo(), 1.0f);
+            return "";
+        case BufferView::Normal:
+            lin3(pl.normal(), -1.0f, 0.5f);
+            return "";
         case BufferView::Position: {
             const float* d = pl.position().data();
             const float* n = pl.normal().data();
@@ -171,7 +208,8 @@ std::string tonemap(const ViewPipeline& pl, BufferView view, const Image* result
                     }
             fill([&](size_t i, unsigned char* p) {
                 for (int c = 0; c < 3; ++c) {
-                    const float r = hi[c] > lo[c] ? (d[c * plane + i] - lo[c]) / (hi[c] - lo[c]) : 0.0f;
+                    const float r =
+                        hi[c] > lo[c] ? (d[c * plane + i] - lo[c]) / (hi[c] - lo[c]) : 0.0f;
                     p[c] = (unsigned char)std::lround(std::clamp(r, 0.0f, 1.0f) * 255.0f);
                 }
             });
@@ -187,7 +225,8 @@ std::string tonemap(const ViewPipeline& pl, BufferView view, const Image* result
                 }
             fill([&](size_t i, unsigned char* p) {
                 const bool bg = !(d[i] < 0.1f * kBackgroundDepth);
-                const float r = bg ? 0.0f : (hi > lo ? 1.0f - 0.85f * (d[i] - lo) / (hi - lo) : 1.0f);
+                const float r =
+                    bg ? 0.0f : (hi > lo ? 1.0f - 0.85f * (d[i] - lo) / (hi - lo) : 1.0f);
                 p[0] = p[1] = p[2] = (unsigned char)std::lround(r * 255.0f);
             });
             return "";
@@ -200,34 +239,47 @@ std::string tonemap(const ViewPipeline& pl, BufferView view, const Image* result
         }
         case BufferView::Motion: {
             const float* m = pl.motion().data();
-            const float s = percentile99(plane, [&](size_t i) { return std::max(std::fabs(m[i]), std::fabs(m[plane + i])); }, 0.5f);
+            const float s = percentile99(
+                plane, [&](size_t i) { return std::max(std::fabs(m[i]), std::fabs(m[plane + i])); },
+                0.5f);
             fill([&](size_t i, unsigned char* p) {
                 if (!std::isfinite(m[i]) || !std::isfinite(m[plane + i])) {
                     p[0] = 255, p[1] = 0, p[2] = 255;  // no history
                     return;
                 }
-                p[0] = (unsigned char)std::lround(std::clamp(0.5f + 0.5f * m[i] / s, 0.0f, 1.0f) * 255.0f);
-                p[1] = (unsigned char)std::lround(std::clamp(0.5f + 0.5f * m[plane + i] / s, 0.0f, 1.0f) * 255.0f);
+                p[0] = (unsigned char)std::lround(std::clamp(0.5f + 0.5f * m[i] / s, 0.0f, 1.0f) *
+                                                  255.0f);
+                p[1] = (unsigned char)std::lround(
+                    std::clamp(0.5f + 0.5f * m[plane + i] / s, 0.0f, 1.0f) * 255.0f);
                 p[2] = 128;
             });
             return "";
         }
         case BufferView::Detail: {
-            if (pl.detail().empty()) return blank("detail: choose a level below the EAW level count");
+            if (pl.detail().empty())
+                return blank("detail: choose a level below the EAW level count");
             const float* d = pl.detail().data();
-            const float s = percentile99(plane, [&](size_t i) { return std::fabs(d[i]) + std::fabs(d[plane + i]) + std::fabs(d[2 * plane + i]); }, 1e-12f);
+            const float s = percentile99(
+                plane,
+                [&](size_t i) {
+                    return std::fabs(d[i]) + std::fabs(d[plane + i]) + std::fabs(d[2 * plane + i]);
+                },
+                1e-12f);
             fill([&](size_t i, unsigned char* p) {  // signed: mid grey = 0
                 for (int c = 0; c < 3; ++c)
-                    p[c] = (unsigned char)std::lround(std::clamp(0.5f + 0.5f * d[c * plane + i] / s, 0.0f, 1.0f) * 255.0f);
+                    p[c] = (unsigned char)std::lround(
+                        std::clamp(0.5f + 0.5f * d[c * plane + i] / s, 0.0f, 1.0f) * 255.0f);
             });
             return "";
         }
         case BufferView::SureFractions: {
             const Image& s = pl.sureFractions();
-            if (s.empty() || level >= s.channels()) return blank("SURE fractions: pick SURE as a method (CPU only)");
+            if (s.empty() || level >= s.channels())
+                return blank("SURE fractions: pick SURE as a method (CPU only)");
             const float* d = s.data() + size_t(level) * plane;
             fill([&](size_t i, unsigned char* p) {
-                p[0] = p[1] = p[2] = (unsigned char)std::lround(std::clamp(d[i], 0.0f, 1.0f) * 255.0f);
+                p[0] = p[1] = p[2] =
+                    (unsigned char)std::lround(std::clamp(d[i], 0.0f, 1.0f) * 255.0f);
             });
             return "";
         }
@@ -248,7 +300,8 @@ void saveFramebuffer(const std::string& path, int fbw, int fbh) {
     const SrgbLut& L = lut();
     for (int y = 0; y < fbh; ++y)
         for (int x = 0; x < fbw; ++x) {
-            const unsigned char* p = &px[(size_t(fbh - 1 - y) * fbw + x) * 4];  // GL rows are bottom-up
+            const unsigned char* p =
+                &px[(size_t(fbh - 1 - y) * fbw + x) * 4];  // GL rows are bottom-up
             for (int c = 0; c < 3; ++c) img(x, y, c) = L.dec[p[c]];
         }
     io::writePng(path, img, 1.0f);
@@ -256,7 +309,8 @@ void saveFramebuffer(const std::string& path, int fbw, int fbh) {
 
 std::string glfwErrorText;
 void glfwErrorCallback(int code, const char* description) {
-    glfwErrorText = std::string(description ? description : "unknown") + " (GLFW error " + std::to_string(code) + ")";
+    glfwErrorText = std::string(description ? description : "unknown") + " (GLFW error " +
+                    std::to_string(code) + ")";
 }
 
 struct GlfwSession {
@@ -315,7 +369,8 @@ void runViewer(const ViewerOptions& opt) {
     if (opt.frames < 0) throw InputError("--frames: must be 0 (interactive) or more");
     if (!opt.screenshot.empty()) {
         if (opt.frames == 0) throw InputError("--screenshot needs --frames N (headless mode)");
-        if (io::extensionOf(opt.screenshot) != ".png") throw InputError("--screenshot: " + opt.screenshot + " must end in .png");
+        if (io::extensionOf(opt.screenshot) != ".png")
+            throw InputError("--screenshot: " + opt.screenshot + " must end in .png");
         const std::filesystem::path parent = std::filesystem::path(opt.screenshot).parent_path();
         io::ensureWritableDirectory(parent.empty() ? "." : parent.string());
     }
@@ -339,9 +394,10 @@ void runViewer(const ViewerOptions& opt) {
     glfwSetErrorCallback(glfwErrorCallback);
     GlfwSession session;
     if (!glfwInit())
-        throw InputError("view: cannot open a window: " + glfwErrorText +
-                         ". No display? Run it under a virtual X server: xvfb-run -a atrous view ... --frames N "
-                         "--screenshot out.png (headless mode)");
+        throw InputError(
+            "view: cannot open a window: " + glfwErrorText +
+            ". No display? Run it under a virtual X server: xvfb-run -a atrous view ... --frames N "
+            "--screenshot out.png (headless mode)");
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
     glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
@@ -349,10 +405,12 @@ void runViewer(const ViewerOptions& opt) {
     glfwWindowHint(GLFW_RESIZABLE, headless ? GLFW_FALSE : GLFW_TRUE);
     const int winW = opt.hideUi ? opt.width : opt.width + int(kPanelWidth);
     const int winH = opt.hideUi ? opt.height : std::max(opt.height, 720);
-    session.window = glfwCreateWindow(winW, winH, ("atrous view: " + scene.name()).c_str(), nullptr, nullptr);
+    session.window =
+        glfwCreateWindow(winW, winH, ("atrous view: " + scene.name()).c_str(), nullptr, nullptr);
     if (!session.window)
-        throw InputError("view: cannot create an OpenGL 3.3 core context: " + glfwErrorText +
-                         " (try xvfb-run -a, or LIBGL_ALWAYS_SOFTWARE=1 for Mesa's software renderer)");
+        throw InputError(
+            "view: cannot create an OpenGL 3.3 core context: " + glfwErrorText +
+            " (try xvfb-run -a, or LIBGL_ALWAYS_SOFTWARE=1 for Mesa's software renderer)");
     GLFWwindow* win = session.window;
     glfwMakeContextCurrent(win);
     glfwSwapInterval(headless ? 0 : 1);
@@ -387,8 +445,9 @@ void runViewer(const ViewerOptions& opt) {
     bool paused = false;
     bool uiVisible = !opt.hideUi;
     float moveSpeed = 0.5f;  // scene radii per second
-    OrbitCamera orbit = OrbitCamera::fromCamera(pl.camera(), std::max(0.1f * pl.sceneRadius(),
-                                                                      dot(pl.sceneCenter() - pl.camera().position, pl.camera().forward)));
+    OrbitCamera orbit = OrbitCamera::fromCamera(
+        pl.camera(), std::max(0.1f * pl.sceneRadius(),
+                              dot(pl.sceneCenter() - pl.camera().position, pl.camera().forward)));
     std::string status, viewNote;
     char candidatesText[128] = "0,0.2,0.4,0.6,0.8,1";
     int snapCounter = 0;
@@ -456,8 +515,10 @@ void runViewer(const ViewerOptions& opt) {
         if (moved) pl.setCamera(orbit.camera());
         bool snapshot = ImGui::IsKeyPressed(GLFW_KEY_F12, false) ||
                         (!io.WantCaptureKeyboard && ImGui::IsKeyPressed(GLFW_KEY_P, false));
-        if (!io.WantCaptureKeyboard && ImGui::IsKeyPressed(GLFW_KEY_TAB, false)) uiVisible = !uiVisible;
-        if (!io.WantCaptureKeyboard && ImGui::IsKeyPressed(GLFW_KEY_ESCAPE, false)) glfwSetWindowShouldClose(win, 1);
+        if (!io.WantCaptureKeyboard && ImGui::IsKeyPressed(GLFW_KEY_TAB, false))
+            uiVisible = !uiVisible;
+        if (!io.WantCaptureKeyboard && ImGui::IsKeyPressed(GLFW_KEY_ESCAPE, false))
+            glfwSetWindowShouldClose(win, 1);
 
         // ---- render, accumulate, denoise ----
         ps.detailLevel = view == BufferView::Detail ? level : -1;
@@ -465,8 +526,8 @@ void runViewer(const ViewerOptions& opt) {
         const bool lastFrame = headless && frame + 1 >= opt.frames;
         auto onRunningMean = [](Method m) { return m != Method::Svgf; };
         ps.needAccumulated = onRunningMean(ps.methodA) || (ps.split && onRunningMean(ps.methodB)) ||
-                             !(view == BufferView::Result || view == BufferView::Motion) || snapshot ||
-                             (lastFrame && !opt.dumpDir.empty());
+                             !(view == BufferView::Result || view == BufferView::Motion) ||
+                             snapshot || (lastFrame && !opt.dumpDir.empty());
         const bool doStep = !paused || moved || frame == 0;
         if (doStep) pl.step(ps);
 
@@ -492,29 +553,36 @@ void runViewer(const ViewerOptions& opt) {
         ImGui_ImplGlfw_NewFrame();
         ImGui::NewFrame();
         ImDrawList* bg = ImGui::GetBackgroundDrawList();
-        bg->AddImage((ImTextureID)(intptr_t)session.texture, ImVec2(imgX, imgY), ImVec2(imgX + imgW, imgY + imgH));
+        bg->AddImage((ImTextureID)(intptr_t)session.texture, ImVec2(imgX, imgY),
+                     ImVec2(imgX + imgW, imgY + imgH));
         if (view == BufferView::Result && ps.split) {
             const float xs = imgX + splitPos * imgW;
-            bg->AddLine(ImVec2(xs, imgY), ImVec2(xs, imgY + imgH), IM_COL32(255, 255, 255, 200), 1.0f);
+            bg->AddLine(ImVec2(xs, imgY), ImVec2(xs, imgY + imgH), IM_COL32(255, 255, 255, 200),
+                        1.0f);
             if (uiVisible) {
-                bg->AddText(ImVec2(imgX + 6, imgY + 4), IM_COL32(255, 255, 255, 230), methodName(ps.methodA));
-                bg->AddText(ImVec2(xs + 6, imgY + 4), IM_COL32(255, 255, 255, 230), methodName(ps.methodB));
+                bg->AddText(ImVec2(imgX + 6, imgY + 4), IM_COL32(255, 255, 255, 230),
+                            methodName(ps.methodA));
+                bg->AddText(ImVec2(xs + 6, imgY + 4), IM_COL32(255, 255, 255, 230),
+                            methodName(ps.methodB));
             }
         }
         bool resetCamera = false;
         if (uiVisible) {
             ImGui::SetNextWindowPos(ImVec2(float(fbw) - kPanelWidth, 0), ImGuiCond_Always);
             ImGui::SetNextWindowSize(ImVec2(kPanelWidth, float(fbh)), ImGuiCond_Always);
-            ImGui::Begin("atrous view", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+            ImGui::Begin(
+                "atrous view", nullptr,
+                ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
             ImGui::PushItemWidth(150.0f);  // leaves the labels their room
             const StageTimes& t = pl.times();
             const double lastMs = frameMs.empty() ? 0.0 : frameMs.back();
             ImGui::Text("%s  %dx%d  %s", scene.name().c_str(), w, h, deviceToString(device));
-            ImGui::Text("frame %d   %d spp   %.1f ms (%.1f fps)", frame + 1, pl.samplesPerPixel(), lastMs,
-                        lastMs > 0 ? 1000.0 / lastMs : 0.0);
-            ImGui::Text("render %.1f  accum %.1f  motion %.1f ms", t.render, t.accumulate, t.motion);
-            ImGui::Text("filter A %.1f (%s %.1f)  B %.1f ms", t.denoiseA, methodName(pl.slot(0).method),
-                        pl.slot(0).filterMs, t.denoiseB);
+            ImGui::Text("frame %d   %d spp   %.1f ms (%.1f fps)", frame + 1, pl.samplesPerPixel(),
+                        lastMs, lastMs > 0 ? 1000.0 / lastMs : 0.0);
+            ImGui::Text("render %.1f  accum %.1f  motion %.1f ms", t.render, t.accumulate,
+                        t.motion);
+            ImGui::Text("filter A %.1f (%s %.1f)  B %.1f ms", t.denoiseA,
+                        methodName(pl.slot(0).method), pl.slot(0).filterMs, t.denoiseB);
             ImGui::Text("debug views %.1f  display %.1f ms", t.debug, displayTime);
             ImGui::Separator();
             if (ImGui::SliderInt("spp / frame", &ps.sppPerFrame, 1, 64)) pl.resetAccumulation();
@@ -524,11 +592,14 @@ void runViewer(const ViewerOptions& opt) {
             ImGui::Checkbox("pause", &paused);
             ImGui::SameLine();
             if (ImGui::Button("restart")) pl.resetAccumulation();
-            ImGui::SliderFloat("exposure", &exposure, 0.05f, 16.0f, "%.2f", ImGuiSliderFlags_Logarithmic);
+            ImGui::SliderFloat("exposure", &exposure, 0.05f, 16.0f, "%.2f",
+                               ImGuiSliderFlags_Logarithmic);
             if (pl.cameraMovable()) {
-                ImGui::SliderFloat("move speed", &moveSpeed, 0.05f, 4.0f, "%.2f", ImGuiSliderFlags_Logarithmic);
+                ImGui::SliderFloat("move speed", &moveSpeed, 0.05f, 4.0f, "%.2f",
+                                   ImGuiSliderFlags_Logarithmic);
                 if (ImGui::Button("reset camera")) resetCamera = true;
-                ImGui::TextDisabled("drag: left orbit, right/middle pan\nwheel zoom, WASD move, Q/E down/up");
+                ImGui::TextDisabled(
+                    "drag: left orbit, right/middle pan\nwheel zoom, WASD move, Q/E down/up");
             } else {
                 ImGui::TextDisabled("camera fixed (CUDA renderer has no camera hook)");
             }
@@ -547,8 +618,10 @@ void runViewer(const ViewerOptions& opt) {
             if (!viewNote.empty()) ImGui::TextWrapped("%s", viewNote.c_str());
             for (int i = 0; i < 2; ++i)
                 if (!pl.slot(i).error.empty())
-                    ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s: %s", i ? "B" : "A", pl.slot(i).error.c_str());
-            if (ImGui::CollapsingHeader("EAW (also SURE's cascade)", ImGuiTreeNodeFlags_DefaultOpen)) {
+                    ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s: %s", i ? "B" : "A",
+                                       pl.slot(i).error.c_str());
+            if (ImGui::CollapsingHeader("EAW (also SURE's cascade)",
+                                        ImGuiTreeNodeFlags_DefaultOpen)) {
                 EawParams& e = ps.eaw;
                 ImGui::SliderInt("levels", &e.levels, 1, 10);
                 ImGui::DragFloat("sigma color (0=auto)", &e.sigmaColor, 0.01f, 0.0f, 100.0f);
@@ -578,7 +651,8 @@ void runViewer(const ViewerOptions& opt) {
                             ok = false;
                         }
                     }
-                    if (ok && !c.empty()) ps.sure.candidates = c;  // range errors surface as the slot's error
+                    if (ok && !c.empty())
+                        ps.sure.candidates = c;  // range errors surface as the slot's error
                 }
                 ImGui::SliderInt("window radius", &ps.sure.windowRadius, 1, 10);
                 ImGui::Checkbox("correlated variance", &ps.sure.correlatedVariance);
@@ -600,12 +674,14 @@ void runViewer(const ViewerOptions& opt) {
                 ImGui::SliderInt("svgf levels", &p.levels, 0, 10);
                 ImGui::SliderInt("feedback tap", &p.feedbackTap, -1, std::max(-1, p.levels - 1));
                 ImGui::SliderInt("spatial variance frames", &p.spatialVarianceFrames, 1, 32);
-                ImGui::DragFloat("reproject depth tol", &p.reprojectDepthTolerance, 0.05f, 0.0f, 100.0f);
+                ImGui::DragFloat("reproject depth tol", &p.reprojectDepthTolerance, 0.05f, 0.0f,
+                                 100.0f);
                 ImGui::SliderFloat("reproject normal cos", &p.reprojectNormalCos, -1.0f, 1.0f);
                 ImGui::Checkbox("TAA", &p.taa);
                 ImGui::SliderFloat("TAA alpha", &p.taaAlpha, 0.01f, 1.0f);
                 ImGui::Checkbox("motion vectors on camera move", &ps.svgfMotionVectors);
-                ImGui::TextDisabled(ps.svgfMotionVectors ? "(history reprojected)" : "(history reset on move)");
+                ImGui::TextDisabled(ps.svgfMotionVectors ? "(history reprojected)"
+                                                         : "(history reset on move)");
             }
             ImGui::Separator();
             if (ImGui::Button("save snapshot (F12 / P)")) snapshot = true;
@@ -616,9 +692,10 @@ void runViewer(const ViewerOptions& opt) {
             ImGui::End();
         }
         if (resetCamera) {
-            orbit = OrbitCamera::fromCamera(pl.sceneCamera(), std::max(0.1f * pl.sceneRadius(),
-                                                                       dot(pl.sceneCenter() - pl.sceneCamera().position,
-                                                                           pl.sceneCamera().forward)));
+            orbit = OrbitCamera::fromCamera(
+                pl.sceneCamera(),
+                std::max(0.1f * pl.sceneRadius(), dot(pl.sceneCenter() - pl.sceneCamera().position,
+                                                      pl.sceneCamera().forward)));
             pl.setCamera(pl.sceneCamera());
         }
         ImGui::Render();
@@ -670,7 +747,9 @@ void runViewer(const ViewerOptions& opt) {
         // The first frame (BVH already built, but first allocations, ImGui font atlas upload) is a
         // warm-up and left out when there are more.
         const size_t skip = frameMs.size() > 1 ? 1 : 0;
-        auto tail = [&](const std::vector<double>& v) { return std::vector<double>(v.begin() + skip, v.end()); };
+        auto tail = [&](const std::vector<double>& v) {
+            return std::vector<double>(v.begin() + skip, v.end());
+        };
         const std::vector<double> f = tail(frameMs);
         double mean = 0;
         for (double x : f) mean += x;
@@ -697,9 +776,9 @@ void runViewer(const ViewerOptions& opt) {
         j.num("denoise_b_ms", median(tail(denBMs)));
         j.num("debug_ms", median(tail(debugMs)));
         j.num("display_ms", median(tail(displayMs)));
-        // CPU time (user + system, all threads) per frame: on a shared machine the wall-clock figures
-        // above depend on the other tenants; frame CPU time / cores bounds the frame time on an
-        // idle machine from below (exact when every stage keeps all cores busy).
+        // CPU time (user + system, all threads) per frame: on a shared machine the wall-clock
+        // figures above depend on the other tenants; frame CPU time / cores bounds the frame time
+        // on an idle machine from below (exact when every stage keeps all cores busy).
         j.num("cpu_ms_per_frame_median", median(tail(frameCpu)));
         j.num("render_cpu_ms", median(tail(renderCpu)));
         j.num("accumulate_cpu_ms", median(tail(accCpu)));

@@ -13,19 +13,19 @@ struct ViewerOptions {
     int spp = 1;                    // samples per pixel per frame
     int maxDepth = 8;
     uint32_t seed = 1;
-    std::string method = "eaw";     // slot A: none | eaw | sure | svgf
-    std::string compare;            // slot B for the split screen (empty: no split)
+    std::string method = "eaw";  // slot A: none | eaw | sure | svgf
+    std::string compare;         // slot B for the split screen (empty: no split)
     bool noAccumulate = false;
     std::string bufferView = "result";  // initial buffer view (see docs/viewer.md)
     float exposure = 1.0f;
     // Headless: render this many frames, save --screenshot (window framebuffer) and exit.
     int frames = 0;
     std::string screenshot;
-    std::string dumpDir;  // headless: also write every buffer (EXR) here at the end
+    std::string dumpDir;                 // headless: also write every buffer (EXR) here at the end
     std::string outDir = "atrous_view";  // F12 / P snapshots go to OUT/snap_NNNN/
-    float orbitDegPerFrame = 0.0f;  // turntable: yaw the orbit camera by this much every frame
-    bool hideUi = false;  // no control panel: the window is exactly width x height
-    bool benchmark = false;  // print a JSON line with frame and stage timings at exit
+    float orbitDegPerFrame = 0.0f;       // turntable: yaw the orbit camera by this much every frame
+    bool hideUi = false;                 // no control panel: the window is exactly width x height
+    bool benchmark = false;              // print a JSON line with frame and stage timings at exit
 };
 
 // Opens the window and runs until it is closed (or --frames are done). Throws InputError for bad
