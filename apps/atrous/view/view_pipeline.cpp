@@ -52,6 +52,10 @@ void forRows(int h, F f) {
     });
 }
 
+bool sameCamera(const pt::Camera& a, const pt::Camera& b) {
+    return std::memcmp(&a, &b, sizeof(pt::Camera)) == 0;
+}
+
 bool sameSvgfParams(const SvgfParams& a, const SvgfParams& b) {
     return a.sigmaL == b.sigmaL && a.sigmaN == b.sigmaN && a.sigmaZ == b.sigmaZ &&
            a.alpha == b.alpha && a.momentsAlpha == b.momentsAlpha && a.historyCap == b.historyCap &&
@@ -154,7 +158,7 @@ void ViewPipeline::resetAccumulation() {
     mSvgfResetPending = true;
 }
 
-void ViewPipeline::renderFrame(const PipelineSettings& s) {
+void ViewPipeline::renderFrame(const PipelineSettings& s, bool svgf) {
     RenderSettings rs;
     rs.width = mWidth;
     rs.height = mHeight;
@@ -165,9 +169,20 @@ void ViewPipeline::renderFrame(const PipelineSettings& s) {
     rs.seed = mSeed + uint32_t(mFrameIndex * 0x9E3779B9ull);
     ++mFrameIndex;
     validateRenderSettings(rs);
+    mRendererMotion = false;
     if (mDevice == Device::Cuda) {
-        // renderBvhCuda takes the scene's own camera (no override hook): see cameraMovable().
-        mFrame = renderBvhCuda(mScene, rs);
+        // renderBvhCuda renders a Scene's own camera: a copy of the scene data with our camera
+        // (re-made only when the camera moves; the CUDA renderer uploads the scene every call
+        // anyway). It writes emission but no motion: computeMotion() rebuilds it from the depth.
+        if (!mCudaScene || !(mCudaCameraValid && sameCamera(mCudaCamera, mCamera))) {
+            auto copy = std::make_shared<pt::SceneData>(mScene.data());
+            copy->camera = mCamera;
+            mCudaScene =
+                std::make_unique<Scene>(std::shared_ptr<const pt::SceneData>(std::move(copy)));
+            mCudaCamera = mCamera;
+            mCudaCameraValid = true;
+        }
+        mFrame = renderBvhCuda(*mCudaScene, rs);
         return;
     }
     // The renderer's own per-pixel functor over the shared BVH, with our camera in the SceneView:
@@ -176,6 +191,16 @@ void ViewPipeline::renderFrame(const PipelineSettings& s) {
     pt::SceneView sv = data.view();
     sv.camera = mCamera;
     auto k = detail::makePathTraceKernel(sv, pt::makeBvhTracer(mBvh->view(), data), mFrame, rs);
+    if (svgf) {
+        // SVGF's extra inputs straight from the renderer: the emission of the primary hit, and the
+        // motion of each sample's primary hit reprojected into the previous camera (averaged over
+        // the pixel's samples; the scene is static, so only the camera moves).
+        k.out.emission = mEmission.view();
+        k.out.motion = mMotion.view();
+        k.motion.enabled = mCameraMoved;
+        k.motion.previousCamera = mPrevCamera;
+        mRendererMotion = true;
+    }
     tbb::parallel_for(tbb::blocked_range2d<int>(0, mHeight, 8, 0, mWidth, 8),
                       [&](const tbb::blocked_range2d<int>& r) {
                           for (int y = r.rows().begin(); y < r.rows().end(); ++y)
@@ -285,7 +310,7 @@ void ViewPipeline::computeMotion() {
     const int w = mWidth, h = mHeight;
     const size_t plane = size_t(w) * h;
     const float aspect = float(w) / float(h);
-    const float nan = std::nanf("");
+    const float kOffscreen = pt::kMotionOffscreen;  // the renderer's "no previous position"
     forRows(h, [&](int y) {
         for (int x = 0; x < w; ++x) {
             const size_t p = size_t(y) * w + x;
@@ -304,7 +329,7 @@ void ViewPipeline::computeMotion() {
                 }
                 const float zf = dot(v, prev.forward);
                 if (zf <= 1e-6f) {
-                    mx = my = nan;  // behind the previous camera: no history (SVGF reads NaN so)
+                    mx = my = kOffscreen;  // behind the previous camera: no history
                 } else {
                     const float sx = dot(v, prev.right) / (zf * prev.tanHalfFov * aspect);
                     const float sy = dot(v, prev.up) / (zf * prev.tanHalfFov);
@@ -435,7 +460,8 @@ void ViewPipeline::step(const PipelineSettings& s) {
         c = now;
         t.reset();
     };
-    renderFrame(s);
+    const bool svgf = s.methodA == Method::Svgf || (s.split && s.methodB == Method::Svgf);
+    renderFrame(s, svgf);
     lap(mTimes.render, mTimes.renderCpu);
 
     if (s.needAccumulated) {
@@ -446,10 +472,12 @@ void ViewPipeline::step(const PipelineSettings& s) {
     }
     lap(mTimes.accumulate, mTimes.accumulateCpu);
 
-    const bool svgf = s.methodA == Method::Svgf || (s.split && s.methodB == Method::Svgf);
-    if (svgf) {
+    if (svgf && !mRendererMotion) {  // the CUDA renderer: motion from the depth buffer
         computeMotion();
-        computeEmission();
+        if (!mFrame.emission.empty())
+            mEmission.copyFrom(mFrame.emission);
+        else
+            computeEmission();
     }
     lap(mTimes.motion, mTimes.motionCpu);
 

@@ -71,14 +71,14 @@ struct SlotResult {
 class ViewPipeline {
   public:
     // `device` Cpu renders with the shared BVH traversal on TBB threads (camera freely movable);
-    // Cuda renders with renderBvhCuda (scene camera only; see docs/viewer.md).
+    // Cuda renders with renderBvhCuda on a copy of the scene carrying the viewer's camera.
     ViewPipeline(const Scene& scene, int width, int height, Device device, uint32_t seed);
     ~ViewPipeline();
 
     int width() const { return mWidth; }
     int height() const { return mHeight; }
     Device device() const { return mDevice; }
-    bool cameraMovable() const { return mDevice == Device::Cpu; }
+    bool cameraMovable() const { return true; }
     const pt::Camera& camera() const { return mCamera; }
     const pt::Camera& sceneCamera() const { return mSceneCamera; }
     // World-space bounds of the scene (for the orbit pivot and movement speed).
@@ -120,7 +120,7 @@ class ViewPipeline {
     std::vector<std::string> saveBuffers(const std::string& dir) const;
 
   private:
-    void renderFrame(const PipelineSettings& s);
+    void renderFrame(const PipelineSettings& s, bool svgf);
     void accumulateFrame(bool accumulate);
     void computeMotion();
     void computeEmission();
@@ -135,8 +135,12 @@ class ViewPipeline {
     bool mCameraMoved = false;
     Vec3 mSceneCenter;
     float mSceneRadius = 1.0f;
-    std::unique_ptr<BvhData> mBvh;  // CPU rendering
-    uint64_t mFrameIndex = 0;       // seeds: every frame draws fresh samples
+    std::unique_ptr<BvhData> mBvh;      // CPU rendering
+    std::unique_ptr<Scene> mCudaScene;  // CUDA rendering: the scene with mCudaCamera
+    pt::Camera mCudaCamera;
+    bool mCudaCameraValid = false;
+    bool mRendererMotion = false;  // this frame's motion and emission came from the renderer
+    uint64_t mFrameIndex = 0;      // seeds: every frame draws fresh samples
 
     RenderBuffers mFrame;  // this frame's render
     // Running sums of the colour moments (double: E[x²] - E[x]² over thousands of frames without

@@ -239,11 +239,18 @@ std::string tonemap(const ViewPipeline& pl, BufferView view, const Image* result
         }
         case BufferView::Motion: {
             const float* m = pl.motion().data();
+            // No previous position: NaN, or the renderer's kMotionOffscreen (-1e4 pixels).
+            auto none = [&](size_t i) {
+                return !(std::fabs(m[i]) < 1e3f) || !(std::fabs(m[plane + i]) < 1e3f);
+            };
             const float s = percentile99(
-                plane, [&](size_t i) { return std::max(std::fabs(m[i]), std::fabs(m[plane + i])); },
+                plane,
+                [&](size_t i) {
+                    return none(i) ? 0.0f : std::max(std::fabs(m[i]), std::fabs(m[plane + i]));
+                },
                 0.5f);
             fill([&](size_t i, unsigned char* p) {
-                if (!std::isfinite(m[i]) || !std::isfinite(m[plane + i])) {
+                if (none(i)) {
                     p[0] = 255, p[1] = 0, p[2] = 255;  // no history
                     return;
                 }
