@@ -78,7 +78,6 @@ class ViewPipeline {
     int width() const { return mWidth; }
     int height() const { return mHeight; }
     Device device() const { return mDevice; }
-    bool cameraMovable() const { return true; }
     const pt::Camera& camera() const { return mCamera; }
     const pt::Camera& sceneCamera() const { return mSceneCamera; }
     // World-space bounds of the scene (for the orbit pivot and movement speed).

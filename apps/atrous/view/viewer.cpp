@@ -480,7 +480,7 @@ void runViewer(const ViewerOptions& opt) {
         const float imgW = float(w) * scale, imgH = float(h) * scale;
         const float imgX = 0.5f * (areaW - imgW), imgY = 0.5f * (areaH - imgH);
         bool moved = false;
-        if (!headless && pl.cameraMovable()) {
+        if (!headless) {
             const pt::Camera cam = orbit.camera();
             for (int b = 0; b < 3; ++b) {
                 if (ImGui::IsMouseClicked(b) && !io.WantCaptureMouse) dragging[b] = true;
@@ -515,7 +515,7 @@ void runViewer(const ViewerOptions& opt) {
                 }
             }
         }
-        if (opt.orbitDegPerFrame != 0.0f && pl.cameraMovable() && !paused && frame > 0) {
+        if (opt.orbitDegPerFrame != 0.0f && !paused && frame > 0) {
             orbit.orbit(opt.orbitDegPerFrame * 3.14159265f / 180.0f, 0.0f);
             moved = true;
         }
@@ -601,15 +601,11 @@ void runViewer(const ViewerOptions& opt) {
             if (ImGui::Button("restart")) pl.resetAccumulation();
             ImGui::SliderFloat("exposure", &exposure, 0.05f, 16.0f, "%.2f",
                                ImGuiSliderFlags_Logarithmic);
-            if (pl.cameraMovable()) {
-                ImGui::SliderFloat("move speed", &moveSpeed, 0.05f, 4.0f, "%.2f",
-                                   ImGuiSliderFlags_Logarithmic);
-                if (ImGui::Button("reset camera")) resetCamera = true;
-                ImGui::TextDisabled(
-                    "drag: left orbit, right/middle pan\nwheel zoom, WASD move, Q/E down/up");
-            } else {
-                ImGui::TextDisabled("camera fixed (CUDA renderer has no camera hook)");
-            }
+            ImGui::SliderFloat("move speed", &moveSpeed, 0.05f, 4.0f, "%.2f",
+                               ImGuiSliderFlags_Logarithmic);
+            if (ImGui::Button("reset camera")) resetCamera = true;
+            ImGui::TextDisabled(
+                "drag: left orbit, right/middle pan\nwheel zoom, WASD move, Q/E down/up");
             ImGui::Separator();
             comboMethod("method A", ps.methodA);
             ImGui::Checkbox("split screen", &ps.split);
