@@ -31,6 +31,7 @@ struct Diff {
     double z2 = 0;                // mean of (a - b)^2 / (var_a + var_b) over pixels with variance
     double idsSame = 0;           // fraction of pixels whose mesh and material ids agree
     double maxDepthRel = 0;       // largest relative depth difference where both hit
+    double emissionSame = 0;      // fraction of pixels whose primary-hit emission agrees
 };
 
 Diff compare(const RenderBuffers& a, const RenderBuffers& b) {
@@ -51,6 +52,9 @@ Diff compare(const RenderBuffers& a, const RenderBuffers& b) {
                 }
             }
             if (a.ids(x, y, 0) == b.ids(x, y, 0) && a.ids(x, y, 1) == b.ids(x, y, 1)) ++same;
+            bool emissionSame = true;
+            for (int c = 0; c < 3; ++c) emissionSame = emissionSame && a.emission(x, y, c) == b.emission(x, y, c);
+            d.emissionSame += emissionSame;
             float da = a.depth(x, y, 0), db = b.depth(x, y, 0);
             if (da < kBackgroundDepth && db < kBackgroundDepth)
                 d.maxDepthRel = std::max(d.maxDepthRel, double(std::fabs(da - db) / std::max(da, 1e-6f)));
@@ -59,6 +63,7 @@ Diff compare(const RenderBuffers& a, const RenderBuffers& b) {
     d.meanB /= double(n);
     d.z2 = nz ? d.z2 / double(nz) : 0.0;
     d.idsSame = double(same) / double(w * h);
+    d.emissionSame /= double(w * h);
     return d;
 }
 
@@ -75,8 +80,8 @@ TEST(BvhRender, MatchesEmbreeRendererOnBuiltinScenes) {
         RenderBuffers embree = render(scene, s);
         RenderBuffers bvh = renderBvhCpu(scene, s);
         Diff d = compare(embree, bvh);
-        std::printf("%s: mean %.6f vs %.6f, mean z^2 %.4f, ids same %.4f, max depth rel diff %.2e\n", name.c_str(),
-                    d.meanA, d.meanB, d.z2, d.idsSame, d.maxDepthRel);
+        std::printf("%s: mean %.6f vs %.6f, mean z^2 %.4f, ids same %.4f, emission same %.4f, max depth rel diff %.2e\n",
+                    name.c_str(), d.meanA, d.meanB, d.z2, d.idsSame, d.emissionSame, d.maxDepthRel);
         // Independent renders would give E[z^2] = 1 (difference of two independent means over the
         // sum of their variances); sharing the RNG streams makes the difference far smaller. A
         // wrong intersector (missed or wrong surfaces) pushes z^2 to 1 or beyond. Bound: 0.25.
@@ -86,6 +91,8 @@ TEST(BvhRender, MatchesEmbreeRendererOnBuiltinScenes) {
         // Primary hits are the same surfaces (ids) at the same depth; sub-pixel jitter is shared,
         // so only pixels whose ray grazes an edge within rounding may differ: 0.5%.
         EXPECT_GE(d.idsSame, 0.995) << name;
+        // The emission buffer (mean emitted radiance of the primary hits) follows the same hits.
+        EXPECT_GE(d.emissionSame, 0.995) << name;
         // Depth is a mean of primary hit distances: both intersectors are accurate to ~1e-6.
         EXPECT_LT(d.maxDepthRel, 1e-3) << name;
     }

@@ -76,6 +76,7 @@ RenderBuffers renderBvhCuda(const Scene& scene, const RenderSettings& settings) 
     out.position = d.position.to(Device::Cpu);
     out.depth = d.depth.to(Device::Cpu);
     out.ids = d.ids.to(Device::Cpu);
+    out.emission = d.emission.to(Device::Cpu);
     return out;
 }
 
