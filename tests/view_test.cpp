@@ -33,18 +33,28 @@ bool haveXvfb() {
     return std::system("command -v xvfb-run > /dev/null 2>&1") == 0;
 }
 
-// runCli's shape, with the CLI started by xvfb-run inside a hard time limit.
+// runCli's shape, with the CLI started by xvfb-run inside a hard time limit. ctest runs test
+// processes in parallel, and two `xvfb-run -a` starting at once can race for the same display
+// number: each process starts its search at its own number, and a run whose X server failed to
+// start is retried once.
 CliResult runUnderXvfb(const std::string& args) {
-    std::string cmd = "timeout -k 5 120 xvfb-run -a -s '-screen 0 1024x768x24' " +
-                      std::string(ATROUS_CLI) + " " + args + " 2>&1";
+    static int calls = 0;
     CliResult r;
-    FILE* pipe = popen(cmd.c_str(), "r");
-    if (!pipe) return r;
-    char buf[4096];
-    size_t n;
-    while ((n = fread(buf, 1, sizeof(buf), pipe)) > 0) r.output.append(buf, n);
-    const int status = pclose(pipe);
-    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    for (int attempt = 0; attempt < 2; ++attempt) {
+        const int display = 100 + int((unsigned(getpid()) * 37u + unsigned(calls++) * 7u) % 4000u);
+        std::string cmd = "timeout -k 5 120 xvfb-run -a -n " + std::to_string(display) +
+                          " -s '-screen 0 1024x768x24' " + std::string(ATROUS_CLI) + " " + args +
+                          " 2>&1";
+        r = CliResult{};
+        FILE* pipe = popen(cmd.c_str(), "r");
+        if (!pipe) return r;
+        char buf[4096];
+        size_t n;
+        while ((n = fread(buf, 1, sizeof(buf), pipe)) > 0) r.output.append(buf, n);
+        const int status = pclose(pipe);
+        r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+        if (r.exitCode == 0 || r.output.find("Xvfb failed to start") == std::string::npos) break;
+    }
     return r;
 }
 
