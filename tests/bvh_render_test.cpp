@@ -110,7 +110,10 @@ TEST(BvhRender, DeterministicAndValidatesSettings) {
     RenderSettings bad = small(16, 16, 0);
     EXPECT_THROW(renderBvhCpu(scene, bad), InputError);
     // Without a CUDA backend or GPU the CUDA renderer refuses with an InputError (CLI: exit 2).
-    if (!cudaAvailable()) EXPECT_THROW(renderBvhCuda(scene, small(16, 16, 4)), InputError);
+    if (!cudaAvailable()) {
+        EXPECT_THROW(renderBvhCuda(scene, small(16, 16, 4)), InputError);
+        EXPECT_THROW(CudaBvhRenderer{scene}, InputError);
+    }
 }
 
 }  // namespace atrous

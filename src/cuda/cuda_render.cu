@@ -56,28 +56,55 @@ private:
 
 }  // namespace
 
-RenderBuffers renderBvhCuda(const Scene& scene, const RenderSettings& settings) {
-    validateRenderSettings(settings);
+struct CudaBvhRenderer::Impl {
+    Scene scene;  // keeps the host arrays alive (shared, immutable)
+    int32_t numTriangles = 0;
+    cuda::DeviceBvh bvh;
+    DeviceScene deviceScene;
+    RenderBuffers frame;  // device buffers, reused while the size stays the same
+
+    explicit Impl(const Scene& s)
+        : scene(s), numTriangles(int32_t(s.data().triMaterial.size())), bvh(pt::buildSceneBvh(s.data())),
+          deviceScene(s.data()) {}
+};
+
+CudaBvhRenderer::CudaBvhRenderer(const Scene& scene) {
     if (!cudaAvailable()) throw InputError("--device cuda: no CUDA device is available");
-    const pt::SceneData& data = scene.data();
-    BvhData bvh = pt::buildSceneBvh(data);
-    cuda::DeviceBvh deviceBvh(bvh);
-    DeviceScene deviceScene(data);
-    RenderBuffers d = detail::allocateRenderBuffers(settings.width, settings.height, Device::Cuda);
-    auto k = detail::makePathTraceKernel(deviceScene.view(), pt::makeBvhTracer(deviceBvh.view(), data), d, settings);
+    mImpl = std::make_unique<Impl>(scene);
+}
+CudaBvhRenderer::~CudaBvhRenderer() = default;
+CudaBvhRenderer::CudaBvhRenderer(CudaBvhRenderer&&) noexcept = default;
+CudaBvhRenderer& CudaBvhRenderer::operator=(CudaBvhRenderer&&) noexcept = default;
+
+RenderBuffers CudaBvhRenderer::render(const RenderSettings& settings, const pt::Camera* camera) {
+    validateRenderSettings(settings);
+    Impl& m = *mImpl;
+    if (m.frame.color.empty() || m.frame.color.width() != settings.width || m.frame.color.height() != settings.height)
+        m.frame = detail::allocateRenderBuffers(settings.width, settings.height, Device::Cuda);
+    pt::SceneView view = m.deviceScene.view();
+    if (camera) view.camera = *camera;
+    pt::BvhTracer tracer;
+    tracer.bvh = m.bvh.view();
+    tracer.numTriangles = m.numTriangles;
+    auto k = detail::makePathTraceKernel(view, tracer, m.frame, settings);
     CudaExec exec;
     exec.forEachPixel(settings.width, settings.height, k);
     exec.synchronize();
     RenderBuffers out;
-    out.color = d.color.to(Device::Cpu);
-    out.variance = d.variance.to(Device::Cpu);
-    out.albedo = d.albedo.to(Device::Cpu);
-    out.normal = d.normal.to(Device::Cpu);
-    out.position = d.position.to(Device::Cpu);
-    out.depth = d.depth.to(Device::Cpu);
-    out.ids = d.ids.to(Device::Cpu);
-    out.emission = d.emission.to(Device::Cpu);
+    out.color = m.frame.color.to(Device::Cpu);
+    out.variance = m.frame.variance.to(Device::Cpu);
+    out.albedo = m.frame.albedo.to(Device::Cpu);
+    out.normal = m.frame.normal.to(Device::Cpu);
+    out.position = m.frame.position.to(Device::Cpu);
+    out.depth = m.frame.depth.to(Device::Cpu);
+    out.ids = m.frame.ids.to(Device::Cpu);
+    out.emission = m.frame.emission.to(Device::Cpu);
     return out;
+}
+
+RenderBuffers renderBvhCuda(const Scene& scene, const RenderSettings& settings) {
+    validateRenderSettings(settings);  // before any GPU work
+    return CudaBvhRenderer(scene).render(settings);
 }
 
 }  // namespace atrous

@@ -34,8 +34,21 @@ RenderBuffers renderBvhCpu(const Scene& scene, const RenderSettings& settings) {
 }
 
 #if !defined(ATROUS_HAVE_CUDA)
-RenderBuffers renderBvhCuda(const Scene&, const RenderSettings&) {
+// Builds without the CUDA backend: the CUDA renderer refuses, as --device cuda does elsewhere.
+struct CudaBvhRenderer::Impl {};
+
+CudaBvhRenderer::CudaBvhRenderer(const Scene&) {
     throw InputError("--device cuda: this build of atrous has no CUDA backend");
+}
+CudaBvhRenderer::~CudaBvhRenderer() = default;
+CudaBvhRenderer::CudaBvhRenderer(CudaBvhRenderer&&) noexcept = default;
+CudaBvhRenderer& CudaBvhRenderer::operator=(CudaBvhRenderer&&) noexcept = default;
+RenderBuffers CudaBvhRenderer::render(const RenderSettings&, const pt::Camera*) {
+    throw InputError("--device cuda: this build of atrous has no CUDA backend");
+}
+
+RenderBuffers renderBvhCuda(const Scene& scene, const RenderSettings& settings) {
+    return CudaBvhRenderer(scene).render(settings);
 }
 #endif
 

@@ -3,6 +3,8 @@
 // renderBvhCuda is the GPU renderer; renderBvhCpu runs the very same code on TBB threads, which
 // lets the CPU test suite check the GPU path against the Embree renderer.
 #pragma once
+#include <memory>
+
 #include "atrous/image.h"
 #include "atrous/render.h"
 #include "render/bvh_tracer.h"
@@ -18,6 +20,28 @@ RenderBuffers renderBvhCpu(const Scene& scene, const RenderSettings& settings);
 // per pixel; buffers come back as host images. Throws InputError when the build has no CUDA
 // backend or no GPU is present (the message names --device cuda).
 RenderBuffers renderBvhCuda(const Scene& scene, const RenderSettings& settings);
+
+// The CUDA path tracer for repeated renders of one scene (interactive viewers, sequences): the
+// BVH is built and the scene uploaded once, the device buffers are kept between calls, and each
+// render may look through another camera. renderBvhCuda(scene, s) equals
+// CudaBvhRenderer(scene).render(s). Both throw InputError without CUDA or a GPU.
+class CudaBvhRenderer {
+public:
+    explicit CudaBvhRenderer(const Scene& scene);
+    ~CudaBvhRenderer();
+    CudaBvhRenderer(CudaBvhRenderer&&) noexcept;
+    CudaBvhRenderer& operator=(CudaBvhRenderer&&) noexcept;
+    CudaBvhRenderer(const CudaBvhRenderer&) = delete;
+    CudaBvhRenderer& operator=(const CudaBvhRenderer&) = delete;
+
+    // Renders with the scene's camera, or with *camera when given. Host buffers as
+    // renderBvhCuda's (motion empty).
+    RenderBuffers render(const RenderSettings& settings, const pt::Camera* camera = nullptr);
+
+private:
+    struct Impl;  // device state (src/cuda/cuda_render.cu)
+    std::unique_ptr<Impl> mImpl;
+};
 
 namespace detail {
 
