@@ -210,15 +210,24 @@ TEST(AnimationCli, WritesOneFolderPerFrameWithEveryBuffer) {
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_EQ(countEntries(tmp.str()), 3);
     for (const char* frame : {"frame_0000", "frame_0001", "frame_0002"}) {
-        for (const char* f : {"color.exr", "variance.exr", "albedo.exr", "normal.exr", "position.exr", "depth.exr",
-                              "ids.exr", "motion.exr", "emission.exr", "reference.exr", "color.png"})
+        for (const char* f : {"color.exr", "albedo.exr", "normal.exr", "position.exr", "depth.exr", "ids.exr",
+                              "motion.exr", "emission.exr", "reference.exr", "color.png"})
             EXPECT_TRUE(fs::exists(tmp.path() / frame / f)) << frame << "/" << f;
-        EXPECT_EQ(countEntries((tmp.path() / frame).string()), 11);
+        // 1 spp: no variance.exr (unknown at one sample; a zero one would read as noise-free).
+        EXPECT_EQ(countEntries((tmp.path() / frame).string()), 10);
     }
     Image m0 = io::readImage((tmp.path() / "frame_0000" / "motion.exr").string());
     Image m1 = io::readImage((tmp.path() / "frame_0001" / "motion.exr").string());
     EXPECT_EQ(m0(8, 6, 0), 0.0f);  // frame 0 has no previous frame
     EXPECT_NE(m1(8, 6, 0), 0.0f);  // the orbit moves everything sideways
+}
+
+TEST(AnimationCli, WritesVarianceFromTwoSamples) {
+    TempDir tmp;
+    auto r = runCli("render --scene cornell --frames 1 --spp 2 --width 8 --height 8 --threads 1 --out " + tmp.str());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_TRUE(fs::exists(tmp.path() / "frame_0000" / "variance.exr"));
+    EXPECT_FALSE(fs::exists(tmp.path() / "frame_0000" / "reference.exr"));  // no --reference-spp
 }
 
 TEST(AnimationCli, BadInputExitsTwoWithOneLineAndWritesNothing) {

@@ -36,11 +36,13 @@ struct RenderArgs {
 uint32_t frameSeed(uint32_t seed, int f) { return seed + uint32_t(f); }
 uint32_t referenceSeed(uint32_t seed, int f) { return seed + 0x9E3779B9u + uint32_t(f) * 7919u; }
 
-void writeBuffers(const std::string& dir, const RenderBuffers& b) {
+// Sequence frames at 1 spp leave variance.exr out: the variance is unknown there (written as 0),
+// and a sequence's optional variance.exr would tell per-frame EAW/SURE the frame is noise-free.
+void writeBuffers(const std::string& dir, const RenderBuffers& b, bool withVariance = true) {
     namespace fs = std::filesystem;
     auto path = [&](const std::string& name) { return (fs::path(dir) / name).string(); };
     io::writeImage(path("color.exr"), b.color);
-    io::writeImage(path("variance.exr"), b.variance);
+    if (withVariance) io::writeImage(path("variance.exr"), b.variance);
     io::writeImage(path("albedo.exr"), b.albedo);
     io::writeImage(path("normal.exr"), b.normal);
     io::writeImage(path("position.exr"), b.position);
@@ -82,7 +84,7 @@ void runFrames(const RenderArgs& a) {
         double seconds = timer.seconds();
         const std::string dir = (fs::path(a.out) / io::sequenceFrameName(f)).string();
         io::ensureWritableDirectory(dir);
-        writeBuffers(dir, b);
+        writeBuffers(dir, b, /*withVariance=*/s.spp > 1);
         io::writeImage((fs::path(dir) / "motion.exr").string(), b.motion);
         io::writeImage((fs::path(dir) / "emission.exr").string(), b.emission);
         if (!reference.empty()) io::writeImage((fs::path(dir) / "reference.exr").string(), reference);
