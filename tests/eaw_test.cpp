@@ -119,10 +119,11 @@ TEST(Eaw, NoEnergyGain) {
 
 TEST(Eaw, CpuFastPathEqualsGenericFunctor) {
     SyntheticScene s = makeScene(70, 45, 0.4f, 4);
-    for (auto m : {DenoiseMethod::Eaw, DenoiseMethod::Sure}) {
+    for (auto m : {DenoiseMethod::Eaw, DenoiseMethod::Sure})
+      for (float sigmaDepth : {0.0f, 0.1f}) {  // the fast path specialises on the depth stop
         DenoiseOptions o;
         o.method = m;
-        o.eaw.sigmaDepth = 0.1f;  // every term on
+        o.eaw.sigmaDepth = sigmaDepth;  // 0.1: every term on
         filters::eawCpuFastPath() = true;
         Image fast = denoise(s.inputs(), o);
         filters::eawCpuFastPath() = false;

@@ -28,7 +28,8 @@ struct RowAcc {
     }
 };
 
-template <bool kPropagate>
+// kDepth = false (the default: no depth stop) skips the depth loads; the term is 0 either way.
+template <bool kPropagate, bool kDepth>
 void levelRows(const EawLevel& f, int y0, int y1) {
     const int w = f.cIn.width, h = f.cIn.height;
     const int s = f.p.step;
@@ -98,7 +99,7 @@ void levelRows(const EawLevel& f, int y0, int y1) {
                 const float cr = pr[x], cg = pg[x], cb = pb[x], sp = pS[x];
                 const float nx = pnx[x], ny = pny[x], nz = pnz[x];
                 const float px = ppx[x], py = ppy[x], pz_ = ppz[x];
-                const float ixp = pix[x], zp = pz[x], izp = piz[x], m0 = pm0[x], m1 = pm1[x];
+                const float ixp = pix[x], zp = kDepth ? pz[x] : 0.0f, izp = kDepth ? piz[x] : 0.0f, m0 = pm0[x], m1 = pm1[x];
                 float ws = 0, ar = 0, ag = 0, ab = 0, vr = 0, vg = 0, vb = 0;
 #define ATROUS_EAW_TAP(QX, PT)                                                                                   \
     {                                                                                                            \
@@ -107,7 +108,7 @@ void levelRows(const EawLevel& f, int y0, int y1) {
         const float dc2 = sq(cr - r) + sq(cg - g) + sq(cb - b);                                                  \
         const float dn2 = sq(nx - qnx[xq]) + sq(ny - qny[xq]) + sq(nz - qnz[xq]);                                \
         const float dx2 = sq(px - qpx[xq]) + sq(py - qpy[xq]) + sq(pz_ - qpz[xq]);                               \
-        const float dz = (zp - qz[xq]) * izp;                                                                    \
+        const float dz = kDepth ? (zp - qz[xq]) * izp : 0.0f;                                                    \
         const float did2 = sq(m0 - qm0[xq]) + sq(m1 - qm1[xq]);                                                  \
         const float e = eawExponent(P, dc2, sp, qS[xq], dn2, dx2, ixp, PT, dz, did2);                            \
         const float wt = hy * b3(QX) * expNeg(-e);                                                               \
@@ -152,10 +153,11 @@ void runEawLevel(const CpuExec& exec, const EawLevel& f) {
     }
     const int h = f.cIn.height;
     tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& r) {
+        const bool depth = f.p.invDepth > 0.0f;
         if (f.p.propagate)
-            levelRows<true>(f, r.begin(), r.end());
+            depth ? levelRows<true, true>(f, r.begin(), r.end()) : levelRows<true, false>(f, r.begin(), r.end());
         else
-            levelRows<false>(f, r.begin(), r.end());
+            depth ? levelRows<false, true>(f, r.begin(), r.end()) : levelRows<false, false>(f, r.begin(), r.end());
     });
 }
 
