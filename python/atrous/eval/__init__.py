@@ -53,7 +53,7 @@ class EvalConfig:
     equal_time: bool = True
     sequence: Optional[str] = None
     static_sequence: int = 0
-    # cornell-point has no emitter in view: the renderer writes no emission buffer, and without
+    # cornell-point has no emitter in view: atrous.render returns no emission buffer, and without
     # one SVGF demodulates a visible light by its (zero) albedo and smears it over its neighbours.
     sequence_scene: str = "cornell-point"
     quick: bool = False
@@ -284,12 +284,12 @@ def run_eval(cfg: EvalConfig) -> Dict[str, Any]:
         if not cfg.sequence:
             sequence["note"] = (f"synthesised by --static-sequence: scene {cfg.sequence_scene}, static camera "
                                 "(motion 0), each frame 1 spp with its own seed, one shared reference; SVGF's "
-                                "easiest case, pure temporal accumulation (the renderer cannot animate yet). "
-                                "The scene has no emitter in view because the renderer writes no emission "
-                                "buffer, without which SVGF's demodulation blows visible lights up.")
+                                "easiest case, pure temporal accumulation. atrous.render has no emission "
+                                "buffer (`atrous render --frames` has), so the scene has no emitter in view: "
+                                "without emission SVGF's demodulation blows visible lights up.")
     else:
-        notes.append("no frame sequence given (--sequence DIR or --static-sequence N): the SVGF column "
-                     "is left out; it needs temporal input, which the renderer cannot animate yet")
+        notes.append("no frame sequence given (--sequence DIR, e.g. from `atrous render --frames F "
+                     "--reference-spp N --out DIR`, or --static-sequence N): the SVGF column is left out")
 
     data = {
         "config": asdict(cfg),
