@@ -31,10 +31,12 @@ struct RenderArgs {
     std::string cameraPath = "auto";
 };
 
-// Seeds of the noisy and reference renders of frame f: every frame gets its own noise (a temporal
-// filter must not see the same pattern twice) and the reference never shares a stream with it.
+// Seeds of the noisy and reference renders of frame f: every noisy frame gets its own noise (a
+// temporal filter must not see the same pattern twice). References all use one other seed, never
+// a noisy frame's: their residual noise then stays put from frame to frame instead of flickering,
+// so reference differences r_f - r_{f-1} (the temporal error's yardstick) show the true change.
 uint32_t frameSeed(uint32_t seed, int f) { return seed + uint32_t(f); }
-uint32_t referenceSeed(uint32_t seed, int f) { return seed + 0x9E3779B9u + uint32_t(f) * 7919u; }
+uint32_t referenceSeed(uint32_t seed) { return seed + 0x9E3779B9u; }
 
 // Sequence frames at 1 spp leave variance.exr out: the variance is unknown there (written as 0),
 // and a sequence's optional variance.exr would tell per-frame EAW/SURE the frame is noise-free.
@@ -78,7 +80,7 @@ void runFrames(const RenderArgs& a) {
         RenderBuffers b = renderFrame(scene, path, t, tPrev, fs_);
         Image reference;
         if (a.referenceSpp > 0) {
-            ref.seed = referenceSeed(s.seed, f);
+            ref.seed = referenceSeed(s.seed);
             reference = renderFrame(scene, path, t, t, ref).color;
         }
         double seconds = timer.seconds();
