@@ -1,8 +1,9 @@
 // CPU fast path of one EAW level. Same math as filters::EawLevel (eawExponent, expNeg, b3 and
 // EawLevel::finish are shared; taps are summed in the same order), organised for AVX2: TBB over
 // row blocks, and for each of the 5 tap rows a contiguous, branch-free x loop over the interior
-// columns with the 5 taps of that row unrolled. Columns within 2·step of the left/right border,
-// where taps fall outside the image, go through the generic functor.
+// columns with the 5 taps of that row unrolled. Columns within 2·step of the left/right border
+// run one contiguous loop per tap over the columns where it is inside the image (through the
+// scalar generic functor they took 19% of the time for 5% of the work).
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -36,16 +37,13 @@ void levelRows(const EawLevel& f, int y0, int y1) {
     const int x0 = s * 2 < w ? s * 2 : w;
     const int x1 = w - s * 2 > x0 ? w - s * 2 : x0;
     const int n = x1 - x0;
-    RowAcc acc(n > 0 ? n : 1);
+    RowAcc acc(w);  // indexed by x
     const EawLevelParams P = f.p;
     float posTap[25];
     for (int qy = -2; qy <= 2; ++qy)
         for (int qx = -2; qx <= 2; ++qx) posTap[(qy + 2) * 5 + qx + 2] = eawPositionTapScale(P, qx, qy);
 
     for (int y = y0; y < y1; ++y) {
-        for (int x = 0; x < x0; ++x) f(x, y);
-        for (int x = x1; x < w; ++x) f(x, y);
-        if (n <= 0) continue;
         acc.clear();
         const size_t rowP = size_t(y) * w;
         const float* ATROUS_RESTRICT pr = f.cIn.channel(0) + rowP;
@@ -94,8 +92,7 @@ void levelRows(const EawLevel& f, int y0, int y1) {
             const float* pt = posTap + (qy + 2) * 5;
             const float pt0 = pt[0], pt1 = pt[1], pt2 = pt[2], pt3 = pt[3], pt4 = pt[4];
 #pragma omp simd
-            for (int i = 0; i < n; ++i) {
-                const int x = x0 + i;
+            for (int x = x0; x < x0 + n; ++x) {
                 const float cr = pr[x], cg = pg[x], cb = pb[x], sp = pS[x];
                 const float nx = pnx[x], ny = pny[x], nz = pnz[x];
                 const float px = ppx[x], py = ppy[x], pz_ = ppz[x];
@@ -128,19 +125,54 @@ void levelRows(const EawLevel& f, int y0, int y1) {
                 ATROUS_EAW_TAP(0, pt2)
                 ATROUS_EAW_TAP(1, pt3)
                 ATROUS_EAW_TAP(2, pt4)
-#undef ATROUS_EAW_TAP
-                aws[i] += ws;
-                aar[i] += ar;
-                aag[i] += ag;
-                aab[i] += ab;
+                aws[x] += ws;
+                aar[x] += ar;
+                aag[x] += ag;
+                aab[x] += ab;
                 if (kPropagate) {
-                    avr[i] += vr;
-                    avg[i] += vg;
-                    avb[i] += vb;
+                    avr[x] += vr;
+                    avg[x] += vg;
+                    avb[x] += vb;
                 }
             }
+            // Border columns (within 2·step of the left/right edge): one loop per tap over the
+            // columns where that tap is inside the image (the others are dropped, as in the
+            // generic functor), so the loads stay contiguous and the loop branch-free.
+#define ATROUS_EAW_BORDER_TAP(QX, PT, XA, XB)                                                                    \
+    {                                                                                                            \
+        const int lo = (XA) > -(QX) * s ? (XA) : -(QX) * s;                                                      \
+        const int hi = (XB) < w - (QX) * s ? (XB) : w - (QX) * s;                                                \
+        _Pragma("omp simd") for (int x = lo; x < hi; ++x) {                                                      \
+            const float cr = pr[x], cg = pg[x], cb = pb[x], sp = pS[x];                                          \
+            const float nx = pnx[x], ny = pny[x], nz = pnz[x];                                                   \
+            const float px = ppx[x], py = ppy[x], pz_ = ppz[x];                                                  \
+            const float ixp = pix[x], zp = kDepth ? pz[x] : 0.0f, izp = kDepth ? piz[x] : 0.0f;                  \
+            const float m0 = pm0[x], m1 = pm1[x];                                                                \
+            float ws = 0, ar = 0, ag = 0, ab = 0, vr = 0, vg = 0, vb = 0;                                        \
+            ATROUS_EAW_TAP(QX, PT)                                                                               \
+            aws[x] += ws;                                                                                        \
+            aar[x] += ar;                                                                                        \
+            aag[x] += ag;                                                                                        \
+            aab[x] += ab;                                                                                        \
+            if (kPropagate) {                                                                                    \
+                avr[x] += vr;                                                                                    \
+                avg[x] += vg;                                                                                    \
+                avb[x] += vb;                                                                                    \
+            }                                                                                                    \
+        }                                                                                                        \
+    }
+            for (int side = 0; side < 2; ++side) {
+                const int xa = side == 0 ? 0 : x1, xb = side == 0 ? x0 : w;
+                ATROUS_EAW_BORDER_TAP(-2, pt0, xa, xb)
+                ATROUS_EAW_BORDER_TAP(-1, pt1, xa, xb)
+                ATROUS_EAW_BORDER_TAP(0, pt2, xa, xb)
+                ATROUS_EAW_BORDER_TAP(1, pt3, xa, xb)
+                ATROUS_EAW_BORDER_TAP(2, pt4, xa, xb)
+            }
+#undef ATROUS_EAW_BORDER_TAP
+#undef ATROUS_EAW_TAP
         }
-        for (int i = 0; i < n; ++i) f.finish(x0 + i, y, aws[i], aar[i], aag[i], aab[i], avr[i], avg[i], avb[i]);
+        for (int x = 0; x < w; ++x) f.finish(x, y, aws[x], aar[x], aag[x], aab[x], avr[x], avg[x], avb[x]);
     }
 }
 
