@@ -16,7 +16,7 @@ namespace atrous::cli {
 namespace {
 
 struct DenoiseArgs {
-    std::string inDir, color, albedo, normal, position, depth, variance, ids, out;
+    std::string inDir, color, albedo, normal, position, depth, variance, ids, emission, out;
     std::string method = "sure", device = "cpu", sureMode = "discrete", sureCandidates;
     bool normalStepScale = false, noIds = false, noCorrelated = false, noFirefly = false, noDemodulate = false;
     DenoiseOptions opt;
@@ -74,12 +74,14 @@ void run(DenoiseArgs& a) {
         if (!std::filesystem::exists(colorPath)) throw InputError("--in '" + a.inDir + "': no color.exr in it");
     }
     Image color = io::readImage(colorPath);
-    std::unique_ptr<Image> bufs[6];
-    const std::string paths[6] = {pick(a.variance, "variance.exr"), pick(a.albedo, "albedo.exr"),
-                                  pick(a.normal, "normal.exr"),     pick(a.position, "position.exr"),
-                                  pick(a.depth, "depth.exr"),       pick(a.ids, "ids.exr")};
-    const char* names[6] = {"variance", "albedo", "normal", "position", "depth", "ids"};
-    for (int i = 0; i < 6; ++i) {
+    constexpr int kBuffers = 7;
+    std::unique_ptr<Image> bufs[kBuffers];
+    const std::string paths[kBuffers] = {pick(a.variance, "variance.exr"), pick(a.albedo, "albedo.exr"),
+                                         pick(a.normal, "normal.exr"),     pick(a.position, "position.exr"),
+                                         pick(a.depth, "depth.exr"),       pick(a.ids, "ids.exr"),
+                                         pick(a.emission, "emission.exr")};
+    const char* names[kBuffers] = {"variance", "albedo", "normal", "position", "depth", "ids", "emission"};
+    for (int i = 0; i < kBuffers; ++i) {
         if (paths[i].empty()) continue;
         bufs[i] = std::make_unique<Image>(io::readImage(paths[i]));
         if (bufs[i]->width() != color.width() || bufs[i]->height() != color.height())
@@ -95,6 +97,7 @@ void run(DenoiseArgs& a) {
     in.position = bufs[3].get();
     in.depth = bufs[4].get();
     in.ids = bufs[5].get();
+    in.emission = bufs[6].get();
     DenoiseReport rep;
     o.report = &rep;
     Timer t;
@@ -104,7 +107,7 @@ void run(DenoiseArgs& a) {
     } catch (const InputError& e) {
         // Name the buffer's file: library messages name the buffer ("variance buffer has ...").
         std::string msg = e.what();
-        for (int i = 0; i < 6; ++i)
+        for (int i = 0; i < kBuffers; ++i)
             if (!paths[i].empty() && msg.rfind(names[i], 0) == 0) msg = "'" + paths[i] + "': " + msg;
         throw InputError(msg);
     }
@@ -136,6 +139,7 @@ void addDenoiseCommand(CLI::App& app) {
     cmd->add_option("--position", a->position, "World-space position buffer");
     cmd->add_option("--depth", a->depth, "View depth buffer");
     cmd->add_option("--ids", a->ids, "Mesh id (R) / material id (G) buffer");
+    cmd->add_option("--emission", a->emission, "Emitted radiance of the primary hit (filtered around, added back)");
     cmd->add_option("--out", a->out, "Output file (.exr, .pfm or .png)")->required();
     cmd->add_option("--method", a->method, "eaw | sure")->capture_default_str();
     cmd->add_option("--device", a->device, "cpu | cuda | auto")->capture_default_str();

@@ -23,6 +23,10 @@ struct DenoiseInputs {
     const Image* position = nullptr;  // world-space hit points
     const Image* depth = nullptr;     // view depth repeated in R,G,B
     const Image* ids = nullptr;       // R = mesh id, G = material id, -1 for background
+    // Emitted radiance of the primary hit (mean over the pixel's samples). When given, the filters
+    // work on color - emission and add it back: a visible light's edge (pixel-coverage noise) is
+    // then left exactly as rendered instead of being an unfilterable outlier.
+    const Image* emission = nullptr;
 };
 
 // Edge-avoiding à-trous cascade (ALGORITHMS.md 2). Also the cascade that SURE runs on.

@@ -15,7 +15,7 @@ Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const Prepar
     Image color = upload(in.color);
     Image variance = in.variance ? upload(in.variance) : prep.estimatedVariance.to(Device::Cuda);
     Image albedo = upload(in.albedo), normal = upload(in.normal), position = upload(in.position),
-          depth = upload(in.depth), ids = upload(in.ids);
+          depth = upload(in.depth), ids = upload(in.ids), emission = upload(in.emission);
     DriverInputs di;
     di.color = color.view();
     di.variance = variance.view();
@@ -24,6 +24,7 @@ Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const Prepar
     di.position = position.view();
     di.depth = depth.view();
     di.ids = ids.view();
+    di.emission = emission.view();
     Image out(w, h, 3, Device::Cuda), after(w, h, 3, Device::Cuda), flag(w, h, 1, Device::Cuda);
     DriverOutputs dout;
     dout.out = out.view();

@@ -108,6 +108,7 @@ PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, D
     checkBuffer(in.position, color, "position");
     checkBuffer(in.depth, color, "depth");
     checkBuffer(in.ids, color, "ids");
+    checkBuffer(in.emission, color, "emission");
     validateDenoiseOptions(o);
     PreparedInputs p;
     const Image colorHost = color.device() == Device::Cpu ? Image() : color.to(Device::Cpu);
@@ -146,6 +147,7 @@ PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, D
     if (in.position) used += ",position";
     if (in.depth) used += o.eaw.sigmaDepth > 0 ? ",depth" : ",depth(unused: sigma-depth 0)";
     if (in.ids) used += o.eaw.useIds ? ",ids" : ",ids(unused)";
+    if (in.emission) used += ",emission";
     rep.buffersUsed = used;
     return p;
 }
@@ -187,6 +189,7 @@ Image denoiseCpu(const DenoiseInputs& in, const DenoiseOptions& o, const Prepare
     di.position = viewOf(in.position);
     di.depth = viewOf(in.depth);
     di.ids = viewOf(in.ids);
+    di.emission = viewOf(in.emission);
     Image out(w, h, 3, Device::Cpu), after(w, h, 3, Device::Cpu), flag(w, h, 1, Device::Cpu);
     DriverOutputs dout;
     dout.out = out.view();
@@ -219,7 +222,7 @@ Image denoise(const DenoiseInputs& inputs, const DenoiseOptions& options) {
         return filters::denoiseCuda(inputs, options, prep, rep);
     }
     for (const Image* img : {inputs.color, inputs.variance, inputs.albedo, inputs.normal, inputs.position,
-                             inputs.depth, inputs.ids})
+                             inputs.depth, inputs.ids, inputs.emission})
         if (img && img->device() != Device::Cpu) {
             // Host path with device inputs: bring them over (rare; the CLI always passes host images).
             throw InputError("denoise on the CPU needs host images (got a CUDA image)");

@@ -20,7 +20,7 @@ constexpr float kIdPenalty = 1e4f;
 
 struct DriverInputs {
     ImageView color, variance;  // variance always valid (a constant estimate when none was given)
-    ImageView albedo, normal, position, depth, ids;  // invalid when absent
+    ImageView albedo, normal, position, depth, ids, emission;  // invalid when absent
 };
 
 struct DriverOutputs {
@@ -87,6 +87,13 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     // 1. Non-finite samples and features.
     Image c0(w, h, 3, dev), v0(w, h, 3, dev);
     exec.forEachPixel(w, h, SanitizeColor{in.color, in.variance, c0.view(), v0.view()});
+    Image emission;
+    if (in.emission.valid()) {
+        // Filter the reflected part only: c_0 = color - emission (emission added back at the end).
+        emission = Image(w, h, 3, dev);
+        exec.forEachPixel(w, h, SanitizeFeature{in.emission, emission.view()});
+        exec.forEachPixel(w, h, SubtractEmission{emission.view(), c0.view()});
+    }
     Image normal(w, h, 3, dev), position(w, h, 3, dev), depth(w, h, 1, dev), ids(w, h, 2, dev);
     if (in.normal.valid()) exec.forEachPixel(w, h, SanitizeFeature{in.normal, normal.view()});
     if (in.position.valid()) exec.forEachPixel(w, h, SanitizeFeature{in.position, position.view()});
@@ -183,7 +190,8 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     }
 
     // 6. out = (c_N + Σ s_i d_i) · albedo.
-    exec.forEachPixel(w, h, Recombine{cfg.albedoEpsilon, cur->view(), sure ? acc.view() : ImageView{}, albedo, out.out});
+    exec.forEachPixel(w, h, Recombine{cfg.albedoEpsilon, cur->view(), sure ? acc.view() : ImageView{}, albedo,
+                                      emission.empty() ? ImageView{} : emission.view(), out.out});
     exec.synchronize();
 }
 

@@ -203,15 +203,26 @@ struct Footprint {
     }
 };
 
-// out = (c_N + Σ s_i d_i) · max(albedo, ε) (albedo invalid: no remodulation).
+// c_0 -= emission (the emission itself is noise-free given the pixel's samples).
+struct SubtractEmission {
+    ImageView emission, color;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        color(x, y, 0) -= emission(x, y, 0);
+        color(x, y, 1) -= emission(x, y, 1);
+        color(x, y, 2) -= emission(x, y, 2);
+    }
+};
+
+// out = (c_N + Σ s_i d_i) · max(albedo, ε) + emission (albedo/emission invalid: skipped).
 struct Recombine {
     float eps;
-    ImageView cN, detailSum, albedo, out;  // detailSum may be invalid (EAW)
+    ImageView cN, detailSum, albedo, emission, out;  // detailSum may be invalid (EAW)
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         for (int c = 0; c < 3; ++c) {
             float v = cN(x, y, c);
             if (detailSum.valid()) v += detailSum(x, y, c);
             if (albedo.valid()) v *= fmaxf(albedo(x, y, c), eps);
+            if (emission.valid()) v += emission(x, y, c);
             out(x, y, c) = v;
         }
     }
