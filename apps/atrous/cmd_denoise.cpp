@@ -9,6 +9,7 @@
 #include "atrous/error.h"
 #include "commands.h"
 #include "core/timer.h"
+#include "denoise_sequence.h"
 #include "io/image_io.h"
 
 namespace atrous::cli {
@@ -16,10 +17,11 @@ namespace atrous::cli {
 namespace {
 
 struct DenoiseArgs {
-    std::string inDir, color, albedo, normal, position, depth, variance, ids, emission, out;
-    std::string method = "sure", device = "cpu", sureMode = "discrete", sureCandidates;
+    std::string inDir, color, albedo, normal, position, depth, variance, ids, emission, out, sequence;
+    std::string method = "sure", device = "auto", sureMode = "discrete", sureCandidates;
     bool normalStepScale = false, noIds = false, noCorrelated = false, noFirefly = false, noDemodulate = false;
     DenoiseOptions opt;
+    SvgfParams svgf;
 };
 
 std::vector<float> parseFloatList(const std::string& s, const char* flag) {
@@ -40,7 +42,10 @@ std::vector<float> parseFloatList(const std::string& s, const char* flag) {
 
 void run(DenoiseArgs& a) {
     DenoiseOptions& o = a.opt;
-    o.method = parseDenoiseMethod(a.method);
+    const bool sequence = !a.sequence.empty();
+    if (a.method == "svgf" && !sequence)
+        throw InputError("--method svgf denoises animated sequences: give --sequence DIR (and an output directory)");
+    o.method = a.method == "svgf" ? DenoiseMethod::Sure : parseDenoiseMethod(a.method);
     if (a.sureMode == "discrete")
         o.sure.mode = SureMode::Discrete;
     else if (a.sureMode == "james-stein")
@@ -55,6 +60,19 @@ void run(DenoiseArgs& a) {
     o.demodulate = !a.noDemodulate;
     validateDenoiseOptions(o);
     o.device = parseDevice(a.device);
+    if (sequence) {
+        if (!a.inDir.empty() || !a.color.empty())
+            throw InputError("--sequence DIR denoises the frames of DIR: drop --in/--color");
+        SequenceDenoiseArgs s;
+        s.method = a.method;
+        s.sequenceDir = a.sequence;
+        s.outDir = a.out;
+        s.device = o.device;
+        s.svgf = a.svgf;
+        s.frameOptions = o;
+        runSequenceDenoise(s);
+        return;
+    }
     const std::string ext = io::extensionOf(a.out);
     if (ext != ".exr" && ext != ".pfm" && ext != ".png")
         throw InputError("--out '" + a.out + "': unsupported extension (use .exr, .pfm or .png)");
@@ -130,8 +148,11 @@ void run(DenoiseArgs& a) {
 
 void addDenoiseCommand(CLI::App& app) {
     auto a = std::make_shared<DenoiseArgs>();
-    auto* cmd = app.add_subcommand("denoise", "Denoise a render with EAW or SURE-based a-trous wavelets");
+    auto* cmd = app.add_subcommand(
+        "denoise", "Denoise a render with EAW or SURE-based a-trous wavelets, or an animated sequence (also SVGF)");
     cmd->add_option("--in", a->inDir, "Render directory (color.exr, variance.exr, albedo.exr, normal.exr, ...)");
+    cmd->add_option("--sequence", a->sequence,
+                    "Sequence directory of frame_NNNN/ folders (atrous render --frames); --out is then a directory");
     cmd->add_option("--color", a->color, "Noisy colour (EXR/PFM)");
     cmd->add_option("--variance", a->variance, "Per-channel variance of the pixel mean");
     cmd->add_option("--albedo", a->albedo, "Albedo buffer");
@@ -140,9 +161,10 @@ void addDenoiseCommand(CLI::App& app) {
     cmd->add_option("--depth", a->depth, "View depth buffer");
     cmd->add_option("--ids", a->ids, "Mesh id (R) / material id (G) buffer");
     cmd->add_option("--emission", a->emission, "Emitted radiance of the primary hit (filtered around, added back)");
-    cmd->add_option("--out", a->out, "Output file (.exr, .pfm or .png)")->required();
-    cmd->add_option("--method", a->method, "eaw | sure")->capture_default_str();
-    cmd->add_option("--device", a->device, "cpu | cuda | auto")->capture_default_str();
+    cmd->add_option("--out", a->out, "Output file (.exr, .pfm or .png); with --sequence, an output directory")
+        ->required();
+    cmd->add_option("--method", a->method, "eaw | sure (| svgf with --sequence)")->capture_default_str();
+    cmd->add_option("--device", a->device, "cpu | cuda | auto (cuda when a GPU is present)")->capture_default_str();
     EawParams& e = a->opt.eaw;
     cmd->add_option("--levels", e.levels, "A-trous levels (1..10)")->capture_default_str();
     cmd->add_option("--sigma-color", e.sigmaColor, "Raw sigma_c (0 = automatic from the variance)")->capture_default_str();
@@ -164,6 +186,7 @@ void addDenoiseCommand(CLI::App& app) {
     cmd->add_option("--firefly-k", a->opt.firefly.k, "Firefly bound: k local standard deviations")->capture_default_str();
     cmd->add_flag("--no-demodulate", a->noDemodulate, "Do not divide by the albedo");
     cmd->add_option("--albedo-epsilon", a->opt.albedoEpsilon, "Demodulation floor")->capture_default_str();
+    addSvgfOptions(*cmd, a->svgf);
     cmd->callback([a] { run(*a); });
 }
 
