@@ -135,6 +135,7 @@ def denoise(
     depth: Any = None,
     variance: Any = None,
     ids: Any = None,
+    emission: Any = None,
     method: str = "sure",
     device: str = "auto",
     **params: Any,
@@ -144,7 +145,9 @@ def denoise(
     color: H x W x 3 mean radiance (linear HDR). variance: the variance of that mean per channel
     (not the sample variance); without it the noise is estimated from the image. albedo, normal
     (world-space, unit), position (world-space), depth (view depth), ids (R mesh id, G material id,
-    -1 background): optional features; a missing one simply has no edge stop.
+    -1 background): optional features; a missing one simply has no edge stop. emission: the
+    emitted radiance seen at the primary hit; the filter works on color - emission and adds it
+    back, so a visible light's edge is not smeared.
 
     method: "eaw" or "sure". device: "auto" (the arrays' device: CUDA arrays on the GPU, numpy on
     the CPU), "cpu" or "cuda" (numpy inputs are then copied to the GPU and back).
@@ -165,7 +168,8 @@ def denoise(
     bufs = {
         name: _prepare(val, name)
         for name, val in (("albedo", albedo), ("normal", normal), ("position", position),
-                          ("depth", depth), ("variance", variance), ("ids", ids))
+                          ("depth", depth), ("variance", variance), ("ids", ids),
+                          ("emission", emission))
     }
     on_gpu = _is_cuda(c)
     if device == "cuda" and not on_gpu:
@@ -178,7 +182,7 @@ def denoise(
         if b is not None and _is_cuda(b) != on_gpu:
             raise ValueError(f"{name}: lives on a different device than color")
     out = _core.denoise(c, bufs["albedo"], bufs["normal"], bufs["position"], bufs["depth"],
-                        bufs["variance"], bufs["ids"], method, dict(params))
+                        bufs["variance"], bufs["ids"], bufs["emission"], method, dict(params))
     return _wrap_like(out, color)
 
 
@@ -187,7 +191,7 @@ def _denoise_numpy_on_gpu(c, bufs, method, params):  # pragma: no cover - needs 
 
     up = {k: (None if v is None else cupy.asarray(v)) for k, v in bufs.items()}
     out = _core.denoise(cupy.asarray(c), up["albedo"], up["normal"], up["position"], up["depth"],
-                        up["variance"], up["ids"], method, dict(params))
+                        up["variance"], up["ids"], up["emission"], method, dict(params))
     return cupy.asnumpy(cupy.from_dlpack(out))
 
 

@@ -129,7 +129,8 @@ void applyDenoiseParam(DenoiseOptions& o, const std::string& k, const nb::handle
 }
 
 nb::object pyDenoise(const Array& color, nb::handle albedo, nb::handle normal, nb::handle position, nb::handle depth,
-                     nb::handle variance, nb::handle ids, const std::string& method, nb::dict params) {
+                     nb::handle variance, nb::handle ids, nb::handle emission, const std::string& method,
+                     nb::dict params) {
     Image c = toImage(color, "color");
     Buffers b;
     DenoiseInputs in;
@@ -140,6 +141,7 @@ nb::object pyDenoise(const Array& color, nb::handle albedo, nb::handle normal, n
     in.depth = b.add(depth, "depth", c);
     in.variance = b.add(variance, "variance", c);
     in.ids = b.add(ids, "ids", c);
+    in.emission = b.add(emission, "emission", c);
     DenoiseOptions o;
     o.method = parseDenoiseMethod(method);
     o.device = c.device();
@@ -260,7 +262,7 @@ NB_MODULE(_core, m) {
     });
     m.def("denoise", &pyDenoise, nb::arg("color"), nb::arg("albedo").none(), nb::arg("normal").none(),
           nb::arg("position").none(), nb::arg("depth").none(), nb::arg("variance").none(), nb::arg("ids").none(),
-          nb::arg("method"), nb::arg("params"));
+          nb::arg("emission").none(), nb::arg("method"), nb::arg("params"));
     m.def("render", &pyRender, nb::arg("scene"), nb::arg("width"), nb::arg("height"), nb::arg("spp"), nb::arg("seed"),
           nb::arg("max_depth"), nb::arg("threads"));
     m.def("metrics", &pyMetrics, nb::arg("image"), nb::arg("reference"));
