@@ -103,8 +103,8 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     // 2. Fireflies (before demodulation: the outlier is in radiance).
     Image cA(w, h, 3, dev), vA(w, h, 3, dev);
     if (cfg.firefly.enabled) {
-        exec.forEachPixel(w, h, FireflyClamp{cfg.firefly.k, cfg.varianceGiven ? 1 : 0, c0.view(), v0.view(), cA.view(),
-                                             vA.view(), out.fireflyFlag});
+        runFireflyClamp(exec, FireflyClamp{cfg.firefly.k, cfg.varianceGiven ? 1 : 0, c0.view(), v0.view(), cA.view(),
+                                           vA.view(), out.fireflyFlag});
     } else {
         cA.copyFrom(c0);
         vA.copyFrom(v0);

@@ -121,7 +121,7 @@ struct EawLevel {
             const float vd = (v0r + v1r - ap2 * v0r) + (v0g + v1g - ap2 * v0g) + (v0b + v1b - ap2 * v0b);
             const float dr = cIn(x, y, 0) - nr, dg = cIn(x, y, 1) - ng, db = cIn(x, y, 2) - nb;
             detail(x, y, 0) = dr * dr + dg * dg + db * db;
-            detail(x, y, 1) = fmaxf(vd, 0.0f) * p.detailVarScale;
+            detail(x, y, 1) = maxSel(vd, 0.0f) * p.detailVarScale;
         }
     }
 };

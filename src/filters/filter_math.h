@@ -5,6 +5,14 @@
 
 #include "atrous/platform.h"
 
+// Host-only forced inlining for the shared per-pixel math called from the CPU row loops: a call
+// left in the x loop stops it vectorising.
+#if defined(__GNUC__) && !defined(__CUDACC__)
+#define ATROUS_FORCE_INLINE __attribute__((always_inline))
+#else
+#define ATROUS_FORCE_INLINE
+#endif
+
 namespace atrous::filters {
 
 // B3 spline taps [1, 4, 6, 4, 1] / 16, indexed by q + 2.
@@ -58,5 +66,10 @@ ATROUS_INLINE float lum(float r, float g, float b) { return 0.2126f * r + 0.7152
 ATROUS_INLINE bool finite(float v) { return v - v == 0.0f; }
 ATROUS_INLINE int clampIdx(int v, int hi) { return v < 0 ? 0 : (v > hi ? hi : v); }
 ATROUS_INLINE float sq(float v) { return v * v; }
+// max/min as selects: libm's fmaxf/fminf are calls on the host (strict IEEE flags), which stop the
+// per-row loops from vectorising. Same result as fmaxf(a, b)/fminf(a, b) whenever a is not NaN
+// (a NaN a gives b, as fmaxf does).
+ATROUS_INLINE float maxSel(float a, float b) { return a > b ? a : b; }
+ATROUS_INLINE float minSel(float a, float b) { return a < b ? a : b; }
 
 }  // namespace atrous::filters

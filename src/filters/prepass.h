@@ -5,6 +5,10 @@
 #include "atrous/image.h"
 #include "filters/filter_math.h"
 
+namespace atrous {
+struct CpuExec;
+}
+
 namespace atrous::filters {
 
 // Largest magnitude a feature keeps; squares of differences then stay finite in float.
@@ -98,32 +102,56 @@ struct FireflyClamp {
                 lv[n] = lum(lum(1, 0, 0) * vIn(xx, yy, 0), lum(0, 1, 0) * vIn(xx, yy, 1), lum(0, 0, 1) * vIn(xx, yy, 2));
                 ++n;
             }
+        const float clamped = apply(x, y, l, lv);
+        if (flag.valid()) flag(x, y, 0) = clamped;
+    }
+    // Everything after the neighbourhood gather; l, lv: the 8 neighbours' luminance and luminance
+    // variance in row order (dy = -1: dx = -1, 0, 1; dy = 0: -1, 1; dy = 1: -1, 0, 1). Shared
+    // with the CPU row loop (src/cpu/prepass_cpu.cpp). Returns 1 where the pixel was clamped, else 0.
+    ATROUS_FORCE_INLINE ATROUS_HOST_DEVICE float apply(int x, int y, const float (&l)[8], const float (&lv)[8]) const {
+        // The brightest neighbour (the first one on ties) and the others' sums, with selects
+        // rather than branches so the x loop vectorises; same order of summation as before.
         int imax = 0;
-        for (int i = 1; i < 8; ++i)
-            if (l[i] > l[imax]) imax = i;
+        float lmax = l[0];
+        for (int i = 1; i < 8; ++i) {
+            const bool more = l[i] > lmax;
+            imax = more ? i : imax;
+            lmax = more ? l[i] : lmax;
+        }
         float m = 0, m2 = 0, vm = 0;
         for (int i = 0; i < 8; ++i) {
-            if (i == imax) continue;
-            m += l[i];
-            m2 += l[i] * l[i];
-            vm += lv[i];
+            const bool keep = i != imax;
+            const float li2 = l[i] * l[i];  // outside the select: GCC keeps a branch around FP math
+            m += keep ? l[i] : 0.0f;
+            m2 += keep ? li2 : 0.0f;
+            vm += keep ? lv[i] : 0.0f;
         }
         m /= 7.0f;
         vm /= 7.0f;
-        const float s2 = fmaxf(m2 / 7.0f - m * m, 0.0f);
-        const float bound = fmaxf(m, 0.0f) + k * sqrtf(s2 + fmaxf(vm, 0.0f));
+        const float s2 = maxSel(m2 / 7.0f - m * m, 0.0f);
+        const float bound = maxSel(m, 0.0f) + k * sqrtf(s2 + maxSel(vm, 0.0f));
         const float L = lum(cIn(x, y, 0), cIn(x, y, 1), cIn(x, y, 2));
         const float ownStd = sqrtf(lum(lum(1, 0, 0) * vIn(x, y, 0), lum(0, 1, 0) * vIn(x, y, 1), lum(0, 0, 1) * vIn(x, y, 2)));
-        const bool noisy = !ownVariance || ownStd > kFireflyOwnStd * (L - m);
-        const bool clamp = L > bound && L > 0.0f && noisy;
-        const float scale = clamp ? bound / L : 1.0f;
+        // Bitwise & and | on the tests (not && and ||): no branches in the vectorised x loop.
+        const bool noisy = (ownVariance == 0) | (ownStd > kFireflyOwnStd * (L - m));
+        const bool clamp = (L > bound) & (L > 0.0f) & noisy;
+        const float ratio = bound / L;  // unused (maybe inf) where not clamped
+        const float scale = clamp ? ratio : 1.0f;
         for (int c = 0; c < 3; ++c) {
             cOut(x, y, c) = cIn(x, y, c) * scale;
             vOut(x, y, c) = vIn(x, y, c) * scale * scale;
         }
-        if (flag.valid()) flag(x, y, 0) = clamp ? 1.0f : 0.0f;
+        return clamp ? 1.0f : 0.0f;
     }
 };
+
+// Runs the firefly pass on `exec`; the CpuExec overload (src/cpu/prepass_cpu.cpp) computes the
+// neighbours' luminances once per row and runs a vectorised x loop with the same math.
+template <class Exec>
+void runFireflyClamp(const Exec& exec, const FireflyClamp& f) {
+    exec.forEachPixel(f.cIn.width, f.cIn.height, f);
+}
+void runFireflyClamp(const CpuExec& exec, const FireflyClamp& f);
 
 // c / max(albedo, ε), var / max(albedo, ε)² (in place).
 struct Demodulate {
@@ -131,7 +159,7 @@ struct Demodulate {
     ImageView albedo, color, var;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         for (int c = 0; c < 3; ++c) {
-            const float a = fmaxf(albedo(x, y, c), eps);
+            const float a = maxSel(albedo(x, y, c), eps);
             const float ia = 1.0f / a;
             color(x, y, c) *= ia;
             var(x, y, c) *= ia * ia;
@@ -180,7 +208,7 @@ struct Footprint {
     float k2 = 1;
     ImageView position, depth, invX, invZ;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        invZ(x, y, 0) = 1.0f / fmaxf(fabsf(depth(x, y, 0)), 1e-6f);
+        invZ(x, y, 0) = 1.0f / maxSel(fabsf(depth(x, y, 0)), 1e-6f);
         if (!hasPosition) {
             invX(x, y, 0) = 0.0f;
             return;
@@ -190,9 +218,9 @@ struct Footprint {
             return;
         }
         const int w = position.width, h = position.height;
-        const float fx = fminf(dist2(x, y, clampIdx(x + 1, w - 1), y), dist2(x, y, clampIdx(x - 1, w - 1), y));
-        const float fy = fminf(dist2(x, y, x, clampIdx(y + 1, h - 1)), dist2(x, y, x, clampIdx(y - 1, h - 1)));
-        const float f2 = fmaxf(fx, fy);
+        const float fx = minSel(dist2(x, y, clampIdx(x + 1, w - 1), y), dist2(x, y, clampIdx(x - 1, w - 1), y));
+        const float fy = minSel(dist2(x, y, x, clampIdx(y + 1, h - 1)), dist2(x, y, x, clampIdx(y - 1, h - 1)));
+        const float f2 = maxSel(fx, fy);
         // 1e-20 keeps the inverse finite (1e20) on degenerate footprints (e.g. background).
         invX(x, y, 0) = 1.0f / (k2 * f2 + 1e-20f);
     }
@@ -221,7 +249,7 @@ struct Recombine {
         for (int c = 0; c < 3; ++c) {
             float v = cN(x, y, c);
             if (detailSum.valid()) v += detailSum(x, y, c);
-            if (albedo.valid()) v *= fmaxf(albedo(x, y, c), eps);
+            if (albedo.valid()) v *= maxSel(albedo(x, y, c), eps);
             if (emission.valid()) v += emission(x, y, c);
             out(x, y, c) = v;
         }

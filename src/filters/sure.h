@@ -21,18 +21,18 @@ struct SureChoiceParams {
 // The s that minimises (1 - s)² ΣD + (2s - 1) ΣV.
 ATROUS_INLINE float sureChoose(const SureChoiceParams& p, float sumD, float sumV) {
     if (p.jamesStein) {
-        if (!(sumD > 0.0f)) return 0.0f;
-        return fminf(fmaxf(1.0f - sumV / sumD, 0.0f), 1.0f);
+        // sumD > 0 makes the ratio finite (sumV is finite), so the selects equal fmaxf/fminf.
+        const float js = minSel(maxSel(1.0f - sumV / sumD, 0.0f), 1.0f);
+        return sumD > 0.0f ? js : 0.0f;
     }
     float best = p.candidates[0];
     float bestRisk = sq(1.0f - best) * sumD + (2.0f * best - 1.0f) * sumV;
     for (int i = 1; i < p.count; ++i) {
         const float s = p.candidates[i];
         const float r = sq(1.0f - s) * sumD + (2.0f * s - 1.0f) * sumV;
-        if (r < bestRisk) {
-            bestRisk = r;
-            best = s;
-        }
+        const bool better = r < bestRisk;  // selects, not a branch: the x loop vectorises
+        bestRisk = better ? r : bestRisk;
+        best = better ? s : best;
     }
     return best;
 }
