@@ -85,16 +85,30 @@ def load_oidn() -> Tuple[Optional[Callable], str]:
     return run, f"pyoidn {version or ''}".strip()
 
 
+def _takes_emission() -> bool:
+    import inspect
+
+    try:
+        return "emission" in inspect.signature(atrous.denoise).parameters
+    except (TypeError, ValueError):
+        return False
+
+
 def _atrous_method(name: str) -> Callable:
+    # Sequences from `atrous render --frames` carry emission.exr; newer atrous.denoise filters
+    # colour - emission and adds it back (no leak of visible lights), older ones have no keyword.
+    extra_kw = ("emission",) if _takes_emission() else ()
+
     def run(b: Dict[str, np.ndarray]) -> np.ndarray:
         # At 1 spp the renderer cannot estimate a variance and writes zeros; a zero variance
         # would tell the filters the input is clean, so they estimate the noise themselves.
         var = b.get("variance")
         if var is not None and not np.any(var > 0):
             var = None
+        kw = {k: b[k] for k in extra_kw if b.get(k) is not None}
         return atrous.denoise(b["color"], albedo=b.get("albedo"), normal=b.get("normal"),
                               position=b.get("position"), depth=b.get("depth"),
-                              variance=var, ids=b.get("ids"), method=name)
+                              variance=var, ids=b.get("ids"), method=name, **kw)
     return run
 
 
