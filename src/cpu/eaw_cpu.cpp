@@ -38,6 +38,8 @@ void levelRows(const EawLevel& f, int y0, int y1) {
     const int x1 = w - s * 2 > x0 ? w - s * 2 : x0;
     const int n = x1 - x0;
     RowAcc acc(w);  // indexed by x
+    EawLevel g = f;
+    g.p.propagate = kPropagate ? 1 : 0;  // a constant, so finish() has no branch left
     const EawLevelParams P = f.p;
     float posTap[25];
     for (int qy = -2; qy <= 2; ++qy)
@@ -172,7 +174,10 @@ void levelRows(const EawLevel& f, int y0, int y1) {
 #undef ATROUS_EAW_BORDER_TAP
 #undef ATROUS_EAW_TAP
         }
-        for (int x = 0; x < w; ++x) f.finish(x, y, aws[x], aar[x], aag[x], aab[x], avr[x], avg[x], avb[x]);
+        // A local copy of the functor, so that its views are known not to alias the stores and
+        // the normalisation loop vectorises (it was a scalar loop: ~1/25 of the tap work).
+#pragma omp simd
+        for (int x = 0; x < w; ++x) g.finish(x, y, aws[x], aar[x], aag[x], aab[x], avr[x], avg[x], avb[x]);
     }
 }
 
