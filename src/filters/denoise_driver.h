@@ -180,10 +180,10 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         f.ids = ids.view();
         runEawLevel(exec, f);
         if (sure) {
-            exec.forEachPixel(w, h, SureBoxH{choice.radius, detail.view(), boxH.view()});
+            runSureBoxH(exec, SureBoxH{choice.radius, detail.view(), boxH.view()});
             ImageView sOut;
             if (out.sureS.valid()) sOut = ImageView{out.sureS.channel(i), w, h, 1};
-            exec.forEachPixel(w, h, SureChoose{choice, boxH.view(), cur->view(), nxt->view(), acc.view(), sOut});
+            runSureChoose(exec, SureChoose{choice, boxH.view(), cur->view(), nxt->view(), acc.view(), sOut});
             std::swap(vcur, vnxt);
         }
         std::swap(cur, nxt);

@@ -7,6 +7,10 @@
 #include "atrous/image.h"
 #include "filters/filter_math.h"
 
+namespace atrous {
+struct CpuExec;
+}
+
 namespace atrous::filters {
 
 constexpr int kMaxSureCandidates = 8;
@@ -19,7 +23,7 @@ struct SureChoiceParams {
 };
 
 // The s that minimises (1 - s)² ΣD + (2s - 1) ΣV.
-ATROUS_INLINE float sureChoose(const SureChoiceParams& p, float sumD, float sumV) {
+ATROUS_FORCE_INLINE ATROUS_INLINE float sureChoose(const SureChoiceParams& p, float sumD, float sumV) {
     if (p.jamesStein) {
         // sumD > 0 makes the ratio finite (sumV is finite), so the selects equal fmaxf/fminf.
         const float js = minSel(maxSel(1.0f - sumV / sumD, 0.0f), 1.0f);
@@ -70,5 +74,18 @@ struct SureChoose {
         if (sOut.valid()) sOut(x, y, 0) = s;
     }
 };
+
+// Run the two window passes on `exec`; the CpuExec overloads (src/cpu/sure_cpu.cpp) run
+// vectorised row loops with the same sums in the same order.
+template <class Exec>
+void runSureBoxH(const Exec& exec, const SureBoxH& f) {
+    exec.forEachPixel(f.in.width, f.in.height, f);
+}
+template <class Exec>
+void runSureChoose(const Exec& exec, const SureChoose& f) {
+    exec.forEachPixel(f.boxH.width, f.boxH.height, f);
+}
+void runSureBoxH(const CpuExec& exec, const SureBoxH& f);
+void runSureChoose(const CpuExec& exec, const SureChoose& f);
 
 }  // namespace atrous::filters
