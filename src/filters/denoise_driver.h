@@ -3,6 +3,7 @@
 // the executor's device; temporaries are allocated there.
 #pragma once
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "atrous/denoise.h"
@@ -101,13 +102,17 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     if (in.ids.valid()) exec.forEachPixel(w, h, SanitizeFeature{in.ids, ids.view()});
 
     // 2. Fireflies (before demodulation: the outlier is in radiance).
-    Image cA(w, h, 3, dev), vA(w, h, 3, dev);
+    // c0/v0 are dead after this step: without the firefly pass they become cA/vA (no copy), with
+    // it they are reused below as the cascade's second buffers (fewer image-sized temporaries).
+    Image cA, vA;
     if (cfg.firefly.enabled) {
+        cA = Image(w, h, 3, dev);
+        vA = Image(w, h, 3, dev);
         runFireflyClamp(exec, FireflyClamp{cfg.firefly.k, cfg.varianceGiven ? 1 : 0, c0.view(), v0.view(), cA.view(),
                                            vA.view(), out.fireflyFlag});
     } else {
-        cA.copyFrom(c0);
-        vA.copyFrom(v0);
+        cA = std::move(c0);
+        vA = std::move(v0);
     }
     if (out.afterFirefly.valid()) {
         exec.forEachPixel(w, h, Copy3{cA.view(), out.afterFirefly});
@@ -131,13 +136,13 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
                                       invX.view(), invZ.view()});
 
     // 5. The cascade. SURE also propagates the variance and keeps Σ s_i d_i in `acc`.
-    Image cB(w, h, 3, dev);
+    Image cB = c0.empty() ? Image(w, h, 3, dev) : std::move(c0);  // fully overwritten by level 0
     Image vB, detail, boxH, acc;
     float alpha[kMaxLevels];
     for (int i = 0; i < kMaxLevels; ++i) alpha[i] = 1.0f;
     SureChoiceParams choice;
     if (sure) {
-        vB = Image(w, h, 3, dev);
+        vB = v0.empty() ? Image(w, h, 3, dev) : std::move(v0);  // fully overwritten by level 0
         detail = Image(w, h, 2, dev);
         boxH = Image(w, h, 2, dev);
         acc = Image(w, h, 3, dev);
