@@ -2,10 +2,12 @@
 // one line naming the problem, nothing written).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
+#include "atrous/device.h"
 #include "atrous/image.h"
 #include "io/image_io.h"
 #include "test_util.h"
@@ -31,14 +33,30 @@ TEST(RenderCli, WritesAllBuffersAndASummary) {
     EXPECT_EQ(lines(r.output), 1) << r.output;
     EXPECT_NE(r.output.find("24x16"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("samples/s"), std::string::npos) << r.output;
-    for (const char* f : {"color.exr", "variance.exr", "albedo.exr", "normal.exr", "position.exr", "depth.exr", "ids.exr", "color.png"})
+    for (const char* f : {"color.exr", "variance.exr", "albedo.exr", "normal.exr", "position.exr", "depth.exr", "ids.exr",
+                          "emission.exr", "color.png"})
         EXPECT_TRUE(fs::exists(tmp / f)) << f;
-    EXPECT_EQ(countEntries(tmp.str()), 8);  // and no temporary files left behind
+    EXPECT_EQ(countEntries(tmp.str()), 9);  // and no temporary files left behind
+    // The camera sees the ceiling light: its emission is in emission.exr, and nowhere else is.
+    Image emission = io::readImage(tmp / "emission.exr");
+    float maxE = 0.0f;
+    for (size_t i = 0; i < emission.size(); ++i) maxE = std::max(maxE, emission.data()[i]);
+    EXPECT_GT(maxE, 1.0f);
     Image ids = io::readImage(tmp / "ids.exr");
     EXPECT_EQ(ids.width(), 24);
     EXPECT_EQ(ids.height(), 16);
     Image depth = io::readImage(tmp / "depth.exr");
     EXPECT_GT(depth(12, 8, 0), 0.0f);
+}
+
+TEST(RenderCli, CudaWithoutAGpuIsAClearError) {
+    if (cudaAvailable()) GTEST_SKIP() << "a GPU is present: --device cuda is valid here";
+    TempDir tmp;
+    auto r = runCli("render --scene cornell --width 8 --height 8 --spp 1 --device cuda --out " + (tmp / "out"));
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_EQ(lines(r.output), 1) << r.output;
+    EXPECT_NE(r.output.find("cuda"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(tmp / "out"));
 }
 
 TEST(RenderCli, HelpListsTheOptions) {

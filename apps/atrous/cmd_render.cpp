@@ -14,6 +14,7 @@
 #include "commands.h"
 #include "core/timer.h"
 #include "io/image_io.h"
+#include "render/bvh_render.h"
 #include "io/sequence.h"
 
 namespace atrous::cli {
@@ -29,6 +30,7 @@ struct RenderArgs {
     bool framesGiven = false;
     int referenceSpp = 0;
     std::string cameraPath = "auto";
+    std::string device = "auto";
 };
 
 // Seeds of the noisy and reference renders of frame f: every noisy frame gets its own noise (a
@@ -50,6 +52,7 @@ void writeBuffers(const std::string& dir, const RenderBuffers& b, bool withVaria
     io::writeImage(path("position.exr"), b.position);
     io::writeImage(path("depth.exr"), b.depth);
     io::writeImage(path("ids.exr"), b.ids);
+    if (!b.emission.empty()) io::writeImage(path("emission.exr"), b.emission);
 }
 
 // `atrous render --frames F`: DIR/frame_NNNN/ per frame (time t = f / max(F - 1, 1)) with the
@@ -88,7 +91,6 @@ void runFrames(const RenderArgs& a) {
         io::ensureWritableDirectory(dir);
         writeBuffers(dir, b, /*withVariance=*/s.spp > 1);
         io::writeImage((fs::path(dir) / "motion.exr").string(), b.motion);
-        io::writeImage((fs::path(dir) / "emission.exr").string(), b.emission);
         if (!reference.empty()) io::writeImage((fs::path(dir) / "reference.exr").string(), reference);
         io::writePng((fs::path(dir) / "color.png").string(), b.color);
         std::printf("frame %d/%d (t = %.4f): %.3f s -> %s\n", f + 1, a.frames, t, seconds, dir.c_str());
@@ -112,7 +114,12 @@ std::vector<DenoiseMethod> parseMethods(const std::string& list) {
 }
 
 void run(const RenderArgs& a) {
-    if (a.framesGiven) return runFrames(a);
+    // InputError for cuda without a GPU or CUDA build. Animations render on the CPU (auto picks it).
+    const Device device = parseDevice(a.framesGiven && a.device == "auto" ? "cpu" : a.device);
+    if (a.framesGiven) {
+        if (device == Device::Cuda) throw InputError("--frames: animation renders on the CPU only so far (use --device cpu)");
+        return runFrames(a);
+    }
     if (a.referenceSpp != 0) throw InputError("--reference-spp: only with --frames");
     if (a.cameraPath != "auto") throw InputError("--camera-path: only with --frames");
     // Everything that can be checked before rendering is: settings, scene, methods, output dir.
@@ -123,7 +130,8 @@ void run(const RenderArgs& a) {
     io::ensureWritableDirectory(a.out);
 
     Timer timer;
-    RenderBuffers b = render(scene, s);
+    // The CUDA path tracer runs the same per-pixel kernel over a BVH built by Embree's builder.
+    RenderBuffers b = device == Device::Cuda ? renderBvhCuda(scene, s) : render(scene, s);
     double seconds = timer.seconds();
 
     std::vector<std::pair<std::string, Image>> denoised;
@@ -137,10 +145,13 @@ void run(const RenderArgs& a) {
         in.position = &b.position;
         in.depth = &b.depth;
         in.ids = &b.ids;
+        // Filtering color - emission keeps a visible light's anti-aliased edge out of its surroundings.
+        in.emission = b.emission.empty() ? nullptr : &b.emission;
         Timer dt;
         for (DenoiseMethod m : methods) {
             DenoiseOptions opt;
             opt.method = m;
+            opt.device = device;
             denoised.emplace_back(denoiseMethodName(m), denoise(in, opt));
         }
         denoiseSeconds = dt.seconds();
@@ -157,8 +168,8 @@ void run(const RenderArgs& a) {
     }
 
     double samples = double(s.width) * s.height * s.spp;
-    std::printf("rendered %s: %dx%d, %d spp, max depth %d, %.3f s, %.2f M samples/s", scene.name().c_str(), s.width,
-                s.height, s.spp, s.maxDepth, seconds, samples / seconds * 1e-6);
+    std::printf("rendered %s on %s: %dx%d, %d spp, max depth %d, %.3f s, %.2f M samples/s", scene.name().c_str(),
+                deviceToString(device), s.width, s.height, s.spp, s.maxDepth, seconds, samples / seconds * 1e-6);
     if (!denoised.empty()) std::printf(", denoised (%s) in %.3f s", a.denoise.c_str(), denoiseSeconds);
     std::printf(" -> %s\n", a.out.c_str());
 }
@@ -178,6 +189,8 @@ void addRenderCommand(CLI::App& app) {
     cmd->add_option("--seed", args->settings.seed, "Random seed (same seed, same image)")->capture_default_str();
     cmd->add_option("--max-depth", args->settings.maxDepth, "Maximum bounces (1 = direct light only)")->capture_default_str();
     cmd->add_option("--threads", args->settings.threads, "Worker threads (0 = all cores)")->capture_default_str();
+    cmd->add_option("--device", args->device, "cpu, cuda or auto (cuda when a GPU is present; the GPU path tracer runs over a BVH built by Embree)")
+        ->capture_default_str();
     cmd->add_option("--denoise", args->denoise, "Also denoise with these methods (comma list: eaw,sure)");
     auto* frames = cmd->add_option("--frames", args->frames,
                                    "Render an animation of this many frames into OUT/frame_NNNN/ (time t = f / max(F-1, 1))");

@@ -208,7 +208,8 @@ def render(
     """Path-traces `scene` (a built-in name or a JSON scene file) on the CPU.
 
     Returns a dict of H x W x 3 float32 arrays: color, variance (of the mean), albedo, normal,
-    position, depth, ids (docs/rendering.md). Same seed, same pixels, whatever the thread count.
+    position, depth, ids, emission (docs/rendering.md). Same seed, same pixels, whatever the
+    thread count.
     """
     for name, v in (("width", width), ("height", height), ("spp", spp)):
         if not isinstance(v, (int, np.integer)) or isinstance(v, bool):

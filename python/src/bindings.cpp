@@ -231,6 +231,7 @@ nb::dict pyRender(const std::string& scene, int width, int height, int spp, uint
     d["position"] = fromImage(std::move(b.position));
     d["depth"] = fromImage(std::move(b.depth));
     d["ids"] = fromImage(std::move(b.ids));
+    d["emission"] = fromImage(std::move(b.emission));
     return d;
 }
 

@@ -11,7 +11,7 @@ def bufs():
 
 
 def test_render_returns_every_buffer_as_float32_hwc(bufs):
-    assert set(bufs) == {"color", "variance", "albedo", "normal", "position", "depth", "ids"}
+    assert set(bufs) == {"color", "variance", "albedo", "normal", "position", "depth", "ids", "emission"}
     for name, arr in bufs.items():
         assert arr.shape == (40, 48, 3), name
         assert arr.dtype == np.float32, name
@@ -42,6 +42,20 @@ def test_denoise_reduces_error_against_a_better_render(bufs, method):
     noisy = atrous.metrics(bufs["color"], ref)["mse"]
     den = atrous.metrics(out, ref)["mse"]
     assert den < noisy / 2, (method, noisy, den)
+
+
+def test_emission_keeps_the_visible_light_out_of_the_ceiling():
+    # cornell sees its ceiling light. Filtering color - emission and adding it back keeps the
+    # light's anti-aliased edge from spreading into the ceiling: with the emission buffer the
+    # filtered image's relMSE is at least 1.5x lower (measured 2-3.5x at this size).
+    b = atrous.render("cornell", width=64, height=64, spp=16, seed=3)
+    ref = atrous.render("cornell", width=64, height=64, spp=1024, seed=9)["color"]
+    assert b["emission"].max() > 1.0
+    kw = dict(albedo=b["albedo"], normal=b["normal"], position=b["position"], variance=b["variance"],
+              ids=b["ids"], method="eaw")
+    without = atrous.metrics(atrous.denoise(b["color"], **kw), ref)["relmse"]
+    with_e = atrous.metrics(atrous.denoise(b["color"], emission=b["emission"], **kw), ref)["relmse"]
+    assert with_e < without / 1.5, (with_e, without)
 
 
 def test_noncontiguous_and_float64_inputs_give_the_same_result(bufs):
