@@ -101,8 +101,9 @@ struct DenoiseReport {
     double milliseconds = 0;           // filter time (excluding validation)
 };
 
-// Denoises inputs.color and returns a 3-channel host image of the same size. Throws InputError
-// for mismatched sizes, missing colour, negative variance or parameters out of range.
+// Denoises inputs.color and returns a 3-channel image of the same size: on the host, except with
+// options.device == Cuda and a colour already on the GPU, when the result stays there. Throws
+// InputError for mismatched sizes, missing colour, negative variance or parameters out of range.
 Image denoise(const DenoiseInputs& inputs, const DenoiseOptions& options);
 
 // Throws InputError naming the parameter when one is out of range.

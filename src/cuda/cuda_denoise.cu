@@ -1,5 +1,7 @@
 // CUDA instantiation of the EAW/SURE driver (src/filters/denoise_driver.h) with CudaExec: the same
-// functors as the CPU path, launched as kernels. Inputs are uploaded, the result downloaded.
+// functors as the CPU path, launched as kernels. Host inputs are uploaded and the result is
+// downloaded; inputs already on the GPU (Python's DLPack arrays) are used there and the result
+// stays on the GPU.
 #include <cmath>
 
 #include "atrous/denoise.h"
@@ -36,12 +38,15 @@ Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const Prepar
     runDenoise(CudaExec{}, di, cfg, dout);
     rep.milliseconds = t.ms();
     Image hostAfter = after.to(Device::Cpu), hostFlag = flag.to(Device::Cpu);
+    const bool colorOnDevice = in.color->device() == Device::Cuda;
+    const Image hostColorCopy = colorOnDevice ? in.color->to(Device::Cpu) : Image();
+    const Image& hostColor = colorOnDevice ? hostColorCopy : *in.color;
     double s0 = 0, s1 = 0;
     size_t n0 = 0;
     int clamped = 0;
     const size_t plane = size_t(w) * h;
     for (size_t i = 0; i < plane; ++i) {
-        const float* c = in.color->data();
+        const float* c = hostColor.data();
         const float l = lum(c[i], c[i + plane], c[i + 2 * plane]);
         if (std::isfinite(l)) {
             s0 += l;
@@ -53,6 +58,7 @@ Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const Prepar
     rep.meanLuminanceIn = n0 ? s0 / double(n0) : 0.0;
     rep.meanLuminanceAfterFirefly = s1 / double(plane);
     rep.firefliesClamped = clamped;
+    if (colorOnDevice) return out;
     return out.to(Device::Cpu);
 }
 
