@@ -1,12 +1,10 @@
 #include "atrous/image.h"
 
-#include <cstdlib>
+#include <tbb/scalable_allocator.h>
+
 #include <cstring>
-#include <mutex>
-#include <new>
 #include <string>
 #include <utility>
-#include <vector>
 
 #include "atrous/error.h"
 #include "core/memory.h"
@@ -15,66 +13,12 @@ namespace atrous {
 
 namespace detail {
 
-namespace {
-
-// Host blocks of large images are kept after release and handed out again for the same size:
-// the denoisers allocate ~15 image-sized temporaries per call, and fresh large blocks come from
-// mmap, so every call paid a page fault per 4 KiB plus the kernel's zeroing (~10% of a 512×512
-// denoise). Bounded, so a long-running process keeps at most kCacheLimit bytes idle.
-constexpr size_t kCacheMinBytes = size_t(256) << 10;
-constexpr size_t kCacheLimit = size_t(512) << 20;
-
-struct HostBlockCache {
-    std::mutex mutex;
-    std::vector<std::pair<void*, size_t>> blocks;  // (pointer, rounded size), most recent last
-    size_t bytes = 0;
-
-    void* take(size_t rounded) {
-        std::lock_guard<std::mutex> lock(mutex);
-        for (size_t i = blocks.size(); i-- > 0;) {
-            if (blocks[i].second != rounded) continue;
-            void* p = blocks[i].first;
-            blocks.erase(blocks.begin() + long(i));
-            bytes -= rounded;
-            return p;
-        }
-        return nullptr;
-    }
-    // Returns false when the block does not fit; the caller frees it then.
-    bool give(void* p, size_t rounded) {
-        std::lock_guard<std::mutex> lock(mutex);
-        while (bytes + rounded > kCacheLimit && !blocks.empty()) {  // drop the oldest
-            std::free(blocks.front().first);
-            bytes -= blocks.front().second;
-            blocks.erase(blocks.begin());
-        }
-        if (bytes + rounded > kCacheLimit) return false;
-        blocks.emplace_back(p, rounded);
-        bytes += rounded;
-        return true;
-    }
-};
-
-// Never destroyed: images in static storage may be released after it would have been.
-HostBlockCache& hostCache() {
-    static HostBlockCache* cache = new HostBlockCache;
-    return *cache;
-}
-
-size_t roundedHostBytes(size_t bytes) {
-    const size_t rounded = (bytes + 63) / 64 * 64;
-    return rounded == 0 ? 64 : rounded;
-}
-
-}  // namespace
-
+// Host memory comes from TBB's scalable allocator: its large-object cache keeps released blocks
+// for reuse, so the denoisers' per-call temporaries (~15 image-sized blocks) do not page-fault and
+// get zeroed by the kernel on every call (that was ~10% of a 512x512 denoise with plain malloc).
 void* allocateBytes(size_t bytes, Device device) {
     if (device == Device::Cuda) return cudaAllocate(bytes);
-    const size_t rounded = roundedHostBytes(bytes);
-    if (rounded >= kCacheMinBytes) {
-        if (void* p = hostCache().take(rounded)) return p;
-    }
-    void* p = std::aligned_alloc(64, rounded);
+    void* p = scalable_aligned_malloc(bytes == 0 ? 64 : bytes, 64);
     if (!p) throw RuntimeError("out of host memory allocating " + std::to_string(bytes) + " bytes");
     return p;
 }
@@ -84,16 +28,7 @@ void freeBytes(void* p, Device device) {
     if (device == Device::Cuda)
         cudaRelease(p);
     else
-        std::free(p);
-}
-
-// freeBytes that may keep a host block of `bytes` (the size it was allocated with) for reuse.
-void releaseBytes(void* p, Device device, size_t bytes) {
-    if (p && device == Device::Cpu) {
-        const size_t rounded = roundedHostBytes(bytes);
-        if (rounded >= kCacheMinBytes && hostCache().give(p, rounded)) return;
-    }
-    freeBytes(p, device);
+        scalable_aligned_free(p);
 }
 
 void copyBytes(void* dst, Device dstDevice, const void* src, Device srcDevice, size_t bytes) {
@@ -129,7 +64,7 @@ Image::Image(int width, int height, int channels, Device device)
 Image::~Image() { release(); }
 
 void Image::release() {
-    detail::releaseBytes(mData, mDevice, size() * sizeof(float));
+    detail::freeBytes(mData, mDevice);
     mData = nullptr;
 }
 
