@@ -115,14 +115,7 @@ void run(const BenchArgs& a) {
         (void)renderMs;
         for (const char* m : {"eaw", "sure"}) {
             if (!wants(m)) continue;
-            DenoiseInputs in;
-            in.color = &b.color;
-            in.variance = &b.variance;
-            in.albedo = &b.albedo;
-            in.normal = &b.normal;
-            in.position = &b.position;
-            in.depth = &b.depth;
-            in.ids = &b.ids;
+            DenoiseInputs in = denoiseInputsOf(b);
             DenoiseReport rep;
             DenoiseOptions o;
             o.method = parseDenoiseMethod(m);

@@ -137,16 +137,9 @@ void run(const RenderArgs& a) {
     std::vector<std::pair<std::string, Image>> denoised;
     double denoiseSeconds = 0.0;
     if (!methods.empty()) {
-        DenoiseInputs in;
-        in.color = &b.color;
-        in.variance = &b.variance;
-        in.albedo = &b.albedo;
-        in.normal = &b.normal;
-        in.position = &b.position;
-        in.depth = &b.depth;
-        in.ids = &b.ids;
-        // Filtering color - emission keeps a visible light's anti-aliased edge out of its surroundings.
-        in.emission = b.emission.empty() ? nullptr : &b.emission;
+        // Every buffer, emission included: filtering color - emission keeps a visible light's
+        // anti-aliased edge out of its surroundings.
+        DenoiseInputs in = denoiseInputsOf(b);
         Timer dt;
         for (DenoiseMethod m : methods) {
             DenoiseOptions opt;

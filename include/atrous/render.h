@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "atrous/denoise.h"
 #include "atrous/image.h"
 
 namespace atrous {
@@ -57,6 +58,21 @@ enum class CameraPath { Auto, Static, Orbit, Dolly, Keyframes };
 
 // "auto", "static", "orbit", "dolly", "keyframes"; InputError naming --camera-path otherwise.
 CameraPath parseCameraPath(const std::string& name);
+
+// The denoiser's view of a render: every buffer it uses (variance, features, ids, emission).
+inline DenoiseInputs denoiseInputsOf(const RenderBuffers& b) {
+    auto opt = [](const Image& img) { return img.empty() ? nullptr : &img; };
+    DenoiseInputs in;
+    in.color = &b.color;
+    in.variance = opt(b.variance);
+    in.albedo = opt(b.albedo);
+    in.normal = opt(b.normal);
+    in.position = opt(b.position);
+    in.depth = opt(b.depth);
+    in.ids = opt(b.ids);
+    in.emission = opt(b.emission);
+    return in;
+}
 
 // Depth written for pixels that see no surface (a finite stand-in for +inf).
 constexpr float kBackgroundDepth = 1e30f;

@@ -2,9 +2,6 @@
 // the per-pixel kernel (src/render/integrator.h) over 8x8 tiles. Nothing but the intersection
 // calls is CPU-specific.
 #include <embree3/rtcore.h>
-#include <tbb/blocked_range2d.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -14,6 +11,7 @@
 #include "atrous/error.h"
 #include "atrous/render.h"
 #include "render/animation.h"
+#include "render/bvh_render.h"
 #include "render/integrator.h"
 #include "render/scene_data.h"
 
@@ -212,47 +210,18 @@ namespace {
 RenderBuffers renderImpl(const Scene& scene, const RenderSettings& settings, const pt::MotionReprojection* motion) {
     validateRenderSettings(settings);
     const SceneData& data = scene.data();
-    RenderBuffers b;
-    const int w = settings.width, h = settings.height;
-    b.color = Image(w, h, 3);
-    b.variance = Image(w, h, 3);
-    b.albedo = Image(w, h, 3);
-    b.normal = Image(w, h, 3);
-    b.position = Image(w, h, 3);
-    b.depth = Image(w, h, 3);
-    b.ids = Image(w, h, 3);
-    b.emission = Image(w, h, 3);
-    if (motion) b.motion = Image(w, h, 3);
+    RenderBuffers b = detail::allocateRenderBuffers(settings.width, settings.height, Device::Cpu);
+    if (motion) b.motion = Image(settings.width, settings.height, 3);
 
     EmbreeScene embree(data);
-    pt::PathTraceKernel<EmbreeTracer> k;
-    k.scene = data.view();
-    k.tracer.scene = embree.handle();
-    k.out = pt::RenderTargets{b.color.view(), b.variance.view(), b.albedo.view(), b.normal.view(),
-                                  b.position.view(), b.depth.view(), b.ids.view(),
-                                  b.motion.empty() ? ImageView{} : b.motion.view(), b.emission.view()};
-    if (motion) k.motion = *motion;
-    k.width = w;
-    k.height = h;
-    k.spp = settings.spp;
-    k.maxDepth = settings.maxDepth;
-    k.seed = settings.seed;
-    k.lightSampling = settings.lightSampling;
-    k.backgroundDepth = kBackgroundDepth;
-
-    // 8x8 tiles: small enough to balance the uneven cost of paths, large enough for coherence.
-    auto run = [&] {
-        tbb::parallel_for(tbb::blocked_range2d<int>(0, h, 8, 0, w, 8), [&](const tbb::blocked_range2d<int>& r) {
-            for (int y = r.rows().begin(); y < r.rows().end(); ++y)
-                for (int x = r.cols().begin(); x < r.cols().end(); ++x) k(x, y);
-        });
-    };
-    if (settings.threads > 0) {
-        tbb::task_arena arena(settings.threads);
-        arena.execute(run);
-    } else {
-        run();
+    EmbreeTracer tracer;
+    tracer.scene = embree.handle();
+    auto k = detail::makePathTraceKernel(data.view(), tracer, b, settings);
+    if (motion) {
+        k.out.motion = b.motion.view();
+        k.motion = *motion;
     }
+    detail::runPathTraceTiles(k, settings);
     return b;
 }
 

@@ -16,20 +16,7 @@ RenderBuffers renderBvhCpu(const Scene& scene, const RenderSettings& settings) {
     BvhData bvh = pt::buildSceneBvh(data);
     RenderBuffers b = detail::allocateRenderBuffers(settings.width, settings.height, Device::Cpu);
     auto k = detail::makePathTraceKernel(data.view(), pt::makeBvhTracer(bvh.view(), data), b, settings);
-    const int w = settings.width, h = settings.height;
-    // 8x8 tiles, as the Embree renderer: paths have uneven cost.
-    auto run = [&] {
-        tbb::parallel_for(tbb::blocked_range2d<int>(0, h, 8, 0, w, 8), [&](const tbb::blocked_range2d<int>& r) {
-            for (int y = r.rows().begin(); y < r.rows().end(); ++y)
-                for (int x = r.cols().begin(); x < r.cols().end(); ++x) k(x, y);
-        });
-    };
-    if (settings.threads > 0) {
-        tbb::task_arena arena(settings.threads);
-        arena.execute(run);
-    } else {
-        run();
-    }
+    detail::runPathTraceTiles(k, settings);
     return b;
 }
 

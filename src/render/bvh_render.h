@@ -3,6 +3,10 @@
 // renderBvhCuda is the GPU renderer; renderBvhCpu runs the very same code on TBB threads, which
 // lets the CPU test suite check the GPU path against the Embree renderer.
 #pragma once
+#include <tbb/blocked_range2d.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
 #include <memory>
 
 #include "atrous/image.h"
@@ -75,6 +79,26 @@ pt::PathTraceKernel<Tracer> makePathTraceKernel(const pt::SceneView& scene, cons
     k.lightSampling = s.lightSampling;
     k.backgroundDepth = kBackgroundDepth;
     return k;
+}
+
+// Runs a path-tracing kernel over the image on TBB threads in 8x8 tiles (small enough to balance
+// the uneven cost of paths, large enough for coherence), in an arena of settings.threads threads
+// when that is > 0. The output does not depend on the tiling (RNG streams are per pixel/sample).
+template <class Kernel>
+void runPathTraceTiles(const Kernel& k, const RenderSettings& settings) {
+    const int w = settings.width, h = settings.height;
+    auto run = [&] {
+        tbb::parallel_for(tbb::blocked_range2d<int>(0, h, 8, 0, w, 8), [&](const tbb::blocked_range2d<int>& r) {
+            for (int y = r.rows().begin(); y < r.rows().end(); ++y)
+                for (int x = r.cols().begin(); x < r.cols().end(); ++x) k(x, y);
+        });
+    };
+    if (settings.threads > 0) {
+        tbb::task_arena arena(settings.threads);
+        arena.execute(run);
+    } else {
+        run();
+    }
 }
 
 }  // namespace detail
