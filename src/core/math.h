@@ -12,13 +12,13 @@ constexpr float kInfinity = 3.0e38f;  // finite stand-in used where a format nee
 
 struct Vec2 {
     float x = 0, y = 0;
-    ATROUS_INLINE Vec2() = default;
+    Vec2() = default;  // defaulted: host and device alike
     ATROUS_INLINE Vec2(float x_, float y_) : x(x_), y(y_) {}
 };
 
 struct Vec3 {
     float x = 0, y = 0, z = 0;
-    ATROUS_INLINE Vec3() = default;
+    Vec3() = default;  // defaulted: host and device alike
     ATROUS_INLINE Vec3(float x_, float y_, float z_) : x(x_), y(y_), z(z_) {}
     ATROUS_INLINE explicit Vec3(float v) : x(v), y(v), z(v) {}
     ATROUS_INLINE float operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
