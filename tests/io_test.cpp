@@ -1,7 +1,13 @@
 #include <gtest/gtest.h>
 
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfOutputFile.h>
+
 #include <cmath>
 #include <fstream>
+#include <vector>
 
 #include "atrous/error.h"
 #include "io/image_io.h"
@@ -86,4 +92,37 @@ TEST(ImageIo, FailedWriteLeavesNothing) {
     EXPECT_THROW(io::writeImage(dir / "nodir/a.exr", ramp(4, 4)), InputError);
     EXPECT_THROW(io::writeImage(dir / "a.bmp", ramp(4, 4)), InputError);
     EXPECT_EQ(atrous::test::countEntries(dir.str()), 0);
+}
+
+// An EXR whose channels are neither R,G,B nor Y nor a single one: rejected, naming the file and
+// the channels it has; through the CLI, exit code 2 and no output.
+TEST(ImageIo, ExrWithTheWrongChannelsIsRejected) {
+    TempDir dir;
+    const std::string path = dir / "uv.exr";
+    {
+        const int w = 4, h = 3;
+        std::vector<float> u(w * h, 0.5f), v(w * h, 0.25f);
+        Imf::Header header(w, h);
+        header.channels().insert("U", Imf::Channel(Imf::FLOAT));
+        header.channels().insert("V", Imf::Channel(Imf::FLOAT));
+        Imf::OutputFile file(path.c_str(), header);
+        Imf::FrameBuffer fb;
+        fb.insert("U", Imf::Slice(Imf::FLOAT, (char*)u.data(), sizeof(float), sizeof(float) * w));
+        fb.insert("V", Imf::Slice(Imf::FLOAT, (char*)v.data(), sizeof(float), sizeof(float) * w));
+        file.setFrameBuffer(fb);
+        file.writePixels(h);
+    }
+    try {
+        io::readImage(path);
+        FAIL() << "a U,V file was accepted";
+    } catch (const InputError& e) {
+        const std::string msg = e.what();
+        EXPECT_NE(msg.find("uv.exr"), std::string::npos) << msg;
+        EXPECT_NE(msg.find("U,V"), std::string::npos) << msg;
+    }
+    const std::string out = dir / "out.exr";
+    auto r = atrous::test::runCli("denoise --color " + path + " --method eaw --out " + out);
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("uv.exr"), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(out));
 }
