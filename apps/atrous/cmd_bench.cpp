@@ -91,9 +91,7 @@ void run(const BenchArgs& a) {
         rs.height = h;
         rs.spp = 2;
         rs.seed = 7;
-        Timer rt;
         RenderBuffers b = render(scene, rs);
-        const double renderMs = rt.ms();
         if (wants("render")) {
             // The CPU path tracer (the GPU one is timed by bench/bench_render on CUDA builds).
             RenderSettings one = rs;
@@ -112,7 +110,6 @@ void run(const BenchArgs& a) {
             r["msamples_per_s"] = double(w) * h / (median(t) * 1e3);
             doc["results"].push_back(r);
         }
-        (void)renderMs;
         for (const char* m : {"eaw", "sure"}) {
             if (!wants(m)) continue;
             DenoiseInputs in = denoiseInputsOf(b);

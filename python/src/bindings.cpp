@@ -151,7 +151,7 @@ nb::object pyDenoise(const Array& color, nb::handle albedo, nb::handle normal, n
         nb::gil_scoped_release release;
         out = denoise(in, o);
     }
-    if (out.device() != c.device()) out = out.to(c.device());
+    // denoise() ran on the colour's device and left its result there (o.device = c.device()).
     return fromImage(std::move(out));
 }
 
