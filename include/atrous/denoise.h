@@ -8,6 +8,7 @@
 
 #include "atrous/device.h"
 #include "atrous/image.h"
+#include "atrous/stage_time.h"
 
 namespace atrous {
 
@@ -99,6 +100,10 @@ struct DenoiseReport {
     double meanLuminanceAfterFirefly = 0;  // ... after firefly suppression
     std::string buffersUsed;           // e.g. "color,variance,normal,position"
     double milliseconds = 0;           // filter time (excluding validation)
+    // Per-stage times of the filter, in order: sanitize, fireflies, demodulate, sigma scales, then
+    // "level i" (and for SURE "sure i": the window sums and the choice of s_i) per level, then
+    // remodulate. CPU: wall clock; CUDA: cudaEvents on the stream (GPU time, no extra syncs).
+    std::vector<StageTime> stages;
 };
 
 // Denoises inputs.color and returns a 3-channel image of the same size: on the host, except with

@@ -6,6 +6,7 @@
 
 #include "atrous/device.h"
 #include "atrous/image.h"
+#include "atrous/stage_time.h"
 
 namespace atrous {
 
@@ -56,6 +57,12 @@ struct SvgfFrame {
     const Image* emission = nullptr;  // optional: emitted radiance at the primary hit, 3 channels
 };
 
+// What the last timed frame did: per-stage times (SvgfDenoiser::setReport).
+struct SvgfReport {
+    std::vector<StageTime> stages;  // demodulate, reproject, accumulate, variance, level i, remodulate, taa
+    double milliseconds = 0;        // sum of the stages (the frame's filter time, uploads excluded)
+};
+
 namespace detail {
 class SvgfBackend;
 }
@@ -79,6 +86,10 @@ public:
     const Image& denoiseFrameOnDevice(const SvgfFrame& frame);
     // Forgets all history (next frame is treated as the first).
     void reset();
+    // Each later denoiseFrame* call fills *report with its per-stage times (null: stop timing).
+    // The report must outlive those calls. On CUDA the stages are timed with events on the
+    // stream, read after the frame's final synchronisation (no extra synchronisation).
+    void setReport(SvgfReport* report);
 
     const SvgfParams& params() const { return mParams; }
     Device device() const { return mDevice; }

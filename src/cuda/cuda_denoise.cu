@@ -8,6 +8,7 @@
 #include "core/timer.h"
 #include "cuda/cuda_exec.cuh"
 #include "filters/denoise_internal.h"
+#include "filters/stage_clock.h"
 
 namespace atrous::filters {
 
@@ -32,11 +33,16 @@ Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const Prepar
     dout.out = out.view();
     dout.afterFirefly = after.view();
     dout.fireflyFlag = flag.view();
+    // Per-stage GPU times only when the caller asked for a report (events, read after the sync).
+    std::unique_ptr<StageClock> clock = o.report ? makeStageClock(Device::Cuda) : nullptr;
+    dout.clock = clock.get();
     Timer t;
     DriverConfig cfg = makeConfig(o);
     cfg.varianceGiven = in.variance != nullptr;
+    if (clock) clock->start();
     runDenoise(CudaExec{}, di, cfg, dout);
     rep.milliseconds = t.ms();
+    if (clock) clock->collect(rep.stages);
     Image hostAfter = after.to(Device::Cpu), hostFlag = flag.to(Device::Cpu);
     const bool colorOnDevice = in.color->device() == Device::Cuda;
     const Image hostColorCopy = colorOnDevice ? in.color->to(Device::Cpu) : Image();

@@ -10,6 +10,7 @@
 #include "atrous/image.h"
 #include "filters/eaw.h"
 #include "filters/prepass.h"
+#include "filters/stage_clock.h"
 #include "filters/sure.h"
 
 namespace atrous::filters {
@@ -29,6 +30,7 @@ struct DriverOutputs {
     ImageView afterFirefly;  // optional: c_0 after sanitising and firefly suppression (3 ch)
     ImageView fireflyFlag;   // optional: 1 where a firefly was clamped (1 ch)
     ImageView sureS;         // optional: s_i per level (levels channels)
+    StageClock* clock = nullptr;  // optional: started by the caller, marked after each stage
 };
 
 struct DriverConfig {
@@ -100,6 +102,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     if (in.position.valid()) exec.forEachPixel(w, h, SanitizeFeature{in.position, position.view()});
     if (in.depth.valid()) exec.forEachPixel(w, h, SanitizeFeature{in.depth, depth.view()});
     if (in.ids.valid()) exec.forEachPixel(w, h, SanitizeFeature{in.ids, ids.view()});
+    markStage(out.clock, "sanitize");
 
     // 2. Fireflies (before demodulation: the outlier is in radiance).
     // c0/v0 are dead after this step: without the firefly pass they become cA/vA (no copy), with
@@ -117,6 +120,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     if (out.afterFirefly.valid()) {
         exec.forEachPixel(w, h, Copy3{cA.view(), out.afterFirefly});
     }
+    markStage(out.clock, "fireflies");
 
     // 3. Albedo demodulation.
     ImageView albedo = cfg.demodulate ? in.albedo : ImageView{};
@@ -127,6 +131,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         albedo = albedoClean.view();
         exec.forEachPixel(w, h, Demodulate{cfg.albedoEpsilon, albedo, cA.view(), vA.view()});
     }
+    markStage(out.clock, "demodulate");
 
     // 4. Per-pixel scales of the automatic σ_c and σ_x.
     Image S(w, h, 1, dev), invX(w, h, 1, dev), invZ(w, h, 1, dev);
@@ -134,6 +139,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     exec.forEachPixel(w, h, Footprint{in.position.valid() ? 1 : 0, cfg.eaw.sigmaPosition,
                                       cfg.eaw.positionScale * cfg.eaw.positionScale, position.view(), depth.view(),
                                       invX.view(), invZ.view()});
+    markStage(out.clock, "sigma scales");
 
     // 5. The cascade. SURE also propagates the variance and keeps Σ s_i d_i in `acc`.
     Image cB = c0.empty() ? Image(w, h, 3, dev) : std::move(c0);  // fully overwritten by level 0
@@ -184,11 +190,13 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         f.invZ = invZ.view();
         f.ids = ids.view();
         runEawLevel(exec, f);
+        markStage(out.clock, "level", i);
         if (sure) {
             runSureBoxH(exec, SureBoxH{choice.radius, detail.view(), boxH.view()});
             ImageView sOut;
             if (out.sureS.valid()) sOut = ImageView{out.sureS.channel(i), w, h, 1};
             runSureChoose(exec, SureChoose{choice, boxH.view(), cur->view(), nxt->view(), acc.view(), sOut});
+            markStage(out.clock, "sure", i);
             std::swap(vcur, vnxt);
         }
         std::swap(cur, nxt);
@@ -197,6 +205,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     // 6. out = (c_N + Σ s_i d_i) · albedo.
     exec.forEachPixel(w, h, Recombine{cfg.albedoEpsilon, cur->view(), sure ? acc.view() : ImageView{}, albedo,
                                       emission.empty() ? ImageView{} : emission.view(), out.out});
+    markStage(out.clock, "remodulate");
     exec.synchronize();
 }
 

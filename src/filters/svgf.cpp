@@ -99,4 +99,6 @@ const Image& SvgfDenoiser::denoiseFrameOnDevice(const SvgfFrame& frame) { return
 
 void SvgfDenoiser::reset() { mImpl->reset(); }
 
+void SvgfDenoiser::setReport(SvgfReport* report) { mImpl->setReport(report); }
+
 }  // namespace atrous

@@ -9,6 +9,7 @@
 
 #include "atrous/error.h"
 #include "atrous/svgf.h"
+#include "filters/stage_clock.h"
 #include "filters/svgf_accumulate.h"
 #include "filters/svgf_atrous.h"
 #include "filters/svgf_demodulate.h"
@@ -27,6 +28,7 @@ public:
     virtual Image denoiseFrame(const SvgfFrame& frame) = 0;
     virtual const Image& denoiseFrameOnDevice(const SvgfFrame& frame) = 0;
     virtual void reset() = 0;
+    virtual void setReport(SvgfReport* report) = 0;
 };
 
 std::unique_ptr<SvgfBackend> makeSvgfCpuBackend(const SvgfParams& params);
@@ -111,6 +113,8 @@ public:
                 views[i] = holders[i].view();
             }
         }
+        filters::StageClock* clock = mReport ? mClock.get() : nullptr;
+        if (clock) clock->start();
         const ImageView color = views[0], albedo = views[1], normalIn = views[2], depthIn = views[3], idsIn = views[4],
                         motionIn = views[5], emission = views[6];
 
@@ -118,6 +122,7 @@ public:
         mExec.forEachPixel(w, h, SanitizeGbuffer{depthIn, normalIn, idsIn, motionIn, s.depth.view(), s.normal.view(),
                                                  s.ids.view(), s.motion.view()});
         mExec.forEachPixel(w, h, DepthGradient{s.depth.view(), s.depthGrad.view()});
+        filters::markStage(clock, "demodulate");
 
         Reproject rp;
         rp.depthTolerance = mParams.reprojectDepthTolerance;
@@ -129,6 +134,7 @@ public:
         rp.prevDepth = s.prevDepth.view(), rp.prevNormal = s.prevNormal.view(), rp.prevIds = s.prevIds.view();
         rp.outIllum = s.reprojIllum.view(), rp.outMoments = s.reprojMoments.view(), rp.outLength = s.reprojLength.view();
         mExec.forEachPixel(w, h, rp);
+        filters::markStage(clock, "reproject");
 
         Accumulate acc;
         acc.alpha = mParams.alpha;
@@ -138,6 +144,7 @@ public:
         acc.histIllum = s.reprojIllum.view(), acc.histMoments = s.reprojMoments.view(), acc.histLength = s.reprojLength.view();
         acc.outIllum = s.accIllum.view(), acc.outMoments = s.accMoments.view(), acc.outLength = s.accLength.view();
         mExec.forEachPixel(w, h, acc);
+        filters::markStage(clock, "accumulate");
 
         Variance var;
         var.spatialFrames = float(mParams.spatialVarianceFrames);
@@ -147,6 +154,7 @@ public:
         var.depth = s.depth.view(), var.normal = s.normal.view(), var.depthGrad = s.depthGrad.view();
         var.variance = s.variance.view();
         mExec.forEachPixel(w, h, var);
+        filters::markStage(clock, "variance");
 
         // À-trous levels, ping-ponging between two buffers; the level at the feedback tap writes
         // straight into next frame's colour history instead (no copy).
@@ -160,11 +168,13 @@ public:
             at.outIllum = level == mParams.feedbackTap ? s.nextHistIllum.view() : s.levelIllum[level & 1].view();
             at.outVariance = s.levelVariance[level & 1].view();
             mExec.forEachPixel(w, h, at);
+            filters::markStage(clock, "level", level);
             inIllum = at.outIllum;
             inVar = at.outVariance;
         }
 
         mExec.forEachPixel(w, h, Remodulate{inIllum, albedo, emission, s.output.view()});
+        filters::markStage(clock, "remodulate");
         s.result = &s.output;
         if (mParams.taa) {
             Taa taa;
@@ -173,6 +183,7 @@ public:
             taa.current = s.output.view(), taa.motion = s.motion.view(), taa.history = s.taaHistory.view();
             taa.out = s.taaOutput.view();
             mExec.forEachPixel(w, h, taa);
+            filters::markStage(clock, "taa");
             std::swap(s.taaHistory, s.taaOutput);
             s.haveTaa = true;
             s.result = &s.taaHistory;
@@ -191,6 +202,7 @@ public:
         s.havePrevious = true;
         ++s.frames;
         mExec.synchronize();  // the holders die at the end of this scope
+        if (clock) mReport->milliseconds = clock->collect(mReport->stages);
     }
 
     // run() and a copy of the result on the host.
@@ -200,12 +212,19 @@ public:
     }
 
     SvgfState& state() { return mState; }
+    // Per-stage timings of each later run() go to *report (null: no timing).
+    void setReport(SvgfReport* report) {
+        mReport = report;
+        if (report && !mClock) mClock = filters::makeStageClock(mExec.device());
+    }
     const SvgfParams& params() const { return mParams; }
 
 private:
     SvgfParams mParams;
     Exec mExec;
     SvgfState mState;
+    SvgfReport* mReport = nullptr;
+    std::unique_ptr<filters::StageClock> mClock;
 };
 
 template <class Exec>
@@ -218,6 +237,7 @@ public:
         return *mPipeline.state().result;
     }
     void reset() override { mPipeline.reset(); }
+    void setReport(SvgfReport* report) override { mPipeline.setReport(report); }
 
 private:
     SvgfPipeline<Exec> mPipeline;
