@@ -1,14 +1,20 @@
 // Speed of EAW and SURE-À-Trous (5 levels, all feature buffers, firefly pass and demodulation on:
 // the defaults) at 512×512 and 1920×1080. Prints JSON: median and min over >= 20 runs after
-// warm-up, the device name and thread count. Usage: bench_denoise [--runs N] [--device cpu|cuda]
+// warm-up, the device name and thread count.
+// Usage: bench_denoise [--runs N] [--device cpu|cuda] [--size WxH] [--method eaw|sure] [--threads N]
+// (--size and --method: time only that size / method; default both sizes and both methods; --threads: limit TBB,
+// e.g. 1 to measure the work alone on a loaded machine)
 #include <sys/resource.h>
+#include <tbb/global_control.h>
 #include <tbb/info.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "atrous/denoise.h"
@@ -72,17 +78,36 @@ struct Buffers {
 int main(int argc, char** argv) {
     int runs = 30;
     Device device = Device::Cpu;
+    std::vector<std::pair<int, int>> sizes = {{512, 512}, {1920, 1080}};
+    std::vector<DenoiseMethod> methods = {DenoiseMethod::Eaw, DenoiseMethod::Sure};
+    int threads = 0;  // 0: TBB's default
     for (int i = 1; i < argc; ++i) {
         if (!std::strcmp(argv[i], "--runs") && i + 1 < argc) runs = std::max(20, std::atoi(argv[++i]));
         else if (!std::strcmp(argv[i], "--device") && i + 1 < argc) device = parseDevice(argv[++i]);
+        else if (!std::strcmp(argv[i], "--size") && i + 1 < argc) {
+            int w = 0, h = 0;
+            if (std::sscanf(argv[++i], "%dx%d", &w, &h) != 2 || w < 1 || h < 1) {
+                std::fprintf(stderr, "bench_denoise: --size expects WxH, e.g. 512x512\n");
+                return 2;
+            }
+            sizes = {{w, h}};
+        } else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) {
+            threads = std::max(1, std::atoi(argv[++i]));
+        } else if (!std::strcmp(argv[i], "--method") && i + 1 < argc) {
+            methods = {parseDenoiseMethod(argv[++i])};
+        } else {
+            std::fprintf(stderr, "bench_denoise: unknown argument '%s'\n", argv[i]);
+            return 2;
+        }
     }
-    const int sizes[2][2] = {{512, 512}, {1920, 1080}};
+    const int concurrency = threads > 0 ? threads : tbb::info::default_concurrency();
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(concurrency));
     std::printf("{\n  \"benchmark\": \"denoise\",\n  \"device\": \"%s\",\n  \"threads\": %d,\n  \"runs\": %d,\n  \"results\": [\n",
-                deviceName(device).c_str(), tbb::info::default_concurrency(), runs);
+                deviceName(device).c_str(), concurrency, runs);
     bool first = true;
     for (auto& sz : sizes) {
-        Buffers b(sz[0], sz[1]);
-        for (DenoiseMethod m : {DenoiseMethod::Eaw, DenoiseMethod::Sure}) {
+        Buffers b(sz.first, sz.second);
+        for (DenoiseMethod m : methods) {
             DenoiseOptions o;
             o.method = m;
             o.device = device;
@@ -90,23 +115,33 @@ int main(int argc, char** argv) {
             o.report = &rep;
             for (int i = 0; i < 3; ++i) denoise(b.inputs(), o);  // warm-up
             std::vector<double> filterMs, totalMs;
+            std::vector<std::string> stageNames;
+            std::vector<std::vector<double>> stageMs;  // [stage][run]
             const double cpu0 = cpuMs();
             for (int i = 0; i < runs; ++i) {
                 Timer t;
                 denoise(b.inputs(), o);
                 totalMs.push_back(t.ms());
                 filterMs.push_back(rep.milliseconds);
+                if (i == 0)
+                    for (const StageTime& st : rep.stages) stageNames.push_back(st.name);
+                stageMs.resize(stageNames.size());
+                for (size_t k = 0; k < rep.stages.size() && k < stageNames.size(); ++k)
+                    stageMs[k].push_back(rep.stages[k].milliseconds);
             }
             const double cpuPerCall = (cpuMs() - cpu0) / runs;
             std::printf("%s    {\"method\": \"%s\", \"width\": %d, \"height\": %d, \"levels\": 5, \"median_ms\": %.3f, "
-                        "\"min_ms\": %.3f, \"median_total_ms\": %.3f, \"cpu_ms_per_call\": %.3f}",
-                        first ? "" : ",\n", denoiseMethodName(m), sz[0], sz[1], median(filterMs),
+                        "\"min_ms\": %.3f, \"median_total_ms\": %.3f, \"cpu_ms_per_call\": %.3f, \"stage_median_ms\": {",
+                        first ? "" : ",\n", denoiseMethodName(m), sz.first, sz.second, median(filterMs),
                         *std::min_element(filterMs.begin(), filterMs.end()), median(totalMs), cpuPerCall);
+            for (size_t k = 0; k < stageNames.size(); ++k)
+                std::printf("%s\"%s\": %.3f", k ? ", " : "", stageNames[k].c_str(), median(stageMs[k]));
+            std::printf("}}");
             first = false;
         }
     }
     std::printf("\n  ],\n  \"note\": \"median_ms: the filter (firefly pass, demodulation, 5 levels, recombination); "
                 "median_total_ms adds input validation and the report; cpu_ms_per_call: process CPU time (all threads, "
-                "getrusage) per whole denoise() call, mean over the runs\"\n}\n");
+                "getrusage) per whole denoise() call, mean over the runs; stage_median_ms: per stage of the filter (DenoiseReport::stages)\"\n}\n");
     return 0;
 }

@@ -119,19 +119,40 @@ TEST(Eaw, NoEnergyGain) {
 
 TEST(Eaw, CpuFastPathEqualsGenericFunctor) {
     SyntheticScene s = makeScene(70, 45, 0.4f, 4);
-    for (auto m : {DenoiseMethod::Eaw, DenoiseMethod::Sure})
-      for (float sigmaDepth : {0.0f, 0.1f}) {  // the fast path specialises on the depth stop
-        DenoiseOptions o;
-        o.method = m;
-        o.eaw.sigmaDepth = sigmaDepth;  // 0.1: every term on
-        filters::eawCpuFastPath() = true;
-        Image fast = denoise(s.inputs(), o);
-        filters::eawCpuFastPath() = false;
-        Image generic = denoise(s.inputs(), o);
-        filters::eawCpuFastPath() = true;
-        // Same math, different summation association and FMA contraction: 1e-5 on values ~1.
-        EXPECT_LT(maxAbsDiff(fast, generic), 1e-5) << denoiseMethodName(m);
-    }
+    // Material ids that change where no other feature does (stripes across the regions), so the
+    // id stop changes the output and both of its specialisations are tested for something.
+    for (int y = 0; y < s.ids.height(); ++y)
+        for (int x = 0; x < s.ids.width(); ++x) s.ids(x, y, 1) = float((x / 9 + y / 7) % 3);
+    // The fast path is compiled for AVX2 and for AVX-512 (picked at run time): test every one this
+    // CPU can run.
+    const bool hasAvx512 = filters::eawCpuAvx512();
+    std::vector<bool> isas = {false};
+    if (hasAvx512) isas.push_back(true);
+    for (bool avx512 : isas)
+        for (auto m : {DenoiseMethod::Eaw, DenoiseMethod::Sure})
+            for (float sigmaDepth : {0.0f, 0.1f})  // the fast path specialises on the depth stop...
+                for (bool ids : {true, false}) {   // ...and on the id stop
+                    DenoiseOptions o;
+                    o.method = m;
+                    o.eaw.sigmaDepth = sigmaDepth;  // 0.1: every term on
+                    o.eaw.useIds = ids;
+                    filters::eawCpuFastPath() = true;
+                    filters::eawCpuAvx512() = avx512;
+                    Image fast = denoise(s.inputs(), o);
+                    filters::eawCpuFastPath() = false;
+                    Image generic = denoise(s.inputs(), o);
+                    filters::eawCpuFastPath() = true;
+                    filters::eawCpuAvx512() = hasAvx512;
+                    // Same math, different summation association and FMA contraction: 1e-5 on
+                    // values ~1.
+                    EXPECT_LT(maxAbsDiff(fast, generic), 1e-5)
+                        << denoiseMethodName(m) << " avx512 " << avx512 << " depth " << sigmaDepth << " ids " << ids;
+                    // The id stop must matter on this scene, or the ids = false case tests nothing new.
+                    if (!ids) {
+                        o.eaw.useIds = true;
+                        EXPECT_GT(maxAbsDiff(denoise(s.inputs(), o), fast), 1e-4) << "ids changed nothing";
+                    }
+                }
 }
 
 TEST(Eaw, EveryParameterChangesTheOutput) {

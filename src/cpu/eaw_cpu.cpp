@@ -1,9 +1,18 @@
-// CPU fast path of one EAW level. Same math as filters::EawLevel (eawExponent, expNeg, b3 and
-// EawLevel::finish are shared; taps are summed in the same order), organised for AVX2: TBB over
-// row blocks, and for each of the 5 tap rows a contiguous, branch-free x loop over the interior
-// columns with the 5 taps of that row unrolled. Columns within 2·step of the left/right border
-// run one contiguous loop per tap over the columns where it is inside the image (through the
-// scalar generic functor they took 19% of the time for 5% of the work).
+// CPU fast path of one EAW level. Same math as filters::EawLevel (eawColorRecip, eawExponent,
+// expNeg, b3 and EawLevel::finish are shared; taps are summed in the same order), organised for
+// SIMD: TBB over row blocks, and for each of the 5 tap rows a contiguous, branch-free x loop over
+// the interior columns with the 5 taps of that row unrolled. Columns within 2·step of the
+// left/right border run one contiguous loop per tap over the columns where it is inside the image
+// (through the scalar generic functor they took 19% of the time for 5% of the work).
+//
+// Where it pays:
+// - the pair's 1/σ_c² is max(r(p), r(q)) of a per-pixel plane r = eawColorRecip(S) computed once
+//   per level, not one division per tap;
+// - the id term and the depth term are compiled out when they are off (their loads too);
+// - the same row loops are compiled twice, for AVX2 (the build's baseline, x86-64-v3) and for
+//   AVX-512, chosen at run time: the tap loop needs ~30 live vectors (16 ymm registers spilled to
+//   the stack on every tap) and 16 lanes halve the instruction count where the core has 512-bit
+//   units (measured 27% less CPU time for the level loop on the AMD EPYC build machine).
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -19,6 +28,25 @@ bool& eawCpuFastPath() {
     return enabled;
 }
 
+#if defined(__GNUC__) && !defined(__clang__) && (defined(__x86_64__) || defined(__i386__))
+#define ATROUS_EAW_AVX512 1
+// Row loops compiled for AVX-512 (F/VL/BW/DQ: the subset every AVX-512 core has) with 512-bit
+// vectors; the inlined shared functors take the caller's target, so the math is the same code.
+#define ATROUS_TARGET_AVX512 __attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,prefer-vector-width=512")))
+#else
+#define ATROUS_EAW_AVX512 0
+#endif
+
+bool& eawCpuAvx512() {
+#if ATROUS_EAW_AVX512
+    static bool enabled = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+                          __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq");
+#else
+    static bool enabled = false;
+#endif
+    return enabled;
+}
+
 namespace {
 
 struct RowAcc {
@@ -29,9 +57,11 @@ struct RowAcc {
     }
 };
 
-// kDepth = false (the default: no depth stop) skips the depth loads; the term is 0 either way.
-template <bool kPropagate, bool kDepth>
-void levelRows(const EawLevel& f, int y0, int y1) {
+// Rows [y0, y1) of one level. rS: the level's plane of eawColorRecip(S). kDepth/kIds = false
+// (no depth stop / no ids) skip those loads; the terms are 0 either way. Always inlined into the
+// per-ISA wrappers below, which decide the vector width.
+template <bool kPropagate, bool kDepth, bool kIds>
+ATROUS_FORCE_INLINE inline void levelRowsBody(const EawLevel& f, const float* rS, int y0, int y1) {
     const int w = f.cIn.width, h = f.cIn.height;
     const int s = f.p.step;
     const int x0 = s * 2 < w ? s * 2 : w;
@@ -51,7 +81,7 @@ void levelRows(const EawLevel& f, int y0, int y1) {
         const float* ATROUS_RESTRICT pr = f.cIn.channel(0) + rowP;
         const float* ATROUS_RESTRICT pg = f.cIn.channel(1) + rowP;
         const float* ATROUS_RESTRICT pb = f.cIn.channel(2) + rowP;
-        const float* ATROUS_RESTRICT pS = f.S.channel(0) + rowP;
+        const float* ATROUS_RESTRICT pS = rS + rowP;
         const float* ATROUS_RESTRICT pnx = f.normal.channel(0) + rowP;
         const float* ATROUS_RESTRICT pny = f.normal.channel(1) + rowP;
         const float* ATROUS_RESTRICT pnz = f.normal.channel(2) + rowP;
@@ -78,7 +108,7 @@ void levelRows(const EawLevel& f, int y0, int y1) {
             const float* ATROUS_RESTRICT qr = f.cIn.channel(0) + rowQ;
             const float* ATROUS_RESTRICT qg = f.cIn.channel(1) + rowQ;
             const float* ATROUS_RESTRICT qb = f.cIn.channel(2) + rowQ;
-            const float* ATROUS_RESTRICT qS = f.S.channel(0) + rowQ;
+            const float* ATROUS_RESTRICT qS = rS + rowQ;
             const float* ATROUS_RESTRICT qnx = f.normal.channel(0) + rowQ;
             const float* ATROUS_RESTRICT qny = f.normal.channel(1) + rowQ;
             const float* ATROUS_RESTRICT qnz = f.normal.channel(2) + rowQ;
@@ -95,32 +125,33 @@ void levelRows(const EawLevel& f, int y0, int y1) {
             const float pt0 = pt[0], pt1 = pt[1], pt2 = pt[2], pt3 = pt[3], pt4 = pt[4];
 #pragma omp simd
             for (int x = x0; x < x0 + n; ++x) {
-                const float cr = pr[x], cg = pg[x], cb = pb[x], sp = pS[x];
+                const float cr = pr[x], cg = pg[x], cb = pb[x], rp = pS[x];
                 const float nx = pnx[x], ny = pny[x], nz = pnz[x];
                 const float px = ppx[x], py = ppy[x], pz_ = ppz[x];
-                const float ixp = pix[x], zp = kDepth ? pz[x] : 0.0f, izp = kDepth ? piz[x] : 0.0f, m0 = pm0[x], m1 = pm1[x];
+                const float ixp = pix[x], zp = kDepth ? pz[x] : 0.0f, izp = kDepth ? piz[x] : 0.0f;
+                const float m0 = kIds ? pm0[x] : 0.0f, m1 = kIds ? pm1[x] : 0.0f;
                 float ws = 0, ar = 0, ag = 0, ab = 0, vr = 0, vg = 0, vb = 0;
-#define ATROUS_EAW_TAP(QX, PT)                                                                                   \
-    {                                                                                                            \
-        const int xq = x + (QX) * s;                                                                             \
-        const float r = qr[xq], g = qg[xq], b = qb[xq];                                                          \
-        const float dc2 = sq(cr - r) + sq(cg - g) + sq(cb - b);                                                  \
-        const float dn2 = sq(nx - qnx[xq]) + sq(ny - qny[xq]) + sq(nz - qnz[xq]);                                \
-        const float dx2 = sq(px - qpx[xq]) + sq(py - qpy[xq]) + sq(pz_ - qpz[xq]);                               \
-        const float dz = kDepth ? (zp - qz[xq]) * izp : 0.0f;                                                    \
-        const float did2 = sq(m0 - qm0[xq]) + sq(m1 - qm1[xq]);                                                  \
-        const float e = eawExponent(P, dc2, sp, qS[xq], dn2, dx2, ixp, PT, dz, did2);                            \
-        const float wt = hy * b3(QX) * expNeg(-e);                                                               \
-        ws += wt;                                                                                                \
-        ar += wt * r;                                                                                            \
-        ag += wt * g;                                                                                            \
-        ab += wt * b;                                                                                            \
-        if (kPropagate) {                                                                                        \
-            const float w2 = wt * wt;                                                                            \
-            vr += w2 * qvr[xq];                                                                                  \
-            vg += w2 * qvg[xq];                                                                                  \
-            vb += w2 * qvb[xq];                                                                                  \
-        }                                                                                                        \
+#define ATROUS_EAW_TAP(QX, PT)                                                        \
+    {                                                                                 \
+        const int xq = x + (QX)*s;                                                    \
+        const float r = qr[xq], g = qg[xq], b = qb[xq];                               \
+        const float dc2 = sq(cr - r) + sq(cg - g) + sq(cb - b);                       \
+        const float dn2 = sq(nx - qnx[xq]) + sq(ny - qny[xq]) + sq(nz - qnz[xq]);     \
+        const float dx2 = sq(px - qpx[xq]) + sq(py - qpy[xq]) + sq(pz_ - qpz[xq]);    \
+        const float dz = kDepth ? (zp - qz[xq]) * izp : 0.0f;                         \
+        const float did2 = kIds ? sq(m0 - qm0[xq]) + sq(m1 - qm1[xq]) : 0.0f;         \
+        const float e = eawExponent(P, dc2, rp, qS[xq], dn2, dx2, ixp, PT, dz, did2); \
+        const float wt = hy * b3(QX) * expNeg(-e);                                    \
+        ws += wt;                                                                     \
+        ar += wt * r;                                                                 \
+        ag += wt * g;                                                                 \
+        ab += wt * b;                                                                 \
+        if (kPropagate) {                                                             \
+            const float w2 = wt * wt;                                                 \
+            vr += w2 * qvr[xq];                                                       \
+            vg += w2 * qvg[xq];                                                       \
+            vb += w2 * qvb[xq];                                                       \
+        }                                                                             \
     }
                 ATROUS_EAW_TAP(-2, pt0)
                 ATROUS_EAW_TAP(-1, pt1)
@@ -140,28 +171,28 @@ void levelRows(const EawLevel& f, int y0, int y1) {
             // Border columns (within 2·step of the left/right edge): one loop per tap over the
             // columns where that tap is inside the image (the others are dropped, as in the
             // generic functor), so the loads stay contiguous and the loop branch-free.
-#define ATROUS_EAW_BORDER_TAP(QX, PT, XA, XB)                                                                    \
-    {                                                                                                            \
-        const int lo = (XA) > -(QX) * s ? (XA) : -(QX) * s;                                                      \
-        const int hi = (XB) < w - (QX) * s ? (XB) : w - (QX) * s;                                                \
-        _Pragma("omp simd") for (int x = lo; x < hi; ++x) {                                                      \
-            const float cr = pr[x], cg = pg[x], cb = pb[x], sp = pS[x];                                          \
-            const float nx = pnx[x], ny = pny[x], nz = pnz[x];                                                   \
-            const float px = ppx[x], py = ppy[x], pz_ = ppz[x];                                                  \
-            const float ixp = pix[x], zp = kDepth ? pz[x] : 0.0f, izp = kDepth ? piz[x] : 0.0f;                  \
-            const float m0 = pm0[x], m1 = pm1[x];                                                                \
-            float ws = 0, ar = 0, ag = 0, ab = 0, vr = 0, vg = 0, vb = 0;                                        \
-            ATROUS_EAW_TAP(QX, PT)                                                                               \
-            aws[x] += ws;                                                                                        \
-            aar[x] += ar;                                                                                        \
-            aag[x] += ag;                                                                                        \
-            aab[x] += ab;                                                                                        \
-            if (kPropagate) {                                                                                    \
-                avr[x] += vr;                                                                                    \
-                avg[x] += vg;                                                                                    \
-                avb[x] += vb;                                                                                    \
-            }                                                                                                    \
-        }                                                                                                        \
+#define ATROUS_EAW_BORDER_TAP(QX, PT, XA, XB)                                                   \
+    {                                                                                           \
+        const int lo = (XA) > -(QX)*s ? (XA) : -(QX)*s;                                         \
+        const int hi = (XB) < w - (QX)*s ? (XB) : w - (QX)*s;                                   \
+        _Pragma("omp simd") for (int x = lo; x < hi; ++x) {                                     \
+            const float cr = pr[x], cg = pg[x], cb = pb[x], rp = pS[x];                         \
+            const float nx = pnx[x], ny = pny[x], nz = pnz[x];                                  \
+            const float px = ppx[x], py = ppy[x], pz_ = ppz[x];                                 \
+            const float ixp = pix[x], zp = kDepth ? pz[x] : 0.0f, izp = kDepth ? piz[x] : 0.0f; \
+            const float m0 = kIds ? pm0[x] : 0.0f, m1 = kIds ? pm1[x] : 0.0f;                   \
+            float ws = 0, ar = 0, ag = 0, ab = 0, vr = 0, vg = 0, vb = 0;                       \
+            ATROUS_EAW_TAP(QX, PT)                                                              \
+            aws[x] += ws;                                                                       \
+            aar[x] += ar;                                                                       \
+            aag[x] += ag;                                                                       \
+            aab[x] += ab;                                                                       \
+            if (kPropagate) {                                                                   \
+                avr[x] += vr;                                                                   \
+                avg[x] += vg;                                                                   \
+                avb[x] += vb;                                                                   \
+            }                                                                                   \
+        }                                                                                       \
     }
             for (int side = 0; side < 2; ++side) {
                 const int xa = side == 0 ? 0 : x1, xb = side == 0 ? x0 : w;
@@ -181,6 +212,50 @@ void levelRows(const EawLevel& f, int y0, int y1) {
     }
 }
 
+// r = eawColorRecip(S) of rows [y0, y1).
+ATROUS_FORCE_INLINE inline void colorRecipBody(const EawLevelParams& P, const float* ATROUS_RESTRICT S,
+                                               float* ATROUS_RESTRICT r, size_t i0, size_t i1) {
+#pragma omp simd
+    for (size_t i = i0; i < i1; ++i) r[i] = eawColorRecip(P, S[i]);
+}
+
+template <bool kPropagate, bool kDepth, bool kIds>
+void levelRowsAvx2(const EawLevel& f, const float* rS, int y0, int y1) {
+    levelRowsBody<kPropagate, kDepth, kIds>(f, rS, y0, y1);
+}
+void colorRecipAvx2(const EawLevelParams& P, const float* S, float* r, size_t i0, size_t i1) {
+    colorRecipBody(P, S, r, i0, i1);
+}
+
+#if ATROUS_EAW_AVX512
+template <bool kPropagate, bool kDepth, bool kIds>
+ATROUS_TARGET_AVX512 void levelRowsAvx512(const EawLevel& f, const float* rS, int y0, int y1) {
+    levelRowsBody<kPropagate, kDepth, kIds>(f, rS, y0, y1);
+}
+ATROUS_TARGET_AVX512 void colorRecipAvx512(const EawLevelParams& P, const float* S, float* r, size_t i0, size_t i1) {
+    colorRecipBody(P, S, r, i0, i1);
+}
+#endif
+
+using LevelRowsFn = void (*)(const EawLevel&, const float*, int, int);
+
+template <bool kPropagate, bool kDepth, bool kIds>
+LevelRowsFn pickLevelRows(bool avx512) {
+#if ATROUS_EAW_AVX512
+    if (avx512) return &levelRowsAvx512<kPropagate, kDepth, kIds>;
+#else
+    (void)avx512;
+#endif
+    return &levelRowsAvx2<kPropagate, kDepth, kIds>;
+}
+
+template <bool kPropagate>
+LevelRowsFn pickLevelRows(bool avx512, bool depth, bool ids) {
+    if (depth)
+        return ids ? pickLevelRows<kPropagate, true, true>(avx512) : pickLevelRows<kPropagate, true, false>(avx512);
+    return ids ? pickLevelRows<kPropagate, false, true>(avx512) : pickLevelRows<kPropagate, false, false>(avx512);
+}
+
 }  // namespace
 
 void runEawLevel(const CpuExec& exec, const EawLevel& f) {
@@ -188,14 +263,27 @@ void runEawLevel(const CpuExec& exec, const EawLevel& f) {
         exec.forEachPixel(f.cIn.width, f.cIn.height, f);
         return;
     }
-    const int h = f.cIn.height;
-    tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& r) {
-        const bool depth = f.p.invDepth > 0.0f;
-        if (f.p.propagate)
-            depth ? levelRows<true, true>(f, r.begin(), r.end()) : levelRows<true, false>(f, r.begin(), r.end());
-        else
-            depth ? levelRows<false, true>(f, r.begin(), r.end()) : levelRows<false, false>(f, r.begin(), r.end());
+    const int w = f.cIn.width, h = f.cIn.height;
+    const bool avx512 = eawCpuAvx512();
+    // The level's r = 1/(colorMul · 2S + ε) plane (see eawColorRecip).
+    Image rS(w, h, 1, Device::Cpu);
+    float* r = rS.data();
+    const float* S = f.S.channel(0);
+    const size_t count = size_t(w) * h;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 16384), [&](const tbb::blocked_range<size_t>& b) {
+#if ATROUS_EAW_AVX512
+        if (avx512) {
+            colorRecipAvx512(f.p, S, r, b.begin(), b.end());
+            return;
+        }
+#endif
+        colorRecipAvx2(f.p, S, r, b.begin(), b.end());
     });
+    const bool depth = f.p.invDepth > 0.0f, ids = f.p.idPenalty > 0.0f;
+    const LevelRowsFn rows =
+        f.p.propagate ? pickLevelRows<true>(avx512, depth, ids) : pickLevelRows<false>(avx512, depth, ids);
+    tbb::parallel_for(tbb::blocked_range<int>(0, h, 8),
+                      [&](const tbb::blocked_range<int>& b) { rows(f, r, b.begin(), b.end()); });
 }
 
 }  // namespace atrous::filters

@@ -24,18 +24,25 @@ struct EawLevelParams {
     float detailVarScale = 1.0f;  // α_i: correlation correction of v_i (1 = independence)
 };
 
+// 1/σ_c² factor of one pixel at this level: r = 1/(colorMul · 2S + ε). The pair's σ_c² uses
+// 2·min(S(p), S(q)) (symmetric, so the filter stays mean-preserving, and a quiet pixel never takes
+// in a noisy bright neighbour: with S(p) + S(q) the sun seen directly leaked into the sky around
+// it), and since s -> 1/(colorMul · 2s + ε) is decreasing (and float rounding is monotone),
+// 1/σ_c²(p, q) = max(r(p), r(q)) exactly: the CPU fast path computes r once per pixel and level
+// instead of one division per tap.
+ATROUS_INLINE float eawColorRecip(const EawLevelParams& P, float S) {
+    return 1.0f / (P.colorMul * (2.0f * S) + P.colorEps);
+}
+
 // Exponent of the combined edge-stopping weight w = exp(-e) of one tap: the colour, normal,
 // position, depth and id terms summed so that a single exp is evaluated per tap.
-//   dc2 = |c_i(p) - c_i(q)|², Sp/Sq = per-pixel colour scales, dn2 = |n(p) - n(q)|²,
+//   dc2 = |c_i(p) - c_i(q)|², rp/rq = eawColorRecip of S(p)/S(q), dn2 = |n(p) - n(q)|²,
 //   dx2 = |x(p) - x(q)|², invXp = 1/σ_x² at p, posTap = 1/|pixel offset|² (auto) or 1,
 //   dzRel = (z_p - z_q)/z_p, did2 = squared mesh + material id difference.
-ATROUS_INLINE float eawExponent(const EawLevelParams& P, float dc2, float Sp, float Sq, float dn2, float dx2,
+ATROUS_INLINE float eawExponent(const EawLevelParams& P, float dc2, float rp, float rq, float dn2, float dx2,
                                 float invXp, float posTap, float dzRel, float did2) {
-    // σ_c² of the pair: 2·min(S(p), S(q)) (symmetric, so the filter stays mean-preserving, and
-    // a quiet pixel never takes in a noisy bright neighbour: with S(p) + S(q) the sun seen
-    // directly leaked into the sky around it). min written as (a + b - |a - b|)/2 so it vectorises.
-    return dc2 / (P.colorMul * (Sp + Sq - fabsf(Sp - Sq)) + P.colorEps) + dn2 * P.invNormal + dx2 * invXp * posTap +
-           dzRel * dzRel * P.invDepth + did2 * P.idPenalty;
+    return dc2 * maxSel(rp, rq) + dn2 * P.invNormal + dx2 * invXp * posTap + dzRel * dzRel * P.invDepth +
+           did2 * P.idPenalty;
 }
 
 // 1/|offset|² of tap q at step s for the automatic σ_x (1 for the raw form; the centre tap has
@@ -60,7 +67,7 @@ struct EawLevel {
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         const int w = cIn.width, h = cIn.height;
         const float cr = cIn(x, y, 0), cg = cIn(x, y, 1), cb = cIn(x, y, 2);
-        const float sp = S(x, y, 0);
+        const float rp = eawColorRecip(p, S(x, y, 0));
         const float nx = normal(x, y, 0), ny = normal(x, y, 1), nz = normal(x, y, 2);
         const float px = position(x, y, 0), py = position(x, y, 1), pz = position(x, y, 2);
         const float ixp = invX(x, y, 0), zp = depth(x, y, 0), izp = invZ(x, y, 0);
@@ -82,7 +89,8 @@ struct EawLevel {
                     sq(px - position(xq, yq, 0)) + sq(py - position(xq, yq, 1)) + sq(pz - position(xq, yq, 2));
                 const float dz = (zp - depth(xq, yq, 0)) * izp;
                 const float did2 = sq(m0 - ids(xq, yq, 0)) + sq(m1 - ids(xq, yq, 1));
-                const float e = eawExponent(p, dc2, sp, S(xq, yq, 0), dn2, dx2, ixp, eawPositionTapScale(p, qx, qy), dz, did2);
+                const float e = eawExponent(p, dc2, rp, eawColorRecip(p, S(xq, yq, 0)), dn2, dx2, ixp,
+                                            eawPositionTapScale(p, qx, qy), dz, did2);
                 const float wt = hy * b3(qx) * expNeg(-e);
                 ws += wt;
                 ar += wt * qr;
@@ -136,5 +144,8 @@ void runEawLevel(const CpuExec& exec, const EawLevel& f);
 
 // The CPU fast path is on by default; tests switch it off to compare with the generic functor.
 bool& eawCpuFastPath();
+// The fast path's AVX-512 row loops: on where the CPU has AVX-512 (F/VL/BW/DQ); tests switch it
+// off to run the AVX2 loops too. Setting it on a CPU without AVX-512 is not allowed.
+bool& eawCpuAvx512();
 
 }  // namespace atrous::filters
