@@ -105,7 +105,12 @@ TEST(RenderFurnace, DiffuseSphereUnderEnvironmentMap) {
 }
 
 // The variance buffer is the variance of the pixel mean: across K independent seeds the empirical
-// variance of each pixel's mean must match the mean reported variance.
+// variance of each pixel's mean must match the mean reported variance, where the pixel's value
+// does not depend on the sub-pixel position. The reported variance (sample variance / n) assumes
+// independent samples; the sub-pixel positions are stratified (pt::PixelSampler::Sobol), which
+// lowers the actual variance of pixels that straddle an edge, so there the report is conservative:
+// reported >= empirical. Edge pixels: those whose emission or feature normal buffer (means over
+// the pixel's sample positions) or mesh/material id (the first sample's) differs between seeds.
 TEST(RenderVariance, MatchesEmpiricalVarianceAcrossSeeds) {
     const int n = 16, K = 32, spp = 8;
     Scene scene = Scene::builtin("cornell");
@@ -115,11 +120,22 @@ TEST(RenderVariance, MatchesEmpiricalVarianceAcrossSeeds) {
         s.maxDepth = 3;
         runs.push_back(render(scene, s));
     }
-    double ratioSum = 0.0;
-    int used = 0;
-    for (int c = 0; c < 3; ++c)
-        for (int y = 0; y < n; ++y)
-            for (int x = 0; x < n; ++x) {
+    auto isEdge = [&](int x, int y) {
+        for (const auto& r : runs)
+            for (int c = 0; c < 3; ++c) {
+                if (std::fabs(r.emission(x, y, c) - runs[0].emission(x, y, c)) > 0.0f) return true;
+                if (std::fabs(r.normal(x, y, c) - runs[0].normal(x, y, c)) > 1e-4f) return true;
+            }
+        for (const auto& r : runs)  // ids are the first sample's, at another position in every run
+            if (r.ids(x, y, 0) != runs[0].ids(x, y, 0) || r.ids(x, y, 1) != runs[0].ids(x, y, 1)) return true;
+        return false;
+    };
+    double ratioSum[2] = {0.0, 0.0};  // [interior, edge]
+    int used[2] = {0, 0};
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            const int e = isEdge(x, y) ? 1 : 0;
+            for (int c = 0; c < 3; ++c) {
                 double m = 0.0, reported = 0.0;
                 for (const auto& r : runs) {
                     m += r.color(x, y, c);
@@ -131,18 +147,26 @@ TEST(RenderVariance, MatchesEmpiricalVarianceAcrossSeeds) {
                 double emp = 0.0;
                 for (const auto& r : runs) emp += (r.color(x, y, c) - m) * (r.color(x, y, c) - m);
                 emp /= (K - 1);
-                ratioSum += emp / reported;
-                ++used;
+                ratioSum[e] += emp / reported;
+                ++used[e];
             }
-    ASSERT_GT(used, 500);
-    double ratio = ratioSum / used;
-    std::printf("empirical / reported variance: %.4f over %d pixel channels\n", ratio, used);
+        }
+    ASSERT_GT(used[0], 250);  // 321 and 447 with these seeds
+    ASSERT_GT(used[1], 150);
+    double interior = ratioSum[0] / used[0], edge = ratioSum[1] / used[1];
+    std::printf("empirical / reported variance: interior %.4f over %d pixel channels, edges %.4f over %d\n",
+                interior, used[0], edge, used[1]);
     // Per pixel, the empirical variance over K = 32 draws has relative standard deviation about
-    // sqrt(2 / 31) = 0.25 for Gaussian means (more with heavy tails); averaged over ~700 pixel
-    // channels the mean ratio's standard deviation is ~0.01-0.03, so 1 +- 0.15 is > 5 sigma while a
+    // sqrt(2 / 31) = 0.25 for Gaussian means (more with heavy tails); averaged over >= 250 pixel
+    // channels (>= 84 pixels: the channels of a pixel are correlated) the mean ratio's standard
+    // deviation is ~0.03 (<~0.04 with heavy tails), so 1 +- 0.15 is ~4-5 sigma while a
     // variance that was off by the classic factor n (= 8, sample variance instead of variance of
     // the mean) or by n/(n-1) = 1.14 at the edge would fail.
-    EXPECT_NEAR(ratio, 1.0, 0.15) << "pixels used " << used;
+    EXPECT_NEAR(interior, 1.0, 0.15) << "interior pixels used " << used[0];
+    // Edges: conservative (measured 0.71 with these seeds; independent jitter gives ~1). Same
+    // statistical margin on the upper side (>= 150 channels: sigma <~ 0.05); a report below the
+    // actual variance would show as a ratio well above 1.
+    EXPECT_LT(edge, 1.15) << "edge pixels used " << used[1];
 }
 
 TEST(RenderVariance, ZeroAtOneSample) {

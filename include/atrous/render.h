@@ -21,6 +21,10 @@ struct RenderSettings {
     int height = 512;
     int spp = 16;        // samples per pixel, >= 1
     uint32_t seed = 1;   // same seed -> bit-identical output, whatever the thread count
+    // Global index of the first sample. Renders averaged together (progressive accumulation) keep
+    // one seed and use consecutive ranges (frame * spp), so the pixel's stratified sub-pixel
+    // sequence continues across them; independent renders leave it at 0.
+    uint32_t firstSample = 0;
     int maxDepth = 8;    // bounces: 0 = emitted light only, 1 = direct lighting, ...
     int threads = 0;     // worker threads, 0 = all cores
     // Next-event estimation with multiple importance sampling (power heuristic). false = BSDF

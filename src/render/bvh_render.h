@@ -76,6 +76,7 @@ pt::PathTraceKernel<Tracer> makePathTraceKernel(const pt::SceneView& scene, cons
     k.spp = s.spp;
     k.maxDepth = s.maxDepth;
     k.seed = s.seed;
+    k.firstSample = s.firstSample;
     k.lightSampling = s.lightSampling;
     k.backgroundDepth = kBackgroundDepth;
     return k;

@@ -164,9 +164,10 @@ void ViewPipeline::renderFrame(const PipelineSettings& s, bool svgf) {
     rs.height = mHeight;
     rs.spp = s.sppPerFrame;
     rs.maxDepth = s.maxDepth;
-    // A fresh seed per frame: Rng(pixel, sample, seed) streams of different seeds are independent,
-    // so the frames are independent estimates and their running mean converges.
-    rs.seed = mSeed + uint32_t(mFrameIndex * 0x9E3779B9ull);
+    // One seed, fresh sample indices per frame (frame * spp + s): every frame draws new samples
+    // (own RNG streams) and the running mean continues each pixel's stratified sub-pixel sequence.
+    rs.seed = mSeed;
+    rs.firstSample = uint32_t(mFrameIndex * uint64_t(rs.spp));
     ++mFrameIndex;
     validateRenderSettings(rs);
     mRendererMotion = false;
