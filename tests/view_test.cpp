@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -213,6 +215,37 @@ TEST(ViewHeadless, SplitScreenAndBufferDump) {
     const Image color = atrous::io::readImage((std::filesystem::path(dump) / "color.exr").string());
     EXPECT_EQ(color.width(), 128);
     EXPECT_GT(meanValue(color), 0.01);
+}
+
+TEST(ViewHeadless, JsonLineHasEveryFilterStageOfBothSlots) {
+    REQUIRE_VIEWER_AND_XVFB();
+    TempDir dir;
+    CliResult r = runUnderXvfb(
+        "view --scene cornell --width 64 --height 64 --method sure --compare svgf --frames 3 "
+        "--screenshot " +
+        (dir / "ui.png"));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    // The CPU build shows frames through the host upload (the interop path is CUDA's only).
+    EXPECT_NE(r.output.find("\"display\": \"host upload\""), std::string::npos) << r.output;
+    const size_t at = r.output.find("\"stage_ms\": {");
+    ASSERT_NE(at, std::string::npos) << r.output;
+    const std::string stages = r.output.substr(at, r.output.find('}', at) - at);
+    std::map<std::string, double> ms;
+    const std::regex entry("\"([^\"]+)\": ([-+0-9.eE]+)");
+    for (std::sregex_iterator it(stages.begin(), stages.end(), entry), end; it != end; ++it)
+        ms[(*it)[1]] = std::stod((*it)[2]);
+    // The pipeline's stages, SURE's driver stages (slot A, 5 levels) and SVGF's (slot B).
+    for (const char* name : {"render", "accumulate", "A sanitize", "A fireflies", "A sigma scales", "A level 0",
+                             "A sure 0", "A level 4", "A sure 4", "A remodulate", "A other", "B demodulate",
+                             "B reproject", "B accumulate", "B variance", "B level 0", "B remodulate", "display"})
+        EXPECT_EQ(ms.count(name), 1u) << name << " missing in " << stages;
+    for (const auto& [name, v] : ms) {
+        EXPECT_GE(v, 0.0) << name;
+        EXPECT_LT(v, 60e3) << name;  // a minute: anything above is a unit or clock bug
+    }
+    // Rendering 64x64 at 1 spp and filtering cannot take zero time on either clock.
+    EXPECT_GT(ms["render"], 0.0);
+    EXPECT_GT(ms["A level 0"], 0.0);
 }
 
 TEST(ViewHeadless, SureFractionsAndDetailBuffers) {

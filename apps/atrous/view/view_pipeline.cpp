@@ -52,10 +52,6 @@ void forRows(int h, F f) {
     });
 }
 
-bool sameCamera(const pt::Camera& a, const pt::Camera& b) {
-    return std::memcmp(&a, &b, sizeof(pt::Camera)) == 0;
-}
-
 bool sameSvgfParams(const SvgfParams& a, const SvgfParams& b) {
     return a.sigmaL == b.sigmaL && a.sigmaN == b.sigmaN && a.sigmaZ == b.sigmaZ &&
            a.alpha == b.alpha && a.momentsAlpha == b.momentsAlpha && a.historyCap == b.historyCap &&
@@ -172,18 +168,11 @@ void ViewPipeline::renderFrame(const PipelineSettings& s, bool svgf) {
     validateRenderSettings(rs);
     mRendererMotion = false;
     if (mDevice == Device::Cuda) {
-        // renderBvhCuda renders a Scene's own camera: a copy of the scene data with our camera
-        // (re-made only when the camera moves; the CUDA renderer uploads the scene every call
-        // anyway). It writes emission but no motion: computeMotion() rebuilds it from the depth.
-        if (!mCudaScene || !(mCudaCameraValid && sameCamera(mCudaCamera, mCamera))) {
-            auto copy = std::make_shared<pt::SceneData>(mScene.data());
-            copy->camera = mCamera;
-            mCudaScene =
-                std::make_unique<Scene>(std::shared_ptr<const pt::SceneData>(std::move(copy)));
-            mCudaCamera = mCamera;
-            mCudaCameraValid = true;
-        }
-        mFrame = renderBvhCuda(*mCudaScene, rs);
+        // The persistent renderer: scene and BVH uploaded once, device buffers kept, our camera
+        // per call. It returns host buffers with emission but no motion: computeMotion() rebuilds
+        // the motion from the depth.
+        if (!mCudaRenderer) mCudaRenderer = std::make_unique<CudaBvhRenderer>(mScene);
+        mFrame = mCudaRenderer->render(rs, &mCamera);
         return;
     }
     // The renderer's own per-pixel functor over the shared BVH, with our camera in the SceneView:
@@ -379,13 +368,26 @@ DenoiseOptions ViewPipeline::denoiseOptions(Method m, const PipelineSettings& s)
     return o;
 }
 
+const Image& ViewPipeline::resultHost(int i) const {
+    SlotResult& r = mSlots[i];
+    if (r.image.empty() && !r.deviceImage.empty()) r.image = r.deviceImage.to(Device::Cpu);
+    return r.image;
+}
+
 void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
     SlotResult& r = mSlots[i];
     r.method = m;
     r.error.clear();
     r.filterMs = 0;
+    r.stages.clear();
+    r.image = Image();
+    r.deviceImage = Image();
+    const bool onDevice = s.deviceResults && mDevice == Device::Cuda;
     if (m == Method::None) {
-        r.image = mColor.clone();
+        if (onDevice)
+            r.deviceImage = mColor.to(Device::Cuda);
+        else
+            r.image = mColor.clone();
         return;
     }
     if (m == Method::Svgf) {
@@ -393,6 +395,7 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
             if (!mSvgf[i] || !sameSvgfParams(mSvgfParams[i], s.svgf)) {
                 mSvgf[i] = std::make_unique<SvgfDenoiser>(s.svgf, mDevice);  // validates
                 mSvgfParams[i] = s.svgf;
+                mSvgf[i]->setReport(&mSvgfReport[i]);
             }
             if (mSvgfResetPending || (mCameraMoved && !s.svgfMotionVectors)) mSvgf[i]->reset();
             // SVGF does its own temporal accumulation, so it takes this frame's samples, not the
@@ -406,8 +409,12 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
             f.motion = &mMotion;
             f.emission = &mEmission;
             Timer t;
-            r.image = mSvgf[i]->denoiseFrame(f);
+            if (onDevice)
+                r.deviceImage = mSvgf[i]->denoiseFrameOnDevice(f).clone();  // valid until next frame
+            else
+                r.image = mSvgf[i]->denoiseFrame(f);
             r.filterMs = t.ms();
+            r.stages = mSvgfReport[i].stages;
         } catch (const InputError& e) {
             mSvgf[i].reset();
             r.error = e.what();
@@ -428,6 +435,7 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
     DenoiseOptions o = denoiseOptions(m, s);
     DenoiseReport rep;
     o.report = &rep;
+    Timer t;
     try {
         if (m == Method::Sure && s.sureFractions && mDevice == Device::Cpu) {
             // The public denoise() has no debug outputs; the internal CPU entry fills s_i(p).
@@ -436,10 +444,16 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
             dbg.sureS = Image(mWidth, mHeight, s.eaw.levels);
             r.image = filters::denoiseCpu(in, o, prep, rep, &dbg);
             mSureS = std::move(dbg.sureS);
+        } else if (onDevice) {
+            // A colour on the GPU keeps denoise()'s result there (the other buffers are uploaded).
+            const Image deviceColor = mColor.to(Device::Cuda);
+            in.color = &deviceColor;
+            r.deviceImage = denoise(in, o);
         } else {
             r.image = denoise(in, o);
         }
-        r.filterMs = rep.milliseconds;
+        r.filterMs = t.ms();
+        r.stages = rep.stages;
     } catch (const InputError& e) {
         r.error = e.what();
         r.image = mColor.clone();
@@ -554,9 +568,11 @@ std::vector<std::string> ViewPipeline::saveBuffers(const std::string& dir) const
     }
     for (int i = 0; i < 2; ++i) {
         const SlotResult& r = mSlots[i];
-        if (r.image.empty() || r.method == Method::None) continue;
+        if (r.method == Method::None) continue;
+        const Image& img = resultHost(i);
+        if (img.empty()) continue;
         put(std::string(i == 0 ? "denoised_a_" : "denoised_b_") + methodName(r.method) + ".exr",
-            r.image);
+            img);
     }
     if (!mDetail.empty()) put("detail_level" + std::to_string(mDetailLevelShown) + ".exr", mDetail);
     for (int l = 0; l < mSureS.channels(); ++l) {

@@ -11,9 +11,14 @@
 #include "atrous/denoise.h"
 #include "atrous/image.h"
 #include "atrous/render.h"
+#include "atrous/stage_time.h"
 #include "atrous/svgf.h"
 #include "render/bvh_build.h"
 #include "render/scene_data.h"
+
+namespace atrous {
+class CudaBvhRenderer;  // render/bvh_render.h
+}
 
 namespace atrous::view {
 
@@ -46,6 +51,9 @@ struct PipelineSettings {
     // Debug buffers, computed only when asked for (they cost extra filter runs).
     int detailLevel = -1;        // >= 0: compute d_i for this level
     bool sureFractions = false;  // capture SURE's s_i(p) (CPU only)
+    // CUDA only: leave the slots' results on the GPU (SlotResult::deviceImage) for the CUDA-OpenGL
+    // interop display; host copies are made only when something asks for them (resultHost()).
+    bool deviceResults = false;
 };
 
 // Milliseconds spent in each stage of the last step(): wall clock, and CPU time of the whole
@@ -64,14 +72,21 @@ double processCpuMs();
 struct SlotResult {
     Method method = Method::None;
     Image image;          // 3-channel linear HDR (the noisy input for Method::None)
+    // On the GPU when PipelineSettings::deviceResults asked for it (image is then empty until
+    // ViewPipeline::resultHost() downloads it).
+    Image deviceImage;
     std::string error;    // non-empty when the filter refused its parameters (image = input then)
-    double filterMs = 0;  // as the denoiser reported it (EAW/SURE) or measured (SVGF)
+    double filterMs = 0;  // wall clock of the slot's filter call (uploads and checks included)
+    // The filter's own per-stage times (DenoiseReport::stages / SvgfReport::stages); their sum is
+    // at most filterMs, the rest being validation, noise estimation and transfers.
+    std::vector<StageTime> stages;
 };
 
 class ViewPipeline {
   public:
     // `device` Cpu renders with the shared BVH traversal on TBB threads (camera freely movable);
-    // Cuda renders with renderBvhCuda on a copy of the scene carrying the viewer's camera.
+    // Cuda renders with a persistent CudaBvhRenderer (scene and BVH uploaded once, the viewer's
+    // camera passed per frame) and runs the filters on the GPU.
     ViewPipeline(const Scene& scene, int width, int height, Device device, uint32_t seed);
     ~ViewPipeline();
 
@@ -108,6 +123,8 @@ class ViewPipeline {
     const Image& ids() const { return mIds; }
     const Image& motion() const { return mMotion; }  // x = dx, y = dy (previous - current), pixels
     const SlotResult& slot(int i) const { return mSlots[i]; }
+    // The slot's result on the host (downloaded once when it lives on the GPU); may be empty.
+    const Image& resultHost(int i) const;
     // d_i = (EAW with i levels) - (EAW with i + 1 levels), remodulated by the albedo; empty
     // unless PipelineSettings::detailLevel asked for it.
     const Image& detail() const { return mDetail; }
@@ -135,9 +152,7 @@ class ViewPipeline {
     Vec3 mSceneCenter;
     float mSceneRadius = 1.0f;
     std::unique_ptr<BvhData> mBvh;      // CPU rendering
-    std::unique_ptr<Scene> mCudaScene;  // CUDA rendering: the scene with mCudaCamera
-    pt::Camera mCudaCamera;
-    bool mCudaCameraValid = false;
+    std::unique_ptr<CudaBvhRenderer> mCudaRenderer;  // CUDA rendering: scene uploaded once
     bool mRendererMotion = false;  // this frame's motion and emission came from the renderer
     uint64_t mFrameIndex = 0;      // seeds: every frame draws fresh samples
 
@@ -152,9 +167,10 @@ class ViewPipeline {
 
     Image mColor, mVariance, mAlbedo, mNormal, mPosition, mDepth, mIds, mMotion, mEmission;
     bool mVarianceValid = false;
-    SlotResult mSlots[2];
+    mutable SlotResult mSlots[2];  // mutable: resultHost() fills the host copy on demand
     std::unique_ptr<SvgfDenoiser> mSvgf[2];
     SvgfParams mSvgfParams[2];
+    SvgfReport mSvgfReport[2];
     bool mSvgfResetPending = false;
     Image mDetail, mSureS;
     int mDetailLevelShown = -1;

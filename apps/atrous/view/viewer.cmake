@@ -20,4 +20,12 @@ if(ATROUS_HAVE_VIEWER)
   target_include_directories(atrous PRIVATE ${CMAKE_CURRENT_LIST_DIR}/..)
   target_compile_definitions(atrous PRIVATE ATROUS_HAVE_VIEWER=1)
   target_link_libraries(atrous PRIVATE PkgConfig::IMGUI glfw OpenGL::GL ${CMAKE_DL_LIBS})
+  if(ATROUS_HAVE_CUDA)
+    # CUDA-OpenGL interop for --device cuda (cuda_display.h; cuda_display_stub.cpp otherwise).
+    # Its own small library: the executable's host flags (-Wall, -march) are not nvcc's.
+    add_library(atrous_view_cuda STATIC ${CMAKE_CURRENT_LIST_DIR}/cuda_display.cu)
+    target_include_directories(atrous_view_cuda PRIVATE ${CMAKE_CURRENT_LIST_DIR}/..)
+    target_link_libraries(atrous_view_cuda PRIVATE atrous_internal)
+    target_link_libraries(atrous PRIVATE atrous_view_cuda)
+  endif()
 endif()

@@ -1,10 +1,14 @@
 // `atrous view`: GLFW window + OpenGL 3.3 core + Dear ImGui over the frame pipeline
 // (view_pipeline.h). The image is tonemapped on the host and uploaded with glTexSubImage2D; ImGui
 // draws it as a textured quad, so the viewer needs only GL 1.1 entry points of its own (ImGui's
-// OpenGL 3 backend loads the rest).
+// OpenGL 3 backend loads the rest). With --device cuda the result instead stays on the GPU and
+// reaches the texture through a CUDA-registered pixel unpack buffer (cuda_display.h); the four
+// buffer-object entry points that needs are loaded through GLFW.
 #include "view/viewer.h"
 
 #include <GLFW/glfw3.h>
+// After GLFW's <GL/gl.h>: the buffer-object types and enums (PFNGLGENBUFFERSPROC, ...).
+#include <GL/glext.h>
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
@@ -25,6 +29,8 @@
 #include "atrous/render.h"
 #include "core/timer.h"
 #include "io/image_io.h"
+#include "view/cuda_display.h"
+#include "view/stage_history.h"
 #include "view/view_pipeline.h"
 
 namespace atrous::view {
@@ -320,11 +326,31 @@ void glfwErrorCallback(int code, const char* description) {
                     std::to_string(code) + ")";
 }
 
+// The GL 1.5 buffer-object entry points of the interop path (not exported by every libGL).
+struct GlBufferFunctions {
+    PFNGLGENBUFFERSPROC genBuffers = nullptr;
+    PFNGLDELETEBUFFERSPROC deleteBuffers = nullptr;
+    PFNGLBINDBUFFERPROC bindBuffer = nullptr;
+    PFNGLBUFFERDATAPROC bufferData = nullptr;
+    bool load() {
+        genBuffers = reinterpret_cast<PFNGLGENBUFFERSPROC>(glfwGetProcAddress("glGenBuffers"));
+        deleteBuffers = reinterpret_cast<PFNGLDELETEBUFFERSPROC>(glfwGetProcAddress("glDeleteBuffers"));
+        bindBuffer = reinterpret_cast<PFNGLBINDBUFFERPROC>(glfwGetProcAddress("glBindBuffer"));
+        bufferData = reinterpret_cast<PFNGLBUFFERDATAPROC>(glfwGetProcAddress("glBufferData"));
+        return genBuffers && deleteBuffers && bindBuffer && bufferData;
+    }
+};
+
 struct GlfwSession {
     GLFWwindow* window = nullptr;
     bool imgui = false;
     GLuint texture = 0;
+    GlBufferFunctions gl;
+    GLuint pbo = 0;                          // pixel unpack buffer of the CUDA interop path
+    std::unique_ptr<CudaGlDisplay> interop;  // null: host upload
     ~GlfwSession() {
+        interop.reset();  // unregister while the context and the buffer still exist
+        if (pbo) gl.deleteBuffers(1, &pbo);
         if (texture) glDeleteTextures(1, &texture);
         if (imgui) {
             ImGui_ImplOpenGL3_Shutdown();
@@ -352,6 +378,56 @@ struct Json {
         s << '"' << v << '"';
     }
 };
+
+// One frame's stages for the timing table, in pipeline order: render, accumulate, motion, then
+// each computed slot's filter stages ("A sanitize", ..., "A other"), debug views, display.
+std::vector<StageTime> frameStages(const ViewPipeline& pl, bool split, double displayMs) {
+    const StageTimes& t = pl.times();
+    std::vector<StageTime> v = {{"render", t.render}, {"accumulate", t.accumulate}, {"motion", t.motion}};
+    for (int i = 0; i < (split ? 2 : 1); ++i) {
+        const SlotResult& r = pl.slot(i);
+        const std::string prefix = i ? "B " : "A ";
+        const double slotMs = i ? t.denoiseB : t.denoiseA;
+        double inStages = 0;
+        for (const StageTime& s : r.stages) {
+            v.push_back({prefix + s.name, s.milliseconds});
+            inStages += s.milliseconds;
+        }
+        // Validation, noise estimation, allocations, transfers, the host copy of the result.
+        v.push_back({prefix + (r.stages.empty() ? methodName(r.method) : "other"), std::max(0.0, slotMs - inStages)});
+    }
+    v.push_back({"debug views", t.debug});
+    v.push_back({"display", displayMs});
+    return v;
+}
+
+// The panel's timing table: stage, mean ms, and a bar of its share of the frame.
+void stageTable(const StageHistory& h) {
+    double total = 0;
+    for (size_t i = 0; i < h.size(); ++i) total += h.mean(i);
+    if (!ImGui::BeginTable("stages", 3, ImGuiTableFlags_SizingFixedFit | ImGuiTableFlags_RowBg)) return;
+    ImGui::TableSetupColumn("stage", ImGuiTableColumnFlags_WidthFixed, 120.0f);
+    ImGui::TableSetupColumn("ms", ImGuiTableColumnFlags_WidthFixed, 52.0f);
+    ImGui::TableSetupColumn("share", ImGuiTableColumnFlags_WidthStretch);
+    ImGui::TableHeadersRow();
+    const float barH = ImGui::GetTextLineHeight() * 0.8f;
+    for (size_t i = 0; i < h.size(); ++i) {
+        const double ms = h.mean(i);
+        ImGui::TableNextRow();
+        ImGui::TableNextColumn();
+        ImGui::TextUnformatted(h.name(i).c_str());
+        ImGui::TableNextColumn();
+        ImGui::Text("%6.2f", ms);
+        ImGui::TableNextColumn();
+        ImGui::ProgressBar(total > 0 ? float(ms / total) : 0.0f, ImVec2(-1.0f, barH), "");
+    }
+    ImGui::TableNextRow();
+    ImGui::TableNextColumn();
+    ImGui::TextUnformatted("sum");
+    ImGui::TableNextColumn();
+    ImGui::Text("%6.2f", total);
+    ImGui::EndTable();
+}
 
 bool comboMethod(const char* label, Method& m) {
     int i = int(m);
@@ -445,6 +521,24 @@ void runViewer(const ViewerOptions& opt) {
     glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
     std::vector<unsigned char> rgba(size_t(w) * h * 4, 0);
 
+    // CUDA: the display's pixel unpack buffer registered with CUDA (cuda_display.h). Any failure
+    // keeps the host upload, and the panel says why.
+    std::string displayPath = "host upload";
+    if (device == Device::Cuda) {
+        std::string why;
+        if (!session.gl.load()) {
+            why = "no GL buffer-object entry points";
+        } else {
+            session.gl.genBuffers(1, &session.pbo);
+            session.gl.bindBuffer(GL_PIXEL_UNPACK_BUFFER, session.pbo);
+            session.gl.bufferData(GL_PIXEL_UNPACK_BUFFER, GLsizeiptr(size_t(w) * h * 4), nullptr, GL_STREAM_DRAW);
+            session.gl.bindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+            session.interop = createCudaGlDisplay(session.pbo, w, h, why);
+        }
+        displayPath = session.interop ? "CUDA-OpenGL interop (PBO)" : "host upload: CUDA-OpenGL interop unavailable (" + why + ")";
+        std::fprintf(stderr, "atrous view: display: %s\n", displayPath.c_str());
+    }
+
     // ---- state ----
     float exposure = opt.exposure;
     float splitPos = 0.5f;
@@ -461,6 +555,8 @@ void runViewer(const ViewerOptions& opt) {
     bool dragging[3] = {false, false, false};
     std::vector<double> frameMs, renderMs, accMs, motionMs, denAMs, denBMs, debugMs, displayMs;
     std::vector<double> frameCpu, renderCpu, accCpu, motionCpu, denACpu, denBCpu, debugCpu;
+    StageHistory stageHistory(30);      // the panel's table: means over the last 30 frames
+    StageHistory benchStages(1u << 20);  // the JSON line: medians over all frames but the first
     Timer frameTimer, lastFrame;
     double displayTime = 0;
 
@@ -536,22 +632,39 @@ void runViewer(const ViewerOptions& opt) {
                              !(view == BufferView::Result || view == BufferView::Motion) ||
                              snapshot || (lastFrame && !opt.dumpDir.empty());
         const bool doStep = !paused || moved || frame == 0;
+        ps.deviceResults = session.interop != nullptr && view == BufferView::Result;
         if (doStep) pl.step(ps);
 
         // ---- display image ----
         Timer dispTimer;
         {  // every frame: exposure and the view can change while paused
-            const SlotResult& a = pl.slot(0);
-            const SlotResult& b = pl.slot(1);
-            if (view == BufferView::Result && ps.split) {
-                const int xs = std::clamp(int(std::lround(splitPos * float(w))), 0, w);
-                viewNote = tonemap(pl, view, &a.image, exposure, level, 0, xs, rgba);
-                tonemap(pl, view, &b.image, exposure, level, xs, w, rgba);
-            } else {
-                viewNote = tonemap(pl, view, &a.image, exposure, level, 0, w, rgba);
+            const bool split = view == BufferView::Result && ps.split;
+            const int xs = split ? std::clamp(int(std::lround(splitPos * float(w))), 0, w) : w;
+            bool shown = false;
+            if (session.interop && view == BufferView::Result && !pl.slot(0).deviceImage.empty() &&
+                (!split || !pl.slot(1).deviceImage.empty())) {
+                // GPU to GPU: tonemap kernel into the PBO, then PBO -> texture inside GL.
+                try {
+                    session.interop->write(pl.slot(0).deviceImage, split ? &pl.slot(1).deviceImage : nullptr, xs,
+                                           exposure);
+                    session.gl.bindBuffer(GL_PIXEL_UNPACK_BUFFER, session.pbo);
+                    glBindTexture(GL_TEXTURE_2D, session.texture);
+                    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+                    session.gl.bindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+                    viewNote.clear();
+                    shown = true;
+                } catch (const std::exception& e) {
+                    session.interop.reset();
+                    displayPath = std::string("host upload: CUDA-OpenGL interop failed (") + e.what() + ")";
+                    std::fprintf(stderr, "atrous view: display: %s\n", displayPath.c_str());
+                }
             }
-            glBindTexture(GL_TEXTURE_2D, session.texture);
-            glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+            if (!shown) {  // host path (resultHost downloads a GPU result once)
+                viewNote = tonemap(pl, view, &pl.resultHost(0), exposure, level, 0, xs, rgba);
+                if (split) tonemap(pl, view, &pl.resultHost(1), exposure, level, xs, w, rgba);
+                glBindTexture(GL_TEXTURE_2D, session.texture);
+                glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+            }
         }
         displayTime = dispTimer.ms();
 
@@ -591,6 +704,9 @@ void runViewer(const ViewerOptions& opt) {
             ImGui::Text("filter A %.1f (%s %.1f)  B %.1f ms", t.denoiseA,
                         methodName(pl.slot(0).method), pl.slot(0).filterMs, t.denoiseB);
             ImGui::Text("debug views %.1f  display %.1f ms", t.debug, displayTime);
+            ImGui::TextWrapped("display: %s", displayPath.c_str());
+            if (ImGui::CollapsingHeader("Timing (ms, mean of last 30 frames)", ImGuiTreeNodeFlags_DefaultOpen))
+                stageTable(stageHistory);
             ImGui::Separator();
             if (ImGui::SliderInt("spp / frame", &ps.sppPerFrame, 1, 64)) pl.resetAccumulation();
             if (ImGui::SliderInt("max depth", &ps.maxDepth, 0, 32)) pl.resetAccumulation();
@@ -743,6 +859,11 @@ void runViewer(const ViewerOptions& opt) {
         denBMs.push_back(t.denoiseB);
         debugMs.push_back(t.debug);
         displayMs.push_back(displayTime);
+        if (doStep) {
+            const std::vector<StageTime> stages = frameStages(pl, ps.split, displayTime);
+            stageHistory.add(stages);
+            if (frame > 0) benchStages.add(stages);
+        }
         if (last) break;
     }
 
@@ -794,6 +915,14 @@ void runViewer(const ViewerOptions& opt) {
         const double cpuMed = median(tail(frameCpu));
         j.num("fps_idle_estimate", cpuMed > 0 ? 1000.0 * std::max(1, cores) / cpuMed : 0.0);
         j.str("device", deviceName(device));
+        j.str("display", displayPath);
+        // Per-stage medians (ms): the pipeline's stages and each slot's filter stages as the
+        // library reported them ("A level 0", ...; "A other" = the slot's wall time not in a stage).
+        j.key("stage_ms");
+        j.s << "{";
+        for (size_t i = 0; i < benchStages.size(); ++i)
+            j.s << (i ? ", " : "") << '"' << benchStages.name(i) << "\": " << benchStages.median(i);
+        j.s << "}";
         std::printf("{%s}\n", j.s.str().c_str());
         std::fflush(stdout);
     }

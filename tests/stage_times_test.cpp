@@ -1,0 +1,96 @@
+// Per-stage timings in the filter reports (DenoiseReport::stages, SvgfReport): the stage list is
+// the driver's, in order, and the times are consistent with the totals. Timings themselves are not
+// checked against any speed (that is the benchmarks' job): only that they are finite, >= 0 and
+// add up.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "atrous/denoise.h"
+#include "atrous/svgf.h"
+#include "denoise_test_util.h"
+
+using namespace atrous;
+
+namespace {
+
+std::vector<std::string> names(const std::vector<StageTime>& stages) {
+    std::vector<std::string> v;
+    for (const StageTime& s : stages) v.push_back(s.name);
+    return v;
+}
+
+double sum(const std::vector<StageTime>& stages) {
+    double s = 0;
+    for (const StageTime& t : stages) {
+        EXPECT_TRUE(std::isfinite(t.milliseconds)) << t.name;
+        EXPECT_GE(t.milliseconds, 0.0) << t.name;
+        s += t.milliseconds;
+    }
+    return s;
+}
+
+}  // namespace
+
+TEST(StageTimes, EawReportListsEveryStageInOrder) {
+    const test::SyntheticScene scene = test::makeScene(48, 40, 0.3f, 7);
+    DenoiseOptions o;
+    o.method = DenoiseMethod::Eaw;
+    o.eaw.levels = 3;
+    DenoiseReport rep;
+    o.report = &rep;
+    denoise(scene.inputs(), o);
+    const std::vector<std::string> expected = {"sanitize", "fireflies",  "demodulate", "sigma scales", "level 0",
+                                               "level 1",  "level 2", "remodulate"};
+    EXPECT_EQ(names(rep.stages), expected);
+    // The stages are timed inside the window of rep.milliseconds with the same steady clock, so
+    // their sum cannot exceed it (1e-6 ms: rounding of the two subtractions).
+    EXPECT_LE(sum(rep.stages), rep.milliseconds + 1e-6);
+    EXPECT_GT(sum(rep.stages), 0.0);
+}
+
+TEST(StageTimes, SureReportHasTheChoiceAfterEachLevel) {
+    const test::SyntheticScene scene = test::makeScene(48, 40, 0.3f, 8);
+    DenoiseOptions o;
+    o.method = DenoiseMethod::Sure;
+    o.eaw.levels = 2;
+    DenoiseReport rep;
+    o.report = &rep;
+    denoise(scene.inputs(), o);
+    const std::vector<std::string> expected = {"sanitize", "fireflies", "demodulate", "sigma scales", "level 0",
+                                               "sure 0",   "level 1",   "sure 1",     "remodulate"};
+    EXPECT_EQ(names(rep.stages), expected);
+    EXPECT_LE(sum(rep.stages), rep.milliseconds + 1e-6);
+}
+
+TEST(StageTimes, SvgfReportFollowsTheFramesWhileSet) {
+    const test::SyntheticScene scene = test::makeScene(40, 32, 0.3f, 9);
+    SvgfParams p;
+    p.levels = 2;
+    p.feedbackTap = 0;
+    p.taa = true;
+    SvgfDenoiser d(p);
+    SvgfFrame f;
+    f.color = &scene.noisy;
+    f.albedo = &scene.albedo;
+    f.normal = &scene.normal;
+    f.depth = &scene.depth;
+    d.denoiseFrame(f);  // untimed: no report set
+    SvgfReport rep;
+    d.setReport(&rep);
+    d.denoiseFrame(f);
+    const std::vector<std::string> expected = {"demodulate", "reproject", "accumulate", "variance",
+                                               "level 0",    "level 1",   "remodulate", "taa"};
+    EXPECT_EQ(names(rep.stages), expected);
+    // milliseconds is the start-to-last-mark span, i.e. the sum of the stages up to rounding.
+    EXPECT_NEAR(rep.milliseconds, sum(rep.stages), 1e-6);
+    // Cleared: later frames leave the report alone.
+    d.setReport(nullptr);
+    rep.stages.clear();
+    rep.milliseconds = -1;
+    d.denoiseFrame(f);
+    EXPECT_TRUE(rep.stages.empty());
+    EXPECT_EQ(rep.milliseconds, -1);
+}
