@@ -58,6 +58,28 @@ std::vector<double> repeat(int warmup, int runs, F&& f) {
     return t;
 }
 
+// Per-stage times of the timed runs (DenoiseReport / SvgfReport stages), reported as medians in the
+// filter's own stage order (a JSON array: an object would sort the names).
+struct StageSamples {
+    std::vector<std::string> names;
+    std::vector<std::vector<double>> ms;
+    void add(const std::vector<StageTime>& stages) {
+        for (const StageTime& s : stages) {
+            const size_t i = size_t(std::find(names.begin(), names.end(), s.name) - names.begin());
+            if (i == names.size()) {
+                names.push_back(s.name);
+                ms.emplace_back();
+            }
+            ms[i].push_back(s.milliseconds);
+        }
+    }
+    nlohmann::json json() const {
+        nlohmann::json a = nlohmann::json::array();
+        for (size_t i = 0; i < names.size(); ++i) a.push_back({{"stage", names[i]}, {"median_ms", median(ms[i])}});
+        return a;
+    }
+};
+
 nlohmann::json stats(const std::vector<double>& ms) {
     std::vector<double> s = ms;
     std::sort(s.begin(), s.end());
@@ -119,10 +141,13 @@ void run(const BenchArgs& a) {
             o.device = device;
             o.report = &rep;
             std::vector<double> total;
+            StageSamples stages;
+            int call = 0;
             auto t = repeat(a.warmup, runs, [&] {
                 Timer tt;
                 denoise(in, o);
                 total.push_back(tt.ms());
+                if (call++ >= a.warmup) stages.add(rep.stages);
                 return rep.milliseconds;
             });
             total.erase(total.begin(), total.begin() + a.warmup);
@@ -134,6 +159,7 @@ void run(const BenchArgs& a) {
             r["levels"] = o.eaw.levels;
             r["total_ms"] = median(total);
             r["mpixels_per_s"] = double(w) * h / (median(t) * 1e3);
+            r["stages"] = stages.json();
             doc["results"].push_back(r);
         }
         if (wants("svgf")) {
@@ -146,10 +172,16 @@ void run(const BenchArgs& a) {
             f.depth = &b.depth;
             f.ids = &b.ids;
             f.motion = &motion;
+            SvgfReport srep;
+            sv.setReport(&srep);
+            StageSamples stages;
+            int call = 0;
             auto t = repeat(a.warmup, runs, [&] {
                 Timer tt;
                 sv.denoiseFrameOnDevice(f);
-                return tt.ms();
+                const double ms = tt.ms();
+                if (call++ >= a.warmup) stages.add(srep.stages);
+                return ms;
             });
             nlohmann::json r = stats(t);
             r["what"] = "svgf";
@@ -157,6 +189,7 @@ void run(const BenchArgs& a) {
             r["width"] = w;
             r["height"] = h;
             r["note"] = "whole SVGF frame; host inputs are uploaded inside the timed call on CUDA";
+            r["stages"] = stages.json();
             doc["results"].push_back(r);
         }
     }

@@ -142,6 +142,12 @@ void run(DenoiseArgs& a) {
         std::printf("denoise: fireflies clamped: %d pixels, mean luminance %.6g -> %.6g\n", rep.firefliesClamped,
                     rep.meanLuminanceIn, rep.meanLuminanceAfterFirefly);
     std::printf("denoise: filter %.2f ms, total %.2f ms, wrote %s\n", rep.milliseconds, ms, a.out.c_str());
+    if (!rep.stages.empty()) {  // the filter's own stages (DenoiseReport::stages)
+        std::printf("denoise: stages ms:");
+        for (size_t i = 0; i < rep.stages.size(); ++i)
+            std::printf("%s %s %.2f", i ? "," : "", rep.stages[i].name.c_str(), rep.stages[i].milliseconds);
+        std::printf("\n");
+    }
 }
 
 }  // namespace
