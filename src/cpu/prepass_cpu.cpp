@@ -13,6 +13,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <atomic>
 #include <vector>
 
 #include "core/parallel.h"
@@ -61,6 +62,132 @@ void runFireflyClamp(const CpuExec& exec, const FireflyClamp& f) {
                 const float l[8] = {L0[x - 1], L0[x], L0[x + 1], L1[x - 1], L1[x + 1], L2[x - 1], L2[x], L2[x + 1]};
                 const float lv[8] = {V0[x - 1], V0[x], V0[x + 1], V1[x - 1], V1[x + 1], V2[x - 1], V2[x], V2[x + 1]};
                 flag[x] = g.apply(x, y, l, lv);
+            }
+            g(w - 1, y);
+        }
+    });
+}
+
+}  // namespace atrous::filters
+
+namespace atrous::filters {
+
+void runSanitizeColor(const CpuExec&, const SanitizeColor& f) {
+    const int w = f.colorIn.width, h = f.colorIn.height;
+    tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& r) {
+        const SanitizeColor g = f;
+        for (int y = r.begin(); y < r.end(); ++y)
+            for (int c = 0; c < 3; ++c)
+                for (int k = 0; k < 2; ++k) {
+                    const ImageView& in = k == 0 ? g.colorIn : g.varIn;
+                    const ImageView& out = k == 0 ? g.colorOut : g.varOut;
+                    const float* ATROUS_RESTRICT a = in.channel(c) + size_t(y) * w;
+                    float* ATROUS_RESTRICT o = out.channel(c) + size_t(y) * w;
+                    int bad = 0;
+#pragma omp simd reduction(| : bad)
+                    for (int x = 0; x < w; ++x) {
+                        o[x] = a[x];
+                        bad |= finite(a[x]) ? 0 : 1;
+                    }
+                    if (!bad) continue;
+                    // Rare: the functor's repair (mean of the finite 5×5 neighbours).
+                    for (int x = 0; x < w; ++x)
+                        if (!finite(a[x])) o[x] = SanitizeColor::fix(in, x, y, c);
+                }
+    });
+}
+
+ImageView sanitizedFeature(const CpuExec& exec, ImageView in, int width, int height, int channels, Image& storage) {
+    if (in.valid()) {
+        // sanitizeFeature(a) == a exactly where a is finite and |a| <= kFeatureClamp.
+        std::atomic<bool> clean{true};
+        tbb::parallel_for(tbb::blocked_range<int>(0, height, 16), [&](const tbb::blocked_range<int>& r) {
+            for (int c = 0; c < channels && clean.load(std::memory_order_relaxed); ++c) {
+                int bad = 0;
+                for (int y = r.begin(); y < r.end(); ++y) {
+                    const float* ATROUS_RESTRICT a = in.channel(c) + size_t(y) * width;
+#pragma omp simd reduction(| : bad)
+                    for (int x = 0; x < width; ++x) bad |= (a[x] >= -kFeatureClamp) & (a[x] <= kFeatureClamp) ? 0 : 1;
+                }
+                if (bad) clean.store(false, std::memory_order_relaxed);
+            }
+        });
+        if (clean.load()) {
+            storage = Image();
+            return in;
+        }
+    }
+    storage = Image(width, height, channels, Device::Cpu);
+    if (in.valid()) exec.forEachPixel(width, height, SanitizeFeature{in, storage.view()});
+    return storage.view();
+}
+
+void runColorScale(const CpuExec& exec, const ColorScale& f) {
+    const int w = f.var.width, h = f.var.height;
+    if (w < 3 || f.rawSigma > 0) {
+        exec.forEachPixel(w, h, f);
+        return;
+    }
+    tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& r) {
+        const ColorScale g = f;  // a local copy: its views cannot alias the stores
+        std::vector<float> rows(size_t(3) * w);
+        for (int y = r.begin(); y < r.end(); ++y) {
+            // Channel-summed variance of rows y-1, y, y+1 (clamped as in the functor).
+            for (int k = 0; k < 3; ++k) {
+                const size_t o = size_t(clampIdx(y + k - 1, h - 1)) * w;
+                const float* ATROUS_RESTRICT vr = g.var.channel(0) + o;
+                const float* ATROUS_RESTRICT vg = g.var.channel(1) + o;
+                const float* ATROUS_RESTRICT vb = g.var.channel(2) + o;
+                float* ATROUS_RESTRICT V = rows.data() + size_t(k) * w;
+#pragma omp simd
+                for (int x = 0; x < w; ++x) V[x] = vr[x] + vg[x] + vb[x];
+            }
+            const float* ATROUS_RESTRICT V0 = rows.data();
+            const float* ATROUS_RESTRICT V1 = V0 + w;
+            const float* ATROUS_RESTRICT V2 = V1 + w;
+            float* ATROUS_RESTRICT S = g.S.channel(0) + size_t(y) * w;
+            g(0, y);
+#pragma omp simd
+            for (int x = 1; x < w - 1; ++x) {
+                const float v[9] = {V0[x - 1], V0[x], V0[x + 1], V1[x - 1], V1[x], V1[x + 1], V2[x - 1], V2[x], V2[x + 1]};
+                S[x] = g.scale(v);
+            }
+            g(w - 1, y);
+        }
+    });
+}
+
+void runFootprint(const CpuExec& exec, const Footprint& f) {
+    const int w = f.invX.width, h = f.invX.height;
+    if (w < 3 || !f.hasPosition || f.rawSigma > 0) {
+        exec.forEachPixel(w, h, f);
+        return;
+    }
+    tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& r) {
+        const Footprint g = f;  // a local copy: its views cannot alias the stores
+        for (int y = r.begin(); y < r.end(); ++y) {
+            const size_t o = size_t(y) * w;
+            // Rows above and below; at the top/bottom border the functor's neighbour is the pixel
+            // itself (kFootprintBorder): the row pointer then stays valid and the select drops it.
+            const int yUp = clampIdx(y - 1, h - 1), yDown = clampIdx(y + 1, h - 1);
+            const bool hasUp = yUp != y, hasDown = yDown != y;
+            const size_t oUp = size_t(yUp) * w, oDown = size_t(yDown) * w;
+            const float* ATROUS_RESTRICT px = g.position.channel(0);
+            const float* ATROUS_RESTRICT py = g.position.channel(1);
+            const float* ATROUS_RESTRICT pz = g.position.channel(2);
+            const float* ATROUS_RESTRICT z = g.depth.channel(0) + o;
+            float* ATROUS_RESTRICT invX = g.invX.channel(0) + o;
+            float* ATROUS_RESTRICT invZ = g.invZ.channel(0) + o;
+            g(0, y);
+#pragma omp simd
+            for (int x = 1; x < w - 1; ++x) {
+                const float cx = px[o + x], cy = py[o + x], cz = pz[o + x];
+                const float dR = sq(cx - px[o + x + 1]) + sq(cy - py[o + x + 1]) + sq(cz - pz[o + x + 1]);
+                const float dL = sq(cx - px[o + x - 1]) + sq(cy - py[o + x - 1]) + sq(cz - pz[o + x - 1]);
+                const float dD = sq(cx - px[oDown + x]) + sq(cy - py[oDown + x]) + sq(cz - pz[oDown + x]);
+                const float dU = sq(cx - px[oUp + x]) + sq(cy - py[oUp + x]) + sq(cz - pz[oUp + x]);
+                invX[x] = g.invXOf(dR, dL, hasDown ? dD : kFootprintBorder, hasUp ? dU : kFootprintBorder);
+                invZ[x] = 1.0f / maxSel(fabsf(z[x]), 1e-6f);
             }
             g(w - 1, y);
         }

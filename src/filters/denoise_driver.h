@@ -9,6 +9,7 @@
 #include "atrous/denoise.h"
 #include "atrous/image.h"
 #include "filters/eaw.h"
+#include "filters/emission_filter.h"
 #include "filters/prepass.h"
 #include "filters/stage_clock.h"
 #include "filters/sure.h"
@@ -89,19 +90,28 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
 
     // 1. Non-finite samples and features.
     Image c0(w, h, 3, dev), v0(w, h, 3, dev);
-    exec.forEachPixel(w, h, SanitizeColor{in.color, in.variance, c0.view(), v0.view()});
-    Image emission;
+    runSanitizeColor(exec, SanitizeColor{in.color, in.variance, c0.view(), v0.view()});
+    // Features: sanitised copies (on the CPU the buffers themselves when already clean), zeros
+    // when absent.
+    Image emissionStore, normalStore, positionStore, depthStore, idsStore, emissionA, emissionB;
+    ImageView emission;
     if (in.emission.valid()) {
         // Filter the reflected part only: c_0 = color - emission (emission added back at the end).
-        emission = Image(w, h, 3, dev);
-        exec.forEachPixel(w, h, SanitizeFeature{in.emission, emission.view()});
-        exec.forEachPixel(w, h, SubtractEmission{emission.view(), c0.view()});
+        emission = sanitizedFeature(exec, in.emission, w, h, 3, emissionStore);
+        exec.forEachPixel(w, h, SubtractEmission{emission, c0.view()});
+        // The emission added back is filtered along emitter edges (filters/emission_filter.h).
+        if (cfg.eaw.emissionLevels > 0) {
+            emissionA = Image(w, h, 3, dev);
+            emissionB = Image(w, h, 3, dev);
+            exec.forEachPixel(w, h, Copy3{emission, emissionA.view()});
+            emission = runEmissionFilter(exec, cfg.eaw.emissionLevels, cfg.eaw.emissionScale, v0.view(),
+                                         emissionA.view(), emissionB.view());
+        }
     }
-    Image normal(w, h, 3, dev), position(w, h, 3, dev), depth(w, h, 1, dev), ids(w, h, 2, dev);
-    if (in.normal.valid()) exec.forEachPixel(w, h, SanitizeFeature{in.normal, normal.view()});
-    if (in.position.valid()) exec.forEachPixel(w, h, SanitizeFeature{in.position, position.view()});
-    if (in.depth.valid()) exec.forEachPixel(w, h, SanitizeFeature{in.depth, depth.view()});
-    if (in.ids.valid()) exec.forEachPixel(w, h, SanitizeFeature{in.ids, ids.view()});
+    const ImageView normal = sanitizedFeature(exec, in.normal, w, h, 3, normalStore);
+    const ImageView position = sanitizedFeature(exec, in.position, w, h, 3, positionStore);
+    const ImageView depth = sanitizedFeature(exec, in.depth, w, h, 1, depthStore);
+    const ImageView ids = sanitizedFeature(exec, in.ids, w, h, 2, idsStore);
     markStage(out.clock, "sanitize");
 
     // 2. Fireflies (before demodulation: the outlier is in radiance).
@@ -124,21 +134,19 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
 
     // 3. Albedo demodulation.
     ImageView albedo = cfg.demodulate ? in.albedo : ImageView{};
-    Image albedoClean;
+    Image albedoStore;
     if (albedo.valid()) {
-        albedoClean = Image(w, h, 3, dev);
-        exec.forEachPixel(w, h, SanitizeFeature{albedo, albedoClean.view()});
-        albedo = albedoClean.view();
+        albedo = sanitizedFeature(exec, albedo, w, h, 3, albedoStore);
         exec.forEachPixel(w, h, Demodulate{cfg.albedoEpsilon, albedo, cA.view(), vA.view()});
     }
     markStage(out.clock, "demodulate");
 
     // 4. Per-pixel scales of the automatic σ_c and σ_x.
     Image S(w, h, 1, dev), invX(w, h, 1, dev), invZ(w, h, 1, dev);
-    exec.forEachPixel(w, h, ColorScale{cfg.eaw.sigmaColor, cfg.eaw.colorScale * cfg.eaw.colorScale, vA.view(), S.view()});
-    exec.forEachPixel(w, h, Footprint{in.position.valid() ? 1 : 0, cfg.eaw.sigmaPosition,
-                                      cfg.eaw.positionScale * cfg.eaw.positionScale, position.view(), depth.view(),
-                                      invX.view(), invZ.view()});
+    runColorScale(exec, ColorScale{cfg.eaw.sigmaColor, cfg.eaw.colorScale * cfg.eaw.colorScale, vA.view(), S.view()});
+    runFootprint(exec, Footprint{in.position.valid() ? 1 : 0, cfg.eaw.sigmaPosition,
+                                 cfg.eaw.positionScale * cfg.eaw.positionScale, position, depth, invX.view(),
+                                 invZ.view()});
     markStage(out.clock, "sigma scales");
 
     // 5. The cascade. SURE also propagates the variance and keeps Σ s_i d_i in `acc`.
@@ -183,12 +191,12 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
             f.detail = detail.view();
         }
         f.S = S.view();
-        f.normal = normal.view();
-        f.position = position.view();
+        f.normal = normal;
+        f.position = position;
         f.invX = invX.view();
-        f.depth = depth.view();
+        f.depth = depth;
         f.invZ = invZ.view();
-        f.ids = ids.view();
+        f.ids = ids;
         runEawLevel(exec, f);
         markStage(out.clock, "level", i);
         if (sure) {
@@ -204,7 +212,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
 
     // 6. out = (c_N + Σ s_i d_i) · albedo.
     exec.forEachPixel(w, h, Recombine{cfg.albedoEpsilon, cur->view(), sure ? acc.view() : ImageView{}, albedo,
-                                      emission.empty() ? ImageView{} : emission.view(), out.out});
+                                      emission, out.out});
     markStage(out.clock, "remodulate");
     exec.synchronize();
 }

@@ -44,6 +44,14 @@ struct SanitizeColor {
     }
 };
 
+// Runs SanitizeColor on `exec`; the CpuExec overload (src/cpu/prepass_cpu.cpp) copies whole rows
+// with a vectorised finiteness test and calls fix() only where a value is not finite.
+template <class Exec>
+void runSanitizeColor(const Exec& exec, const SanitizeColor& f) {
+    exec.forEachPixel(f.colorIn.width, f.colorIn.height, f);
+}
+void runSanitizeColor(const CpuExec& exec, const SanitizeColor& f);
+
 // Copies a feature buffer, mapping non-finite values to 0 and clamping to ±kFeatureClamp.
 // (Selects instead of fminf/fmaxf, which do not vectorise under strict IEEE flags.)
 ATROUS_INLINE float sanitizeFeature(float a) {
@@ -59,6 +67,18 @@ struct SanitizeFeature {
         if (out.channels >= 3) out(x, y, 2) = sanitizeFeature(in(x, y, 2));
     }
 };
+
+// The view the filters read for one feature buffer: a sanitised copy of the first `channels`
+// channels of `in` kept in `storage`, or zeros when `in` is absent (its terms then vanish). The
+// CpuExec overload (src/cpu/prepass_cpu.cpp) returns `in` itself, with no copy, when every value
+// is already finite and within ±kFeatureClamp: the copy would equal it bit for bit.
+template <class Exec>
+ImageView sanitizedFeature(const Exec& exec, ImageView in, int width, int height, int channels, Image& storage) {
+    storage = Image(width, height, channels, exec.device());
+    if (in.valid()) exec.forEachPixel(width, height, SanitizeFeature{in, storage.view()});
+    return storage.view();
+}
+ImageView sanitizedFeature(const CpuExec& exec, ImageView in, int width, int height, int channels, Image& storage);
 
 // Plain 3-channel copy.
 struct Copy3 {
@@ -181,21 +201,39 @@ struct ColorScale {
             S(x, y, 0) = 0.5f * rawSigma * rawSigma;
             return;
         }
-        float s = 0, vmax = -1, wmax = 0;
+        float v[9];
         for (int dy = -1; dy <= 1; ++dy)
             for (int dx = -1; dx <= 1; ++dx) {
                 const int xx = clampIdx(x + dx, var.width - 1), yy = clampIdx(y + dy, var.height - 1);
-                const float wt = (dx == 0 ? 2.0f : 1.0f) * (dy == 0 ? 2.0f : 1.0f) * (1.0f / 16.0f);
-                const float v = var(xx, yy, 0) + var(xx, yy, 1) + var(xx, yy, 2);
-                s += wt * v;
-                if ((dx != 0 || dy != 0) && v > vmax) {
-                    vmax = v;
-                    wmax = wt;
-                }
+                v[(dy + 1) * 3 + dx + 1] = var(xx, yy, 0) + var(xx, yy, 1) + var(xx, yy, 2);
             }
-        S(x, y, 0) = k2 * (s - wmax * vmax) / (1.0f - wmax);
+        S(x, y, 0) = scale(v);
+    }
+    // S from the 3×3 channel-summed variances v in row order (v[4] the centre); shared with the
+    // CPU row loop (src/cpu/prepass_cpu.cpp). Selects, not branches, so that loop vectorises.
+    ATROUS_FORCE_INLINE ATROUS_HOST_DEVICE float scale(const float (&v)[9]) const {
+        float s = 0, vmax = -1, wmax = 0;
+        for (int i = 0; i < 9; ++i) {
+            const float wt = (i % 3 == 1 ? 2.0f : 1.0f) * (i / 3 == 1 ? 2.0f : 1.0f) * (1.0f / 16.0f);
+            s += wt * v[i];
+            const bool more = (i != 4) & (v[i] > vmax);  // the largest neighbour, the first on ties
+            vmax = more ? v[i] : vmax;
+            wmax = more ? wt : wmax;
+        }
+        return k2 * (s - wmax * vmax) / (1.0f - wmax);
     }
 };
+
+// Runs ColorScale on `exec`; the CpuExec overload sums the variance channels of three rows once
+// per row and runs a vectorised x loop over the interior with the shared ColorScale::scale.
+template <class Exec>
+void runColorScale(const Exec& exec, const ColorScale& f) {
+    exec.forEachPixel(f.var.width, f.var.height, f);
+}
+void runColorScale(const CpuExec& exec, const ColorScale& f);
+
+// Distance that stands for a neighbour outside the image in the footprint's per-axis minimum.
+constexpr float kFootprintBorder = 3.0e38f;
 
 // invX = 1/σ_x² per pixel and invZ = 1/z. Automatic σ_x: k_x · F(p), F the world-space size of a
 // pixel at p: per axis the smaller of the forward and backward position differences (the smaller,
@@ -218,18 +256,32 @@ struct Footprint {
             return;
         }
         const int w = position.width, h = position.height;
-        const float fx = minSel(dist2(x, y, clampIdx(x + 1, w - 1), y), dist2(x, y, clampIdx(x - 1, w - 1), y));
-        const float fy = minSel(dist2(x, y, x, clampIdx(y + 1, h - 1)), dist2(x, y, x, clampIdx(y - 1, h - 1)));
-        const float f2 = maxSel(fx, fy);
-        // 1e-20 keeps the inverse finite (1e20) on degenerate footprints (e.g. background).
-        invX(x, y, 0) = 1.0f / (k2 * f2 + 1e-20f);
+        invX(x, y, 0) = invXOf(dist2(x, y, clampIdx(x + 1, w - 1), y), dist2(x, y, clampIdx(x - 1, w - 1), y),
+                               dist2(x, y, x, clampIdx(y + 1, h - 1)), dist2(x, y, x, clampIdx(y - 1, h - 1)));
     }
     ATROUS_HOST_DEVICE float dist2(int x0, int y0, int x1, int y1) const {
-        if (x0 == x1 && y0 == y1) return 3.0e38f;  // image border: use the other side only
+        if (x0 == x1 && y0 == y1) return kFootprintBorder;  // image border: use the other side only
         return sq(position(x0, y0, 0) - position(x1, y1, 0)) + sq(position(x0, y0, 1) - position(x1, y1, 1)) +
                sq(position(x0, y0, 2) - position(x1, y1, 2));
     }
+    // 1/σ_x² from the squared position distances to the right, left, lower and upper neighbours
+    // (kFootprintBorder where that neighbour is outside the image); shared with the CPU row loop.
+    ATROUS_FORCE_INLINE ATROUS_HOST_DEVICE float invXOf(float dxp, float dxm, float dyp, float dym) const {
+        const float fx = minSel(dxp, dxm);
+        const float fy = minSel(dyp, dym);
+        const float f2 = maxSel(fx, fy);
+        // 1e-20 keeps the inverse finite (1e20) on degenerate footprints (e.g. background).
+        return 1.0f / (k2 * f2 + 1e-20f);
+    }
 };
+
+// Runs Footprint on `exec`; the CpuExec overload runs vectorised row loops with the shared
+// Footprint::invXOf (the automatic σ_x; the other modes go through the functor).
+template <class Exec>
+void runFootprint(const Exec& exec, const Footprint& f) {
+    exec.forEachPixel(f.invX.width, f.invX.height, f);
+}
+void runFootprint(const CpuExec& exec, const Footprint& f);
 
 // c_0 -= emission (the emission itself is noise-free given the pixel's samples).
 struct SubtractEmission {
