@@ -9,7 +9,7 @@
 
 #include "atrous/error.h"
 #include "atrous/render.h"
-#include "core/rng.h"
+#include "core/sampler.h"
 #include "io/image_io.h"
 #include "render/animation.h"
 #include "render/camera.h"
@@ -43,8 +43,8 @@ RenderSettings smallSettings(uint32_t seed = 5) {
 // the inverse projection the renderer uses: the angle between the two rays times the focal length
 // in pixels.
 double reprojectionErrorPx(const pt::Camera& prevCam, Vec3 prevPoint, const Image& motion, int x, int y, uint32_t seed) {
-    Rng rng(uint32_t(y) * kW + uint32_t(x), 0u, seed);
-    float jx = rng.next(), jy = rng.next();
+    Vec2 j = stratifiedPixelJitter(uint32_t(y) * kW + uint32_t(x), 0u, seed);  // sample 0's position
+    float jx = j.x, jy = j.y;
     float px = float(x) + jx + motion(x, y, 0), py = float(y) + jy + motion(x, y, 1);
     Vec3 want = normalize(prevPoint - prevCam.position);
     Vec3 got = pt::cameraRayDirection(prevCam, px, py, kW, kH);

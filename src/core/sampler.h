@@ -93,4 +93,10 @@ ATROUS_INLINE uint32_t pixelSamplerSeed(uint32_t pixel, uint32_t seed) {
     return hashCombine(pixel, seed ^ 0x27d4eb2fU);
 }
 
+// Sub-pixel position in [0,1)^2 of sample `index` of pixel `pixel` in a render of `seed`: what the
+// path tracer uses (pt::PixelSampler::Sobol), for code that needs to know where a sample landed.
+ATROUS_INLINE Vec2 stratifiedPixelJitter(uint32_t pixel, uint32_t index, uint32_t seed) {
+    return sobol02Scrambled(index, pixelSamplerSeed(pixel, seed));
+}
+
 }  // namespace atrous

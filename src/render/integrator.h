@@ -251,13 +251,12 @@ struct PathTraceKernel {
         int featureHits = 0, depthHits = 0;
         int32_t mesh = -1, material = -1;
         Vec3 motionSum(0.0f), emissionSum(0.0f);
-        const uint32_t samplerSeed = pixelSamplerSeed(pixel, seed);
         for (int i = 0; i < spp; ++i) {
             const uint32_t index = firstSample + uint32_t(i);
             Rng rng(pixel, index, seed);
             float jx, jy;
             if (pixelSampler == PixelSampler::Sobol) {
-                Vec2 u = sobol02Scrambled(index, samplerSeed);
+                Vec2 u = stratifiedPixelJitter(pixel, index, seed);
                 jx = u.x;
                 jy = u.y;
             } else {
