@@ -175,8 +175,27 @@ TEST(Sure, ZeroFractionIsEawAndOneIsTheInput) {
     EXPECT_LT(maxAbsDiff(denoise(s.inputs(), eaw), denoise(s.inputs(), sure0)), 1e-6);
     DenoiseOptions sure1 = plainOptions(DenoiseMethod::Sure);
     sure1.sure.candidates = {1.0f};
+    sure1.sure.firstLevel = 0;  // the paper's form: every level's detail can be kept
     // c_N + Σ d_i telescopes to c_0: float cancellation over 5 levels, 1e-5.
     EXPECT_LT(maxAbsDiff(denoise(s.inputs(), sure1), s.noisy), 1e-5);
+}
+
+// With firstLevel = k, levels below k keep no detail: s = 1 on the others gives
+// c_N + Σ_{i>=k} d_i = c_k, the k-level EAW output (same cascade, same weights).
+TEST(Sure, FirstLevelDropsTheFinerDetails) {
+    SyntheticScene s = makeScene(48, 48, 0.3f, 14);
+    for (int k = 1; k <= 4; ++k) {
+        DenoiseOptions sure1 = plainOptions(DenoiseMethod::Sure);
+        sure1.sure.candidates = {1.0f};
+        sure1.sure.firstLevel = k;
+        DenoiseOptions eawK = plainOptions(DenoiseMethod::Eaw);
+        eawK.eaw.levels = k;
+        // Same telescoping cancellation as above: 1e-5.
+        EXPECT_LT(maxAbsDiff(denoise(s.inputs(), sure1), denoise(s.inputs(), eawK)), 1e-5) << "firstLevel " << k;
+    }
+    // The default keeps none of levels 0 and 1 (docs/quality.md: their detail noise is correlated
+    // across levels, which the per-level risk ignores).
+    EXPECT_EQ(SureParams{}.firstLevel, 2);
 }
 
 TEST(Sure, EveryParameterChangesTheOutput) {
@@ -195,6 +214,7 @@ TEST(Sure, EveryParameterChangesTheOutput) {
     changed("windowRadius", [](DenoiseOptions& o) { o.sure.windowRadius = 1; });
     changed("correlatedVariance", [](DenoiseOptions& o) { o.sure.correlatedVariance = false; });
     changed("eaw.levels", [](DenoiseOptions& o) { o.eaw.levels = 2; });
+    changed("firstLevel", [](DenoiseOptions& o) { o.sure.firstLevel = 0; });
 }
 
 TEST(Sure, EstimatesTheNoiseWithoutAVarianceBuffer) {

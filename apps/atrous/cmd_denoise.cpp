@@ -183,9 +183,17 @@ void addDenoiseCommand(CLI::App& app) {
     cmd->add_option("--position-scale", e.positionScale, "k_x of the automatic sigma_x")->capture_default_str();
     cmd->add_option("--sigma-depth", e.sigmaDepth, "sigma_z on relative depth (0 = off)")->capture_default_str();
     cmd->add_flag("--no-ids", a->noIds, "Ignore the ids buffer");
+    cmd->add_option("--emission-levels", e.emissionLevels,
+                    "Levels of the edge-avoiding filter of the emission buffer (0 = add emission back as is)")
+        ->capture_default_str();
+    cmd->add_option("--emission-scale", e.emissionScale, "k of the emission filter's sigma^2 = k * 2 min(V_p, V_q)")
+        ->capture_default_str();
     cmd->add_option("--sure-mode", a->sureMode, "discrete | james-stein")->capture_default_str();
     cmd->add_option("--sure-candidates", a->sureCandidates, "Comma-separated fractions (default 0,0.2,0.4,0.6,0.8,1)");
     cmd->add_option("--sure-window", a->opt.sure.windowRadius, "SURE window radius r ((2r+1)^2 window)")
+        ->capture_default_str();
+    cmd->add_option("--sure-first-level", a->opt.sure.firstLevel,
+                    "SURE keeps no detail of levels below this one (0 = the paper's form)")
         ->capture_default_str();
     cmd->add_flag("--no-correlated-variance", a->noCorrelated, "Plain independence propagation of the variance");
     cmd->add_flag("--no-firefly", a->noFirefly, "Disable firefly suppression");

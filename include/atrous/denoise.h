@@ -25,8 +25,9 @@ struct DenoiseInputs {
     const Image* depth = nullptr;     // view depth repeated in R,G,B
     const Image* ids = nullptr;       // R = mesh id, G = material id, -1 for background
     // Emitted radiance of the primary hit (mean over the pixel's samples). When given, the filters
-    // work on color - emission and add it back: a visible light's edge (pixel-coverage noise) is
-    // then left exactly as rendered instead of being an unfilterable outlier.
+    // work on color - emission and add it back, through an edge-avoiding filter of its own
+    // (EawParams::emissionLevels) that averages a visible light's partly covered edge pixels
+    // (pixel-coverage noise) with each other and with nothing else.
     const Image* emission = nullptr;
 };
 
@@ -53,6 +54,12 @@ struct EawParams {
     // position already covers it).
     float sigmaDepth = 0.0f;
     bool useIds = true;  // weight 0 across mesh or material id changes when an ids buffer is given
+    // Emission buffer (both methods): the emission added back after filtering goes through an
+    // edge-avoiding cascade of this many levels (0 = added back as is), with σ² at a tap pair
+    // emissionScale · 2·min(V_p, V_q) · 4^-i (V = the pixel's summed variance), so pixels partly
+    // covered by an emitter average with each other and nothing crosses a full/empty emitter edge.
+    int emissionLevels = 4;     // 0..10
+    float emissionScale = 6.0f;  // > 0
 };
 
 enum class SureMode { Discrete, JamesStein };
@@ -65,6 +72,10 @@ struct SureParams {
     // Correct the propagated variance v_i for the correlation the independence assumption ignores
     // (per-level factors computed exactly for the unweighted B3 cascade on white noise).
     bool correlatedVariance = true;
+    // Levels i < firstLevel keep none of their detail (s_i = 0); 0 is the paper's form. The default
+    // 2 is measured (docs/quality.md "SURE"): fine levels' detail noise is strongly correlated
+    // across levels, which the per-level risk ignores, and an oracle keeps ~0% of them anyway.
+    int firstLevel = 2;
 };
 
 // Firefly suppression before either filter (ALGORITHMS.md 3a): a pixel whose luminance exceeds

@@ -120,6 +120,9 @@ void applyDenoiseParam(DenoiseOptions& o, const std::string& k, const nb::handle
         else throw InputError("parameter 'sure_mode' must be 'discrete' or 'james-stein', got '" + m + "'");
     } else if (k == "sure_candidates") o.sure.candidates = as<std::vector<float>>(v, k);
     else if (k == "sure_window") o.sure.windowRadius = as<int>(v, k);
+    else if (k == "sure_first_level") o.sure.firstLevel = as<int>(v, k);
+    else if (k == "emission_levels") o.eaw.emissionLevels = as<int>(v, k);
+    else if (k == "emission_scale") o.eaw.emissionScale = as<float>(v, k);
     else if (k == "correlated_variance") o.sure.correlatedVariance = as<bool>(v, k);
     else if (k == "firefly") o.firefly.enabled = as<bool>(v, k);
     else if (k == "firefly_k") o.firefly.k = as<float>(v, k);

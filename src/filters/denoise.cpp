@@ -42,6 +42,9 @@ void validateDenoiseOptions(const DenoiseOptions& o) {
     requireRange(std::isfinite(e.sigmaDepth) && e.sigmaDepth >= 0, "sigma-depth must be >= 0 (0 = off)");
     const SureParams& s = o.sure;
     requireRange(s.windowRadius >= 1 && s.windowRadius <= 10, "sure-window must be in 1..10");
+    requireRange(s.firstLevel >= 0 && s.firstLevel <= 16, "sure-first-level must be in 0..16");
+    requireRange(o.eaw.emissionLevels >= 0 && o.eaw.emissionLevels <= 10, "emission-levels must be in 0..10");
+    requireRange(std::isfinite(o.eaw.emissionScale) && o.eaw.emissionScale > 0, "emission-scale must be > 0");
     requireRange(!s.candidates.empty() && int(s.candidates.size()) <= filters::kMaxSureCandidates,
                  "sure-candidates must list 1..8 values");
     for (float c : s.candidates) requireRange(std::isfinite(c) && c >= 0 && c <= 1, "sure-candidates must be in [0, 1]");

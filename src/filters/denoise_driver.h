@@ -203,7 +203,17 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
             runSureBoxH(exec, SureBoxH{choice.radius, detail.view(), boxH.view()});
             ImageView sOut;
             if (out.sureS.valid()) sOut = ImageView{out.sureS.channel(i), w, h, 1};
-            runSureChoose(exec, SureChoose{choice, boxH.view(), cur->view(), nxt->view(), acc.view(), sOut});
+            // Levels below sure.firstLevel keep s_i = 0 (their details are dropped, as in EAW): the
+            // per-level risk assumes the levels' noise is independent, but adjacent fine levels'
+            // detail noise correlates at ~0.7 after colour-weighted levels (docs/quality.md), so
+            // their individual SURE choices keep noise.
+            SureChoiceParams levelChoice = choice;
+            if (i < cfg.sure.firstLevel) {
+                levelChoice.jamesStein = 0;
+                levelChoice.count = 1;
+                levelChoice.candidates[0] = 0.0f;
+            }
+            runSureChoose(exec, SureChoose{levelChoice, boxH.view(), cur->view(), nxt->view(), acc.view(), sOut});
             markStage(out.clock, "sure", i);
             std::swap(vcur, vnxt);
         }
