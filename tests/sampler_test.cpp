@@ -41,6 +41,14 @@ TEST(Sampler, ReverseBitsAndSobolDirectionNumbers) {
     // Sobol dimension 1 in index order: 0, 1/2, 3/4, 1/4, 5/8, 1/8, 3/8, 7/8.
     const double expected[8] = {0.0, 0.5, 0.75, 0.25, 0.625, 0.125, 0.375, 0.875};
     for (uint32_t i = 0; i < 8; ++i) EXPECT_EQ(double(sobolDim1(i)) / 4294967296.0, expected[i]) << "index " << i;
+    // The bit-parallel form equals the direction-number loop for every bit pattern.
+    uint32_t x = 12345u;
+    for (int k = 0; k < 100000; ++k) {
+        x = hash32(x + uint32_t(k));
+        uint32_t index = k < 1024 ? uint32_t(k) : x;
+        ASSERT_EQ(sobolDim1(index), sobolDim1Reference(index)) << "index " << index;
+    }
+    EXPECT_EQ(sobolDim1(0xffffffffu), sobolDim1Reference(0xffffffffu));
 }
 
 TEST(Sampler, UnscrambledSequenceIsAZeroTwoSequence) {

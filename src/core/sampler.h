@@ -39,14 +39,29 @@ ATROUS_INLINE uint32_t reverseBits32(uint32_t x) {
 // Sobol dimension 0 (the van der Corput radical inverse in base 2) as a 0.32 fixed-point number.
 ATROUS_INLINE uint32_t sobolDim0(uint32_t index) { return reverseBits32(index); }
 
-// Sobol dimension 1: direction numbers v_1 = 2^31, v_k = v_(k-1) ^ (v_(k-1) >> 1) (the generator
-// matrix is Pascal's triangle mod 2). With dimension 0 this is a (0,2)-sequence in base 2.
-ATROUS_INLINE uint32_t sobolDim1(uint32_t index) {
+// Sobol dimension 1: direction numbers v_0 = 2^31, v_k = v_(k-1) ^ (v_(k-1) >> 1); the generator
+// matrix is Pascal's triangle mod 2. With dimension 0 this is a (0,2)-sequence in base 2.
+// Reference form (one step per index bit); sobolDim1 below computes the same bits faster.
+ATROUS_INLINE uint32_t sobolDim1Reference(uint32_t index) {
     uint32_t r = 0;
     for (uint32_t v = 1u << 31; index != 0; index >>= 1, v ^= v >> 1)
         if (index & 1u) r ^= v;
     return r;
 }
+
+// By Lucas' theorem C(k, p) is odd iff the bits of p are a subset of those of k, so bit 31 - p of
+// the result is the XOR of the index bits k ⊇ p: a superset (zeta) transform over the 5-bit bit
+// positions, five shift/mask/XOR steps instead of a 32-step loop. Returned bit-reversed (the
+// scramble below works on reversed numbers anyway): sobolDim1(i) = reverseBits32(supersetXor(i)).
+ATROUS_INLINE uint32_t sobolDim1Reversed(uint32_t a) {
+    a ^= (a >> 1) & 0x55555555U;
+    a ^= (a >> 2) & 0x33333333U;
+    a ^= (a >> 4) & 0x0f0f0f0fU;
+    a ^= (a >> 8) & 0x00ff00ffU;
+    a ^= (a >> 16) & 0x0000ffffU;
+    return a;
+}
+ATROUS_INLINE uint32_t sobolDim1(uint32_t index) { return reverseBits32(sobolDim1Reversed(index)); }
 
 // A Laine-Karras style permutation: every step (add, multiply by an odd number, x ^= x * even) is
 // a bijection in which bit k of the output depends only on bits 0..k of the input. Applied to
@@ -75,18 +90,31 @@ constexpr uint32_t kSobolShuffleSalt = 0x1b873593U;
 constexpr uint32_t kSobolDim0Salt = 0x85ebca6bU;
 constexpr uint32_t kSobolDim1Salt = 0xc2b2ae35U;
 
-// Point `index` of the shuffled, Owen-scrambled 2D Sobol sequence of one `seed` (Burley 2020,
-// listing 4). The index is shuffled by a nested uniform scramble too: it maps every aligned block
-// of 2^m indices onto another aligned block, so any n = 2^m consecutive aligned indices are still
-// a (0,m,2)-net, while the order inside the block (and which block) is random per seed, which
-// decorrelates a sequence's prefixes across pixels.
-ATROUS_INLINE Vec2 sobol02Scrambled(uint32_t index, uint32_t seed) {
-    uint32_t i = nestedUniformScramble(index, hashCombine(seed, kSobolShuffleSalt));
-    // nestedUniformScramble(sobolDim0(i)) = reverse(lk(i)): two bit reversals saved.
-    uint32_t x = reverseBits32(laineKarrasPermutation(i, hashCombine(seed, kSobolDim0Salt)));
-    uint32_t y = nestedUniformScramble(sobolDim1(i), hashCombine(seed, kSobolDim1Salt));
-    return Vec2(fixedToUnitFloat(x), fixedToUnitFloat(y));
-}
+// One pixel's shuffled, Owen-scrambled 2D Sobol sequence (Burley 2020, listing 4). The index is
+// shuffled by a nested uniform scramble too: it maps every aligned block of 2^m indices onto
+// another aligned block, so any n = 2^m consecutive aligned indices are still a (0,m,2)-net, while
+// the order inside the block (and which block) is random per seed, which decorrelates a
+// sequence's prefixes across pixels. The three hash seeds are derived once per pixel.
+struct Sobol02Sequence {
+    uint32_t shuffleSeed = 0, xSeed = 0, ySeed = 0;
+
+    ATROUS_INLINE explicit Sobol02Sequence(uint32_t seed)
+        : shuffleSeed(hashCombine(seed, kSobolShuffleSalt)),
+          xSeed(hashCombine(seed, kSobolDim0Salt)),
+          ySeed(hashCombine(seed, kSobolDim1Salt)) {}
+
+    ATROUS_INLINE Vec2 point(uint32_t index) const {
+        uint32_t i = nestedUniformScramble(index, shuffleSeed);
+        // nestedUniformScramble(v) = reverse(lk(reverse(v))); with sobolDim0(i) = reverse(i) and
+        // sobolDim1(i) = reverse(sobolDim1Reversed(i)) the inner reversals cancel.
+        uint32_t x = reverseBits32(laineKarrasPermutation(i, xSeed));
+        uint32_t y = reverseBits32(laineKarrasPermutation(sobolDim1Reversed(i), ySeed));
+        return Vec2(fixedToUnitFloat(x), fixedToUnitFloat(y));
+    }
+};
+
+// Point `index` of the scrambled sequence of `seed`.
+ATROUS_INLINE Vec2 sobol02Scrambled(uint32_t index, uint32_t seed) { return Sobol02Sequence(seed).point(index); }
 
 // The scrambling seed of a pixel: one independent Owen scramble per (pixel, render seed).
 ATROUS_INLINE uint32_t pixelSamplerSeed(uint32_t pixel, uint32_t seed) {

@@ -251,12 +251,13 @@ struct PathTraceKernel {
         int featureHits = 0, depthHits = 0;
         int32_t mesh = -1, material = -1;
         Vec3 motionSum(0.0f), emissionSum(0.0f);
+        const Sobol02Sequence pixelSequence(pixelSamplerSeed(pixel, seed));  // = stratifiedPixelJitter
         for (int i = 0; i < spp; ++i) {
             const uint32_t index = firstSample + uint32_t(i);
             Rng rng(pixel, index, seed);
             float jx, jy;
             if (pixelSampler == PixelSampler::Sobol) {
-                Vec2 u = stratifiedPixelJitter(pixel, index, seed);
+                Vec2 u = pixelSequence.point(index);
                 jx = u.x;
                 jy = u.y;
             } else {
