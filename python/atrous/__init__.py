@@ -16,13 +16,18 @@ HDR. The array rule:
   float32; on a CUDA build they are denoised on their GPU without a host round trip, and the result
   comes back as the same kind of array on the same device.
 
+Image files: :func:`read_image` and :func:`write_image` use the library's own readers and writers
+(OpenEXR, PFM, PNG), so Python reads what ``atrous render`` writes and the CLI reads what Python
+writes.
+
 Errors from the library arrive as ValueError (bad input: shapes, sizes, parameters, files) or
 RuntimeError (everything else). NaN and Inf in the colour are treated as missing samples; the
 output is always finite.
 """
 from __future__ import annotations
 
-from typing import Any, Dict, Optional
+import os
+from typing import Any, Dict, Optional, Union
 
 import numpy as np
 
@@ -32,6 +37,8 @@ __all__ = [
     "denoise",
     "render",
     "metrics",
+    "read_image",
+    "write_image",
     "Svgf",
     "builtin_scenes",
     "cuda_available",
@@ -222,6 +229,36 @@ def metrics(image: Any, reference: Any) -> Dict[str, float]:
     """MSE, relMSE, PSNR (tonemapped) and SSIM of `image` against `reference` (ALGORITHMS.md 5)."""
     return dict(_core.metrics(_prepare(image, "image", allow_gray=False),
                               _prepare(reference, "reference", allow_gray=False)))
+
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+def read_image(path: PathLike) -> np.ndarray:
+    """Reads an image file as an H x W x 3 float32 numpy array (linear RGB).
+
+    The format follows the extension, read by the C++ library: .exr (OpenEXR: R, G, B channels,
+    A ignored; or Y, or a single channel, repeated into R, G, B; any compression and pixel type
+    OpenEXR reads), .pfm (colour or grey), .png/.jpg/.hdr (8-bit files converted from sRGB to
+    linear). Raises ValueError naming the file when it is missing, unreadable, truncated, not an
+    image or has channels that do not make RGB.
+    """
+    return _core.read_image(os.fsdecode(os.fspath(path)))
+
+
+def write_image(path: PathLike, image: Any) -> None:
+    """Writes an H x W x 3 (or H x W / H x W x 1 grey) image by the file's extension.
+
+    .exr: 32-bit float R, G, B, ZIP compressed (lossless: :func:`read_image` returns the same
+    float32 values; grey is written into all three channels); .pfm: colour or grey; .png: an 8-bit
+    sRGB preview (clamped to [0, 1]). The array rule of the module docstring applies (other float
+    dtypes are converted to float32, integers are rejected). The file is written under a temporary
+    name and renamed, so a failure never leaves half a file. Raises ValueError naming the file for
+    a bad shape or dtype, an unknown extension or a directory that does not exist or cannot be
+    written; RuntimeError when the encoder itself fails.
+    """
+    p = os.fsdecode(os.fspath(path))
+    _core.write_image(p, _prepare(image, p))
 
 
 class Svgf:

@@ -20,6 +20,7 @@
 #include "atrous/metrics.h"
 #include "atrous/render.h"
 #include "atrous/svgf.h"
+#include "io/image_io.h"
 
 namespace nb = nanobind;
 using namespace atrous;
@@ -251,6 +252,30 @@ nb::dict pyMetrics(const Array& image, const Array& reference) {
     return d;
 }
 
+// Image files go through the library's readers and writers (OpenEXR, PFM, stb), so Python reads
+// exactly what the CLI writes and the other way round; errors name the file (InputError).
+nb::object pyReadImage(const std::string& path) {
+    Image img;
+    {
+        nb::gil_scoped_release release;
+        img = io::readImage(path);
+    }
+    return fromImage(std::move(img));
+}
+
+// `image` is H x W x 3, H x W x 1 or H x W float32 (python/atrous/__init__.py converts other float
+// dtypes); one channel stays one channel so that PFM writes grey ("Pf") and EXR repeats it.
+void pyWriteImage(const std::string& path, const Array& image) {
+    const int channels = image.ndim() == 3 ? int(image.shape(2)) : 1;
+    if (image.ndim() == 3 && channels != 1 && channels != 3)
+        throw InputError(path + ": expected an array of shape (H, W, 3), (H, W, 1) or (H, W), got " +
+                         std::to_string(channels) + " channels");
+    Image img = toImage(image, path.c_str(), channels);
+    if (img.device() != Device::Cpu) img = img.to(Device::Cpu);  // the writers read host memory
+    nb::gil_scoped_release release;
+    io::writeImage(path, img);
+}
+
 }  // namespace
 
 NB_MODULE(_core, m) {
@@ -270,6 +295,8 @@ NB_MODULE(_core, m) {
     m.def("render", &pyRender, nb::arg("scene"), nb::arg("width"), nb::arg("height"), nb::arg("spp"), nb::arg("seed"),
           nb::arg("max_depth"), nb::arg("threads"));
     m.def("metrics", &pyMetrics, nb::arg("image"), nb::arg("reference"));
+    m.def("read_image", &pyReadImage, nb::arg("path"));
+    m.def("write_image", &pyWriteImage, nb::arg("path"), nb::arg("image"));
     m.def("builtin_scenes", [] { return builtinSceneNames(); });
     m.def("cuda_available", &cudaAvailable);
     m.def("cuda_compiled", &cudaCompiled);

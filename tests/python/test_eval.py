@@ -8,7 +8,7 @@ import pytest
 
 import atrous
 from atrous import eval as ev
-from atrous.eval import exr, sequence
+from atrous.eval import sequence
 
 METRICS = ("relmse", "psnr", "ssim", "flip", "ms")
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -130,45 +130,28 @@ def test_cli_rejects_bad_flags():
     assert (cfg.width, cfg.height, cfg.spp, cfg.ref_spp, cfg.resolutions) == (96, 48, [2, 8], 512, [])
 
 
-def test_exr_round_trip_and_reads_the_renderers_layout(tmp_path):
-    rng = np.random.default_rng(0)
-    img = rng.normal(size=(7, 5, 3)).astype(np.float32) * 100
-    exr.write_exr(tmp_path / "a.exr", img)
-    np.testing.assert_array_equal(exr.read_exr(tmp_path / "a.exr"), img)  # float32, lossless
-    (tmp_path / "bad.exr").write_bytes(b"not an exr")
-    with pytest.raises(ValueError, match="bad.exr"):
-        exr.read_exr(tmp_path / "bad.exr")
-
-
-def test_exr_reads_zip_compressed_files(tmp_path):
-    # A ZIP-compressed file as OpenEXR writes it (src/io/image_io.cpp writes this kind): the
-    # encoder below follows the OpenEXR spec (interleave, byte predictor, zlib, 16-line chunks).
-    # The smooth ramp compresses, so the reader's decompression path is the one tested.
-    import struct
-    import zlib
-    h, w = 21, 6  # two chunks, the second partial
-    img = np.arange(h * w * 3, dtype=np.float32).reshape(h, w, 3) * 0.37 - 5
-    chunks = []
-    for y0 in range(0, h, 16):
-        raw = b"".join(img[y, :, c].astype("<f4").tobytes() for y in range(y0, min(h, y0 + 16)) for c in (2, 1, 0))
-        b = np.frombuffer(raw, np.uint8)
-        inter = np.concatenate([b[0::2], b[1::2]]).astype(np.int64)
-        pred = inter.copy()
-        pred[1:] = (inter[1:] - inter[:-1] + 128) % 256
-        z = zlib.compress(pred.astype(np.uint8).tobytes())
-        z = z if len(z) < len(raw) else raw  # OpenEXR stores a block raw when it does not shrink
-        chunks.append(struct.pack("<ii", y0, len(z)) + z)
-    def attr(n, t, v):
-        return n.encode() + b"\0" + t.encode() + b"\0" + struct.pack("<i", len(v)) + v
-    chl = b"".join(c.encode() + b"\0" + struct.pack("<iB3xii", 2, 0, 1, 1) for c in "BGR") + b"\0"
-    hdr = struct.pack("<ii", 20000630, 2) + attr("channels", "chlist", chl) + attr("compression", "compression", b"\3")
-    hdr += attr("dataWindow", "box2i", struct.pack("<iiii", 0, 0, w - 1, h - 1)) + b"\0"
-    offs, pos = [], len(hdr) + 8 * len(chunks)
-    for c in chunks:
-        offs.append(pos)
-        pos += len(c)
-    (tmp_path / "z.exr").write_bytes(hdr + struct.pack(f"<{len(chunks)}Q", *offs) + b"".join(chunks))
-    np.testing.assert_array_equal(exr.read_exr(tmp_path / "z.exr"), img)
+def test_sequence_frames_load_through_read_image_and_errors_name_the_file(tmp_path):
+    # EXRs of a frame are read by atrous.read_image (the library's OpenEXR code): what
+    # write_image wrote comes back exactly; a broken, missing or mis-sized buffer names its file.
+    f = tmp_path / "frame_0000"
+    f.mkdir()
+    rng = np.random.default_rng(1)
+    imgs = {n: rng.normal(size=(6, 9, 3)).astype(np.float32) for n in sequence.REQUIRED}
+    for n, img in imgs.items():
+        atrous.write_image(f / f"{n}.exr", img)
+    loaded = sequence.load_frame(f)
+    assert set(loaded) == set(sequence.REQUIRED)
+    for n, img in imgs.items():
+        np.testing.assert_array_equal(loaded[n], img)
+    (f / "albedo.exr").write_bytes(b"not an exr")
+    with pytest.raises(ValueError, match=r"frame_0000[/\\]albedo\.exr"):
+        sequence.load_frame(f)
+    (f / "albedo.exr").unlink()
+    with pytest.raises(ValueError, match=r"albedo\.exr: missing"):
+        sequence.load_frame(f)
+    atrous.write_image(f / "albedo.exr", np.zeros((6, 8, 3), np.float32))
+    with pytest.raises(ValueError, match=r"albedo\.exr: is 8x6 but color\.exr is 9x6"):
+        sequence.load_frame(f)
 
 
 def test_static_sequence_adds_an_svgf_column(tmp_path):

@@ -2,7 +2,8 @@
 
 Layout (the one src/io/sequence.h reads): DIR/frame_0000/, frame_0001/, ... each holding
 color.exr albedo.exr normal.exr position.exr depth.exr ids.exr motion.exr and optionally
-reference.exr, variance.exr, emission.exr. EXRs are read by the pure-Python reader in exr.py.
+reference.exr, variance.exr, emission.exr. EXRs are read and written by the library's OpenEXR
+code (atrous.read_image / atrous.write_image), the same that `atrous render` writes with.
 """
 from __future__ import annotations
 
@@ -14,8 +15,6 @@ from typing import Any, Callable, Dict, List, Optional
 import numpy as np
 
 import atrous
-
-from .exr import read_exr, write_exr
 
 REQUIRED = ("color", "albedo", "normal", "position", "depth", "ids", "motion")
 OPTIONAL = ("reference", "variance", "emission")
@@ -44,7 +43,7 @@ def load_frame(frame_dir: Path) -> Dict[str, np.ndarray]:
             if name in REQUIRED:
                 raise ValueError(f"{p}: missing (every frame needs {name}.exr)")
             continue
-        bufs[name] = read_exr(p)
+        bufs[name] = atrous.read_image(p)
         if bufs[name].shape != bufs["color"].shape:
             raise ValueError(f"{p}: is {bufs[name].shape[1]}x{bufs[name].shape[0]} but color.exr is "
                              f"{bufs['color'].shape[1]}x{bufs['color'].shape[0]}")
@@ -65,9 +64,9 @@ def write_static_sequence(seq_dir: str, scene: str, frames: int, width: int, hei
         f = d / f"frame_{i:04d}"
         f.mkdir(exist_ok=True)
         for name in ("color", "albedo", "normal", "position", "depth", "ids", "variance"):
-            write_exr(f / f"{name}.exr", b[name])
-        write_exr(f / "motion.exr", np.zeros_like(b["color"]))
-        write_exr(f / "reference.exr", ref)
+            atrous.write_image(f / f"{name}.exr", b[name])
+        atrous.write_image(f / "motion.exr", np.zeros_like(b["color"]))
+        atrous.write_image(f / "reference.exr", ref)
 
 
 def _relmse(x: np.ndarray, r: np.ndarray) -> float:
