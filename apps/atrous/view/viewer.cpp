@@ -862,7 +862,7 @@ void runViewer(const ViewerOptions& opt) {
         if (doStep) {
             const std::vector<StageTime> stages = frameStages(pl, ps.split, displayTime);
             stageHistory.add(stages);
-            if (frame > 0) benchStages.add(stages);
+            if (frame > 0 && (opt.benchmark || headless)) benchStages.add(stages);  // for the JSON line
         }
         if (last) break;
     }
