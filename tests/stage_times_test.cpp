@@ -94,3 +94,23 @@ TEST(StageTimes, SvgfReportFollowsTheFramesWhileSet) {
     EXPECT_TRUE(rep.stages.empty());
     EXPECT_EQ(rep.milliseconds, -1);
 }
+
+// The viewer's timing table (apps/atrous/view/stage_history.h, header-only, no GL).
+#include "../apps/atrous/view/stage_history.h"
+
+TEST(StageHistory, MeansOverTheWindowAndRestartsWhenTheStagesChange) {
+    view::StageHistory h(3);
+    for (double v : {1.0, 2.0, 3.0, 10.0}) h.add({{"render", v}, {"A level 0", 2 * v}});
+    ASSERT_EQ(h.size(), 2u);
+    EXPECT_EQ(h.name(1), "A level 0");
+    EXPECT_EQ(h.frames(), 3u);  // the window keeps the last 3 frames: 2, 3, 10
+    EXPECT_DOUBLE_EQ(h.mean(0), 5.0);
+    EXPECT_DOUBLE_EQ(h.median(0), 3.0);
+    EXPECT_DOUBLE_EQ(h.mean(1), 10.0);
+    // Another method: another stage list, and nothing of the old one is mixed in.
+    h.add({{"render", 4.0}, {"A reproject", 1.0}});
+    ASSERT_EQ(h.size(), 2u);
+    EXPECT_EQ(h.name(1), "A reproject");
+    EXPECT_EQ(h.frames(), 1u);
+    EXPECT_DOUBLE_EQ(h.mean(0), 4.0);
+}
