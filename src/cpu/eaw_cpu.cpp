@@ -9,6 +9,9 @@
 // - the pair's 1/σ_c² is max(r(p), r(q)) of a per-pixel plane r = eawColorRecip(S) computed once
 //   per level, not one division per tap;
 // - the id term and the depth term are compiled out when they are off (their loads too);
+// - tap loads go through the centre row's plane pointers plus one row offset: the loop then has
+//   13-16 plane pointers instead of twice that (they did not fit in registers and were reloaded
+//   from the stack for every tap);
 // - the same row loops are compiled twice, for AVX2 (the build's baseline, x86-64-v3) and for
 //   AVX-512, chosen at run time: the tap loop needs ~30 live vectors (16 ymm registers spilled to
 //   the stack on every tap) and 16 lanes halve the instruction count where the core has 512-bit
@@ -93,6 +96,9 @@ ATROUS_FORCE_INLINE inline void levelRowsBody(const EawLevel& f, const float* rS
         const float* ATROUS_RESTRICT piz = f.invZ.channel(0) + rowP;
         const float* ATROUS_RESTRICT pm0 = f.ids.channel(0) + rowP;
         const float* ATROUS_RESTRICT pm1 = f.ids.channel(1) + rowP;
+        const float* ATROUS_RESTRICT pvr = kPropagate ? f.vIn.channel(0) + rowP : nullptr;
+        const float* ATROUS_RESTRICT pvg = kPropagate ? f.vIn.channel(1) + rowP : nullptr;
+        const float* ATROUS_RESTRICT pvb = kPropagate ? f.vIn.channel(2) + rowP : nullptr;
         float* ATROUS_RESTRICT aws = acc.ws.data();
         float* ATROUS_RESTRICT aar = acc.ar.data();
         float* ATROUS_RESTRICT aag = acc.ag.data();
@@ -105,22 +111,9 @@ ATROUS_FORCE_INLINE inline void levelRowsBody(const EawLevel& f, const float* rS
             if (yq < 0 || yq >= h) continue;  // dropped tap row, as in the generic functor
             const size_t rowQ = size_t(yq) * w;
             const float hy = b3(qy);
-            const float* ATROUS_RESTRICT qr = f.cIn.channel(0) + rowQ;
-            const float* ATROUS_RESTRICT qg = f.cIn.channel(1) + rowQ;
-            const float* ATROUS_RESTRICT qb = f.cIn.channel(2) + rowQ;
-            const float* ATROUS_RESTRICT qS = rS + rowQ;
-            const float* ATROUS_RESTRICT qnx = f.normal.channel(0) + rowQ;
-            const float* ATROUS_RESTRICT qny = f.normal.channel(1) + rowQ;
-            const float* ATROUS_RESTRICT qnz = f.normal.channel(2) + rowQ;
-            const float* ATROUS_RESTRICT qpx = f.position.channel(0) + rowQ;
-            const float* ATROUS_RESTRICT qpy = f.position.channel(1) + rowQ;
-            const float* ATROUS_RESTRICT qpz = f.position.channel(2) + rowQ;
-            const float* ATROUS_RESTRICT qz = f.depth.channel(0) + rowQ;
-            const float* ATROUS_RESTRICT qm0 = f.ids.channel(0) + rowQ;
-            const float* ATROUS_RESTRICT qm1 = f.ids.channel(1) + rowQ;
-            const float* ATROUS_RESTRICT qvr = kPropagate ? f.vIn.channel(0) + rowQ : nullptr;
-            const float* ATROUS_RESTRICT qvg = kPropagate ? f.vIn.channel(1) + rowQ : nullptr;
-            const float* ATROUS_RESTRICT qvb = kPropagate ? f.vIn.channel(2) + rowQ : nullptr;
+            // Tap row q: the centre row's pointers plus dRow (one index per tap rather than a
+            // second set of 13-16 row pointers, which the x loop had to reload from the stack).
+            const ptrdiff_t dRow = ptrdiff_t(rowQ) - ptrdiff_t(rowP);
             const float* pt = posTap + (qy + 2) * 5;
             const float pt0 = pt[0], pt1 = pt[1], pt2 = pt[2], pt3 = pt[3], pt4 = pt[4];
 #pragma omp simd
@@ -131,27 +124,27 @@ ATROUS_FORCE_INLINE inline void levelRowsBody(const EawLevel& f, const float* rS
                 const float ixp = pix[x], zp = kDepth ? pz[x] : 0.0f, izp = kDepth ? piz[x] : 0.0f;
                 const float m0 = kIds ? pm0[x] : 0.0f, m1 = kIds ? pm1[x] : 0.0f;
                 float ws = 0, ar = 0, ag = 0, ab = 0, vr = 0, vg = 0, vb = 0;
-#define ATROUS_EAW_TAP(QX, PT)                                                        \
-    {                                                                                 \
-        const int xq = x + (QX)*s;                                                    \
-        const float r = qr[xq], g = qg[xq], b = qb[xq];                               \
-        const float dc2 = sq(cr - r) + sq(cg - g) + sq(cb - b);                       \
-        const float dn2 = sq(nx - qnx[xq]) + sq(ny - qny[xq]) + sq(nz - qnz[xq]);     \
-        const float dx2 = sq(px - qpx[xq]) + sq(py - qpy[xq]) + sq(pz_ - qpz[xq]);    \
-        const float dz = kDepth ? (zp - qz[xq]) * izp : 0.0f;                         \
-        const float did2 = kIds ? sq(m0 - qm0[xq]) + sq(m1 - qm1[xq]) : 0.0f;         \
-        const float e = eawExponent(P, dc2, rp, qS[xq], dn2, dx2, ixp, PT, dz, did2); \
-        const float wt = hy * b3(QX) * expNeg(-e);                                    \
-        ws += wt;                                                                     \
-        ar += wt * r;                                                                 \
-        ag += wt * g;                                                                 \
-        ab += wt * b;                                                                 \
-        if (kPropagate) {                                                             \
-            const float w2 = wt * wt;                                                 \
-            vr += w2 * qvr[xq];                                                       \
-            vg += w2 * qvg[xq];                                                       \
-            vb += w2 * qvb[xq];                                                       \
-        }                                                                             \
+#define ATROUS_EAW_TAP(QX, PT)                                                         \
+    {                                                                                  \
+        const ptrdiff_t xqr = x + (QX)*s + dRow;                                       \
+        const float r = pr[xqr], g = pg[xqr], b = pb[xqr];                             \
+        const float dc2 = sq(cr - r) + sq(cg - g) + sq(cb - b);                        \
+        const float dn2 = sq(nx - pnx[xqr]) + sq(ny - pny[xqr]) + sq(nz - pnz[xqr]);   \
+        const float dx2 = sq(px - ppx[xqr]) + sq(py - ppy[xqr]) + sq(pz_ - ppz[xqr]);  \
+        const float dz = kDepth ? (zp - pz[xqr]) * izp : 0.0f;                         \
+        const float did2 = kIds ? sq(m0 - pm0[xqr]) + sq(m1 - pm1[xqr]) : 0.0f;        \
+        const float e = eawExponent(P, dc2, rp, pS[xqr], dn2, dx2, ixp, PT, dz, did2); \
+        const float wt = hy * b3(QX) * expNeg(-e);                                     \
+        ws += wt;                                                                      \
+        ar += wt * r;                                                                  \
+        ag += wt * g;                                                                  \
+        ab += wt * b;                                                                  \
+        if (kPropagate) {                                                              \
+            const float w2 = wt * wt;                                                  \
+            vr += w2 * pvr[xqr];                                                       \
+            vg += w2 * pvg[xqr];                                                       \
+            vb += w2 * pvb[xqr];                                                       \
+        }                                                                              \
     }
                 ATROUS_EAW_TAP(-2, pt0)
                 ATROUS_EAW_TAP(-1, pt1)
