@@ -111,7 +111,8 @@ struct DenoiseReport {
     double meanLuminanceAfterFirefly = 0;  // ... after firefly suppression
     std::string buffersUsed;           // e.g. "color,variance,normal,position"
     double milliseconds = 0;           // filter time (excluding validation)
-    // Per-stage times of the filter, in order: sanitize, fireflies, demodulate, sigma scales, then
+    // Per-stage times of the filter, in order: sanitize (NaN/Inf repair, the emission split and,
+    // with an emission buffer, the emission filter), fireflies, demodulate, sigma scales, then
     // "level i" (and for SURE "sure i": the window sums and the choice of s_i) per level, then
     // remodulate. CPU: wall clock; CUDA: cudaEvents on the stream (GPU time, no extra syncs).
     std::vector<StageTime> stages;
