@@ -7,8 +7,9 @@ For each scene (NAME:CAMERA_PATH) it renders a 1-spp sequence with per-frame ref
 measures per frame
   relMSE    mean((x - r)^2 / (r^2 + 0.01))                       (atrous compare --json)
   temporal  relMSE of x_f - x_{f-1} against r_f - r_{f-1}        (ALGORITHMS.md 5; tool metrics)
-  temporal_no_emitters  the same without the pixels that see a light (emission.exr > 0): at 1 spp
-            their jittered edges flicker identically for every method and dominate `temporal`
+  temporal_no_emitters  the same without the pixels that see a light (emission.exr > 0 in either
+            frame, dilated by 1 px): at 1 spp their jittered edges flicker and dominate `temporal`
+            unless the emission is accumulated (SVGF); this column is the rest of the image
 Prints JSON (and writes it with --json), a Markdown section with --markdown, SVG plots with --plots.
 Python 3 standard library only.
 """
@@ -121,18 +122,23 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--work", default="out/svgf_quality", help="sequences and denoised frames go here")
     ap.add_argument("--reuse", action="store_true", help="keep already rendered sequences of the same settings")
+    ap.add_argument("--reuse-baselines", action="store_true",
+                    help="with --reuse: keep eaw/sure outputs already denoised from the same sequence (SVGF always re-runs)")
+    ap.add_argument("--use-tool", action="store_true", help="denoise with --tool even when the CLI has --sequence")
+    ap.add_argument("--svgf-args", default="", help="extra flags for the SVGF denoise, e.g. '--svgf-emission-alpha 1'")
+    ap.add_argument("--svgf-tag", default="", help="suffix of the SVGF output directory (to keep variants apart)")
     ap.add_argument("--skip-frames", type=int, default=8, help="frames left out of the summary means (history warm-up)")
     ap.add_argument("--json", help="also write the JSON here")
     ap.add_argument("--plots", help="write svgf_<scene>_<path>_{relmse,temporal_no_emitters}.svg into this directory")
     ap.add_argument("--markdown", help="write the tables (Markdown) to this file")
     a = ap.parse_args()
 
-    use_cli = has_sequence_flag(a.atrous)
+    use_cli = not a.use_tool and has_sequence_flag(a.atrous)
     result = {"benchmark": "svgf_quality", "date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime()),
               "machine": os.uname().nodename + " (" + str(os.cpu_count()) + " CPUs, CPU denoisers)",
               "frames": a.frames, "size": a.size, "spp": 1, "reference_spp": a.reference_spp,
               "denoise_via": "atrous denoise --sequence" if use_cli else "bench/svgf_sequence_tool denoise",
-              "skip_frames": a.skip_frames, "scenes": []}
+              "skip_frames": a.skip_frames, "svgf_args": a.svgf_args, "scenes": []}
     for spec in a.scenes.split(","):
         name, path = (spec.split(":") + ["auto"])[:2]
         seq = os.path.join(a.work, "%s_%s_%d" % (name, path, a.size))
@@ -149,12 +155,17 @@ def main():
         scene = {"scene": name, "camera_path": path, "render_seconds": round(render_s, 1), "methods": {}}
         outs = {}
         for m in METHODS:
-            out = os.path.join(a.work, "%s_%s_%d_%s" % (name, path, a.size, m))
-            if use_cli:
-                run(nice([a.atrous, "denoise", "--method", m, "--sequence", seq, "--out", out]))
-            else:
-                run(nice([a.tool, "denoise", "--method", m, "--sequence", seq, "--out", out, "--quiet"]))
+            out = os.path.join(a.work, "%s_%s_%d_%s" % (name, path, a.size, m + (a.svgf_tag if m == "svgf" else "")))
             outs[m] = out
+            frames_in = sorted(d for d in os.listdir(seq) if d.startswith("frame_"))
+            if m != "svgf" and a.reuse_baselines and not fresh and \
+                    all(os.path.exists(os.path.join(out, f + ".exr")) for f in frames_in):
+                continue
+            extra = a.svgf_args.split() if m == "svgf" else []
+            if use_cli:
+                run(nice([a.atrous, "denoise", "--method", m, "--sequence", seq, "--out", out] + extra))
+            else:
+                run(nice([a.tool, "denoise", "--method", m, "--sequence", seq, "--out", out, "--quiet"] + extra))
         frames = sorted(d for d in os.listdir(seq) if d.startswith("frame_"))
         series = {k: {"relmse": [], "temporal": [], "temporal_no_emitters": []} for k in ["noisy"] + METHODS}
         for f in frames:

@@ -92,6 +92,12 @@ void addSvgfOptions(CLI::App& cmd, SvgfParams& p) {
         ->capture_default_str()->group(g);
     cmd.add_flag("--taa", p.taa, "temporal anti-aliasing after SVGF (off by default)")->group(g);
     cmd.add_option("--taa-alpha", p.taaAlpha, "TAA blend weight of the current frame, (0, 1]")->capture_default_str()->group(g);
+    cmd.add_option("--svgf-emission-alpha", p.emissionAlpha,
+                   "minimum temporal blend factor of the emission (3x3-clamped history; 1 = raw emission), (0, 1]")
+        ->capture_default_str()->group(g);
+    cmd.add_option("--svgf-emission-motion-alpha", p.emissionMotionAlpha,
+                   "emission blend factor at least this times the motion across a light's edge, pixels per frame (0 = off), >= 0")
+        ->capture_default_str()->group(g);
 }
 
 std::string findOnPath(const std::string& name) {

@@ -38,6 +38,15 @@ struct SvgfParams {
     // clamped to the current 3x3 neighbourhood's colour box, blended with weight taaAlpha.
     bool taa = false;
     float taaAlpha = 0.1f;
+    // Temporal accumulation of the emission buffer before it is added back (svgf_emission.h):
+    // the reprojected emission history (Catmull-Rom), clamped into the current 3x3 emission's
+    // min/max box, is blended with weight max(emissionAlpha, 1/historyLength,
+    // emissionMotionAlpha·|motion across the edge in pixels|). It smooths the 1-spp coverage
+    // flicker on a visible light's edge; the motion term bounds the lag of a moving edge.
+    // emissionAlpha in (0, 1] (1 = the raw emission, no accumulation); emissionMotionAlpha >= 0
+    // (0 = off). Defaults measured on cornell orbit / cornell-moving (docs/quality.md, SVGF).
+    float emissionAlpha = 0.1f;
+    float emissionMotionAlpha = 6.0f;
 };
 
 // Throws InputError naming the field when a parameter is out of range.

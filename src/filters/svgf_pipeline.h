@@ -13,6 +13,7 @@
 #include "filters/svgf_accumulate.h"
 #include "filters/svgf_atrous.h"
 #include "filters/svgf_demodulate.h"
+#include "filters/svgf_emission.h"
 #include "filters/svgf_gbuffer.h"
 #include "filters/svgf_remodulate.h"
 #include "filters/svgf_reproject.h"
@@ -47,23 +48,26 @@ struct SvgfState {
     int width = 0, height = 0;
     bool havePrevious = false;  // history buffers hold a previous frame
     bool haveTaa = false;       // taaHistory holds a previous output
+    bool haveEmission = false;  // histEmission holds a previous frame's accumulated emission
     int frames = 0;             // frames since the last reset
 
     // Carried across frames: accumulated illumination after the feedback tap, luminance moments,
-    // history length, the previous frame's sanitised features, and the TAA output.
+    // history length, the previous frame's sanitised features, the TAA output, and the
+    // accumulated emission with its own history length.
     Image histIllum, histMoments, histLength, prevDepth, prevNormal, prevIds, taaHistory;
+    Image histEmission, histEmissionLength;
     // This frame.
     Image illum, valid, depth, normal, ids, motion, depthGrad;
     Image reprojIllum, reprojMoments, reprojLength;
     Image accIllum, accMoments, accLength, variance;
     Image levelIllum[2], levelVariance[2], nextHistIllum;
-    Image output, taaOutput;
+    Image output, taaOutput, accEmission, accEmissionLength;
     const Image* result = nullptr;  // output or taaHistory after the last run
 
     void allocate(int w, int h, Device d) {
         width = w;
         height = h;
-        havePrevious = haveTaa = false;
+        havePrevious = haveTaa = haveEmission = false;
         frames = 0;
         auto make = [&](int c) { return Image(w, h, c, d); };
         histIllum = make(3), histMoments = make(2), histLength = make(1);
@@ -75,6 +79,7 @@ struct SvgfState {
         for (int i = 0; i < 2; ++i) levelIllum[i] = make(3), levelVariance[i] = make(1);
         nextHistIllum = make(3);
         output = make(3), taaOutput = make(3);
+        histEmission = make(3), histEmissionLength = make(1), accEmission = make(3), accEmissionLength = make(1);
         result = nullptr;
     }
 };
@@ -87,7 +92,7 @@ public:
     }
 
     void reset() {
-        mState.havePrevious = mState.haveTaa = false;
+        mState.havePrevious = mState.haveTaa = mState.haveEmission = false;
         mState.frames = 0;
     }
 
@@ -173,7 +178,23 @@ public:
             inVar = at.outVariance;
         }
 
-        mExec.forEachPixel(w, h, Remodulate{inIllum, albedo, emission, s.output.view()});
+        // Emission: with a buffer and emissionAlpha < 1 the accumulated emission is added back
+        // instead of this frame's (see svgf_emission.h); its history follows the same frames.
+        ImageView remodEmission = emission;
+        const bool accumulateEmission = emission.valid() && mParams.emissionAlpha < 1.0f;
+        if (accumulateEmission) {
+            AccumulateEmission ae;
+            ae.alpha = mParams.emissionAlpha;
+            ae.motionAlpha = mParams.emissionMotionAlpha;
+            ae.historyCap = float(mParams.historyCap);
+            ae.havePrevious = s.haveEmission;
+            ae.emission = emission, ae.motion = s.motion.view();
+            ae.prevEmission = s.histEmission.view(), ae.prevLength = s.histEmissionLength.view();
+            ae.outEmission = s.accEmission.view(), ae.outLength = s.accEmissionLength.view();
+            mExec.forEachPixel(w, h, ae);
+            remodEmission = s.accEmission.view();
+        }
+        mExec.forEachPixel(w, h, Remodulate{inIllum, albedo, remodEmission, s.output.view()});
         filters::markStage(clock, "remodulate");
         s.result = &s.output;
         if (mParams.taa) {
@@ -199,6 +220,11 @@ public:
         std::swap(s.prevDepth, s.depth);
         std::swap(s.prevNormal, s.normal);
         std::swap(s.prevIds, s.ids);
+        if (accumulateEmission) {
+            std::swap(s.histEmission, s.accEmission);
+            std::swap(s.histEmissionLength, s.accEmissionLength);
+        }
+        s.haveEmission = accumulateEmission;  // a frame without emission breaks the emission history
         s.havePrevious = true;
         ++s.frames;
         mExec.synchronize();  // the holders die at the end of this scope

@@ -13,13 +13,16 @@ using namespace atrous;
 namespace {
 
 struct Frame {
-    Image color, albedo, normal, depth, ids, motion;
+    Image color, albedo, normal, depth, ids, motion, emission;
 };
 
 // A textured, tilted ground plane, a sky strip and a box sliding right by 3 px per frame, with
-// Gaussian noise (and a few NaN samples) on the colour.
+// Gaussian noise (and a few NaN samples) on the colour, and a light (emission 17) in the box's top
+// rows whose bottom edge row is covered at random (1-spp coverage noise on a moving emitter).
 Frame makeFrame(int w, int h, int t) {
-    Frame f{Image(w, h, 3), Image(w, h, 3), Image(w, h, 3), Image(w, h, 3), Image(w, h, 3), Image(w, h, 3)};
+    Frame f{Image(w, h, 3), Image(w, h, 3), Image(w, h, 3), Image(w, h, 3), Image(w, h, 3), Image(w, h, 3),
+            Image(w, h, 3)};
+    std::bernoulli_distribution cover(0.5);
     std::mt19937 rng(99u + unsigned(t));
     std::normal_distribution<float> gauss(0.0f, 0.2f);
     const int bx = w / 4 + 3 * t, by = h / 3, bs = w / 4;
@@ -29,9 +32,11 @@ Frame makeFrame(int w, int h, int t) {
             float a = box ? 0.5f : (((x / 8 + y / 8) % 2) ? 0.8f : 0.2f);
             float e = sky ? 0.5f : (box ? 2.0f : 1.0f + 0.5f * std::sin(float(x) / 10.0f));
             float n = gauss(rng);
+            bool light = box && (y < by + 4 || (y == by + 4 && cover(rng)));
             for (int c = 0; c < 3; ++c) {
                 f.albedo(x, y, c) = sky ? 1.0f : a;
-                f.color(x, y, c) = (sky ? 1.0f : a) * e + n;
+                f.emission(x, y, c) = light ? 17.0f : 0.0f;
+                f.color(x, y, c) = (sky ? 1.0f : a) * e + n + f.emission(x, y, c);
                 f.depth(x, y, c) = sky ? 1e30f : (box ? 3.0f : 4.0f + 0.05f * float(y));
                 f.ids(x, y, c) = sky ? -1.0f : (box ? 1.0f : 0.0f);
             }
@@ -50,12 +55,13 @@ TEST(SvgfCuda, MatchesTheCpuBackend) {
     for (bool taa : {false, true}) {
         SvgfParams p;
         p.taa = taa;
+        p.emissionMotionAlpha = taa ? 0.1f : 0.0f;  // both α rules of the emission accumulation
         SvgfDenoiser cpu(p, Device::Cpu), gpu(p, Device::Cuda);
         for (int t = 0; t < 5; ++t) {
             Frame f = makeFrame(96, 64, t);
             SvgfFrame in;
             in.color = &f.color, in.albedo = &f.albedo, in.normal = &f.normal;
-            in.depth = &f.depth, in.ids = &f.ids, in.motion = &f.motion;
+            in.depth = &f.depth, in.ids = &f.ids, in.motion = &f.motion, in.emission = &f.emission;
             Image a = cpu.denoiseFrame(in);
             Image b = gpu.denoiseFrame(in);  // host inputs are uploaded by the driver
             ASSERT_EQ(a.size(), b.size());
