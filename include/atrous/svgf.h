@@ -46,7 +46,7 @@ struct SvgfParams {
     // emissionAlpha in (0, 1] (1 = the raw emission, no accumulation); emissionMotionAlpha >= 0
     // (0 = off). Defaults measured on cornell orbit / cornell-moving (docs/quality.md, SVGF).
     float emissionAlpha = 0.1f;
-    float emissionMotionAlpha = 6.0f;
+    float emissionMotionAlpha = 4.0f;
 };
 
 // Throws InputError naming the field when a parameter is out of range.

@@ -265,7 +265,8 @@ class Svgf:
     """Spatiotemporal variance-guided filtering of a stream of 1-spp frames (keeps history).
 
     params: sigma_l, sigma_n, sigma_z, alpha, moments_alpha, history_cap, levels, feedback_tap,
-    spatial_variance_frames, reproject_depth_tolerance, reproject_normal_cos, taa, taa_alpha.
+    spatial_variance_frames, reproject_depth_tolerance, reproject_normal_cos, taa, taa_alpha,
+    emission_alpha, emission_motion_alpha.
     """
 
     def __init__(self, device: str = "cpu", **params: Any) -> None:
