@@ -46,10 +46,7 @@ EdgeScene makeEdge(int w, int h, int n, unsigned seed) {
 
 Image filtered(const EdgeScene& s, int levels, float k) {
     Image a(s.emission.width(), s.emission.height(), 3), b(s.emission.width(), s.emission.height(), 3);
-    for (int y = 0; y < a.height(); ++y)
-        for (int x = 0; x < a.width(); ++x)
-            for (int c = 0; c < 3; ++c) a(x, y, c) = s.emission(x, y, c);
-    ImageView r = filters::runEmissionFilter(CpuExec{}, levels, k, s.variance.view(), a.view(), b.view());
+    ImageView r = filters::runEmissionFilter(CpuExec{}, levels, k, s.variance.view(), s.emission.view(), a.view(), b.view());
     Image out(a.width(), a.height(), 3);
     for (int y = 0; y < a.height(); ++y)
         for (int x = 0; x < a.width(); ++x)

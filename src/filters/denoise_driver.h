@@ -103,8 +103,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         if (cfg.eaw.emissionLevels > 0) {
             emissionA = Image(w, h, 3, dev);
             emissionB = Image(w, h, 3, dev);
-            exec.forEachPixel(w, h, Copy3{emission, emissionA.view()});
-            emission = runEmissionFilter(exec, cfg.eaw.emissionLevels, cfg.eaw.emissionScale, v0.view(),
+            emission = runEmissionFilter(exec, cfg.eaw.emissionLevels, cfg.eaw.emissionScale, v0.view(), emission,
                                          emissionA.view(), emissionB.view());
         }
     }
