@@ -62,6 +62,15 @@ Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const Prepar
         clamped += hostFlag.data()[i] > 0.5f;
     }
     rep.meanLuminanceIn = n0 ? s0 / double(n0) : 0.0;
+    // `after` is c_0 = colour − emission after the pass: add the emission's mean back so that both
+    // figures are of the whole image (see denoise.cpp).
+    if (in.emission) {
+        const Image hostEm = in.emission->to(Device::Cpu);
+        for (size_t i = 0; i < plane; ++i) {
+            const float l = lum(hostEm.data()[i], hostEm.data()[i + plane], hostEm.data()[i + 2 * plane]);
+            if (std::isfinite(l)) s1 += l;
+        }
+    }
     rep.meanLuminanceAfterFirefly = s1 / double(plane);
     rep.firefliesClamped = clamped;
     if (colorOnDevice) return out;

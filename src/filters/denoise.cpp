@@ -211,7 +211,9 @@ Image denoiseCpu(const DenoiseInputs& in, const DenoiseOptions& o, const Prepare
     rep.milliseconds = t.ms();
     clock->collect(rep.stages);
     rep.meanLuminanceIn = meanLuminance(*in.color);
-    rep.meanLuminanceAfterFirefly = meanLuminance(after);
+    // `after` is c_0 = colour − emission after the pass: add the emission back so that both
+    // figures are of the whole image (with the sky as emission, they differed by the sky).
+    rep.meanLuminanceAfterFirefly = meanLuminance(after) + (in.emission ? meanLuminance(*in.emission) : 0.0);
     int clamped = 0;
     for (size_t i = 0; i < flag.plane(); ++i) clamped += flag.data()[i] > 0.5f;
     rep.firefliesClamped = clamped;
