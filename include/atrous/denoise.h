@@ -59,7 +59,7 @@ struct EawParams {
     // emissionScale · 2·min(V_p, V_q) · 4^-i (V = the pixel's summed variance), so pixels partly
     // covered by an emitter average with each other and nothing crosses a full/empty emitter edge.
     int emissionLevels = 4;     // 0..10
-    float emissionScale = 6.0f;  // > 0
+    float emissionScale = 1.0f;  // > 0
 };
 
 enum class SureMode { Discrete, JamesStein };
