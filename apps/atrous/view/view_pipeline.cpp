@@ -132,12 +132,12 @@ ViewPipeline::ViewPipeline(const Scene& scene, int width, int height, Device dev
     mFrame = detail::allocateRenderBuffers(width, height, Device::Cpu);
     const size_t n = size_t(width) * height;
     for (auto* v : {&mSumX, &mSumX2, &mSumM2}) v->assign(3 * n, 0.0);
-    for (auto* v : {&mSumAlbedo, &mSumNormal, &mSumPosition}) v->assign(3 * n, 0.0f);
+    for (auto* v : {&mSumAlbedo, &mSumNormal, &mSumPosition, &mSumEmission}) v->assign(3 * n, 0.0f);
     mSumDepth.assign(n, 0.0f);
     mFeatureHits.assign(n, 0);
     mDepthHits.assign(n, 0);
     for (Image* img : {&mColor, &mVariance, &mAlbedo, &mNormal, &mPosition, &mDepth, &mIds,
-                       &mMotion, &mEmission})
+                       &mMotion, &mEmission, &mEmissionMean})
         *img = Image(width, height, 3);
 }
 
@@ -185,7 +185,6 @@ void ViewPipeline::renderFrame(const PipelineSettings& s, bool svgf) {
         // SVGF's extra inputs straight from the renderer: the emission of the primary hit, and the
         // motion of each sample's primary hit reprojected into the previous camera (averaged over
         // the pixel's samples; the scene is static, so only the camera moves).
-        k.out.emission = mEmission.view();
         k.out.motion = mMotion.view();
         k.motion.enabled = mCameraMoved;
         k.motion.previousCamera = mPrevCamera;
@@ -214,6 +213,8 @@ void ViewPipeline::accumulateFrame(bool accumulate) {
         mPosition.copyFrom(mFrame.position);
         mDepth.copyFrom(mFrame.depth);
         mIds.copyFrom(mFrame.ids);  // ids are never averaged (as the renderer: the first sample's)
+        mEmissionValid = !mFrame.emission.empty();
+        if (mEmissionValid) mEmissionMean.copyFrom(mFrame.emission);
         mVarianceValid = mSppAccumulated > 1;
         if (!accumulate) return;
     } else {
@@ -231,6 +232,7 @@ void ViewPipeline::accumulateFrame(bool accumulate) {
     const float* fn = mFrame.normal.data();
     const float* fp = mFrame.position.data();
     const float* fd = mFrame.depth.data();
+    const float* fe = mEmissionValid ? mFrame.emission.data() : nullptr;
     auto rows = [&](int y) {
         for (int x = 0; x < w; ++x) {
             const size_t p = size_t(y) * w + x;
@@ -248,6 +250,7 @@ void ViewPipeline::accumulateFrame(bool accumulate) {
                     mSumX2[i] = v * v;
                     if (withinFrame) mSumM2[i] = double(fv[i]) * spp * (spp - 1.0);
                     mSumAlbedo[i] = fa[i];
+                    if (fe) mSumEmission[i] = fe[i];
                     mSumNormal[i] = featureHit ? fn[i] : 0.0f;
                     mSumPosition[i] = featureHit ? fp[i] : 0.0f;
                 }
@@ -274,6 +277,7 @@ void ViewPipeline::accumulateFrame(bool accumulate) {
                 mColor.data()[i] = float(mean);
                 mVariance.data()[i] = float(m2 * invVar);
                 mAlbedo.data()[i] = (mSumAlbedo[i] += fa[i]) * float(invN);
+                if (fe) mEmissionMean.data()[i] = (mSumEmission[i] += fe[i]) * float(invN);
                 if (featureHit) {
                     mSumNormal[i] += fn[i];
                     mSumPosition[i] += fp[i];
@@ -432,6 +436,9 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
     in.position = &mPosition;
     in.depth = &mDepth;
     in.ids = &mIds;
+    // Emission: the filters work on colour - emission and add back its edge-filtered mean, so a
+    // visible light neither bleeds into the ceiling nor keeps its coverage noise (docs/denoising.md).
+    in.emission = mEmissionValid ? &mEmissionMean : nullptr;
     DenoiseOptions o = denoiseOptions(m, s);
     DenoiseReport rep;
     o.report = &rep;
@@ -487,8 +494,8 @@ void ViewPipeline::step(const PipelineSettings& s) {
     }
     lap(mTimes.accumulate, mTimes.accumulateCpu);
 
-    if (svgf && !mRendererMotion) {  // the CUDA renderer: motion from the depth buffer
-        computeMotion();
+    if (svgf) {
+        if (!mRendererMotion) computeMotion();  // the CUDA renderer: motion from the depth buffer
         if (!mFrame.emission.empty())
             mEmission.copyFrom(mFrame.emission);
         else
@@ -520,6 +527,7 @@ void ViewPipeline::step(const PipelineSettings& s) {
             in.position = &mPosition;
             in.depth = &mDepth;
             in.ids = &mIds;
+            in.emission = mEmissionValid ? &mEmissionMean : nullptr;
             DenoiseOptions o = denoiseOptions(Method::Eaw, s);
             const int L = s.detailLevel;
             Image fine;

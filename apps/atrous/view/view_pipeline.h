@@ -160,12 +160,14 @@ class ViewPipeline {
     // Running sums of the colour moments (double: E[x²] - E[x]² over thousands of frames without
     // cancellation trouble) and of the features (float: plain averages).
     std::vector<double> mSumX, mSumX2, mSumM2;
-    std::vector<float> mSumAlbedo, mSumNormal, mSumPosition, mSumDepth;
+    std::vector<float> mSumAlbedo, mSumNormal, mSumPosition, mSumDepth, mSumEmission;
     std::vector<int> mFeatureHits, mDepthHits;
     int mFrames = 0, mSppAccumulated = 0;
     bool mAccumulating = false;
 
-    Image mColor, mVariance, mAlbedo, mNormal, mPosition, mDepth, mIds, mMotion, mEmission;
+    // mEmission: this frame's emission (SVGF's input); mEmissionMean: its running mean (EAW/SURE).
+    Image mColor, mVariance, mAlbedo, mNormal, mPosition, mDepth, mIds, mMotion, mEmission, mEmissionMean;
+    bool mEmissionValid = false;
     bool mVarianceValid = false;
     mutable SlotResult mSlots[2];  // mutable: resultHost() fills the host copy on demand
     std::unique_ptr<SvgfDenoiser> mSvgf[2];
