@@ -199,20 +199,24 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         runEawLevel(exec, f);
         markStage(out.clock, "level", i);
         if (sure) {
-            runSureBoxH(exec, SureBoxH{choice.radius, detail.view(), boxH.view()});
-            ImageView sOut;
-            if (out.sureS.valid()) sOut = ImageView{out.sureS.channel(i), w, h, 1};
             // Levels below sure.firstLevel keep s_i = 0 (their details are dropped, as in EAW): the
             // per-level risk assumes the levels' noise is independent, but adjacent fine levels'
             // detail noise correlates at ~0.7 after colour-weighted levels (docs/quality.md), so
-            // their individual SURE choices keep noise.
-            SureChoiceParams levelChoice = choice;
-            if (i < cfg.sure.firstLevel) {
-                levelChoice.jamesStein = 0;
-                levelChoice.count = 1;
-                levelChoice.candidates[0] = 0.0f;
+            // their individual SURE choices keep noise. Adding 0·d_i to acc is a no-op, so such a
+            // level runs no window passes unless its s_i map is asked for (it is then all 0).
+            const bool dropped = i < cfg.sure.firstLevel;
+            if (!dropped || out.sureS.valid()) {
+                runSureBoxH(exec, SureBoxH{choice.radius, detail.view(), boxH.view()});
+                ImageView sOut;
+                if (out.sureS.valid()) sOut = ImageView{out.sureS.channel(i), w, h, 1};
+                SureChoiceParams levelChoice = choice;
+                if (dropped) {
+                    levelChoice.jamesStein = 0;
+                    levelChoice.count = 1;
+                    levelChoice.candidates[0] = 0.0f;
+                }
+                runSureChoose(exec, SureChoose{levelChoice, boxH.view(), cur->view(), nxt->view(), acc.view(), sOut});
             }
-            runSureChoose(exec, SureChoose{levelChoice, boxH.view(), cur->view(), nxt->view(), acc.view(), sOut});
             markStage(out.clock, "sure", i);
             std::swap(vcur, vnxt);
         }
