@@ -360,6 +360,23 @@ void ViewPipeline::computeEmission() {
     }
 }
 
+DenoiseInputs ViewPipeline::accumulatedInputs() const {
+    DenoiseInputs in;
+    in.color = &mColor;
+    // At one sample per pixel there is no variance estimate: the filter then estimates the noise
+    // from the image (Donoho's MAD) rather than seeing zero noise everywhere.
+    in.variance = mVarianceValid ? &mVariance : nullptr;
+    in.albedo = &mAlbedo;
+    in.normal = &mNormal;
+    in.position = &mPosition;
+    in.depth = &mDepth;
+    in.ids = &mIds;
+    // Emission: the filters work on colour - emission and add back its edge-filtered mean, so a
+    // visible light neither bleeds into the ceiling nor keeps its coverage noise (docs/denoising.md).
+    in.emission = mEmissionValid ? &mEmissionMean : nullptr;
+    return in;
+}
+
 DenoiseOptions ViewPipeline::denoiseOptions(Method m, const PipelineSettings& s) const {
     DenoiseOptions o;
     o.method = m == Method::Sure ? DenoiseMethod::Sure : DenoiseMethod::Eaw;
@@ -426,19 +443,7 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
         }
         return;
     }
-    DenoiseInputs in;
-    in.color = &mColor;
-    // At one sample per pixel there is no variance estimate: the filter then estimates the noise
-    // from the image (Donoho's MAD) rather than seeing zero noise everywhere.
-    in.variance = mVarianceValid ? &mVariance : nullptr;
-    in.albedo = &mAlbedo;
-    in.normal = &mNormal;
-    in.position = &mPosition;
-    in.depth = &mDepth;
-    in.ids = &mIds;
-    // Emission: the filters work on colour - emission and add back its edge-filtered mean, so a
-    // visible light neither bleeds into the ceiling nor keeps its coverage noise (docs/denoising.md).
-    in.emission = mEmissionValid ? &mEmissionMean : nullptr;
+    DenoiseInputs in = accumulatedInputs();
     DenoiseOptions o = denoiseOptions(m, s);
     DenoiseReport rep;
     o.report = &rep;
@@ -519,15 +524,7 @@ void ViewPipeline::step(const PipelineSettings& s) {
         // not depend on the total), so d_i = c_i - c_{i+1} = EAW(i levels) - EAW(i + 1 levels),
         // both remodulated by the albedo. c_0 is taken as the colour before firefly suppression.
         try {
-            DenoiseInputs in;
-            in.color = &mColor;
-            in.variance = mVarianceValid ? &mVariance : nullptr;
-            in.albedo = &mAlbedo;
-            in.normal = &mNormal;
-            in.position = &mPosition;
-            in.depth = &mDepth;
-            in.ids = &mIds;
-            in.emission = mEmissionValid ? &mEmissionMean : nullptr;
+            const DenoiseInputs in = accumulatedInputs();
             DenoiseOptions o = denoiseOptions(Method::Eaw, s);
             const int L = s.detailLevel;
             Image fine;

@@ -141,6 +141,8 @@ class ViewPipeline {
     void computeMotion();
     void computeEmission();
     void runSlot(int i, Method m, const PipelineSettings& s);
+    // The running means (colour, variance, features, emission) as the EAW/SURE slots filter them.
+    DenoiseInputs accumulatedInputs() const;
     DenoiseOptions denoiseOptions(Method m, const PipelineSettings& s) const;
 
     Scene mScene;
