@@ -11,28 +11,9 @@
 #include "atrous/denoise.h"
 #include "atrous/svgf.h"
 #include "denoise_test_util.h"
+#include "stage_times_test_util.h"
 
 using namespace atrous;
-
-namespace {
-
-std::vector<std::string> names(const std::vector<StageTime>& stages) {
-    std::vector<std::string> v;
-    for (const StageTime& s : stages) v.push_back(s.name);
-    return v;
-}
-
-double sum(const std::vector<StageTime>& stages) {
-    double s = 0;
-    for (const StageTime& t : stages) {
-        EXPECT_TRUE(std::isfinite(t.milliseconds)) << t.name;
-        EXPECT_GE(t.milliseconds, 0.0) << t.name;
-        s += t.milliseconds;
-    }
-    return s;
-}
-
-}  // namespace
 
 TEST(StageTimes, EawReportListsEveryStageInOrder) {
     const test::SyntheticScene scene = test::makeScene(48, 40, 0.3f, 7);
@@ -44,11 +25,11 @@ TEST(StageTimes, EawReportListsEveryStageInOrder) {
     denoise(scene.inputs(), o);
     const std::vector<std::string> expected = {"sanitize", "fireflies",  "demodulate", "sigma scales", "level 0",
                                                "level 1",  "level 2", "remodulate"};
-    EXPECT_EQ(names(rep.stages), expected);
+    EXPECT_EQ(test::stageNames(rep.stages), expected);
     // The stages are timed inside the window of rep.milliseconds with the same steady clock, so
     // their sum cannot exceed it (1e-6 ms: rounding of the two subtractions).
-    EXPECT_LE(sum(rep.stages), rep.milliseconds + 1e-6);
-    EXPECT_GT(sum(rep.stages), 0.0);
+    EXPECT_LE(test::stageSum(rep.stages), rep.milliseconds + 1e-6);
+    EXPECT_GT(test::stageSum(rep.stages), 0.0);
 }
 
 TEST(StageTimes, SureReportHasTheChoiceAfterEachLevel) {
@@ -61,8 +42,8 @@ TEST(StageTimes, SureReportHasTheChoiceAfterEachLevel) {
     denoise(scene.inputs(), o);
     const std::vector<std::string> expected = {"sanitize", "fireflies", "demodulate", "sigma scales", "level 0",
                                                "sure 0",   "level 1",   "sure 1",     "remodulate"};
-    EXPECT_EQ(names(rep.stages), expected);
-    EXPECT_LE(sum(rep.stages), rep.milliseconds + 1e-6);
+    EXPECT_EQ(test::stageNames(rep.stages), expected);
+    EXPECT_LE(test::stageSum(rep.stages), rep.milliseconds + 1e-6);
 }
 
 TEST(StageTimes, SvgfReportFollowsTheFramesWhileSet) {
@@ -83,9 +64,9 @@ TEST(StageTimes, SvgfReportFollowsTheFramesWhileSet) {
     d.denoiseFrame(f);
     const std::vector<std::string> expected = {"demodulate", "reproject", "accumulate", "variance",
                                                "level 0",    "level 1",   "remodulate", "taa"};
-    EXPECT_EQ(names(rep.stages), expected);
+    EXPECT_EQ(test::stageNames(rep.stages), expected);
     // milliseconds is the start-to-last-mark span, i.e. the sum of the stages up to rounding.
-    EXPECT_NEAR(rep.milliseconds, sum(rep.stages), 1e-6);
+    EXPECT_NEAR(rep.milliseconds, test::stageSum(rep.stages), 1e-6);
     // Cleared: later frames leave the report alone.
     d.setReport(nullptr);
     rep.stages.clear();

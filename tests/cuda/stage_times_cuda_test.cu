@@ -10,28 +10,9 @@
 #include "atrous/device.h"
 #include "atrous/svgf.h"
 #include "../denoise_test_util.h"
+#include "../stage_times_test_util.h"
 
 using namespace atrous;
-
-namespace {
-
-std::vector<std::string> names(const std::vector<StageTime>& stages) {
-    std::vector<std::string> v;
-    for (const StageTime& s : stages) v.push_back(s.name);
-    return v;
-}
-
-double sumChecked(const std::vector<StageTime>& stages) {
-    double s = 0;
-    for (const StageTime& t : stages) {
-        EXPECT_TRUE(std::isfinite(t.milliseconds)) << t.name;
-        EXPECT_GE(t.milliseconds, 0.0) << t.name;
-        s += t.milliseconds;
-    }
-    return s;
-}
-
-}  // namespace
 
 TEST(StageTimesCuda, DenoiseStagesMatchTheCpuListAndFitInTheTotal) {
     if (!cudaAvailable()) GTEST_SKIP() << "no CUDA device";
@@ -45,11 +26,11 @@ TEST(StageTimesCuda, DenoiseStagesMatchTheCpuListAndFitInTheTotal) {
         o.device = Device::Cuda;
         o.report = &gpu;
         denoise(scene.inputs(), o);
-        EXPECT_EQ(names(gpu.stages), names(cpu.stages)) << denoiseMethodName(m);
+        EXPECT_EQ(test::stageNames(gpu.stages), test::stageNames(cpu.stages)) << denoiseMethodName(m);
         // GPU time between the first and last event lies inside the host's wall-clock window
         // around the driver (which also waits for the final synchronisation); 0.01 ms of slack for
         // the two clocks' different resolutions.
-        EXPECT_LE(sumChecked(gpu.stages), gpu.milliseconds + 0.01) << denoiseMethodName(m);
+        EXPECT_LE(test::stageSum(gpu.stages), gpu.milliseconds + 0.01) << denoiseMethodName(m);
     }
 }
 
@@ -69,8 +50,8 @@ TEST(StageTimesCuda, SvgfReportOnTheGpu) {
     for (int i = 0; i < 2; ++i) d.denoiseFrameOnDevice(f);
     const std::vector<std::string> expected = {"demodulate", "reproject", "accumulate", "variance",
                                                "level 0",    "level 1",   "level 2",    "remodulate"};
-    EXPECT_EQ(names(rep.stages), expected);
+    EXPECT_EQ(test::stageNames(rep.stages), expected);
     // milliseconds sums the same float event intervals in double: equal up to rounding.
-    EXPECT_NEAR(rep.milliseconds, sumChecked(rep.stages), 1e-6);
+    EXPECT_NEAR(rep.milliseconds, test::stageSum(rep.stages), 1e-6);
     EXPECT_GT(rep.milliseconds, 0.0);
 }
