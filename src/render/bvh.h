@@ -241,14 +241,15 @@ ATROUS_INLINE bool hitSphere(const BvhPrim& p, const BvhRay& ray, float tmin, fl
     return false;
 }
 
-}  // namespace bvh_detail
-
-// Closest hit in [tmin, tmax). Returns primId -1 on a miss.
-ATROUS_INLINE BvhHit intersect(const BvhView& bvh, const BvhRay& ray, float tmin, float tmax) {
+// The one traversal behind intersect() and occluded(): ordered depth-first descent of the binary
+// BVH with a short stack. Closest hit shrinks the ray's interval to each hit found; any hit
+// (kAnyHit) returns at the first one, since a shadow ray only asks whether something blocks it.
+template <bool kAnyHit>
+ATROUS_INLINE BvhHit traverse(const BvhView& bvh, const BvhRay& ray, float tmin, float tmax) {
     BvhHit hit;
     hit.t = tmax;
     if (bvh.root == kBvhInvalidRef) return hit;
-    const bvh_detail::RayPre pre = bvh_detail::prepare(ray);
+    const RayPre pre = prepare(ray);
     uint32_t stack[kBvhStackSize];
     int sp = 0;
     uint32_t ref = bvh.root;
@@ -256,8 +257,8 @@ ATROUS_INLINE BvhHit intersect(const BvhView& bvh, const BvhRay& ray, float tmin
         if (!bvhIsLeaf(ref)) {
             const BvhNode node = bvh.nodes[ref];
             float t0 = 0.0f, t1 = 0.0f;
-            bool h0 = bvh_detail::hitBox(node.lo0, node.hi0, pre, tmin, hit.t, t0);
-            bool h1 = bvh_detail::hitBox(node.lo1, node.hi1, pre, tmin, hit.t, t1);
+            bool h0 = hitBox(node.lo0, node.hi0, pre, tmin, hit.t, t0);
+            bool h1 = hitBox(node.lo1, node.hi1, pre, tmin, hit.t, t1);
             if (h0 && h1) {
                 // Ordered traversal: nearer child now, the other later.
                 bool firstIs0 = t0 <= t1;
@@ -273,22 +274,15 @@ ATROUS_INLINE BvhHit intersect(const BvhView& bvh, const BvhRay& ray, float tmin
             uint32_t first = bvhLeafFirst(ref), end = first + bvhLeafCount(ref);
             for (uint32_t i = first; i < end; ++i) {
                 const BvhPrim& p = bvh.prims[i];
-                if (p.kind == kBvhPrimTriangle) {
-                    float t, u, v;
-                    if (bvh_detail::hitTriangle(p, pre, tmin, hit.t, t, u, v)) {
-                        hit.t = t;
-                        hit.u = u;
-                        hit.v = v;
-                        hit.primId = int32_t(p.primId);
-                    }
-                } else {
-                    float t;
-                    if (bvh_detail::hitSphere(p, ray, tmin, hit.t, t)) {
-                        hit.t = t;
-                        hit.u = 0.0f;
-                        hit.v = 0.0f;
-                        hit.primId = int32_t(p.primId);
-                    }
+                float t, u = 0.0f, v = 0.0f;
+                const bool h = p.kind == kBvhPrimTriangle ? hitTriangle(p, pre, tmin, hit.t, t, u, v)
+                                                          : hitSphere(p, ray, tmin, hit.t, t);
+                if (h) {
+                    hit.t = t;
+                    hit.u = u;
+                    hit.v = v;
+                    hit.primId = int32_t(p.primId);
+                    if (kAnyHit) return hit;
                 }
             }
         }
@@ -298,43 +292,16 @@ ATROUS_INLINE BvhHit intersect(const BvhView& bvh, const BvhRay& ray, float tmin
     return hit;
 }
 
+}  // namespace bvh_detail
+
+// Closest hit in [tmin, tmax). Returns primId -1 on a miss.
+ATROUS_INLINE BvhHit intersect(const BvhView& bvh, const BvhRay& ray, float tmin, float tmax) {
+    return bvh_detail::traverse<false>(bvh, ray, tmin, tmax);
+}
+
 // Any hit in [tmin, tmax): true when something blocks the segment (shadow rays).
 ATROUS_INLINE bool occluded(const BvhView& bvh, const BvhRay& ray, float tmin, float tmax) {
-    if (bvh.root == kBvhInvalidRef) return false;
-    const bvh_detail::RayPre pre = bvh_detail::prepare(ray);
-    uint32_t stack[kBvhStackSize];
-    int sp = 0;
-    uint32_t ref = bvh.root;
-    for (;;) {
-        if (!bvhIsLeaf(ref)) {
-            const BvhNode node = bvh.nodes[ref];
-            float t0 = 0.0f, t1 = 0.0f;
-            bool h0 = bvh_detail::hitBox(node.lo0, node.hi0, pre, tmin, tmax, t0);
-            bool h1 = bvh_detail::hitBox(node.lo1, node.hi1, pre, tmin, tmax, t1);
-            if (h0 && h1) {
-                bool firstIs0 = t0 <= t1;
-                stack[sp++] = firstIs0 ? node.child[1] : node.child[0];
-                ref = firstIs0 ? node.child[0] : node.child[1];
-                continue;
-            }
-            if (h0 || h1) {
-                ref = h0 ? node.child[0] : node.child[1];
-                continue;
-            }
-        } else {
-            uint32_t first = bvhLeafFirst(ref), end = first + bvhLeafCount(ref);
-            for (uint32_t i = first; i < end; ++i) {
-                const BvhPrim& p = bvh.prims[i];
-                float t, u, v;
-                bool h = p.kind == kBvhPrimTriangle ? bvh_detail::hitTriangle(p, pre, tmin, tmax, t, u, v)
-                                                    : bvh_detail::hitSphere(p, ray, tmin, tmax, t);
-                if (h) return true;
-            }
-        }
-        if (sp == 0) break;
-        ref = stack[--sp];
-    }
-    return false;
+    return bvh_detail::traverse<true>(bvh, ray, tmin, tmax).primId >= 0;
 }
 
 }  // namespace atrous
