@@ -1,8 +1,10 @@
 // `atrous bench`: timings of every render and denoise path at several resolutions, as JSON.
 // Each figure is the median of --runs timed runs after --warmup untimed ones. Denoiser times are
 // the filter alone (inputs already in place; on CUDA the driver ends with a stream synchronise, so
-// the time covers every kernel); `total_ms` adds validation and, on CUDA, the host<->device copies
-// of the public denoise() call.
+// the time covers every kernel); `total_ms` is the whole public denoise() call (validation, the
+// noise estimate when there is no variance, the report). On CUDA the inputs are uploaded once
+// before timing, and each EAW/SURE row adds the modelled compulsory DRAM traffic, the bandwidth
+// it achieves and the GPU's peak.
 #include <algorithm>
 #include <cstdio>
 #include <memory>
@@ -17,6 +19,7 @@
 #include "atrous/render.h"
 #include "atrous/svgf.h"
 #include "commands.h"
+#include "core/memory.h"
 #include "core/timer.h"
 
 namespace atrous::cli {
@@ -86,6 +89,40 @@ nlohmann::json stats(const std::vector<double>& ms) {
     return {{"median_ms", median(ms)}, {"min_ms", s.front()}, {"max_ms", s.back()}, {"runs", int(ms.size())}};
 }
 
+// Compulsory DRAM traffic of one CUDA EAW/SURE call, in bytes: each pass of the driver
+// (src/filters/denoise_driver.h, CudaExec) is counted as reading every plane it uses once and
+// writing every plane it produces once; the 25 taps of a level are assumed to hit in cache (a
+// level's working set at 1920x1080 is ~35 MB, under an H100's 50 MB L2). This is the floor of the
+// present pass structure, not of the method: fusing the pre-passes and storing the features in
+// half precision lower it (docs/benchmarks.md, "CUDA: bandwidth floor"). Keep it in step with
+// the driver when passes change.
+double cudaDenoiseTrafficBytes(const DenoiseOptions& o, const DenoiseInputs& in, int w, int h) {
+    const bool sure = o.method == DenoiseMethod::Sure;
+    auto has = [](const Image* i) { return i != nullptr; };
+    double planes = 12;  // SanitizeColor: colour + variance in, c_0 + v_0 out
+    // sanitizedFeature copies each feature (read + write) on the GPU.
+    planes += 2 * (3 * has(in.normal) + 3 * has(in.position) + 1 * has(in.depth) + 2 * has(in.ids));
+    if (has(in.emission)) {
+        planes += 6 + 9;                        // copy; SubtractEmission reads e, updates c_0
+        planes += 9 * o.eaw.emissionLevels;     // EmissionLevel: e and variance in, e out
+    }
+    if (o.firefly.enabled) planes += 13;        // c, v in; c, v, flag out
+    planes += 6;                                // Copy3 of c_0 for the report
+    const bool demod = o.demodulate && has(in.albedo);
+    if (demod) planes += 6 + 15;                // albedo copy; Demodulate: albedo in, c, v updated
+    planes += 4 + 6;                            // ColorScale (v -> S); Footprint (x, z -> 1/σ_x, 1/σ_z)
+    const int levels = o.eaw.levels;
+    for (int i = 0; i < levels; ++i) {
+        planes += 18;                           // EawLevel: c, S, n, x, 1/σ_x, z, 1/σ_z, ids in; c out
+        if (sure) {
+            planes += 8;                        // v in, v out, detail (D, V) out
+            if (i >= o.sure.firstLevel) planes += 4 + 14;  // SureBoxH; SureChoose (box, c_i, c_i+1, acc)
+        }
+    }
+    planes += 3 + 3 * sure + 3 * demod + 3 * has(in.emission) + 3;  // Recombine
+    return planes * 4.0 * double(w) * double(h);
+}
+
 void run(const BenchArgs& a) {
     const Device device = parseDevice(a.device);
     const int runs = a.runs > 0 ? a.runs : (device == Device::Cuda ? 50 : 10);
@@ -132,9 +169,21 @@ void run(const BenchArgs& a) {
             r["msamples_per_s"] = double(w) * h / (median(t) * 1e3);
             doc["results"].push_back(r);
         }
+        // On CUDA the inputs are uploaded once, outside the timed calls: the filters then read
+        // them in place (as the viewer and DLPack callers do) and total_ms covers no transfer.
+        RenderBuffers onDevice;
+        if (device == Device::Cuda && (wants("eaw") || wants("sure") || wants("svgf"))) {
+            for (auto [dst, src] : {std::pair<Image*, const Image*>{&onDevice.color, &b.color},
+                                    {&onDevice.variance, &b.variance}, {&onDevice.albedo, &b.albedo},
+                                    {&onDevice.normal, &b.normal}, {&onDevice.position, &b.position},
+                                    {&onDevice.depth, &b.depth}, {&onDevice.ids, &b.ids},
+                                    {&onDevice.emission, &b.emission}})
+                *dst = src->to(Device::Cuda);
+        }
+        const RenderBuffers& inputs = device == Device::Cuda ? onDevice : b;
         for (const char* m : {"eaw", "sure"}) {
             if (!wants(m)) continue;
-            DenoiseInputs in = denoiseInputsOf(b);
+            DenoiseInputs in = denoiseInputsOf(inputs);
             DenoiseReport rep;
             DenoiseOptions o;
             o.method = parseDenoiseMethod(m);
@@ -160,18 +209,30 @@ void run(const BenchArgs& a) {
             r["total_ms"] = median(total);
             r["mpixels_per_s"] = double(w) * h / (median(t) * 1e3);
             r["stages"] = stages.json();
+            if (device == Device::Cuda) {
+                // Achieved bandwidth of the compulsory traffic, against the GPU's peak.
+                const double bytes = cudaDenoiseTrafficBytes(o, in, w, h);
+                const double peak = detail::cudaPeakBandwidthGBs();
+                const double achieved = bytes / (median(t) * 1e-3) / 1e9;
+                r["model_dram_mb"] = bytes / 1e6;
+                r["achieved_gb_s"] = achieved;
+                r["peak_gb_s"] = peak;
+                r["fraction_of_peak"] = peak > 0 ? achieved / peak : 0.0;
+                r["bandwidth_floor_ms"] = peak > 0 ? bytes / (peak * 1e9) * 1e3 : 0.0;
+            }
             doc["results"].push_back(r);
         }
         if (wants("svgf")) {
             SvgfDenoiser sv(SvgfParams{}, device);
             Image motion(w, h, 2);
             SvgfFrame f;
-            f.color = &b.color;
-            f.albedo = &b.albedo;
-            f.normal = &b.normal;
-            f.depth = &b.depth;
-            f.ids = &b.ids;
-            f.motion = &motion;
+            const Image motionIn = device == Device::Cuda ? motion.to(Device::Cuda) : Image();
+            f.color = &inputs.color;
+            f.albedo = &inputs.albedo;
+            f.normal = &inputs.normal;
+            f.depth = &inputs.depth;
+            f.ids = &inputs.ids;
+            f.motion = device == Device::Cuda ? &motionIn : &motion;
             SvgfReport srep;
             sv.setReport(&srep);
             StageSamples stages;
@@ -188,7 +249,7 @@ void run(const BenchArgs& a) {
             r["device"] = deviceToString(device);
             r["width"] = w;
             r["height"] = h;
-            r["note"] = "whole SVGF frame; host inputs are uploaded inside the timed call on CUDA";
+            r["note"] = "whole SVGF frame (inputs already on the device)";
             r["stages"] = stages.json();
             doc["results"].push_back(r);
         }

@@ -21,5 +21,8 @@ void cudaCopy(void* dst, Device dstDevice, const void* src, Device srcDevice, si
 void cudaFillFloats(float* dst, float value, size_t count);
 bool cudaDevicePresent();
 std::string cudaDeviceName();
+// Theoretical peak DRAM bandwidth of the current GPU in GB/s (memory clock x bus width x 2, from
+// the device attributes); 0 without a GPU.
+double cudaPeakBandwidthGBs();
 
 }  // namespace atrous::detail

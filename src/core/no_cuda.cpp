@@ -19,6 +19,7 @@ void cudaCopy(void*, Device, const void*, Device, size_t) { noCuda(); }
 void cudaFillFloats(float*, float, size_t) { noCuda(); }
 bool cudaDevicePresent() { return false; }
 std::string cudaDeviceName() { return "none (no CUDA backend)"; }
+double cudaPeakBandwidthGBs() { return 0.0; }
 void cudaGatherStrided(const GatherStrided&, int, int) { noCuda(); }
 void cudaScatterInterleaved(const ScatterInterleaved&, int, int) { noCuda(); }
 

@@ -107,5 +107,16 @@ std::string cudaDeviceName() {
     return prop.name;
 }
 
+double cudaPeakBandwidthGBs() {
+    if (!cudaDevicePresent()) return 0.0;
+    int dev = 0, clockKHz = 0, busBits = 0;
+    ATROUS_CUDA_CHECK(cudaGetDevice(&dev));
+    // Attributes, not cudaDeviceProp fields: CUDA 13 removed cudaDeviceProp::memoryClockRate.
+    ATROUS_CUDA_CHECK(cudaDeviceGetAttribute(&clockKHz, cudaDevAttrMemoryClockRate, dev));
+    ATROUS_CUDA_CHECK(cudaDeviceGetAttribute(&busBits, cudaDevAttrGlobalMemoryBusWidth, dev));
+    // Double data rate: two transfers per clock.
+    return 2.0 * double(clockKHz) * 1e3 * double(busBits) / 8.0 / 1e9;
+}
+
 }  // namespace detail
 }  // namespace atrous
