@@ -91,8 +91,9 @@ nlohmann::json stats(const std::vector<double>& ms) {
 
 // Compulsory DRAM traffic of one CUDA EAW/SURE call, in bytes: each pass of the driver
 // (src/filters/denoise_driver.h, CudaExec) is counted as reading every plane it uses once and
-// writing every plane it produces once; the 25 taps of a level are assumed to hit in cache (a
-// level's working set at 1920x1080 is ~35 MB, under an H100's 50 MB L2). This is the floor of the
+// writing every plane it produces once; the 25 taps of a level are assumed to hit in cache (they
+// reach ±2·step rows: at step 16, 65 rows × 1920 px × 60 B ≈ 7.5 MB, well under an H100's 50 MB
+// L2). This is the floor of the
 // present pass structure, not of the method: fusing the pre-passes and storing the features in
 // half precision lower it (docs/benchmarks.md, "CUDA: bandwidth floor"). Keep it in step with
 // the driver when passes change.
