@@ -76,7 +76,7 @@ CudaBvhRenderer::~CudaBvhRenderer() = default;
 CudaBvhRenderer::CudaBvhRenderer(CudaBvhRenderer&&) noexcept = default;
 CudaBvhRenderer& CudaBvhRenderer::operator=(CudaBvhRenderer&&) noexcept = default;
 
-RenderBuffers CudaBvhRenderer::render(const RenderSettings& settings, const pt::Camera* camera) {
+const RenderBuffers& CudaBvhRenderer::renderOnDevice(const RenderSettings& settings, const pt::Camera* camera) {
     validateRenderSettings(settings);
     Impl& m = *mImpl;
     if (m.frame.color.empty() || m.frame.color.width() != settings.width || m.frame.color.height() != settings.height)
@@ -90,15 +90,20 @@ RenderBuffers CudaBvhRenderer::render(const RenderSettings& settings, const pt::
     CudaExec exec;
     exec.forEachPixel(settings.width, settings.height, k);
     exec.synchronize();
+    return m.frame;
+}
+
+RenderBuffers CudaBvhRenderer::render(const RenderSettings& settings, const pt::Camera* camera) {
+    const RenderBuffers& f = renderOnDevice(settings, camera);
     RenderBuffers out;
-    out.color = m.frame.color.to(Device::Cpu);
-    out.variance = m.frame.variance.to(Device::Cpu);
-    out.albedo = m.frame.albedo.to(Device::Cpu);
-    out.normal = m.frame.normal.to(Device::Cpu);
-    out.position = m.frame.position.to(Device::Cpu);
-    out.depth = m.frame.depth.to(Device::Cpu);
-    out.ids = m.frame.ids.to(Device::Cpu);
-    out.emission = m.frame.emission.to(Device::Cpu);
+    out.color = f.color.to(Device::Cpu);
+    out.variance = f.variance.to(Device::Cpu);
+    out.albedo = f.albedo.to(Device::Cpu);
+    out.normal = f.normal.to(Device::Cpu);
+    out.position = f.position.to(Device::Cpu);
+    out.depth = f.depth.to(Device::Cpu);
+    out.ids = f.ids.to(Device::Cpu);
+    out.emission = f.emission.to(Device::Cpu);
     return out;
 }
 

@@ -33,6 +33,9 @@ CudaBvhRenderer& CudaBvhRenderer::operator=(CudaBvhRenderer&&) noexcept = defaul
 RenderBuffers CudaBvhRenderer::render(const RenderSettings&, const pt::Camera*) {
     throw InputError("--device cuda: this build of atrous has no CUDA backend");
 }
+const RenderBuffers& CudaBvhRenderer::renderOnDevice(const RenderSettings&, const pt::Camera*) {
+    throw InputError("--device cuda: this build of atrous has no CUDA backend");
+}
 
 RenderBuffers renderBvhCuda(const Scene& scene, const RenderSettings& settings) {
     return CudaBvhRenderer(scene).render(settings);

@@ -39,8 +39,14 @@ public:
     CudaBvhRenderer& operator=(const CudaBvhRenderer&) = delete;
 
     // Renders with the scene's camera, or with *camera when given. Host buffers as
-    // renderBvhCuda's (motion empty).
+    // renderBvhCuda's (motion empty): renderOnDevice() and a download of each buffer.
     RenderBuffers render(const RenderSettings& settings, const pt::Camera* camera = nullptr);
+    // The same render left on the GPU: the renderer's own device buffers (Device::Cuda images,
+    // motion empty), owned by the renderer and valid until the next render call or its
+    // destruction (a later call overwrites them; a new size reallocates them). The kernel has
+    // finished and been checked when it returns. For GPU pipelines (the viewer) that keep
+    // filtering on the device.
+    const RenderBuffers& renderOnDevice(const RenderSettings& settings, const pt::Camera* camera = nullptr);
 
 private:
     struct Impl;  // device state (src/cuda/cuda_render.cu)

@@ -2,7 +2,6 @@
 #include "view/view_pipeline.h"
 
 #include <sys/resource.h>
-#include <tbb/blocked_range.h>
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
 
@@ -10,11 +9,13 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <initializer_list>
 
 #include "atrous/error.h"
 #include "core/timer.h"
 #include "filters/denoise_internal.h"
 #include "io/image_io.h"
+#include "render/accumulate.h"
 #include "render/bvh_render.h"
 #include "render/bvh_tracer.h"
 #include "render/camera.h"
@@ -44,13 +45,6 @@ Method parseMethod(const std::string& name) {
 }
 
 namespace {
-
-template <class F>
-void forRows(int h, F f) {
-    tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& r) {
-        for (int y = r.begin(); y < r.end(); ++y) f(y);
-    });
-}
 
 bool sameSvgfParams(const SvgfParams& a, const SvgfParams& b) {
     return a.sigmaL == b.sigmaL && a.sigmaN == b.sigmaN && a.sigmaZ == b.sigmaZ &&
@@ -129,16 +123,19 @@ ViewPipeline::ViewPipeline(const Scene& scene, int width, int height, Device dev
         mSceneCenter = data.camera.position + data.camera.forward;
         mSceneRadius = 1.0f;
     }
-    mFrame = detail::allocateRenderBuffers(width, height, Device::Cpu);
-    const size_t n = size_t(width) * height;
-    for (auto* v : {&mSumX, &mSumX2, &mSumM2}) v->assign(3 * n, 0.0);
-    for (auto* v : {&mSumAlbedo, &mSumNormal, &mSumPosition, &mSumEmission}) v->assign(3 * n, 0.0f);
-    mSumDepth.assign(n, 0.0f);
-    mFeatureHits.assign(n, 0);
-    mDepthHits.assign(n, 0);
+    if (device == Device::Cuda) {
+        // The persistent renderer first: without a GPU its InputError names --device cuda before
+        // anything is allocated on the device.
+        mCudaRenderer = std::make_unique<CudaBvhRenderer>(mScene);
+    } else {
+        mFrame = detail::allocateRenderBuffers(width, height, Device::Cpu);
+    }
+    mMoments = Image(width, height, kAccumMomentChannels, device);
+    mNormalMean = Image(width, height, kAccumNormalChannels, device);
+    mCounts = Image(width, height, kAccumCountChannels, device);
     for (Image* img : {&mColor, &mVariance, &mAlbedo, &mNormal, &mPosition, &mDepth, &mIds,
                        &mMotion, &mEmission, &mEmissionMean})
-        *img = Image(width, height, 3);
+        *img = Image(width, height, 3, device);
 }
 
 ViewPipeline::~ViewPipeline() = default;
@@ -167,12 +164,12 @@ void ViewPipeline::renderFrame(const PipelineSettings& s, bool svgf) {
     ++mFrameIndex;
     validateRenderSettings(rs);
     mRendererMotion = false;
+    mCur = &mFrame;
     if (mDevice == Device::Cuda) {
         // The persistent renderer: scene and BVH uploaded once, device buffers kept, our camera
-        // per call. It returns host buffers with emission but no motion: computeMotion() rebuilds
-        // the motion from the depth.
-        if (!mCudaRenderer) mCudaRenderer = std::make_unique<CudaBvhRenderer>(mScene);
-        mFrame = mCudaRenderer->render(rs, &mCamera);
+        // per call. Its buffers stay on the GPU (emission, no motion: computeMotion() rebuilds the
+        // motion from the depth there).
+        mCur = &mCudaRenderer->renderOnDevice(rs, &mCamera);
         return;
     }
     // The renderer's own per-pixel functor over the shared BVH, with our camera in the SceneView:
@@ -197,147 +194,65 @@ void ViewPipeline::renderFrame(const PipelineSettings& s, bool svgf) {
                       });
 }
 
+namespace {
+
+// Every image a functor is about to read or write must live on the device it runs on (a host
+// pointer in a CUDA kernel, or the reverse, is the classic failure): checked before each launch.
+void requireOn(Device d, std::initializer_list<const Image*> images, const char* what) {
+    for (const Image* img : images)
+        if (img->empty() || img->device() != d)
+            throw RuntimeError(std::string("view pipeline: ") + what + ": a buffer is " +
+                               (img->empty() ? "missing" : "on the wrong device") + " (expected " +
+                               deviceName(d) + ")");
+}
+
+}  // namespace
+
 void ViewPipeline::accumulateFrame(bool accumulate) {
-    const int w = mWidth;
-    const size_t plane = size_t(w) * mHeight;
+    const RenderBuffers& f = frame();
     const bool restart = !accumulate || !mAccumulating;
     mAccumulating = accumulate;
     if (restart) {
         // One frame: its buffers are the filters' input as they are (the renderer already averaged
-        // the frame's samples). The sums are seeded only when later frames will add to them.
+        // the frame's samples). The state is seeded only when later frames will add to it.
         mFrames = 1;
-        mColor.copyFrom(mFrame.color);
-        mVariance.copyFrom(mFrame.variance);
-        mAlbedo.copyFrom(mFrame.albedo);
-        mNormal.copyFrom(mFrame.normal);
-        mPosition.copyFrom(mFrame.position);
-        mDepth.copyFrom(mFrame.depth);
-        mIds.copyFrom(mFrame.ids);  // ids are never averaged (as the renderer: the first sample's)
-        mEmissionValid = !mFrame.emission.empty();
-        if (mEmissionValid) mEmissionMean.copyFrom(mFrame.emission);
-        mVarianceValid = mSppAccumulated > 1;
-        if (!accumulate) return;
+        mEmissionValid = !f.emission.empty();
     } else {
         ++mFrames;
     }
-    const int N = mFrames;
-    const double spp = double(mSppAccumulated);
-    const double invN = 1.0 / N;
-    const double n = double(N) * spp;
-    const double invVar = n > 1 ? 1.0 / (n * (n - 1.0)) : 0.0;
-    const bool withinFrame = mSppAccumulated > 1;  // at 1 spp a frame has no own variance
-    const float* fc = mFrame.color.data();
-    const float* fv = mFrame.variance.data();
-    const float* fa = mFrame.albedo.data();
-    const float* fn = mFrame.normal.data();
-    const float* fp = mFrame.position.data();
-    const float* fd = mFrame.depth.data();
-    const float* fe = mEmissionValid ? mFrame.emission.data() : nullptr;
-    auto rows = [&](int y) {
-        for (int x = 0; x < w; ++x) {
-            const size_t p = size_t(y) * w + x;
-            const bool featureHit =
-                fn[p] != 0.0f || fn[plane + p] != 0.0f || fn[2 * plane + p] != 0.0f;
-            const bool depthHit = fd[p] < 0.1f * kBackgroundDepth;
-            if (restart) {
-                mFeatureHits[p] = featureHit;
-                mDepthHits[p] = depthHit;
-                mSumDepth[p] = depthHit ? fd[p] : 0.0f;
-                for (int c = 0; c < 3; ++c) {
-                    const size_t i = c * plane + p;
-                    const double v = fc[i];
-                    mSumX[i] = v;
-                    mSumX2[i] = v * v;
-                    if (withinFrame) mSumM2[i] = double(fv[i]) * spp * (spp - 1.0);
-                    mSumAlbedo[i] = fa[i];
-                    if (fe) mSumEmission[i] = fe[i];
-                    mSumNormal[i] = featureHit ? fn[i] : 0.0f;
-                    mSumPosition[i] = featureHit ? fp[i] : 0.0f;
-                }
-                continue;  // outputs already copied
-            }
-            const int fh = mFeatureHits[p] += featureHit;
-            const int dh = mDepthHits[p] += depthHit;
-            if (depthHit) mSumDepth[p] += fd[p];
-            const float depth = dh ? mSumDepth[p] / float(dh) : kBackgroundDepth;
-            const float invFh = fh ? 1.0f / float(fh) : 0.0f;
-            float nrm[3];
-            for (int c = 0; c < 3; ++c) {
-                const size_t i = c * plane + p;
-                const double v = fc[i];
-                const double sx = mSumX[i] += v;
-                const double sx2 = mSumX2[i] += v * v;
-                // Each frame's own sum of squared deviations: the variance of its mean · s (s - 1).
-                const double sm2 =
-                    withinFrame ? (mSumM2[i] += double(fv[i]) * spp * (spp - 1.0)) : 0.0;
-                // Variance of the mean pooled over all n = N·s samples:
-                // M2 = Σ M2_k + s Σ (x_k - x̄)²,  var = M2 / (n (n - 1)).
-                const double mean = sx * invN;
-                const double m2 = sm2 + spp * std::max(0.0, sx2 - sx * mean);
-                mColor.data()[i] = float(mean);
-                mVariance.data()[i] = float(m2 * invVar);
-                mAlbedo.data()[i] = (mSumAlbedo[i] += fa[i]) * float(invN);
-                if (fe) mEmissionMean.data()[i] = (mSumEmission[i] += fe[i]) * float(invN);
-                if (featureHit) {
-                    mSumNormal[i] += fn[i];
-                    mSumPosition[i] += fp[i];
-                }
-                mPosition.data()[i] = mSumPosition[i] * invFh;
-                nrm[c] = mSumNormal[i] * invFh;
-                mDepth.data()[i] = depth;
-            }
-            const float len = std::sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
-            const float inv = len > 0 ? 1.0f / len : 0.0f;
-            for (int c = 0; c < 3; ++c) mNormal.data()[c * plane + p] = nrm[c] * inv;
-        }
-    };
-    forRows(mHeight, rows);
-    mVarianceValid = n > 1.0;
+    AccumulateFrame a;
+    a.p = makeAccumulateParams(restart, accumulate, mFrames, mSppAccumulated, kBackgroundDepth);
+    requireOn(mDevice,
+              {&f.color, &f.variance, &f.albedo, &f.normal, &f.position, &f.depth, &f.ids, &mColor,
+               &mVariance, &mAlbedo, &mNormal, &mPosition, &mDepth, &mIds, &mEmissionMean, &mMoments,
+               &mNormalMean, &mCounts},
+              "accumulation");
+    if (mEmissionValid) requireOn(mDevice, {&f.emission}, "accumulation");
+    a.color = f.color.view(), a.variance = f.variance.view(), a.albedo = f.albedo.view();
+    a.normal = f.normal.view(), a.position = f.position.view(), a.depth = f.depth.view();
+    a.ids = f.ids.view();
+    a.emission = mEmissionValid ? f.emission.view() : ImageView{};
+    a.outColor = mColor.view(), a.outVariance = mVariance.view(), a.outAlbedo = mAlbedo.view();
+    a.outNormal = mNormal.view(), a.outPosition = mPosition.view(), a.outDepth = mDepth.view();
+    a.outIds = mIds.view(), a.outEmission = mEmissionMean.view();
+    a.moments = mMoments.view(), a.normalMean = mNormalMean.view(), a.counts = mCounts.view();
+    runAccumulateFrame(mDevice, a);
+    mVarianceValid = double(mFrames) * double(mSppAccumulated) > 1.0;
 }
 
 void ViewPipeline::computeMotion() {
-    // Screen-space motion of the primary hit, previous - current, in pixels (ALGORITHMS.md 1). The
-    // hit point is rebuilt from the frame's depth (distance along the forward axis) on the pixel
-    // centre's ray; background pixels move like directions (points at infinity).
-    const pt::Camera cur = mCamera, prev = mPrevCamera;
-    const bool moved = mCameraMoved;
-    const int w = mWidth, h = mHeight;
-    const size_t plane = size_t(w) * h;
-    const float aspect = float(w) / float(h);
-    const float kOffscreen = pt::kMotionOffscreen;  // the renderer's "no previous position"
-    forRows(h, [&](int y) {
-        for (int x = 0; x < w; ++x) {
-            const size_t p = size_t(y) * w + x;
-            float mx = 0.0f, my = 0.0f;
-            if (moved) {
-                const Vec3 dir =
-                    pt::cameraRayDirection(cur, float(x) + 0.5f, float(y) + 0.5f, w, h);
-                const float z = mFrame.depth.data()[p];
-                Vec3 v;  // from the previous eye towards the point
-                if (z < 0.1f * kBackgroundDepth) {
-                    const Vec3 hit =
-                        cur.position + dir * (z / std::max(dot(dir, cur.forward), 1e-6f));
-                    v = hit - prev.position;
-                } else {
-                    v = dir;
-                }
-                const float zf = dot(v, prev.forward);
-                if (zf <= 1e-6f) {
-                    mx = my = kOffscreen;  // behind the previous camera: no history
-                } else {
-                    const float sx = dot(v, prev.right) / (zf * prev.tanHalfFov * aspect);
-                    const float sy = dot(v, prev.up) / (zf * prev.tanHalfFov);
-                    const float px = (sx + 1.0f) * 0.5f * float(w),
-                                py = (1.0f - sy) * 0.5f * float(h);
-                    mx = px - (float(x) + 0.5f);
-                    my = py - (float(y) + 0.5f);
-                }
-            }
-            mMotion.data()[p] = mx;
-            mMotion.data()[plane + p] = my;
-            mMotion.data()[2 * plane + p] = 0.0f;
-        }
-    });
+    // Screen-space motion from the frame's depth (render/accumulate.h, MotionFromDepth), for the
+    // CUDA renderer, which writes no motion buffer.
+    MotionFromDepth m;
+    m.p.current = mCamera;
+    m.p.previous = mPrevCamera;
+    m.p.moved = mCameraMoved ? 1 : 0;
+    m.p.hitDepth = 0.1f * kBackgroundDepth;
+    m.p.offscreen = pt::kMotionOffscreen;  // the renderer's "no previous position"
+    requireOn(mDevice, {&frame().depth, &mMotion}, "motion");
+    m.depth = frame().depth.view();
+    m.motion = mMotion.view();
+    runMotionFromDepth(mDevice, m);
 }
 
 void ViewPipeline::computeEmission() {
@@ -349,7 +264,7 @@ void ViewPipeline::computeEmission() {
     const pt::SceneData& data = mScene.data();
     const int nm = int(data.materials.size());
     const size_t plane = size_t(mWidth) * mHeight;
-    const float* mat = mFrame.ids.data() + plane;
+    const float* mat = frame().ids.data() + plane;  // host: computeEmission runs on the CPU only
     float* e = mEmission.data();
     for (size_t p = 0; p < plane; ++p) {
         const int m = int(mat[p]);
@@ -395,6 +310,36 @@ const Image& ViewPipeline::resultHost(int i) const {
     return r.image;
 }
 
+const Image* ViewPipeline::buffer(Buffer b) const {
+    switch (b) {
+        case kColor: return &mColor;
+        case kVariance: return &mVariance;
+        case kAlbedo: return &mAlbedo;
+        case kNormal: return &mNormal;
+        case kPosition: return &mPosition;
+        case kDepth: return &mDepth;
+        case kIds: return &mIds;
+        case kMotion: return &mMotion;
+        case kEmission: return &mEmission;
+        case kEmissionMean: return &mEmissionMean;
+        case kBufferCount: break;
+    }
+    return &mColor;
+}
+
+const Image& ViewPipeline::hostBuffer(Buffer b) const {
+    const Image& img = *buffer(b);
+    if (img.device() == Device::Cpu) return img;
+    // Downloaded once per step, into the same host allocation each time. Every kernel of the step
+    // ran on the default stream and cudaMemcpy waits for them, so the copy sees the finished buffer.
+    if (!mHostValid[b]) {
+        if (mHost[b].empty()) mHost[b] = Image(img.width(), img.height(), img.channels(), Device::Cpu);
+        mHost[b].copyFrom(img);
+        mHostValid[b] = true;
+    }
+    return mHost[b];
+}
+
 void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
     SlotResult& r = mSlots[i];
     r.method = m;
@@ -403,12 +348,15 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
     r.stages.clear();
     r.image = Image();
     r.deviceImage = Image();
+    // On CUDA every input is on the GPU: the result stays there when the display can take it
+    // (deviceResults) and is downloaded once here otherwise.
     const bool onDevice = s.deviceResults && mDevice == Device::Cuda;
+    auto hostCopy = [](const Image& img) { return img.device() == Device::Cpu ? img.clone() : img.to(Device::Cpu); };
     if (m == Method::None) {
         if (onDevice)
-            r.deviceImage = mColor.to(Device::Cuda);
+            r.deviceImage = mColor.clone();  // GPU to GPU
         else
-            r.image = mColor.clone();
+            r.image = hostCopy(mColor);
         return;
     }
     if (m == Method::Svgf) {
@@ -420,13 +368,15 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
             }
             if (mSvgfResetPending || (mCameraMoved && !s.svgfMotionVectors)) mSvgf[i]->reset();
             // SVGF does its own temporal accumulation, so it takes this frame's samples, not the
-            // running mean.
+            // running mean. On CUDA all of them are device images, which the SVGF pipeline reads
+            // in place (svgf_pipeline.h copies only inputs that are not on its device).
+            const RenderBuffers& fr = frame();
             SvgfFrame f;
-            f.color = &mFrame.color;
-            f.albedo = &mFrame.albedo;
-            f.normal = &mFrame.normal;
-            f.depth = &mFrame.depth;
-            f.ids = &mFrame.ids;
+            f.color = &fr.color;
+            f.albedo = &fr.albedo;
+            f.normal = &fr.normal;
+            f.depth = &fr.depth;
+            f.ids = &fr.ids;
             f.motion = &mMotion;
             f.emission = &mEmission;
             Timer t;
@@ -439,7 +389,7 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
         } catch (const InputError& e) {
             mSvgf[i].reset();
             r.error = e.what();
-            r.image = mFrame.color.clone();
+            r.image = hostCopy(frame().color);
         }
         return;
     }
@@ -456,11 +406,14 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
             dbg.sureS = Image(mWidth, mHeight, s.eaw.levels);
             r.image = filters::denoiseCpu(in, o, prep, rep, &dbg);
             mSureS = std::move(dbg.sureS);
-        } else if (onDevice) {
-            // A colour on the GPU keeps denoise()'s result there (the other buffers are uploaded).
-            const Image deviceColor = mColor.to(Device::Cuda);
-            in.color = &deviceColor;
-            r.deviceImage = denoise(in, o);
+        } else if (mDevice == Device::Cuda) {
+            // The inputs are the running means on the GPU: denoise() reads them in place and
+            // leaves its result there.
+            Image result = denoise(in, o);
+            if (onDevice)
+                r.deviceImage = std::move(result);
+            else
+                r.image = hostCopy(result);
         } else {
             r.image = denoise(in, o);
         }
@@ -468,12 +421,13 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
         r.stages = rep.stages;
     } catch (const InputError& e) {
         r.error = e.what();
-        r.image = mColor.clone();
+        r.image = hostCopy(mColor);
     }
 }
 
 void ViewPipeline::step(const PipelineSettings& s) {
     mTimes = StageTimes{};
+    for (bool& v : mHostValid) v = false;  // this step rewrites the buffers
     if (s.sppPerFrame != mSppAccumulated) {
         mAccumulating = false;  // a running mean mixes frames of one spp only
         mSppAccumulated = s.sppPerFrame;
@@ -501,10 +455,12 @@ void ViewPipeline::step(const PipelineSettings& s) {
 
     if (svgf) {
         if (!mRendererMotion) computeMotion();  // the CUDA renderer: motion from the depth buffer
-        if (!mFrame.emission.empty())
-            mEmission.copyFrom(mFrame.emission);
-        else
+        if (!frame().emission.empty())
+            mEmission.copyFrom(frame().emission);  // same device: a host or a GPU-to-GPU copy
+        else if (mDevice == Device::Cpu)
             computeEmission();
+        else
+            throw RuntimeError("view pipeline: the CUDA renderer wrote no emission buffer");
     }
     lap(mTimes.motion, mTimes.motionCpu);
 
@@ -527,15 +483,18 @@ void ViewPipeline::step(const PipelineSettings& s) {
             const DenoiseInputs in = accumulatedInputs();
             DenoiseOptions o = denoiseOptions(Method::Eaw, s);
             const int L = s.detailLevel;
+            // A debug view: on CUDA both results are brought to the host (the view shows them
+            // from there anyway).
+            auto toHost = [](Image img) { return img.device() == Device::Cpu ? std::move(img) : img.to(Device::Cpu); };
             Image fine;
             if (L == 0) {
-                fine = mColor.clone();
+                fine = color().clone();
             } else {
                 o.eaw.levels = L;
-                fine = denoise(in, o);
+                fine = toHost(denoise(in, o));
             }
             o.eaw.levels = L + 1;
-            Image coarse = denoise(in, o);
+            Image coarse = toHost(denoise(in, o));
             for (size_t k = 0; k < fine.size(); ++k) fine.data()[k] -= coarse.data()[k];
             mDetail = std::move(fine);
             mDetailLevelShown = L;
@@ -559,17 +518,18 @@ std::vector<std::string> ViewPipeline::saveBuffers(const std::string& dir) const
         io::writeImage((fs::path(dir) / name).string(), img);
         names.push_back(name);
     };
-    put("color.exr", mColor);
-    if (mVarianceValid) put("variance.exr", mVariance);
-    put("albedo.exr", mAlbedo);
-    put("normal.exr", mNormal);
-    put("position.exr", mPosition);
-    put("depth.exr", mDepth);
-    put("ids.exr", mIds);
+    // The host accessors: on CUDA each buffer is downloaded here (once per step).
+    put("color.exr", color());
+    if (mVarianceValid) put("variance.exr", variance());
+    put("albedo.exr", albedo());
+    put("normal.exr", normal());
+    put("position.exr", position());
+    put("depth.exr", depth());
+    put("ids.exr", ids());
     const bool svgf = mSlots[0].method == Method::Svgf || mSlots[1].method == Method::Svgf;
     if (svgf) {
-        put("motion.exr", mMotion);
-        put("emission.exr", mEmission);
+        put("motion.exr", motion());
+        put("emission.exr", emission());
     }
     for (int i = 0; i < 2; ++i) {
         const SlotResult& r = mSlots[i];

@@ -112,16 +112,25 @@ class ViewPipeline {
     int samplesPerPixel() const { return mFrames * mSppAccumulated; }
     const StageTimes& times() const { return mTimes; }
 
-    // The buffers the filters saw in the last step (accumulated ones when accumulating).
-    const Image& color() const { return mColor; }
-    const Image& variance() const { return mVariance; }
+    enum Buffer { kColor, kVariance, kAlbedo, kNormal, kPosition, kDepth, kIds, kMotion, kEmission, kEmissionMean,
+                  kBufferCount };
+    // The buffers the filters saw in the last step (accumulated ones when accumulating), on the
+    // host. On Device::Cuda they live on the GPU (deviceBuffer()) and these accessors download a
+    // buffer the first time it is asked for after a step (buffer views, save, screenshot); nothing
+    // is copied to the host otherwise. The references stay valid until the next step().
+    const Image& color() const { return hostBuffer(kColor); }
+    const Image& variance() const { return hostBuffer(kVariance); }
     bool varianceValid() const { return mVarianceValid; }  // false at 1 sample per pixel
-    const Image& albedo() const { return mAlbedo; }
-    const Image& normal() const { return mNormal; }
-    const Image& position() const { return mPosition; }
-    const Image& depth() const { return mDepth; }
-    const Image& ids() const { return mIds; }
-    const Image& motion() const { return mMotion; }  // x = dx, y = dy (previous - current), pixels
+    const Image& albedo() const { return hostBuffer(kAlbedo); }
+    const Image& normal() const { return hostBuffer(kNormal); }
+    const Image& position() const { return hostBuffer(kPosition); }
+    const Image& depth() const { return hostBuffer(kDepth); }
+    const Image& ids() const { return hostBuffer(kIds); }
+    const Image& motion() const { return hostBuffer(kMotion); }  // x = dx, y = dy (previous - current), pixels
+    const Image& emission() const { return hostBuffer(kEmission); }  // this frame's (SVGF's input)
+    const Image& emissionMean() const { return hostBuffer(kEmissionMean); }  // running mean (EAW/SURE)
+    // The same buffers where they live, on device() (no copy; for GPU consumers).
+    const Image& deviceBuffer(Buffer b) const { return *buffer(b); }
     const SlotResult& slot(int i) const { return mSlots[i]; }
     // The slot's result on the host (downloaded once when it lives on the GPU); may be empty.
     const Image& resultHost(int i) const;
@@ -136,6 +145,10 @@ class ViewPipeline {
     std::vector<std::string> saveBuffers(const std::string& dir) const;
 
   private:
+    const Image* buffer(Buffer b) const;
+    const Image& hostBuffer(Buffer b) const;
+    // This frame's render: mFrame on the CPU, the CUDA renderer's device buffers on the GPU.
+    const RenderBuffers& frame() const { return *mCur; }
     void renderFrame(const PipelineSettings& s, bool svgf);
     void accumulateFrame(bool accumulate);
     void computeMotion();
@@ -158,17 +171,21 @@ class ViewPipeline {
     bool mRendererMotion = false;  // this frame's motion and emission came from the renderer
     uint64_t mFrameIndex = 0;      // seeds: every frame draws fresh samples
 
-    RenderBuffers mFrame;  // this frame's render
-    // Running sums of the colour moments (double: E[x²] - E[x]² over thousands of frames without
-    // cancellation trouble) and of the features (float: plain averages).
-    std::vector<double> mSumX, mSumX2, mSumM2;
-    std::vector<float> mSumAlbedo, mSumNormal, mSumPosition, mSumDepth, mSumEmission;
-    std::vector<int> mFeatureHits, mDepthHits;
+    RenderBuffers mFrame;  // this frame's render on the CPU (unused on CUDA)
+    const RenderBuffers* mCur = &mFrame;
+    // Running-mean state on device() (render/accumulate.h): colour moments (Welford M2 and the
+    // mean within-frame variance), the mean of the unnormalised normals, and hit counts with the
+    // mean depth. The outputs below double as the running means.
+    Image mMoments, mNormalMean, mCounts;
     int mFrames = 0, mSppAccumulated = 0;
     bool mAccumulating = false;
 
-    // mEmission: this frame's emission (SVGF's input); mEmissionMean: its running mean (EAW/SURE).
+    // All on device(). mEmission: this frame's emission (SVGF's input); mEmissionMean: its running
+    // mean (EAW/SURE).
     Image mColor, mVariance, mAlbedo, mNormal, mPosition, mDepth, mIds, mMotion, mEmission, mEmissionMean;
+    // Host copies of the buffers above on Device::Cuda, made on demand (hostBuffer()).
+    mutable Image mHost[kBufferCount];
+    mutable bool mHostValid[kBufferCount] = {};
     bool mEmissionValid = false;
     bool mVarianceValid = false;
     mutable SlotResult mSlots[2];  // mutable: resultHost() fills the host copy on demand

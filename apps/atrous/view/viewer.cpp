@@ -632,7 +632,9 @@ void runViewer(const ViewerOptions& opt) {
                              !(view == BufferView::Result || view == BufferView::Motion) ||
                              snapshot || (lastFrame && !opt.dumpDir.empty());
         const bool doStep = !paused || moved || frame == 0;
-        ps.deviceResults = session.interop != nullptr && view == BufferView::Result;
+        // CUDA: results stay on the GPU; the host path downloads them only when it shows them
+        // (resultHost), the interop path never.
+        ps.deviceResults = device == Device::Cuda;
         if (doStep) pl.step(ps);
 
         // ---- display image ----
@@ -641,12 +643,21 @@ void runViewer(const ViewerOptions& opt) {
             const bool split = view == BufferView::Result && ps.split;
             const int xs = split ? std::clamp(int(std::lround(splitPos * float(w))), 0, w) : w;
             bool shown = false;
+            // What the interop path can show straight from the GPU: the slots' results, or the
+            // noisy colour (the running mean), which the pipeline keeps on the GPU too.
+            const Image* left = nullptr;
+            const Image* right = nullptr;
             if (session.interop && view == BufferView::Result && !pl.slot(0).deviceImage.empty() &&
                 (!split || !pl.slot(1).deviceImage.empty())) {
+                left = &pl.slot(0).deviceImage;
+                right = split ? &pl.slot(1).deviceImage : nullptr;
+            } else if (session.interop && view == BufferView::Noisy) {
+                left = &pl.deviceBuffer(ViewPipeline::kColor);
+            }
+            if (left) {
                 // GPU to GPU: tonemap kernel into the PBO, then PBO -> texture inside GL.
                 try {
-                    session.interop->write(pl.slot(0).deviceImage, split ? &pl.slot(1).deviceImage : nullptr, xs,
-                                           exposure);
+                    session.interop->write(*left, right, xs, exposure);
                     session.gl.bindBuffer(GL_PIXEL_UNPACK_BUFFER, session.pbo);
                     glBindTexture(GL_TEXTURE_2D, session.texture);
                     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
@@ -660,8 +671,10 @@ void runViewer(const ViewerOptions& opt) {
                 }
             }
             if (!shown) {  // host path (resultHost downloads a GPU result once)
-                viewNote = tonemap(pl, view, &pl.resultHost(0), exposure, level, 0, xs, rgba);
-                if (split) tonemap(pl, view, &pl.resultHost(1), exposure, level, xs, w, rgba);
+                // Only the result view reads the results (on CUDA that downloads them once).
+                const bool result = view == BufferView::Result;
+                viewNote = tonemap(pl, view, result ? &pl.resultHost(0) : nullptr, exposure, level, 0, xs, rgba);
+                if (split) tonemap(pl, view, result ? &pl.resultHost(1) : nullptr, exposure, level, xs, w, rgba);
                 glBindTexture(GL_TEXTURE_2D, session.texture);
                 glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
             }
