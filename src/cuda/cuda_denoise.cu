@@ -1,33 +1,121 @@
 // CUDA instantiation of the EAW/SURE driver (src/filters/denoise_driver.h) with CudaExec: the same
-// functors as the CPU path, launched as kernels. Host inputs are uploaded and the result is
-// downloaded; inputs already on the GPU (Python's DLPack arrays) are used there and the result
-// stays on the GPU.
+// functors as the CPU path, launched as kernels. Inputs already on the GPU (the viewer's running
+// means, Python's DLPack arrays) are read in place and the result stays on the GPU; host inputs
+// are uploaded and the result is downloaded. The report's statistics are reduced on the GPU, so a
+// device-resident call moves nothing but the few bytes of the reduction back to the host.
+#include <cuda_runtime.h>
+#include <thrust/execution_policy.h>
+#include <thrust/find.h>
+#include <thrust/iterator/counting_iterator.h>
+#include <thrust/transform_reduce.h>
+
 #include <cmath>
+#include <exception>
+#include <string>
 
 #include "atrous/denoise.h"
+#include "atrous/error.h"
+#include "core/math.h"
 #include "core/timer.h"
+#include "cuda/cuda_check.cuh"
 #include "cuda/cuda_exec.cuh"
 #include "filters/denoise_internal.h"
 #include "filters/stage_clock.h"
 
 namespace atrous::filters {
+namespace {
+
+// Partial sums of the report (denoise.cpp's meanLuminance and the firefly count): luminance sums
+// in double over the finite luminances only, with their counts, as the CPU does.
+struct ReportSums {
+    double in = 0, after = 0, emission = 0;
+    unsigned long long nIn = 0, nAfter = 0, nEmission = 0, clamped = 0;
+    unsigned long long nonFinite = 0;  // colour pixels with a NaN/Inf channel (prepareInputs' count)
+};
+
+struct AddReportSums {
+    ATROUS_HOST_DEVICE ReportSums operator()(const ReportSums& a, const ReportSums& b) const {
+        ReportSums r;
+        r.in = a.in + b.in;
+        r.after = a.after + b.after;
+        r.emission = a.emission + b.emission;
+        r.nIn = a.nIn + b.nIn;
+        r.nAfter = a.nAfter + b.nAfter;
+        r.nEmission = a.nEmission + b.nEmission;
+        r.clamped = a.clamped + b.clamped;
+        r.nonFinite = a.nonFinite + b.nonFinite;
+        return r;
+    }
+};
+
+// One pixel's contribution. All views are device images (color and emission: the caller's inputs
+// as given, after: c_0 after the firefly pass, flag: 1 where a firefly was clamped).
+struct PixelReportSums {
+    ImageView color, after, flag, emission;  // emission invalid when absent
+
+    ATROUS_HOST_DEVICE ReportSums operator()(size_t i) const {
+        ReportSums r;
+        const size_t pl = color.plane();
+        const float c0 = color.data[i], c1 = color.data[pl + i], c2 = color.data[2 * pl + i];
+        r.nonFinite = isFiniteF(c0) && isFiniteF(c1) && isFiniteF(c2) ? 0 : 1;
+        const float lc = lum(c0, c1, c2);
+        if (isFiniteF(lc)) r.in = lc, r.nIn = 1;  // non-finite input luminance skipped (denoise.cpp)
+        const float la = lum(after.data[i], after.data[pl + i], after.data[2 * pl + i]);
+        if (isFiniteF(la)) r.after = la, r.nAfter = 1;
+        if (emission.data) {
+            const float le = lum(emission.data[i], emission.data[pl + i], emission.data[2 * pl + i]);
+            if (isFiniteF(le)) r.emission = le, r.nEmission = 1;
+        }
+        r.clamped = flag.data[i] > 0.5f ? 1 : 0;
+        return r;
+    }
+};
+
+struct IsNegative {
+    const float* data;
+    ATROUS_HOST_DEVICE bool operator()(size_t i) const { return data[i] < 0.0f; }
+};
+
+// prepareInputs' negative-variance check for a variance on the GPU: the first negative value in
+// planar order (as the host scan finds it), read back alone for the message.
+void checkDeviceVariance(const Image& variance) {
+    const size_t n = 3 * variance.plane();
+    size_t first = n;
+    try {
+        first = *thrust::find_if(thrust::cuda::par, thrust::counting_iterator<size_t>(0),
+                                 thrust::counting_iterator<size_t>(n), IsNegative{variance.data()});
+    } catch (const std::exception& e) {
+        throw RuntimeError(std::string("CUDA variance check failed: ") + e.what());
+    }
+    if (first >= n) return;
+    float value = 0.0f;
+    ATROUS_CUDA_CHECK(cudaMemcpy(&value, variance.data() + first, sizeof(float), cudaMemcpyDeviceToHost));
+    throw negativeVarianceError(value, first % variance.plane(), variance.width());
+}
+
+}  // namespace
 
 Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const PreparedInputs& prep, DenoiseReport& rep) {
     const int w = in.color->width(), h = in.color->height();
-    auto upload = [](const Image* img) { return img ? img->to(Device::Cuda) : Image(); };
-    Image color = upload(in.color);
-    Image variance = in.variance ? upload(in.variance) : prep.estimatedVariance.to(Device::Cuda);
-    Image albedo = upload(in.albedo), normal = upload(in.normal), position = upload(in.position),
-          depth = upload(in.depth), ids = upload(in.ids), emission = upload(in.emission);
+    if (in.variance && in.variance->device() == Device::Cuda) checkDeviceVariance(*in.variance);
+    // A device input is used in place (no copy); a host input is uploaded into its holder, which
+    // lives until the driver has finished (runDenoise synchronises before returning).
+    Image holders[8];
+    auto onDevice = [&holders](const Image* img, int slot) -> ImageView {
+        if (!img) return ImageView{};
+        if (img->device() == Device::Cuda) return img->view();
+        holders[slot] = img->to(Device::Cuda);
+        return holders[slot].view();
+    };
     DriverInputs di;
-    di.color = color.view();
-    di.variance = variance.view();
-    di.albedo = albedo.view();
-    di.normal = normal.view();
-    di.position = position.view();
-    di.depth = depth.view();
-    di.ids = ids.view();
-    di.emission = emission.view();
+    di.color = onDevice(in.color, 0);
+    di.variance = onDevice(in.variance ? in.variance : &prep.estimatedVariance, 1);
+    di.albedo = onDevice(in.albedo, 2);
+    di.normal = onDevice(in.normal, 3);
+    di.position = onDevice(in.position, 4);
+    di.depth = onDevice(in.depth, 5);
+    di.ids = onDevice(in.ids, 6);
+    di.emission = onDevice(in.emission, 7);
     Image out(w, h, 3, Device::Cuda), after(w, h, 3, Device::Cuda), flag(w, h, 1, Device::Cuda);
     DriverOutputs dout;
     dout.out = out.view();
@@ -40,40 +128,29 @@ Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const Prepar
     DriverConfig cfg = makeConfig(o);
     cfg.varianceGiven = in.variance != nullptr;
     if (clock) clock->start();
-    runDenoise(CudaExec{}, di, cfg, dout);
+    runDenoise(CudaExec{}, di, cfg, dout);  // ends with a stream synchronisation
     rep.milliseconds = t.ms();
     if (clock) clock->collect(rep.stages);
-    Image hostAfter = after.to(Device::Cpu), hostFlag = flag.to(Device::Cpu);
-    const bool colorOnDevice = in.color->device() == Device::Cuda;
-    const Image hostColorCopy = colorOnDevice ? in.color->to(Device::Cpu) : Image();
-    const Image& hostColor = colorOnDevice ? hostColorCopy : *in.color;
-    double s0 = 0, s1 = 0;
-    size_t n0 = 0;
-    int clamped = 0;
+
+    // The report's statistics in one reduction over the pixels (the same definitions as
+    // denoiseCpu; summation order differs, so the doubles may differ in their last digits).
     const size_t plane = size_t(w) * h;
-    for (size_t i = 0; i < plane; ++i) {
-        const float* c = hostColor.data();
-        const float l = lum(c[i], c[i + plane], c[i + 2 * plane]);
-        if (std::isfinite(l)) {
-            s0 += l;
-            ++n0;
-        }
-        s1 += lum(hostAfter.data()[i], hostAfter.data()[i + plane], hostAfter.data()[i + 2 * plane]);
-        clamped += hostFlag.data()[i] > 0.5f;
+    PixelReportSums px{di.color, after.view(), flag.view(), di.emission};
+    ReportSums sums;
+    try {
+        sums = thrust::transform_reduce(thrust::cuda::par, thrust::counting_iterator<size_t>(0),
+                                        thrust::counting_iterator<size_t>(plane), px, ReportSums{}, AddReportSums{});
+    } catch (const std::exception& e) {  // thrust::system_error: turn it into the library's error
+        throw RuntimeError(std::string("CUDA denoise report reduction failed: ") + e.what());
     }
-    rep.meanLuminanceIn = n0 ? s0 / double(n0) : 0.0;
-    // `after` is c_0 = colour − emission after the pass: add the emission's mean back so that both
-    // figures are of the whole image (see denoise.cpp).
-    if (in.emission) {
-        const Image hostEm = in.emission->to(Device::Cpu);
-        for (size_t i = 0; i < plane; ++i) {
-            const float l = lum(hostEm.data()[i], hostEm.data()[i + plane], hostEm.data()[i + 2 * plane]);
-            if (std::isfinite(l)) s1 += l;
-        }
-    }
-    rep.meanLuminanceAfterFirefly = s1 / double(plane);
-    rep.firefliesClamped = clamped;
-    if (colorOnDevice) return out;
+    rep.meanLuminanceIn = sums.nIn ? sums.in / double(sums.nIn) : 0.0;
+    // `after` is c_0 = colour − emission after the pass: the emission's mean is added back so that
+    // both figures are of the whole image (see denoise.cpp).
+    rep.meanLuminanceAfterFirefly = (sums.nAfter ? sums.after / double(sums.nAfter) : 0.0) +
+                                    (in.emission && sums.nEmission ? sums.emission / double(sums.nEmission) : 0.0);
+    rep.firefliesClamped = int(sums.clamped);
+    if (in.color->device() == Device::Cuda) rep.nonFinitePixels = int(sums.nonFinite);  // host: prepareInputs
+    if (in.color->device() == Device::Cuda) return out;
     return out.to(Device::Cpu);
 }
 

@@ -102,6 +102,11 @@ static void checkBuffer(const Image* img, const Image& color, const char* name) 
     if (img->channels() < 3) throw InputError(std::string(name) + " buffer needs 3 channels");
 }
 
+InputError negativeVarianceError(float value, size_t pixel, int width) {
+    return InputError("variance buffer has a negative value (" + std::to_string(value) + ") at pixel (" +
+                      std::to_string(pixel % size_t(width)) + ", " + std::to_string(pixel / size_t(width)) + ")");
+}
+
 PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, DenoiseReport& rep) {
     if (!in.color || in.color->empty()) throw InputError("no color buffer given");
     const Image& color = *in.color;
@@ -115,28 +120,31 @@ PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, D
     checkBuffer(in.emission, color, "emission");
     validateDenoiseOptions(o);
     PreparedInputs p;
-    const Image colorHost = color.device() == Device::Cpu ? Image() : color.to(Device::Cpu);
-    const Image& ch = color.device() == Device::Cpu ? color : colorHost;
+    // GPU inputs (the viewer's running means, DLPack arrays) are not downloaded for these scans:
+    // denoiseCuda counts the non-finite pixels and checks the variance on the GPU
+    // (checkDeviceVariance). Only the noise estimate below needs the colour on the host.
+    const bool colorOnHost = color.device() == Device::Cpu;
     rep.nonFinitePixels = 0;
-    for (size_t i = 0; i < ch.plane(); ++i) {
-        if (!std::isfinite(ch.data()[i]) || !std::isfinite(ch.data()[i + ch.plane()]) ||
-            !std::isfinite(ch.data()[i + 2 * ch.plane()]))
-            ++rep.nonFinitePixels;
+    if (colorOnHost) {
+        for (size_t i = 0; i < color.plane(); ++i) {
+            if (!std::isfinite(color.data()[i]) || !std::isfinite(color.data()[i + color.plane()]) ||
+                !std::isfinite(color.data()[i + 2 * color.plane()]))
+                ++rep.nonFinitePixels;
+        }
     }
     std::string used = "color";
     if (in.variance) {
-        const Image varHost = in.variance->device() == Device::Cpu ? Image() : in.variance->to(Device::Cpu);
-        const Image& vh = in.variance->device() == Device::Cpu ? *in.variance : varHost;
-        for (size_t i = 0; i < 3 * vh.plane(); ++i)
-            if (vh.data()[i] < 0) {
-                const size_t px = i % vh.plane();
-                throw InputError("variance buffer has a negative value (" + std::to_string(vh.data()[i]) + ") at pixel (" +
-                                 std::to_string(px % vh.width()) + ", " + std::to_string(px / vh.width()) + ")");
-            }
+        if (in.variance->device() == Device::Cpu) {
+            const Image& vh = *in.variance;
+            for (size_t i = 0; i < 3 * vh.plane(); ++i)
+                if (vh.data()[i] < 0) throw negativeVarianceError(vh.data()[i], i % vh.plane(), vh.width());
+        }
         used += ",variance";
         rep.noiseEstimated = false;
     } else {
         // No variance: Donoho's MAD estimate, constant over the image.
+        const Image colorHost = colorOnHost ? Image() : color.to(Device::Cpu);
+        const Image& ch = colorOnHost ? color : colorHost;
         estimateNoiseSigma(ch, rep.noiseSigma);
         rep.noiseEstimated = true;
         p.estimatedVariance = Image(color.width(), color.height(), 3, Device::Cpu);

@@ -2,6 +2,7 @@
 // (src/cuda/cuda_denoise.cu) and the white-box tests.
 #pragma once
 #include "atrous/denoise.h"
+#include "atrous/error.h"
 #include "atrous/image.h"
 #include "filters/denoise_driver.h"
 
@@ -17,8 +18,11 @@ struct DriverDebug {
 };
 
 // Validates sizes, channels, negative variance and parameters (InputError), counts non-finite
-// colour pixels and estimates the noise when there is no variance buffer.
+// colour pixels and estimates the noise when there is no variance buffer. For inputs on the GPU
+// the non-finite count and the negative-variance check are left to denoiseCuda (no download).
 PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, DenoiseReport& rep);
+// The InputError for a negative variance value at planar index `pixel` (of one plane).
+InputError negativeVarianceError(float value, size_t pixel, int width);
 DriverConfig makeConfig(const DenoiseOptions& o);
 // Per-channel noise standard deviation by Donoho's MAD of the finest B3 detail.
 void estimateNoiseSigma(const Image& color, float sigma[3]);
