@@ -25,6 +25,7 @@
 
 #include "atrous/error.h"
 #include "core/parallel.h"
+#include "cpu/cpu_simd.h"
 #include "filters/eaw.h"
 
 namespace atrous::filters {
@@ -34,22 +35,8 @@ bool& eawCpuFastPath() {
     return enabled;
 }
 
-#if defined(__GNUC__) && !defined(__clang__) && (defined(__x86_64__) || defined(__i386__))
-#define ATROUS_EAW_AVX512 1
-// Row loops compiled for AVX-512 (F/VL/BW/DQ: the subset every AVX-512 core has) with 512-bit
-// vectors; the inlined shared functors take the caller's target, so the math is the same code.
-#define ATROUS_TARGET_AVX512 __attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,prefer-vector-width=512")))
-#else
-#define ATROUS_EAW_AVX512 0
-#endif
-
 bool& eawCpuAvx512() {
-#if ATROUS_EAW_AVX512
-    static bool enabled = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
-                          __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq");
-#else
-    static bool enabled = false;
-#endif
+    static bool enabled = cpuHasAvx512();
     return enabled;
 }
 
@@ -226,7 +213,7 @@ void colorRecipAvx2(const EawLevelParams& P, const float* S, float* r, size_t i0
     colorRecipBody(P, S, r, i0, i1);
 }
 
-#if ATROUS_EAW_AVX512
+#if ATROUS_CPU_AVX512
 template <bool kPropagate, bool kDepth, bool kIds>
 ATROUS_TARGET_AVX512 void levelRowsAvx512(const EawLevel& f, const float* rS, int y0, int y1) {
     levelRowsBody<kPropagate, kDepth, kIds>(f, rS, y0, y1);
@@ -240,7 +227,7 @@ using LevelRowsFn = void (*)(const EawLevel&, const float*, int, int);
 
 template <bool kPropagate, bool kDepth, bool kIds>
 LevelRowsFn pickLevelRows(bool avx512) {
-#if ATROUS_EAW_AVX512
+#if ATROUS_CPU_AVX512
     if (avx512) return &levelRowsAvx512<kPropagate, kDepth, kIds>;
 #else
     (void)avx512;
@@ -273,7 +260,7 @@ void runEawLevel(const CpuExec& exec, const EawLevel& f) {
     const float* S = f.S.channel(0);
     const size_t count = size_t(w) * h;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 16384), [&](const tbb::blocked_range<size_t>& b) {
-#if ATROUS_EAW_AVX512
+#if ATROUS_CPU_AVX512
         if (avx512) {
             colorRecipAvx512(f.p, S, r, b.begin(), b.end());
             return;

@@ -7,7 +7,48 @@
 #pragma once
 #include "filters/svgf_common.h"
 
+namespace atrous {
+struct CpuExec;
+}
+
 namespace atrous::svgf {
+
+// Per-tap math of the à-trous level, shared by Atrous::operator() (both backends) and the CPU
+// fast path (src/cpu/svgf_atrous_cpu.cpp) so that they compute the same thing. Branch-free
+// (selectF) so the CPU row loops vectorise.
+
+// A tap whose geometry log-weight is below this is dropped (weight < 4e-18 of the centre's).
+constexpr float kAtrousMinLogWeight = -40.0f;
+
+// 1/(σ_l sqrt(g3x3(var)_p) + ε) of the luminance stop. ε keeps the stop finite where the variance
+// is exactly 0 (then only equal luminance passes).
+ATROUS_FORCE_INLINE ATROUS_INLINE float atrousLumStopRecip(float sigmaL, float prefilteredVar) {
+    return 1.0f / fmaf(sigmaL, sqrtf(selectF(prefilteredVar > 0.0f, prefilteredVar, 0.0f)), 1e-10f);
+}
+
+// Luminance of an illumination value (plain floats: the CPU row loops must not construct a Vec3
+// themselves, see svgf_atrous_cpu.cpp). Multiply-adds are explicit fmaf here and below, so every
+// backend rounds the same way (see dotFma in svgf_common.h).
+ATROUS_FORCE_INLINE ATROUS_INLINE float atrousLuminance(float r, float g, float b) {
+    return fmaf(0.0722f, b, fmaf(0.7152f, g, 0.2126f * r));  // Rec. 709, as luminance()
+}
+
+// Depth and normal stops of tap q at pixel offset (dx, dy), as one log-weight.
+ATROUS_FORCE_INLINE ATROUS_INLINE float atrousGeometryLogWeight(float zp, float zq, float gx, float gy, float npx, float npy, float npz,
+                                            float nqx, float nqy, float nqz, float dx, float dy, float sigmaZ,
+                                            float sigmaN) {
+    return depthLogWeight(zp, zq, gx, gy, dx, dy, sigmaZ) +
+           normalLogWeight(Vec3(npx, npy, npz), Vec3(nqx, nqy, nqz), sigmaN);
+}
+
+// w of tap q: h(q) exp(lwGeo - |l_p - l_q| / (σ_l sqrt(g3x3(var)_p) + ε)), hxy = h(q); 0 where q
+// is empty (history length 0) or across an edge (lwGeo < kAtrousMinLogWeight). lwGeo = 0 for the
+// centre tap.
+ATROUS_FORCE_INLINE ATROUS_INLINE float atrousTapWeight(float hxy, float lwGeo, float lp, float lq, float invLumDenom, float lenq) {
+    const float lw = fmaf(-fabsf(lp - lq), invLumDenom, lwGeo);
+    const float wq = hxy * fastExp(lw);
+    return selectF(!(lenq <= 0.0f) & !(lwGeo < kAtrousMinLogWeight), wq, 0.0f);
+}
 
 struct Atrous {
     float sigmaL = 4.0f, sigmaN = 128.0f, sigmaZ = 1.0f;
@@ -29,7 +70,7 @@ struct Atrous {
                 int qx = x + i;
                 if (qx < 0 || qx >= variance.width) continue;
                 float k = (i == 0 ? 0.5f : 0.25f) * (j == 0 ? 0.5f : 0.25f);
-                sum += k * variance(qx, qy, 0);
+                sum = fmaf(k, variance(qx, qy, 0), sum);
                 sumK += k;
             }
         }
@@ -39,12 +80,11 @@ struct Atrous {
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         const int w = illum.width, h = illum.height;
         Vec3 cp = readVec3(illum, x, y);
-        float lp = luminance(cp);
+        float lp = atrousLuminance(cp.x, cp.y, cp.z);
         float zp = depth(x, y, 0);
         Vec3 np = readVec3(normal, x, y);
         float gx = depthGrad(x, y, 0), gy = depthGrad(x, y, 1);
-        // ε keeps the stop finite where the variance is exactly 0 (then only equal luminance passes).
-        float invLumDenom = 1.0f / (sigmaL * sqrtf(maxf(prefilteredVariance(x, y), 0.0f)) + 1e-10f);
+        float invLumDenom = atrousLumStopRecip(sigmaL, prefilteredVariance(x, y));
 
         Vec3 sumC(0.0f);
         float sumV = 0.0f, sumW = 0.0f;
@@ -55,20 +95,22 @@ struct Atrous {
             for (int i = -2; i <= 2; ++i) {
                 int qx = x + i * step;
                 if (qx < 0 || qx >= w) continue;
-                if (length(qx, qy, 0) <= 0.0f) continue;  // empty pixel: contributes nothing
-                float lw = 0.0f;
+                // Dropped taps (empty pixel, across an edge) skip their loads here; the CPU fast
+                // path gives them weight 0 instead, which adds exactly nothing.
+                const float lenq = length(qx, qy, 0);
+                if (lenq <= 0.0f) continue;  // empty pixel: contributes nothing
+                float lwGeo = 0.0f;
                 if (i != 0 || j != 0) {
-                    float dx = float(i * step), dy = float(j * step);
                     // Geometry first: across an edge the tap is dropped without touching its colour.
-                    lw = depthLogWeight(zp, depth(qx, qy, 0), gx, gy, dx, dy, sigmaZ) +
-                         normalLogWeight(np, readVec3(normal, qx, qy), sigmaN);
-                    if (lw < -40.0f) continue;  // weight < 4e-18 of the centre's
+                    lwGeo = atrousGeometryLogWeight(zp, depth(qx, qy, 0), gx, gy, np.x, np.y, np.z, normal(qx, qy, 0),
+                                                    normal(qx, qy, 1), normal(qx, qy, 2), float(i * step),
+                                                    float(j * step), sigmaZ, sigmaN);
+                    if (lwGeo < kAtrousMinLogWeight) continue;
                 }
                 Vec3 cq = readVec3(illum, qx, qy);
-                lw -= fabsf(lp - luminance(cq)) * invLumDenom;
-                float wq = hy * b3Tap(i) * fastExp(lw);
-                sumC += wq * cq;
-                sumV += wq * wq * variance(qx, qy, 0);
+                float wq = atrousTapWeight(hy * b3Tap(i), lwGeo, lp, atrousLuminance(cq.x, cq.y, cq.z), invLumDenom, lenq);
+                sumC = Vec3(fmaf(wq, cq.x, sumC.x), fmaf(wq, cq.y, sumC.y), fmaf(wq, cq.z, sumC.z));
+                sumV = fmaf(wq * wq, variance(qx, qy, 0), sumV);
                 sumW += wq;
             }
         }
@@ -82,5 +124,19 @@ struct Atrous {
         outVariance(x, y, 0) = sumV * inv * inv;
     }
 };
+
+// Runs one level on `exec`. The generic version launches the functor (CudaExec); the CpuExec
+// overload (src/cpu/svgf_atrous_cpu.cpp) runs vectorised row loops with the same math.
+template <class Exec>
+void runSvgfAtrous(const Exec& exec, const Atrous& f) {
+    exec.forEachPixel(f.illum.width, f.illum.height, f);
+}
+void runSvgfAtrous(const CpuExec& exec, const Atrous& f);
+
+// The CPU fast path is on by default; tests switch it off to compare with the generic functor.
+bool& svgfCpuFastPath();
+// Its AVX-512 row loops: on where the CPU has AVX-512 (F/VL/BW/DQ); tests switch it off to run
+// the AVX2 loops too. Setting it on a CPU without AVX-512 is not allowed.
+bool& svgfCpuAvx512();
 
 }  // namespace atrous::svgf

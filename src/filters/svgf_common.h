@@ -5,6 +5,7 @@
 
 #include "atrous/image.h"
 #include "core/math.h"
+#include "filters/filter_math.h"  // ATROUS_FORCE_INLINE
 
 namespace atrous::svgf {
 
@@ -46,45 +47,105 @@ ATROUS_INLINE Vec3 sanitizedEmission(const ImageView& emission, int x, int y) {
     return Vec3(finiteOr(e.x, 0.0f), finiteOr(e.y, 0.0f), finiteOr(e.z, 0.0f));
 }
 
-ATROUS_INLINE bool hasNormal(Vec3 n) { return dot(n, n) > 0.25f; }
+// a·b with every multiply-add written as fmaf. The edge-stop math below spells out its FMAs so
+// that no compiler is free to contract a·b + c differently: the CPU row loops, the scalar functor
+// and the GPU then round identically (bit-equal CPU paths; measured with GCC 12), which matters
+// because σ_n = 128 multiplies the rounding of n_p·n_q and the exponentials that of their argument.
+ATROUS_INLINE float dotFma(Vec3 a, Vec3 b) { return fmaf(a.z, b.z, fmaf(a.y, b.y, a.x * b.x)); }
+
+ATROUS_INLINE bool hasNormal(Vec3 n) { return dotFma(n, n) > 0.25f; }
+
+// c ? a : b for the edge-stopping math. On the host a bit mask: GCC turns a plain `?:` (or
+// fmaxf/floorf) into a branch inside the CPU row loops and then refuses to vectorise them
+// (src/cpu/svgf_atrous_cpu.cpp); the result is the same value either way. Arguments are
+// evaluated unconditionally, so both must be safe to compute (an Inf or NaN in the unused one is
+// harmless).
+ATROUS_FORCE_INLINE ATROUS_INLINE float selectF(bool c, float a, float b) {
+#if ATROUS_ON_DEVICE
+    return c ? a : b;
+#else
+    int ai, bi;
+    memcpy(&ai, &a, sizeof(float));
+    memcpy(&bi, &b, sizeof(float));
+    const int m = -int(c);  // all ones or 0
+    const int ri = (ai & m) | (bi & ~m);
+    float r;
+    memcpy(&r, &ri, sizeof(float));
+    return r;
+#endif
+}
+
+// Smallest normal float: fastLog's argument is clamped here (its exponent trick needs a normal
+// number); log(1.2e-38) = -87.3, so σ_n log d already gives a weight of 0 for any σ_n >= 1.
+constexpr float kMinNormalFloat = 1.17549435e-38f;
+
+// ln(d) for finite d >= kMinNormalFloat, to ~1.5e-7 relative on (0, 1] (the float rounding of
+// s below; the series' truncation is 2e-9). Plain arithmetic, identical on host and device (so
+// the two backends agree to float rounding, like fastExp), and branch-free so the CPU row loops
+// vectorise (libm's logf is a call that does not; it was ~25% of the à-trous taps' time).
+// d = m·2^e with m in [√½, √2) read from the bits, then ln m = 2 atanh(s), s = (m − 1)/(m + 1),
+// |s| <= 0.1716: the odd series 2s(1 + s²/3 + s⁴/5 + s⁶/7 + s⁸/9).
+ATROUS_FORCE_INLINE ATROUS_INLINE float fastLog(float d) {
+    int bits;
+    memcpy(&bits, &d, sizeof(float));
+    const int e = (bits - 0x3f3504f3) >> 23;  // 0x3f3504f3 = √½: e = 0 for d in [√½, √2)
+    bits -= e * (1 << 23);                    // m = d / 2^e
+    float m;
+    memcpy(&m, &bits, sizeof(float));
+    const float s = (m - 1.0f) / (m + 1.0f);
+    const float s2 = s * s;
+    const float p = s2 * fmaf(s2, fmaf(s2, fmaf(s2, 0.111111111f, 0.142857143f), 0.2f), 0.333333333f);
+    const float s2x = 2.0f * s;
+    return fmaf(float(e), 0.693147181f, fmaf(s2x, p, s2x));
+}
 
 // Normal edge stop, as a log-weight: σ_n log max(0, n_p·n_q). Two background (zero) normals
-// match; a zero normal against a real one does not.
-ATROUS_INLINE float normalLogWeight(Vec3 np, Vec3 nq, float sigmaN) {
-    bool hp = hasNormal(np), hq = hasNormal(nq);
-    if (!hp || !hq) return (hp == hq) ? 0.0f : -1e30f;
-    float d = dot(np, nq);
-    if (d <= 0.0f) return -1e30f;
-    return d >= 1.0f ? 0.0f : sigmaN * logf(d);
+// match; a zero normal against a real one does not. Written with selects (see selectF).
+ATROUS_FORCE_INLINE ATROUS_INLINE float normalLogWeight(Vec3 np, Vec3 nq, float sigmaN) {
+    const bool hp = hasNormal(np), hq = hasNormal(nq);
+    const float d = dotFma(np, nq);
+    // d >= 1 (unit normals, rounding) gives exactly 0: fastLog(1) = 0.
+    float dc = selectF(d < 1.0f, d, 1.0f);
+    dc = selectF(dc > kMinNormalFloat, dc, kMinNormalFloat);
+    const float lw = selectF(d > 0.0f, sigmaN * fastLog(dc), -1e30f);
+    return selectF(hp & hq, lw, selectF(hp == hq, 0.0f, -1e30f));
 }
 
 // Depth edge stop, as a log-weight: -|z_p - z_q| / (σ_z |∇z_p·(p - q)| + ε). ε is relative to
 // the depth (1e-3 z_p) so that the rule does not depend on the scene's units; two background
-// pixels match, background against surface does not.
-ATROUS_INLINE float depthLogWeight(float zp, float zq, float gx, float gy, float dx, float dy, float sigmaZ) {
-    bool bp = isBackground(zp), bq = isBackground(zq);
-    if (bp || bq) return (bp == bq) ? 0.0f : -1e30f;
-    float denom = sigmaZ * fabsf(gx * dx + gy * dy) + 1e-3f * fabsf(zp) + 1e-8f;
-    return -fabsf(zp - zq) / denom;
+// pixels match, background against surface does not. Written with selects (see selectF).
+ATROUS_FORCE_INLINE ATROUS_INLINE float depthLogWeight(float zp, float zq, float gx, float gy, float dx, float dy, float sigmaZ) {
+    const bool bp = isBackground(zp), bq = isBackground(zq);
+    const float denom = fmaf(sigmaZ, fabsf(fmaf(gx, dx, gy * dy)), fmaf(1e-3f, fabsf(zp), 1e-8f));
+    const float lw = -fabsf(zp - zq) / denom;
+    return selectF(bp | bq, selectF(bp == bq, 0.0f, -1e30f), lw);
 }
 
-// e^x for the edge-stopping weights, to ~2e-7 relative error (below float rounding of the sums it
-// feeds), 0 below e^-87. Plain arithmetic instead of expf: several times faster on the CPU, where
-// the à-trous taps spend most of their time in expf, and identical on host and device so the two
-// backends agree to float rounding.
-ATROUS_INLINE float fastExp(float x) {
-    if (!(x > -87.0f)) return 0.0f;  // also NaN -> 0
-    x = minf(x, 88.0f);
-    float t = x * 1.44269504f;  // log2(e)
-    float k = floorf(t + 0.5f);
-    float f = t - k;            // in [-0.5, 0.5]
+// e^x for the edge-stopping weights, to ~2e-7 relative error (plus 1.6e-8·|x log2 e| from the
+// rounding of the constant log2 e), 0 at or below -87 (and for NaN). Plain arithmetic instead of expf: several times faster
+// on the CPU, identical on host and device so the two backends agree to float rounding, and
+// branch-free (selects, no floorf) so the CPU row loops vectorise.
+ATROUS_FORCE_INLINE ATROUS_INLINE float fastExp(float x) {
+    const bool keep = x > -87.0f;  // false for NaN
+    x = selectF(keep, x, -87.0f);
+    x = selectF(x < 88.0f, x, 88.0f);
+    // t = x log2(e) in [-125.6, 127]; k = nearest integer to t: truncation of a positive number is
+    // floor, hence the offset 128 (rounding can give k one too large right below a half-integer;
+    // f is then 2^-16 beyond -0.5, where the series is just as accurate). f = t - k with the
+    // exact product (one rounding), so the result does not lose ulp(t) ~ 1e-5 at |t| ~ 100.
+    const int k = int(fmaf(x, 1.44269504f, 128.5f)) - 128;
+    const float f = fmaf(x, 1.44269504f, -float(k));  // in [-0.5, 0.5]
     // 2^f by its Taylor series in f ln 2 to degree 6 (remainder < 1.3e-7 on [-0.5, 0.5]).
-    float p = 1.0f + f * (0.693147181f + f * (0.240226507f + f * (0.0555041087f + f * (0.00961812911f +
-                     f * (0.00133335581f + f * 0.000154035304f)))));
-    int bits = (int(k) + 127) << 23;  // 2^k, k in [-126, 127]
+    float p = fmaf(f, 0.000154035304f, 0.00133335581f);
+    p = fmaf(f, p, 0.00961812911f);
+    p = fmaf(f, p, 0.0555041087f);
+    p = fmaf(f, p, 0.240226507f);
+    p = fmaf(f, p, 0.693147181f);
+    p = fmaf(f, p, 1.0f);
+    const int bits = (k + 127) << 23;  // 2^k, k in [-125, 127]
     float scale;
     memcpy(&scale, &bits, sizeof(float));
-    return p * scale;
+    return selectF(keep, p * scale, 0.0f);
 }
 
 // B3-spline taps [1, 4, 6, 4, 1] / 16.

@@ -172,7 +172,7 @@ public:
             at.depth = s.depth.view(), at.normal = s.normal.view(), at.depthGrad = s.depthGrad.view();
             at.outIllum = level == mParams.feedbackTap ? s.nextHistIllum.view() : s.levelIllum[level & 1].view();
             at.outVariance = s.levelVariance[level & 1].view();
-            mExec.forEachPixel(w, h, at);
+            runSvgfAtrous(mExec, at);
             filters::markStage(clock, "level", level);
             inIllum = at.outIllum;
             inVar = at.outVariance;
