@@ -5,13 +5,17 @@
 // many frames after a warm-up long enough for the histories to fill, and the median process CPU
 // time per frame (all threads together; robust to other load on a shared machine).
 //
-//   build/bench/bench_svgf [--device cpu|cuda] [--runs N] [--warmup N] [--taa]
+// With --stages also the median per-stage milliseconds (SvgfReport::stages; the timing itself
+// costs ~1 µs per frame).
+//
+//   build/bench/bench_svgf [--device cpu|cuda] [--runs N] [--warmup N] [--taa] [--stages]
 #include <time.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <string>
@@ -77,7 +81,7 @@ double processCpuMs() {
 int main(int argc, char** argv) {
     int runs = 15, warmup = 6;
     std::string deviceName_ = "cpu";
-    bool taa = false;
+    bool taa = false, stages = false;
     for (int i = 1; i < argc; ++i) {
         if (!std::strcmp(argv[i], "--runs") && i + 1 < argc)
             runs = std::atoi(argv[++i]);
@@ -87,8 +91,10 @@ int main(int argc, char** argv) {
             deviceName_ = argv[++i];
         else if (!std::strcmp(argv[i], "--taa"))
             taa = true;
+        else if (!std::strcmp(argv[i], "--stages"))
+            stages = true;
         else {
-            std::fprintf(stderr, "usage: bench_svgf [--device cpu|cuda] [--runs N] [--warmup N] [--taa]\n");
+            std::fprintf(stderr, "usage: bench_svgf [--device cpu|cuda] [--runs N] [--warmup N] [--taa] [--stages]\n");
             return 2;
         }
     }
@@ -108,6 +114,10 @@ int main(int argc, char** argv) {
             std::vector<Frame> frames;
             for (int t = 0; t < 4; ++t) frames.push_back(makeFrame(w, h, t, device));
             SvgfDenoiser denoiser(params, device);
+            SvgfReport report;
+            if (stages) denoiser.setReport(&report);
+            std::vector<std::string> stageOrder;
+            std::map<std::string, std::vector<double>> stageMs;
             std::vector<double> ms, cpuMs;
             for (int i = 0; i < warmup + runs; ++i) {
                 const Frame& f = frames[i % frames.size()];
@@ -120,12 +130,21 @@ int main(int argc, char** argv) {
                 if (i >= warmup) {
                     ms.push_back(timer.ms());
                     cpuMs.push_back(processCpuMs() - cpu0);
+                    for (const StageTime& st : report.stages) {
+                        if (!stageMs.count(st.name)) stageOrder.push_back(st.name);
+                        stageMs[st.name].push_back(st.milliseconds);
+                    }
                 }
             }
             double mn = *std::min_element(ms.begin(), ms.end());
-            out["results"].push_back({{"width", w}, {"height", h}, {"runs", runs}, {"warmup", warmup},
-                                      {"ms_median", median(ms)}, {"ms_min", mn},
-                                      {"cpu_ms_median", median(cpuMs)}});
+            nlohmann::json r = {{"width", w}, {"height", h}, {"runs", runs}, {"warmup", warmup},
+                                {"ms_median", median(ms)}, {"ms_min", mn}, {"cpu_ms_median", median(cpuMs)}};
+            if (stages) {
+                nlohmann::json st = nlohmann::json::array();  // in the pipeline's order
+                for (const std::string& name : stageOrder) st.push_back({{"stage", name}, {"ms_median", median(stageMs[name])}});
+                r["stages"] = st;
+            }
+            out["results"].push_back(r);
         }
         std::printf("%s\n", out.dump(2).c_str());
     } catch (const std::exception& e) {

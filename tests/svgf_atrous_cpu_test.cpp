@@ -158,6 +158,39 @@ TEST(SvgfFastMath, NormalStopMatchesThePowerItStandsFor) {
     EXPECT_EQ(svgf::normalLogWeight(a, zero, 128.0f), -1e30f);
 }
 
+// The scalar stops (with early returns, used by the variance functor) and their branch-free twins
+// (used by the à-trous) must give the same value, bit for bit, in every case.
+TEST(SvgfFastMath, ScalarAndSelectStopsAreEqual) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    auto randomNormal = [&](int kind) {
+        if (kind == 0) return Vec3(0.0f);                     // missing / background
+        if (kind == 1) return Vec3(0.0f, 0.0f, 1.0f);         // exactly equal pairs
+        return normalize(Vec3(u(rng), u(rng), u(rng) + 2.0f));  // near +z, some pairs at d >= 1
+    };
+    int cases[4] = {0, 0, 0, 0};  // background pair, mismatch, d >= 1 or d <= 0, 0 < d < 1
+    for (int i = 0; i < 20000; ++i) {
+        const Vec3 a = randomNormal(i % 5 == 0 ? 0 : (i % 7 == 0 ? 1 : 2));
+        const Vec3 b = randomNormal(i % 11 == 0 ? 0 : (i % 3 == 0 ? 1 : 2));
+        const Vec3 bb = i % 13 == 0 ? -1.0f * b : b;  // some opposite pairs
+        for (float sigmaN : {0.0f, 1.0f, 128.0f}) {
+            const float s1 = svgf::normalLogWeight(a, bb, sigmaN), s2 = svgf::normalLogWeightSel(a, bb, sigmaN);
+            ASSERT_EQ(s1, s2) << i;
+        }
+        const bool ha = svgf::hasNormal(a), hb = svgf::hasNormal(bb);
+        const float d = svgf::dotFma(a, bb);
+        ++cases[!ha && !hb ? 0 : (ha != hb ? 1 : ((d >= 1.0f || d <= 0.0f) ? 2 : 3))];
+    }
+    for (int c = 0; c < 4; ++c) EXPECT_GT(cases[c], 100) << "case " << c << " not exercised";
+    for (int i = 0; i < 2000; ++i) {
+        const float zp = i % 9 == 0 ? 1e30f : 1.0f + 3.0f * (u(rng) + 1.0f);
+        const float zq = i % 4 == 0 ? 1e30f : 1.0f + 3.0f * (u(rng) + 1.0f);
+        const float gx = u(rng), gy = u(rng), dx = float(i % 5 - 2), dy = float(i % 7 - 3);
+        ASSERT_EQ(svgf::depthLogWeight(zp, zq, gx, gy, dx, dy, 0.7f), svgf::depthLogWeightSel(zp, zq, gx, gy, dx, dy, 0.7f))
+            << i;
+    }
+}
+
 // The core check: fast path == functor through plain loops, for every step, odd sizes, images
 // smaller than the kernel's reach (4·step), and parameter sets that exercise each stop.
 //

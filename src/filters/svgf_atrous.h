@@ -37,8 +37,8 @@ ATROUS_FORCE_INLINE ATROUS_INLINE float atrousLuminance(float r, float g, float 
 ATROUS_FORCE_INLINE ATROUS_INLINE float atrousGeometryLogWeight(float zp, float zq, float gx, float gy, float npx, float npy, float npz,
                                             float nqx, float nqy, float nqz, float dx, float dy, float sigmaZ,
                                             float sigmaN) {
-    return depthLogWeight(zp, zq, gx, gy, dx, dy, sigmaZ) +
-           normalLogWeight(Vec3(npx, npy, npz), Vec3(nqx, nqy, nqz), sigmaN);
+    return depthLogWeightSel(zp, zq, gx, gy, dx, dy, sigmaZ) +
+           normalLogWeightSel(Vec3(npx, npy, npz), Vec3(nqx, nqy, nqz), sigmaN);
 }
 
 // w of tap q: h(q) exp(lwGeo - |l_p - l_q| / (σ_l sqrt(g3x3(var)_p) + ε)), hxy = h(q); 0 where q

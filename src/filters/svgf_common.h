@@ -100,11 +100,23 @@ ATROUS_FORCE_INLINE ATROUS_INLINE float fastLog(float d) {
 }
 
 // Normal edge stop, as a log-weight: σ_n log max(0, n_p·n_q). Two background (zero) normals
-// match; a zero normal against a real one does not. Written with selects (see selectF).
-ATROUS_FORCE_INLINE ATROUS_INLINE float normalLogWeight(Vec3 np, Vec3 nq, float sigmaN) {
+// match; a zero normal against a real one does not. Written for scalar code (the per-pixel
+// functors): only the case that applies is computed. normalLogWeightSel is the same value
+// without branches, for the vectorised loops.
+ATROUS_INLINE float normalLogWeight(Vec3 np, Vec3 nq, float sigmaN) {
+    const bool hp = hasNormal(np), hq = hasNormal(nq);
+    if (!hp || !hq) return (hp == hq) ? 0.0f : -1e30f;
+    const float d = dotFma(np, nq);
+    if (!(d > 0.0f)) return -1e30f;
+    if (!(d < 1.0f)) return 0.0f;  // unit normals, rounding: as σ_n fastLog(1) = 0
+    return sigmaN * fastLog(maxf(d, kMinNormalFloat));
+}
+
+// normalLogWeight with selects (see selectF): every case computed, the one that applies kept.
+ATROUS_FORCE_INLINE ATROUS_INLINE float normalLogWeightSel(Vec3 np, Vec3 nq, float sigmaN) {
     const bool hp = hasNormal(np), hq = hasNormal(nq);
     const float d = dotFma(np, nq);
-    // d >= 1 (unit normals, rounding) gives exactly 0: fastLog(1) = 0.
+    // d >= 1 gives exactly 0: fastLog(1) = 0.
     float dc = selectF(d < 1.0f, d, 1.0f);
     dc = selectF(dc > kMinNormalFloat, dc, kMinNormalFloat);
     const float lw = selectF(d > 0.0f, sigmaN * fastLog(dc), -1e30f);
@@ -113,11 +125,22 @@ ATROUS_FORCE_INLINE ATROUS_INLINE float normalLogWeight(Vec3 np, Vec3 nq, float 
 
 // Depth edge stop, as a log-weight: -|z_p - z_q| / (σ_z |∇z_p·(p - q)| + ε). ε is relative to
 // the depth (1e-3 z_p) so that the rule does not depend on the scene's units; two background
-// pixels match, background against surface does not. Written with selects (see selectF).
-ATROUS_FORCE_INLINE ATROUS_INLINE float depthLogWeight(float zp, float zq, float gx, float gy, float dx, float dy, float sigmaZ) {
+// pixels match, background against surface does not. depthLogWeightSel: the same without branches.
+ATROUS_FORCE_INLINE ATROUS_INLINE float depthLogWeightDenom(float zp, float gx, float gy, float dx, float dy,
+                                                             float sigmaZ) {
+    return fmaf(sigmaZ, fabsf(fmaf(gx, dx, gy * dy)), fmaf(1e-3f, fabsf(zp), 1e-8f));
+}
+
+ATROUS_INLINE float depthLogWeight(float zp, float zq, float gx, float gy, float dx, float dy, float sigmaZ) {
     const bool bp = isBackground(zp), bq = isBackground(zq);
-    const float denom = fmaf(sigmaZ, fabsf(fmaf(gx, dx, gy * dy)), fmaf(1e-3f, fabsf(zp), 1e-8f));
-    const float lw = -fabsf(zp - zq) / denom;
+    if (bp || bq) return (bp == bq) ? 0.0f : -1e30f;
+    return -fabsf(zp - zq) / depthLogWeightDenom(zp, gx, gy, dx, dy, sigmaZ);
+}
+
+ATROUS_FORCE_INLINE ATROUS_INLINE float depthLogWeightSel(float zp, float zq, float gx, float gy, float dx, float dy,
+                                                           float sigmaZ) {
+    const bool bp = isBackground(zp), bq = isBackground(zq);
+    const float lw = -fabsf(zp - zq) / depthLogWeightDenom(zp, gx, gy, dx, dy, sigmaZ);
     return selectF(bp | bq, selectF(bp == bq, 0.0f, -1e30f), lw);
 }
 
