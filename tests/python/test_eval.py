@@ -120,14 +120,51 @@ def test_missing_pyoidn_skips_its_column_with_a_note(tmp_path, monkeypatch):
 
 
 def test_cli_rejects_bad_flags():
-    with pytest.raises(SystemExit):
-        ev.parse_args(["--spp", "4,x"])
-    with pytest.raises(SystemExit):
-        ev.parse_args(["--scenes", "no-such-scene"])
-    with pytest.raises(SystemExit):
-        ev.parse_args(["--methods", "eaw,magic"])
+    for argv in (["--spp", "4,x"], ["--scenes", "no-such-scene"], ["--methods", "eaw,magic"]):
+        with pytest.raises(SystemExit) as e:
+            ev.parse_args(argv)
+        assert e.value.code == 2, argv
     cfg = ev.parse_args(["--size", "96x48", "--spp", "2,8", "--ref-spp", "512", "--resolutions", "0"])
     assert (cfg.width, cfg.height, cfg.spp, cfg.ref_spp, cfg.resolutions) == (96, 48, [2, 8], 512, [])
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["--spp", "0"], "--spp"),
+    (["--scenes", "nosuch"], "--scenes"),
+    (["--methods", "foo"], "--methods"),
+    (["--size", "-4"], "--size"),
+    (["--runs", "-1"], "--runs"),
+    (["--runs", "abc"], "--runs"),
+    (["--seed", "-3"], "--seed"),
+    (["--static-sequence", "-2"], "--static-sequence"),
+    (["--bogus-flag"], "--bogus-flag"),
+    (["--quick", "--sequence", "{tmp}/nosuchdir"], "--sequence"),
+    (["--quick", "--sequence", "{tmp}/emptyseq"], "no frame_NNNN"),
+    (["--quick", "--sequence", "{tmp}/seqnomotion"], "motion.exr"),
+])
+def test_cli_bad_input_exits_2_with_one_line_and_writes_nothing(tmp_path, capsys, argv, needle):
+    # Every argument is checked before any work (the quick run would take ~30 s before failing).
+    (tmp_path / "emptyseq").mkdir()
+    frame = tmp_path / "seqnomotion" / "frame_0000"
+    frame.mkdir(parents=True)
+    for name in ("color", "albedo", "normal", "position", "depth", "ids"):
+        (frame / f"{name}.exr").write_bytes(b"")  # existence is what the up-front check looks at
+    out = tmp_path / "out"
+    argv = [a.replace("{tmp}", str(tmp_path)) for a in argv] + ["--out", str(out)]
+    assert ev.main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("atrous-eval: error:") and needle in err[0], err
+    assert not out.exists()
+
+
+def test_cli_out_must_be_a_directory(tmp_path, capsys):
+    afile = tmp_path / "afile"
+    afile.write_text("x")
+    for out in (afile, afile / "sub"):
+        assert ev.main(["--quick", "--out", str(out)]) == 2
+        err = capsys.readouterr().err
+        assert "not a directory" in err and "Errno" not in err, err
+    assert afile.read_text() == "x"
 
 
 def test_sequence_frames_load_through_read_image_and_errors_name_the_file(tmp_path):
