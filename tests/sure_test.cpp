@@ -238,6 +238,49 @@ TEST(Sure, EstimatesTheNoiseWithoutAVarianceBuffer) {
     EXPECT_TRUE(allFinite(out));
 }
 
+TEST(Sure, IgnoresAnAllZeroVarianceBuffer) {
+    // A 1-spp render writes a variance of exactly 0 (a one-sample mean has no estimate). Taken at
+    // face value it says "noise-free" and both filters would return the noisy input unchanged;
+    // denoise() must ignore it, estimate the noise as without one, and say so in the report.
+    const int w = 64, h = 64;
+    Image y(w, h, 3), zero(w, h, 3);
+    zero.fill(0.0f);
+    std::mt19937 rng(5);
+    std::normal_distribution<float> g(0.0f, 0.05f);
+    for (int yy = 0; yy < h; ++yy)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c) y(x, yy, c) = 0.3f + 0.2f * std::sin(x * 0.1f) + g(rng);
+    for (DenoiseMethod m : {DenoiseMethod::Eaw, DenoiseMethod::Sure}) {
+        DenoiseInputs without, withZero;
+        without.color = withZero.color = &y;
+        withZero.variance = &zero;
+        DenoiseOptions o;
+        o.method = m;
+        DenoiseReport rep;
+        o.report = &rep;
+        Image a = denoise(withZero, o);
+        EXPECT_TRUE(rep.varianceIgnored);
+        EXPECT_TRUE(rep.noiseEstimated);
+        EXPECT_NE(rep.buffersUsed.find("variance(ignored"), std::string::npos) << rep.buffersUsed;
+        EXPECT_GT(maxAbsDiff(a, y), 0.05) << "the filter left the noisy input unchanged";
+        o.report = nullptr;
+        Image b = denoise(without, o);
+        // Same path as no variance at all: identical output (same code, same estimate).
+        EXPECT_EQ(maxAbsDiff(a, b), 0.0);
+    }
+    // One nonzero value is information: the buffer is used as given.
+    zero(3, 4, 1) = 1e-6f;
+    DenoiseInputs in;
+    in.color = &y;
+    in.variance = &zero;
+    DenoiseReport rep;
+    DenoiseOptions o;
+    o.report = &rep;
+    denoise(in, o);
+    EXPECT_FALSE(rep.varianceIgnored);
+    EXPECT_FALSE(rep.noiseEstimated);
+}
+
 TEST(Sure, QualityOnSyntheticScene) {
     // 64×64 piecewise-smooth scene with features, noise σ ≈ 0.3·sqrt(0.02 + t) (a 16-spp-like
     // level). Measured (printed): EAW ~60x, SURE ~33x (the features here explain every edge, so

@@ -104,6 +104,9 @@ struct DenoiseOptions {
 // What a denoise() call did, for the CLI and for measurements.
 struct DenoiseReport {
     bool noiseEstimated = false;  // no variance buffer: noise estimated by Donoho's MAD
+    // A variance buffer was given but was zero everywhere (a 1-spp render has no variance
+    // estimate): it was ignored and the noise estimated as without one.
+    bool varianceIgnored = false;
     float noiseSigma[3] = {0, 0, 0};  // the estimated per-channel standard deviation
     int nonFinitePixels = 0;          // colour samples that were NaN/Inf (treated as missing)
     int firefliesClamped = 0;

@@ -230,11 +230,36 @@ Image denoiseCpu(const DenoiseInputs& in, const DenoiseOptions& o, const Prepare
 
 }  // namespace filters
 
-Image denoise(const DenoiseInputs& inputs, const DenoiseOptions& options) {
+namespace {
+
+// True when a host variance buffer holds no information: every value is 0 (or non-finite, which the
+// filters treat as missing). A renderer at 1 sample per pixel writes exactly that (a one-sample
+// mean has no variance estimate), and taken at face value it tells the filters the image is
+// noise-free, so they would return it unchanged. A converged image still has tiny nonzero values.
+bool varianceIsEmpty(const Image& v) {
+    if (v.device() != Device::Cpu) return false;  // GPU buffers are taken as given
+    const float* d = v.data();
+    for (size_t i = 0, n = v.plane() * size_t(std::min(v.channels(), 3)); i < n; ++i)
+        if (d[i] != 0.0f && std::isfinite(d[i])) return false;
+    return true;
+}
+
+}  // namespace
+
+Image denoise(const DenoiseInputs& given, const DenoiseOptions& options) {
     DenoiseReport local;
     DenoiseReport& rep = options.report ? *options.report : local;
     rep = DenoiseReport{};
+    DenoiseInputs inputs = given;
+    const bool varianceIgnored = inputs.variance && inputs.color && !inputs.color->empty() &&
+                                 inputs.variance->view().sameSize(inputs.color->view()) &&
+                                 varianceIsEmpty(*inputs.variance);
+    if (varianceIgnored) inputs.variance = nullptr;  // estimate the noise from the image instead
     filters::PreparedInputs prep = filters::prepareInputs(inputs, options, rep);
+    if (varianceIgnored) {
+        rep.varianceIgnored = true;
+        rep.buffersUsed += ",variance(ignored: all zero, e.g. a 1-spp render; noise estimated)";
+    }
     if (options.device == Device::Cuda) {
         if (!cudaCompiled()) throw InputError("--device cuda: this build of atrous has no CUDA backend");
         if (!cudaAvailable()) throw InputError("--device cuda: no CUDA-capable GPU is available");
