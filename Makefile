@@ -1,23 +1,36 @@
 # The two commands of the README: `make demo` and `make test`. Both set up what is missing first.
+# `make python` installs the Python package into .venv (without running the tests).
 BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
+# cmake --build runs make again: no "Entering/Leaving directory" lines from the nested makes.
+MAKEFLAGS += --no-print-directory
 
-.PHONY: setup build demo test bench clean
+.PHONY: setup setup-python configure build demo test python bench clean
 
 setup:
 	@./scripts/setup.sh
 
-build: setup
+setup-python:
+	@./scripts/setup.sh --python
+
+configure: setup
 	@cmake -S . -B $(BUILD) $(CMAKE_FLAGS) > $(BUILD).configure.log 2>&1 || (cat $(BUILD).configure.log; exit 1)
+
+build: configure
 	@cmake --build $(BUILD) -j $(JOBS)
 
-demo: build
+# The demo needs the CLI only: no tests, benchmarks or Python packages.
+demo: configure
+	@cmake --build $(BUILD) -j $(JOBS) --target atrous
 	@./scripts/demo.sh $(BUILD)
 
-test: build
+test: build setup-python
 	@cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 	@JOBS=$(JOBS) ./scripts/python_test.sh
+
+python: setup-python
+	@JOBS=$(JOBS) ./scripts/python_install.sh
 
 bench: build
 	@./scripts/bench.sh $(BUILD)

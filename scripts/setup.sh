@@ -1,8 +1,12 @@
 #!/usr/bin/env bash
 # Installs what atrous needs on a fresh Debian 12 machine: the C++ libraries from Debian's
-# packages (only those missing), and, when the Python side exists, a local venv in .venv.
+# packages (only those missing), and with --python a local venv in .venv with the Python side's
+# requirements (nanobind, numpy, pytest, matplotlib, pyoidn, flip-evaluator: ~400 MB, so
+# `make demo`, which needs none of it, skips it).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+WITH_PYTHON=0
+[ "${1:-}" = "--python" ] && WITH_PYTHON=1
 
 PKGS=(build-essential cmake pkg-config
       libembree-dev libtbb-dev libopenexr-dev libcli11-dev libtinyobjloader-dev libstb-dev
@@ -20,7 +24,7 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-if [ -f python/requirements.txt ]; then
+if [ "$WITH_PYTHON" = 1 ] && [ -f python/requirements.txt ]; then
   if [ ! -x .venv/bin/python ]; then
     echo "setup: creating .venv"
     python3 -m venv .venv
@@ -28,6 +32,7 @@ if [ -f python/requirements.txt ]; then
   stamp=.venv/.requirements.stamp
   if [ ! -f "$stamp" ] || ! cmp -s python/requirements.txt "$stamp"; then
     .venv/bin/python -m pip install -q --upgrade pip
+    echo "setup: installing the Python requirements into .venv (a few minutes the first time)"
     .venv/bin/python -m pip install -q -r python/requirements.txt
     cp python/requirements.txt "$stamp"
   fi
