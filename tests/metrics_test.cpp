@@ -49,10 +49,16 @@ TEST(Metrics, SsimDropsWithNoiseAndNanCountsAsError) {
     EXPECT_GT(ma.psnr, mb.psnr);
     EXPECT_LT(ma.mse, mb.mse);
     EXPECT_LE(ma.ssim, 1.0);
+    EXPECT_EQ(ma.nonFinitePixels, 0);
     a.data()[5] = NAN;
+    a.data()[r.plane() + 5] = INFINITY;  // same pixel, another channel: still one pixel
+    a.data()[7] = -INFINITY;
+    r.data()[2 * r.plane() + 9] = NAN;
     ImageMetrics mn = computeMetrics(a, r);
     EXPECT_TRUE(std::isfinite(mn.mse));
     EXPECT_GT(mn.mse, ma.mse);
+    EXPECT_EQ(mn.nonFinitePixels, 2);
+    EXPECT_EQ(mn.referenceNonFinitePixels, 1);
 }
 
 TEST(Metrics, ErrorMapsAndSizeMismatch) {

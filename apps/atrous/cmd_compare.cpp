@@ -1,4 +1,5 @@
 // `atrous compare`: MSE, relMSE, tonemapped PSNR and SSIM of images against a reference.
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -25,17 +26,35 @@ struct CompareArgs {
 void run(const CompareArgs& a) {
     if (a.images.empty()) throw InputError("compare: give at least one image to compare with --ref");
     if (!a.errorMaps.empty()) io::ensureWritableDirectory(a.errorMaps);
+    // PNG is an 8-bit, clamped, display-encoded preview: accepted (LDR images can be compared), but
+    // the figures are then not of the HDR radiance the metrics are meant for.
+    auto notePng = [](const std::string& p) {
+        std::string ext = std::filesystem::path(p).extension().string();
+        for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+        if (ext == ".png")
+            std::fprintf(stderr, "note: %s is an 8-bit PNG preview, compared as its [0,1] values, not HDR radiance\n",
+                         p.c_str());
+    };
+    notePng(a.ref);
     Image ref = io::readImage(a.ref);
     std::vector<ImageMetrics> ms;
     std::vector<Image> imgs;
     for (const auto& p : a.images) {
+        notePng(p);
         imgs.push_back(io::readImage(p));
         try {
             ms.push_back(computeMetrics(imgs.back(), ref));
         } catch (const InputError& e) {
             throw InputError("'" + p + "' vs reference '" + a.ref + "': " + e.what());
         }
+        const ImageMetrics& m = ms.back();
+        if (m.nonFinitePixels > 0)
+            std::fprintf(stderr, "note: %s has %d non-finite (NaN/Inf) pixels, counted as 0\n", p.c_str(),
+                         m.nonFinitePixels);
     }
+    if (!ms.empty() && ms.front().referenceNonFinitePixels > 0)
+        std::fprintf(stderr, "note: reference %s has %d non-finite (NaN/Inf) pixels, counted as 0\n", a.ref.c_str(),
+                     ms.front().referenceNonFinitePixels);
     if (!a.errorMaps.empty()) {
         for (size_t i = 0; i < imgs.size(); ++i) {
             const std::string stem = std::filesystem::path(a.images[i]).stem().string();
@@ -53,7 +72,9 @@ void run(const CompareArgs& a) {
                                    {"mse", ms[i].mse},
                                    {"relmse", ms[i].relMse},
                                    {"psnr", ms[i].psnr},
-                                   {"ssim", ms[i].ssim}});
+                                   {"ssim", ms[i].ssim},
+                                   {"non_finite_pixels", ms[i].nonFinitePixels}});
+        j["reference_non_finite_pixels"] = ms.empty() ? 0 : ms.front().referenceNonFinitePixels;
         std::printf("%s\n", j.dump(2).c_str());
     } else {
         std::printf("%-40s %14s %14s %10s %8s\n", "image", "MSE", "relMSE", "PSNR(dB)", "SSIM");

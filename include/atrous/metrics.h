@@ -11,6 +11,10 @@ struct ImageMetrics {
     double relMse = 0;  // mean of (x - r)² / (r² + 0.01)
     double psnr = 0;    // dB, on tonemapped images: x/(1+x), then ^(1/2.2), clamped to [0,1]
     double ssim = 0;    // on the tonemapped luminance, 11×11 Gaussian window σ = 1.5
+    // Pixels with a NaN or Inf in any channel (counted as 0 in the figures above): the CLI and
+    // Python report them, since a broken image must not pass for a good one.
+    int nonFinitePixels = 0;           // in the image
+    int referenceNonFinitePixels = 0;  // in the reference
 };
 
 // Throws InputError when the sizes differ or an image is empty.

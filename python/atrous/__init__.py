@@ -226,7 +226,11 @@ def render(
 
 
 def metrics(image: Any, reference: Any) -> Dict[str, float]:
-    """MSE, relMSE, PSNR (tonemapped) and SSIM of `image` against `reference` (ALGORITHMS.md 5)."""
+    """MSE, relMSE, PSNR (tonemapped) and SSIM of `image` against `reference` (ALGORITHMS.md 5).
+
+    NaN/Inf pixels count as 0 in the figures; their numbers are returned as ``non_finite_pixels``
+    (in `image`) and ``reference_non_finite_pixels``, so a broken image cannot pass for a good one.
+    """
     return dict(_core.metrics(_prepare(image, "image", allow_gray=False),
                               _prepare(reference, "reference", allow_gray=False)))
 

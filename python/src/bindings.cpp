@@ -251,6 +251,8 @@ nb::dict pyMetrics(const Array& image, const Array& reference) {
     d["relmse"] = m.relMse;
     d["psnr"] = m.psnr;
     d["ssim"] = m.ssim;
+    d["non_finite_pixels"] = m.nonFinitePixels;
+    d["reference_non_finite_pixels"] = m.referenceNonFinitePixels;
     return d;
 }
 

@@ -69,6 +69,14 @@ ImageMetrics computeMetrics(const Image& a, const Image& r) {
             const double td = double(tonemapForMetrics(float(x))) - tonemapForMetrics(float(ref));
             tse += td * td;
         }
+    for (size_t i = 0; i < plane; ++i) {
+        auto bad = [&](const Image& img) {
+            return !std::isfinite(img.data()[i]) || !std::isfinite(img.data()[plane + i]) ||
+                   !std::isfinite(img.data()[2 * plane + i]);
+        };
+        m.nonFinitePixels += bad(a);
+        m.referenceNonFinitePixels += bad(r);
+    }
     const double n = 3.0 * double(plane);
     m.mse = se / n;
     m.relMse = rel / n;
