@@ -1,6 +1,9 @@
 // End-to-end tests of `atrous render`: the files it writes and every bad-input case (exit code 2,
 // one line naming the problem, nothing written).
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <stdlib.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -132,6 +135,69 @@ TEST(RenderCli, UnwritableOutputDirectory) {
     EXPECT_EQ(r.exitCode, 2) << r.output;
     EXPECT_NE(r.output.find("not a directory"), std::string::npos) << r.output;
     EXPECT_EQ(countEntries(tmp.str()), 1);  // still just the blocker
+}
+
+// Runs the CLI with stderr on a pseudo-terminal (stdout on a pipe): what an interactive user sees.
+// Returns the exit code; `out` gets stdout, `tty` what was written to the terminal.
+int runCliWithTerminal(const std::string& args, std::string& out, std::string& tty) {
+    const int master = posix_openpt(O_RDWR | O_NOCTTY);
+    if (master < 0 || grantpt(master) != 0 || unlockpt(master) != 0) return -1;
+    const std::string slave = ptsname(master);
+    const int keep = open(slave.c_str(), O_RDWR | O_NOCTTY);  // held open: no hang-up when the CLI exits
+    test::CliResult r = runCli(args + " 2>" + slave + " #");       // '#' comments out runCli's own 2>&1
+    out = r.output;
+    fcntl(master, F_SETFL, O_NONBLOCK);
+    char buf[4096];
+    for (ssize_t n; (n = read(master, buf, sizeof(buf))) > 0;) tty.append(buf, size_t(n));
+    close(keep);
+    close(master);
+    return r.exitCode;
+}
+
+// Long renders show a progress line on a terminal (UX audit, item 3): still images by finished
+// tiles, sequences per frame with an ETA; --quiet silences it, and a pipe (logs, the other
+// tests here) never gets it.
+TEST(RenderCli, ProgressLineOnlyOnATerminal) {
+    TempDir tmp;
+    std::string out, tty;
+    int rc = runCliWithTerminal("render --scene cornell --width 16 --height 16 --spp 1 --out " + (tmp / "a"), out, tty);
+    ASSERT_EQ(rc, 0) << out << tty;
+    EXPECT_NE(tty.find("render: "), std::string::npos) << tty;
+    EXPECT_NE(tty.find("% ("), std::string::npos) << tty;
+    EXPECT_NE(tty.find("\r\033[K"), std::string::npos) << tty;  // redrawn in place and cleared at the end
+    EXPECT_EQ(out.find("%"), std::string::npos) << out;         // stdout keeps the one summary line
+
+    tty.clear();
+    rc = runCliWithTerminal("render --scene cornell --width 16 --height 16 --spp 1 --frames 2 --reference-spp 2 --out " +
+                                (tmp / "s"),
+                            out, tty);
+    ASSERT_EQ(rc, 0) << out << tty;
+    EXPECT_NE(tty.find("render: frame 1/2, "), std::string::npos) << tty;
+    EXPECT_NE(tty.find("ETA"), std::string::npos) << tty;
+
+    tty.clear();
+    rc = runCliWithTerminal("render --quiet --scene cornell --width 16 --height 16 --spp 1 --frames 2 --out " + (tmp / "q"),
+                            out, tty);
+    ASSERT_EQ(rc, 0) << out << tty;
+    EXPECT_EQ(tty, "");
+
+    auto r = runCli("render --scene cornell --width 16 --height 16 --spp 1 --out " + (tmp / "p"));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_EQ(r.output.find("ETA"), std::string::npos) << r.output;
+    EXPECT_EQ(lines(r.output), 1) << r.output;
+}
+
+// Messages that name the flag (UX audit, item 7).
+TEST(RenderCli, ErrorsNameTheFlag) {
+    TempDir tmp;
+    const std::string ok = "render --scene cornell --width 8 --height 8 --spp 1 --out " + tmp.str();
+    auto r = runCli(ok + " --device gpu");
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("--device: unknown device 'gpu' (expected cpu, cuda or auto)"), std::string::npos) << r.output;
+    r = runCli(ok + " --denoise foo");
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("--denoise: unknown denoise method 'foo'"), std::string::npos) << r.output;
+    EXPECT_EQ(countEntries(tmp.str()), 0);
 }
 
 }  // namespace

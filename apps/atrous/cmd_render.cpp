@@ -11,11 +11,13 @@
 #include "atrous/denoise.h"
 #include "atrous/error.h"
 #include "atrous/render.h"
+#include "cli_flags.h"
 #include "commands.h"
 #include "core/timer.h"
 #include "io/image_io.h"
 #include "render/bvh_render.h"
 #include "io/sequence.h"
+#include "progress.h"
 
 namespace atrous::cli {
 namespace {
@@ -31,6 +33,7 @@ struct RenderArgs {
     int referenceSpp = 0;
     std::string cameraPath = "auto";
     std::string device = "auto";
+    bool quiet = false;  // no progress line on stderr
 };
 
 // Seeds of the noisy and reference renders of frame f: every noisy frame gets its own noise (a
@@ -73,29 +76,51 @@ void runFrames(const RenderArgs& a) {
     io::ensureWritableDirectory(a.out);
 
     namespace fs = std::filesystem;
+    // An earlier, longer sequence in OUT would leave frames this run does not render; a later
+    // `atrous denoise --sequence OUT` would take them in. They go first (said in one line).
+    const std::vector<std::string> stale =
+        io::removeSequenceEntries(a.out, "", [&](int index) { return index < a.frames; });
+    if (!stale.empty())
+        std::fprintf(stderr, "render: removed %zu frame director%s of an earlier run from %s (%s%s)\n", stale.size(),
+                     stale.size() == 1 ? "y" : "ies", a.out.c_str(), stale.front().c_str(),
+                     stale.size() > 1 ? (" ... " + stale.back()).c_str() : "");
     Timer total;
+    const uint64_t frameSamples = uint64_t(s.width) * uint64_t(s.height) * uint64_t(s.spp + a.referenceSpp);
+    ProgressLine progress(!a.quiet && stderrIsTerminal(), "render", frameSamples * uint64_t(a.frames), a.frames);
     for (int f = 0; f < a.frames; ++f) {
+        progress.setFrame(f);
         const float t = frameTime(f, a.frames);
         const float tPrev = f > 0 ? frameTime(f - 1, a.frames) : t;  // frame 0: no previous frame, motion 0
         RenderSettings fs_ = s;
         fs_.seed = frameSeed(s.seed, f);
+        fs_.samplesDone = progress.counter();
         Timer timer;
         RenderBuffers b = renderFrame(scene, path, t, tPrev, fs_);
         Image reference;
         if (a.referenceSpp > 0) {
             ref.seed = referenceSeed(s.seed);
+            ref.samplesDone = progress.counter();
             reference = renderFrame(scene, path, t, t, ref).color;
         }
         double seconds = timer.seconds();
         const std::string dir = (fs::path(a.out) / io::sequenceFrameName(f)).string();
-        io::ensureWritableDirectory(dir);
-        writeBuffers(dir, b, /*withVariance=*/s.spp > 1);
-        io::writeImage((fs::path(dir) / "motion.exr").string(), b.motion);
-        if (!reference.empty()) io::writeImage((fs::path(dir) / "reference.exr").string(), reference);
-        io::writePng((fs::path(dir) / "color.png").string(), b.color);
-        std::printf("frame %d/%d (t = %.4f): %.3f s -> %s\n", f + 1, a.frames, t, seconds, dir.c_str());
-        std::fflush(stdout);
+        // The frame is written into a hidden directory that then replaces frame_NNNN/ whole: an
+        // earlier run's optional buffers (reference.exr, variance.exr) never survive next to this run's.
+        const std::string stage = (fs::path(a.out) / ("." + io::sequenceFrameName(f) + ".partial")).string();
+        std::error_code ec;
+        fs::remove_all(stage, ec);
+        io::ensureWritableDirectory(stage);
+        writeBuffers(stage, b, /*withVariance=*/s.spp > 1);
+        io::writeImage((fs::path(stage) / "motion.exr").string(), b.motion);
+        if (!reference.empty()) io::writeImage((fs::path(stage) / "reference.exr").string(), reference);
+        io::writePng((fs::path(stage) / "color.png").string(), b.color);
+        fs::remove_all(dir, ec);
+        if (!ec) fs::rename(stage, dir, ec);
+        if (ec) throw RuntimeError(dir + ": cannot move the frame into place (" + ec.message() + ")");
+        progress.above(
+            [&] { std::printf("frame %d/%d (t = %.4f): %.3f s -> %s\n", f + 1, a.frames, t, seconds, dir.c_str()); });
     }
+    progress.finish();
     std::printf("rendered %s: %d frames, %dx%d, %d spp%s, %.3f s -> %s\n", scene.name().c_str(), a.frames, s.width,
                 s.height, s.spp, a.referenceSpp > 0 ? (", reference " + std::to_string(a.referenceSpp) + " spp").c_str() : "",
                 total.seconds(), a.out.c_str());
@@ -108,14 +133,14 @@ std::vector<DenoiseMethod> parseMethods(const std::string& list) {
     std::string item;
     while (std::getline(ss, item, ',')) {
         if (item.empty()) throw InputError("--denoise: empty method name in \"" + list + "\"");
-        methods.push_back(parseDenoiseMethod(item));  // InputError names the bad method
+        methods.push_back(withFlag("--denoise", [&] { return parseDenoiseMethod(item); }));
     }
     return methods;
 }
 
 void run(const RenderArgs& a) {
     // InputError for cuda without a GPU or CUDA build. Animations render on the CPU (auto picks it).
-    const Device device = parseDevice(a.framesGiven && a.device == "auto" ? "cpu" : a.device);
+    const Device device = parseDeviceFlag(a.framesGiven && a.device == "auto" ? "cpu" : a.device);
     if (a.framesGiven) {
         if (device == Device::Cuda) throw InputError("--frames: animation renders on the CPU only so far (use --device cpu)");
         return runFrames(a);
@@ -130,8 +155,14 @@ void run(const RenderArgs& a) {
     io::ensureWritableDirectory(a.out);
 
     Timer timer;
-    // The CUDA path tracer runs the same per-pixel kernel over a BVH built by Embree's builder.
-    RenderBuffers b = device == Device::Cuda ? renderBvhCuda(scene, s) : render(scene, s);
+    // The CUDA path tracer runs the same per-pixel kernel over a BVH built by Embree's builder
+    // (no progress line there: it reports no tiles, and it is fast).
+    RenderSettings rs = s;
+    ProgressLine progress(!a.quiet && stderrIsTerminal() && device == Device::Cpu, "render",
+                          uint64_t(s.width) * uint64_t(s.height) * uint64_t(s.spp));
+    rs.samplesDone = progress.counter();
+    RenderBuffers b = device == Device::Cuda ? renderBvhCuda(scene, s) : render(scene, rs);
+    progress.finish();
     double seconds = timer.seconds();
 
     std::vector<std::pair<std::string, Image>> denoised;
@@ -175,7 +206,10 @@ void addRenderCommand(CLI::App& app) {
     std::string names;
     for (const auto& n : builtinSceneNames()) names += (names.empty() ? "" : ", ") + n;
     cmd->add_option("--scene", args->scene, "Built-in scene (" + names + ") or a scene .json file")->required();
-    cmd->add_option("--out", args->out, "Output directory (created if missing)")->required();
+    cmd->add_option("--out", args->out,
+                    "Output directory (created if missing). With --frames, OUT/frame_NNNN/ is replaced whole, and "
+                    "frame_NNNN/ directories of an earlier run with NNNN >= --frames are removed (one note on stderr)")
+        ->required();
     cmd->add_option("--width", args->settings.width, "Image width in pixels")->capture_default_str();
     cmd->add_option("--height", args->settings.height, "Image height in pixels")->capture_default_str();
     cmd->add_option("--spp", args->settings.spp, "Samples per pixel")->capture_default_str();
@@ -189,6 +223,9 @@ void addRenderCommand(CLI::App& app) {
                                    "Render an animation of this many frames into OUT/frame_NNNN/ (time t = f / max(F-1, 1))");
     cmd->add_option("--reference-spp", args->referenceSpp, "With --frames: also write reference.exr per frame at this spp (other seed)");
     cmd->add_option("--camera-path", args->cameraPath, "With --frames: auto, static, orbit, dolly or keyframes")->capture_default_str();
+    cmd->add_flag("--quiet", args->quiet,
+                  "No progress line on stderr (it is shown only when stderr is a terminal: per frame with an ETA "
+                  "for --frames, by finished tiles for a still image)");
     cmd->callback([args, frames] {
         args->framesGiven = frames->count() > 0;
         run(*args);

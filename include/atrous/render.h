@@ -2,6 +2,7 @@
 // writes the noisy colour together with the per-pixel buffers the denoisers use
 // (ALGORITHMS.md section 1, docs/rendering.md).
 #pragma once
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -30,6 +31,9 @@ struct RenderSettings {
     // Next-event estimation with multiple importance sampling (power heuristic). false = BSDF
     // sampling only (for tests; delta lights such as point lights then contribute nothing).
     bool lightSampling = true;
+    // Optional progress counter (the CLI's progress line): the CPU renderers add pixels x spp
+    // once per finished 8x8 tile (one relaxed atomic add per tile, never per pixel or sample).
+    std::atomic<uint64_t>* samplesDone = nullptr;
 };
 
 // All buffers are 3-channel planar host images of width x height (ALGORITHMS.md section 1):

@@ -22,17 +22,6 @@ namespace {
 
 const char* const kOptionalBuffers[3] = {"reference", "emission", "variance"};
 
-// frame_NNNN -> NNNN, or -1 when the name is not a frame directory name.
-int parseFrameName(const std::string& name) {
-    const std::string prefix = "frame_";
-    if (name.size() < prefix.size() + 4 || name.compare(0, prefix.size(), prefix) != 0) return -1;
-    std::string digits = name.substr(prefix.size());
-    if (digits.size() > 8) return -1;
-    for (char c : digits)
-        if (!std::isdigit(static_cast<unsigned char>(c))) return -1;
-    return std::stoi(digits);
-}
-
 std::string sizeText(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
 
 // Data-window size from the EXR header alone.
@@ -49,6 +38,40 @@ void exrSize(const std::string& path, int& w, int& h) {
 
 }  // namespace
 
+int parseSequenceFrameName(const std::string& name) {
+    const std::string prefix = "frame_";
+    if (name.size() < prefix.size() + 4 || name.compare(0, prefix.size(), prefix) != 0) return -1;
+    std::string digits = name.substr(prefix.size());
+    if (digits.size() > 8) return -1;
+    for (char c : digits)
+        if (!std::isdigit(static_cast<unsigned char>(c))) return -1;
+    return std::stoi(digits);
+}
+
+std::vector<std::string> removeSequenceEntries(const std::string& dir, const std::string& suffix,
+                                               const std::function<bool(int)>& keep) {
+    std::vector<fs::path> doomed;
+    std::error_code ec;
+    for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
+        const std::string name = it->path().filename().string();
+        if (name.size() <= suffix.size() || name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0) continue;
+        std::error_code ec2;
+        // Directories for frame_NNNN, regular files for frame_NNNN.exr: never anything else.
+        if (suffix.empty() ? !it->is_directory(ec2) : !it->is_regular_file(ec2)) continue;
+        const int index = parseSequenceFrameName(name.substr(0, name.size() - suffix.size()));
+        if (index >= 0 && !keep(index)) doomed.push_back(it->path());
+    }
+    if (ec) throw RuntimeError(dir + ": cannot list the directory (" + ec.message() + ")");
+    std::sort(doomed.begin(), doomed.end());
+    std::vector<std::string> removed;
+    for (const auto& p : doomed) {
+        fs::remove_all(p, ec);
+        if (ec) throw RuntimeError(p.string() + ": cannot remove a stale entry of an earlier run (" + ec.message() + ")");
+        removed.push_back(p.filename().string());
+    }
+    return removed;
+}
+
 std::string sequenceFrameName(int index) {
     char buf[32];
     std::snprintf(buf, sizeof(buf), "frame_%04d", index);
@@ -62,7 +85,7 @@ std::vector<std::string> listSequenceFrames(const std::string& dir) {
     for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
         std::error_code ec2;
         if (!it->is_directory(ec2)) continue;
-        int index = parseFrameName(it->path().filename().string());
+        int index = parseSequenceFrameName(it->path().filename().string());
         if (index >= 0) frames.emplace_back(index, it->path().string());
     }
     if (ec) throw InputError("sequence " + dir + ": cannot list the directory (" + ec.message() + ")");
@@ -114,7 +137,7 @@ void validateSequence(const std::vector<std::string>& frameDirs, int& width, int
 SequenceFrame loadSequenceFrame(const std::string& frameDir) {
     SequenceFrame f;
     f.dir = frameDir;
-    f.index = parseFrameName(fs::path(frameDir).filename().string());
+    f.index = parseSequenceFrameName(fs::path(frameDir).filename().string());
     Image* required[7] = {&f.color, &f.albedo, &f.normal, &f.position, &f.depth, &f.ids, &f.motion};
     std::string firstPath;
     auto load = [&](const std::string& name, Image& dst) {

@@ -7,6 +7,7 @@
 // as the renderer writes them (ALGORITHMS.md §1: depth in R (1e30 = background), ids R = mesh id
 // (-1 = background), motion R = dx, G = dy in pixels, previous - current). Other entries are ignored.
 #pragma once
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -42,5 +43,15 @@ SequenceFrame loadSequenceFrame(const std::string& frameDir);
 
 // "frame_0007" for 7 (at least four digits).
 std::string sequenceFrameName(int index);
+
+// The number of a "frame_NNNN" name (four to eight digits), or -1 when `name` is not one.
+int parseSequenceFrameName(const std::string& name);
+
+// Removes the entries of `dir` named frame_NNNN + `suffix` ("" for the frame directories of
+// `atrous render --frames`, ".exr"/".png" for the files of `atrous denoise --sequence`) for which
+// keep(NNNN) is false; directories are removed with their contents. Returns the removed names,
+// sorted. Throws RuntimeError naming the entry when one cannot be removed.
+std::vector<std::string> removeSequenceEntries(const std::string& dir, const std::string& suffix,
+                                               const std::function<bool(int)>& keep);
 
 }  // namespace atrous::io

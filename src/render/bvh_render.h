@@ -98,6 +98,9 @@ void runPathTraceTiles(const Kernel& k, const RenderSettings& settings) {
         tbb::parallel_for(tbb::blocked_range2d<int>(0, h, 8, 0, w, 8), [&](const tbb::blocked_range2d<int>& r) {
             for (int y = r.rows().begin(); y < r.rows().end(); ++y)
                 for (int x = r.cols().begin(); x < r.cols().end(); ++x) k(x, y);
+            if (settings.samplesDone)
+                settings.samplesDone->fetch_add(uint64_t(r.rows().size()) * uint64_t(r.cols().size()) * uint64_t(settings.spp),
+                                                std::memory_order_relaxed);
         });
     };
     if (settings.threads > 0) {
