@@ -1,7 +1,11 @@
 // `atrous denoise --sequence`: the CLI wiring of the sequence denoiser (SVGF, per-frame EAW/SURE).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
 
 #include "io/image_io.h"
 #include "test_util.h"
@@ -60,4 +64,73 @@ TEST(SequenceCli, BadSequencesExitTwoAndWriteNothing) {
     // Not a directory.
     r = runCli("denoise --method svgf --sequence " + (dir / "nope") + " --out " + out);
     EXPECT_EQ(r.exitCode, 2) << r.output;
+}
+
+namespace {
+
+std::string readFile(const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+}
+
+// Names of the entries of `dir`, sorted.
+std::vector<std::string> entries(const std::string& dir) {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+}  // namespace
+
+// A frame that only decoding finds broken (header fine, pixels cut off) fails after earlier frames
+// were denoised: OUTDIR must still be as it was (absent, or with its old files), and no staging
+// directory may be left next to it.
+TEST(SequenceCli, TruncatedFrameLeavesTheOutputUntouched) {
+    TempDir dir;
+    const std::string seq = renderSequence(dir);
+    const std::string color = seq + "/frame_0002/color.exr";
+    fs::resize_file(color, fs::file_size(color) * 2 / 3);
+    fs::create_directories(dir / "old");
+    std::ofstream(dir / "old/frame_0000.exr") << "old result";
+    for (const char* method : {"svgf", "eaw", "sure"}) {
+        for (const std::string out : {dir / "fresh", dir / "old"}) {
+            auto r = runCli(std::string("denoise --method ") + method + " --sequence " + seq + " --out " + out);
+            EXPECT_EQ(r.exitCode, 2) << r.output;
+            EXPECT_NE(r.output.find("frame_0002/color.exr"), std::string::npos) << r.output;
+        }
+        EXPECT_FALSE(fs::exists(dir / "fresh")) << method;
+        EXPECT_EQ(entries(dir / "old"), std::vector<std::string>{"frame_0000.exr"}) << method;
+        EXPECT_EQ(readFile(dir / "old/frame_0000.exr"), "old result");
+        EXPECT_EQ(entries(dir.str()), (std::vector<std::string>{"old", "seq"})) << method;  // no staging left
+    }
+}
+
+// Re-using directories: a shorter render removes the old sequence's extra frames (and the old
+// frames' reference.exr when this run writes none), and a shorter denoise run removes the old
+// frame_NNNN.exr/png it does not write; both say so in one line. Other files stay.
+TEST(SequenceCli, ReusedDirectoriesHoldOnlyThisRunsFrames) {
+    TempDir dir;
+    const std::string seq = renderSequence(dir);  // 3 frames with reference.exr
+    const std::string out = dir / "out";
+    auto r = runCli("denoise --method eaw --sequence " + seq + " --out " + out);
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    std::ofstream(out + "/notes.txt") << "mine";
+
+    r = runCli("render --scene cornell --frames 2 --spp 1 --width 32 --height 24 --out " + seq);
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("removed 1 frame directory of an earlier run"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("frame_0002"), std::string::npos) << r.output;
+    EXPECT_EQ(entries(seq), (std::vector<std::string>{"frame_0000", "frame_0001"}));
+    EXPECT_FALSE(fs::exists(seq + "/frame_0001/reference.exr"));  // the old run's, not this one's
+
+    r = runCli("denoise --method eaw --sequence " + seq + " --out " + out);
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("removed 2 files of an earlier run"), std::string::npos) << r.output;
+    std::vector<std::string> want = {"frame_0000.exr", "frame_0000.png", "frame_0001.exr", "frame_0001.png", "notes.txt"};
+    std::vector<std::string> got = entries(out);
+    got.erase(std::remove(got.begin(), got.end(), "preview.mp4"), got.end());  // when ffmpeg is on PATH
+    EXPECT_EQ(got, want);
+    EXPECT_EQ(readFile(out + "/notes.txt"), "mine");
+    EXPECT_EQ(entries(dir.str()), (std::vector<std::string>{"out", "seq"}));  // no staging left
 }

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -41,10 +42,12 @@ std::string shellQuote(const std::string& s) {
     return out + "'";
 }
 
-void writeAnimatedPreview(const std::string& outDir, int firstIndex, bool quiet) {
+// Encodes the PNGs of `outDir` (the staging directory) into outDir/preview.mp4; messages name
+// `finalDir`, where the video ends up.
+void writeAnimatedPreview(const std::string& outDir, int firstIndex, bool quiet, const std::string& finalDir) {
     std::string ffmpeg = findOnPath("ffmpeg");
     if (ffmpeg.empty()) {
-        std::printf("ffmpeg is not on PATH: skipping the animated preview (the per-frame PNGs are in %s)\n", outDir.c_str());
+        std::printf("ffmpeg is not on PATH: skipping the animated preview (the per-frame PNGs are in %s)\n", finalDir.c_str());
         return;
     }
     std::string finalPath = (fs::path(outDir) / "preview.mp4").string();
@@ -66,7 +69,7 @@ void writeAnimatedPreview(const std::string& outDir, int firstIndex, bool quiet)
         std::printf("warning: could not rename the animated preview into place\n");
         return;
     }
-    if (!quiet) std::printf("animated preview: %s\n", finalPath.c_str());
+    if (!quiet) std::printf("animated preview: %s\n", (fs::path(finalDir) / "preview.mp4").c_str());
 }
 
 }  // namespace
@@ -114,6 +117,93 @@ std::string findOnPath(const std::string& name) {
     return "";
 }
 
+namespace {
+
+// OUTDIR's contents are built in a hidden sibling directory and moved into place only when every
+// frame has been denoised, so bad input that the header check cannot see (a truncated EXR) leaves
+// OUTDIR as it was. The sibling sits in OUTDIR's parent so the final rename stays on one file system.
+class StagedOutput {
+public:
+    explicit StagedOutput(const std::string& outDir) {
+        mOut = fs::path(outDir).lexically_normal();
+        if (mOut.filename().empty()) mOut = mOut.parent_path();  // "out/" -> "out"
+        std::error_code ec;
+        if (fs::exists(mOut, ec) && !fs::is_directory(mOut, ec))
+            throw InputError("--out '" + outDir + "': exists and is not a directory");
+        if (fs::is_directory(mOut, ec) && ::access(mOut.c_str(), W_OK | X_OK) != 0)
+            throw InputError("--out '" + outDir + "': output directory is not writable");
+        const fs::path parent = mOut.has_parent_path() ? mOut.parent_path() : fs::path(".");
+        // Parents created here are removed again on failure (nothing is left behind).
+        for (fs::path p = parent; !p.empty() && !fs::exists(p, ec); p = p.parent_path()) mCreatedParent = p;
+        mStage = parent / ("." + mOut.filename().string() + ".partial-" + std::to_string(::getpid()));
+        fs::remove_all(mStage, ec);  // a leftover of a killed run with the same pid
+        if (!fs::create_directories(mStage, ec) || ec)
+            throw InputError("--out '" + outDir + "': cannot create the output directory (" +
+                             (ec ? ec.message() : std::string("it could not be made")) + ")");
+    }
+    ~StagedOutput() {
+        if (mCommitted) return;
+        std::error_code ec;
+        fs::remove_all(mStage, ec);
+        if (!mCreatedParent.empty()) fs::remove_all(mCreatedParent, ec);
+    }
+    StagedOutput(const StagedOutput&) = delete;
+    StagedOutput& operator=(const StagedOutput&) = delete;
+
+    std::string stage() const { return mStage.string(); }
+
+    // Moves the staged files into OUTDIR. An absent or empty OUTDIR is replaced by the staging
+    // directory in one rename. A non-empty OUTDIR keeps its other files; this run's files replace
+    // those of the same name, and the frame_NNNN.exr/.png (and preview.mp4) of an earlier run
+    // that this run did not write are removed, named in one line on stderr.
+    void commit() {
+        std::error_code ec;
+        bool emptyOut = !fs::exists(mOut, ec) || fs::is_empty(mOut, ec);
+        if (emptyOut) {
+            fs::rename(mStage, mOut, ec);
+            if (!ec) {
+                mCommitted = true;
+                return;
+            }
+            fs::create_directories(mOut, ec);  // the rename failed: move file by file instead
+        }
+        std::vector<std::string> written;
+        for (auto it = fs::directory_iterator(mStage, ec); !ec && it != fs::directory_iterator(); it.increment(ec))
+            written.push_back(it->path().filename().string());
+        if (ec) throw RuntimeError(mStage.string() + ": cannot list the staged output (" + ec.message() + ")");
+        for (const auto& name : written) {
+            fs::rename(mStage / name, mOut / name, ec);
+            if (ec) throw RuntimeError((mOut / name).string() + ": cannot move the result into place (" + ec.message() + ")");
+        }
+        mCommitted = true;
+        fs::remove_all(mStage, ec);
+        auto wrote = [&](const std::string& name) { return std::find(written.begin(), written.end(), name) != written.end(); };
+        std::vector<std::string> removed;
+        for (const char* ext : {".exr", ".png"}) {
+            auto r = io::removeSequenceEntries(mOut.string(), ext,
+                                               [&](int index) { return wrote(io::sequenceFrameName(index) + ext); });
+            removed.insert(removed.end(), r.begin(), r.end());
+        }
+        if (!wrote("preview.mp4") && fs::is_regular_file(mOut / "preview.mp4", ec)) {
+            fs::remove(mOut / "preview.mp4", ec);
+            if (!ec) removed.push_back("preview.mp4");
+        }
+        if (!removed.empty()) {
+            std::sort(removed.begin(), removed.end());
+            std::string list = removed.front();
+            if (removed.size() > 1) list += ", ..., " + removed.back();
+            std::fprintf(stderr, "denoise: removed %zu file%s of an earlier run from %s (%s)\n", removed.size(),
+                         removed.size() == 1 ? "" : "s", mOut.c_str(), list.c_str());
+        }
+    }
+
+private:
+    fs::path mOut, mStage, mCreatedParent;
+    bool mCommitted = false;
+};
+
+}  // namespace
+
 int runSequenceDenoise(const SequenceDenoiseArgs& args) {
     const bool svgf = args.method == "svgf";
     if (!svgf && args.method != "eaw" && args.method != "sure")
@@ -122,7 +212,8 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
     if (args.outDir.empty()) throw InputError("--out: no output directory given");
     if (!(args.exposure > 0.0f)) throw InputError("--exposure must be > 0");
 
-    // Everything that can be checked before writing is checked first (nothing is written on error).
+    // Everything that can be checked before writing is checked first; what only decoding finds
+    // (a truncated EXR) fails inside the loop, before anything reaches OUTDIR (StagedOutput).
     std::vector<std::string> frames = io::listSequenceFrames(args.sequenceDir);
     int width = 0, height = 0;
     io::validateSequence(frames, width, height);
@@ -135,7 +226,8 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
         options.device = args.device;
         validateDenoiseOptions(options);
     }
-    io::ensureWritableDirectory(args.outDir);
+    StagedOutput staged(args.outDir);
+    const std::string stage = staged.stage();
 
     int firstIndex = -1;
     for (const auto& dir : frames) {
@@ -166,8 +258,8 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
         }
         double ms = timer.ms();
         std::string name = io::sequenceFrameName(f.index);
-        io::writeImage((fs::path(args.outDir) / (name + ".exr")).string(), out);
-        io::writePng((fs::path(args.outDir) / (name + ".png")).string(), out, args.exposure);
+        io::writeImage((fs::path(stage) / (name + ".exr")).string(), out);
+        io::writePng((fs::path(stage) / (name + ".png")).string(), out, args.exposure);
         if (!args.quiet) {
             std::printf("%s: %s %.1f ms", name.c_str(), args.method.c_str(), ms);
             if (!f.reference.empty())
@@ -177,7 +269,8 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
             std::fflush(stdout);
         }
     }
-    if (args.preview) writeAnimatedPreview(args.outDir, firstIndex, args.quiet);
+    if (args.preview) writeAnimatedPreview(stage, firstIndex, args.quiet, args.outDir);
+    staged.commit();
     return 0;
 }
 
