@@ -193,3 +193,39 @@ TEST(DenoiseCli, QualityOnRenderedScenes) {
         EXPECT_LT(sure, 1.05 * eaw) << scene;
     }
 }
+
+// Library messages name the value or parameter; the CLI names the flag (UX audit, item 7), and a
+// file in the place of the output directory is called what it is (item 8).
+TEST(DenoiseCli, ErrorsNameTheFlag) {
+    TempDir in, out;
+    SyntheticScene s = makeScene(16, 16, 0.3f, 26);
+    writeScene(s, in);
+    const std::string o = " --out " + (out / "d.exr");
+    expectBadInput("denoise --in " + in.str() + " --device gpu" + o, "--device: unknown device 'gpu'", out);
+    expectBadInput("denoise --in " + in.str() + " --levels 11" + o, "--levels: must be in 1..10 (got 11)", out);
+    expectBadInput("denoise --in " + in.str() + " --sure-window 12" + o, "--sure-window: must be in 1..10 (got 12)", out);
+    expectBadInput("denoise --in " + in.str() + " --method foo" + o, "--method: unknown denoise method 'foo'", out);
+    expectBadInput("denoise --method svgf --sequence " + in.str() + " --svgf-alpha 2 --out " + (out / "seq"),
+                   "--svgf-alpha: must be in (0, 1] (got 2)", out);
+    std::ofstream(out / "afile") << "x";
+    CliResult r = runCli("denoise --in " + in.str() + " --out " + (out / "afile/x.exr"));
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("is not a directory"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("does not exist"), std::string::npos) << r.output;
+    EXPECT_EQ(countEntries(out.str()), 1);  // still just afile
+}
+
+// Flags of another method are named in one note line instead of being dropped silently (item 6).
+TEST(DenoiseCli, FlagsOfOtherMethodsAreNamedInANote) {
+    TempDir in, out;
+    SyntheticScene s = makeScene(16, 16, 0.3f, 27);
+    writeScene(s, in);
+    CliResult r = runCli("denoise --in " + in.str() + " --method eaw --svgf-alpha 0.5 --taa --sure-window 5 --levels 3 --out " +
+                         (out / "d.exr"));
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("ignored with --method eaw: --sure-window, --svgf-alpha, --taa"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("--levels"), std::string::npos) << r.output;  // eaw uses it
+    r = runCli("denoise --in " + in.str() + " --method sure --sure-window 2 --out " + (out / "e.exr"));
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_EQ(r.output.find("ignored"), std::string::npos) << r.output;
+}

@@ -7,6 +7,7 @@
 
 #include "atrous/denoise.h"
 #include "atrous/error.h"
+#include "cli_flags.h"
 #include "commands.h"
 #include "core/timer.h"
 #include "denoise_sequence.h"
@@ -40,9 +41,83 @@ std::vector<float> parseFloatList(const std::string& s, const char* flag) {
     return v;
 }
 
-void run(DenoiseArgs& a) {
+// Option groups: the flags of one method are ignored by the others (a note says which).
+const char* const kGroupEawSure = "EAW and SURE (--method eaw|sure)";
+const char* const kGroupSure = "SURE (--method sure)";
+const char* const kGroupSvgf = "SVGF (--method svgf)";  // addSvgfOptions' group
+const char* const kGroupBuffers = "Buffers (without --sequence)";
+
+// One note line on stderr naming the given flags that the chosen method (or --sequence) ignores.
+void noteIgnoredFlags(const CLI::App& cmd, const std::string& method, bool sequence) {
+    std::string ignored, ignoredSeq;
+    for (const CLI::Option* opt : cmd.get_options()) {
+        if (opt->count() == 0) continue;
+        const std::string& g = opt->get_group();
+        const bool unused = (g == kGroupEawSure && method == "svgf") || (g == kGroupSure && method != "sure") ||
+                            (g == kGroupSvgf && method != "svgf");
+        if (unused) ignored += (ignored.empty() ? "" : ", ") + opt->get_name();
+        if (g == kGroupBuffers && sequence) ignoredSeq += (ignoredSeq.empty() ? "" : ", ") + opt->get_name();
+    }
+    if (!ignored.empty()) std::fprintf(stderr, "denoise: note: ignored with --method %s: %s\n", method.c_str(), ignored.c_str());
+    if (!ignoredSeq.empty())
+        std::fprintf(stderr, "denoise: note: ignored with --sequence (frames bring their own buffers): %s\n", ignoredSeq.c_str());
+}
+
+// validateDenoiseOptions says "parameter out of range: levels must be in 1..10"; the parameter
+// names there are the flag names.
+void validateDenoiseFlags(const DenoiseOptions& o, const CLI::App& cmd) {
+    try {
+        validateDenoiseOptions(o);
+    } catch (const InputError& e) {
+        rethrowParameterError(e, "parameter out of range: ", cmd, [](const std::string& name) { return "--" + name; });
+    }
+}
+
+// validateSvgfParams says "SVGF parameter alpha must be in (0, 1]" with the SvgfParams field name.
+void validateSvgfFlags(const SvgfParams& p, const CLI::App& cmd) {
+    static const char* const kFlags[][2] = {
+        {"sigmaL", "--svgf-sigma-l"},
+        {"sigmaN", "--svgf-sigma-n"},
+        {"sigmaZ", "--svgf-sigma-z"},
+        {"alpha", "--svgf-alpha"},
+        {"momentsAlpha", "--svgf-moments-alpha"},
+        {"historyCap", "--svgf-history-cap"},
+        {"levels", "--svgf-levels"},
+        {"feedbackTap", "--svgf-feedback-tap"},
+        {"spatialVarianceFrames", "--svgf-spatial-variance-frames"},
+        {"reprojectDepthTolerance", "--svgf-depth-tolerance"},
+        {"reprojectNormalCos", "--svgf-normal-cos"},
+        {"taaAlpha", "--taa-alpha"},
+        {"emissionAlpha", "--svgf-emission-alpha"},
+        {"emissionMotionAlpha", "--svgf-emission-motion-alpha"},
+    };
+    try {
+        validateSvgfParams(p);
+    } catch (const InputError& e) {
+        rethrowParameterError(e, "SVGF parameter ", cmd, [](const std::string& name) -> std::string {
+            for (const auto& f : kFlags)
+                if (name == f[0]) return f[1];
+            return "";
+        });
+    }
+}
+
+// --out FILE: its directory must exist and be a directory (checked before any work).
+void checkOutputFile(const std::string& out) {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::path(out).has_parent_path() ? fs::path(out).parent_path() : fs::path(".");
+    std::error_code ec;
+    if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+        throw InputError("--out '" + out + "': " + dir.string() + " is not a directory");
+    if (!fs::exists(dir, ec)) throw InputError("--out '" + out + "': output directory " + dir.string() + " does not exist");
+    if (fs::is_directory(out, ec)) throw InputError("--out '" + out + "': is a directory (give a file name)");
+}
+
+void run(DenoiseArgs& a, const CLI::App& cmd) {
     DenoiseOptions& o = a.opt;
     const bool sequence = !a.sequence.empty();
+    if (a.method != "svgf" && a.method != "eaw" && a.method != "sure")
+        throw InputError("--method: unknown denoise method '" + a.method + "' (expected eaw, sure or svgf)");
     if (a.method == "svgf" && !sequence)
         throw InputError("--method svgf denoises animated sequences: give --sequence DIR (and an output directory)");
     o.method = a.method == "svgf" ? DenoiseMethod::Sure : parseDenoiseMethod(a.method);
@@ -58,8 +133,10 @@ void run(DenoiseArgs& a) {
     o.sure.correlatedVariance = !a.noCorrelated;
     o.firefly.enabled = !a.noFirefly;
     o.demodulate = !a.noDemodulate;
-    validateDenoiseOptions(o);
-    o.device = parseDevice(a.device);
+    validateDenoiseFlags(o, cmd);
+    if (a.method == "svgf") validateSvgfFlags(a.svgf, cmd);
+    o.device = parseDeviceFlag(a.device);
+    noteIgnoredFlags(cmd, a.method, sequence);
     if (sequence) {
         if (!a.inDir.empty() || !a.color.empty())
             throw InputError("--sequence DIR denoises the frames of DIR: drop --in/--color");
@@ -77,6 +154,7 @@ void run(DenoiseArgs& a) {
     if (ext != ".exr" && ext != ".pfm" && ext != ".png")
         throw InputError("--out '" + a.out + "': unsupported extension (use .exr, .pfm or .png)");
     if (a.inDir.empty() == a.color.empty()) throw InputError("give exactly one of --in RENDER_DIR or --color FILE");
+    checkOutputFile(a.out);
 
     // Buffer paths: --in DIR takes the renderer's file names where present; explicit flags win.
     auto pick = [&](const std::string& flag, const char* name) -> std::string {
@@ -160,48 +238,52 @@ void addDenoiseCommand(CLI::App& app) {
     cmd->add_option("--sequence", a->sequence,
                     "Sequence directory of frame_NNNN/ folders (atrous render --frames); --out is then a directory");
     cmd->add_option("--color", a->color, "Noisy colour (EXR/PFM)");
-    cmd->add_option("--variance", a->variance, "Per-channel variance of the pixel mean");
-    cmd->add_option("--albedo", a->albedo, "Albedo buffer");
-    cmd->add_option("--normal", a->normal, "World-space normal buffer");
-    cmd->add_option("--position", a->position, "World-space position buffer");
-    cmd->add_option("--depth", a->depth, "View depth buffer");
-    cmd->add_option("--ids", a->ids, "Mesh id (R) / material id (G) buffer");
-    cmd->add_option("--emission", a->emission, "Emitted radiance of the primary hit (filtered around, added back)");
-    cmd->add_option("--out", a->out, "Output file (.exr, .pfm or .png); with --sequence, an output directory")
+    cmd->add_option("--variance", a->variance, "Per-channel variance of the pixel mean")->group(kGroupBuffers);
+    cmd->add_option("--albedo", a->albedo, "Albedo buffer")->group(kGroupBuffers);
+    cmd->add_option("--normal", a->normal, "World-space normal buffer")->group(kGroupBuffers);
+    cmd->add_option("--position", a->position, "World-space position buffer")->group(kGroupBuffers);
+    cmd->add_option("--depth", a->depth, "View depth buffer")->group(kGroupBuffers);
+    cmd->add_option("--ids", a->ids, "Mesh id (R) / material id (G) buffer")->group(kGroupBuffers);
+    cmd->add_option("--emission", a->emission, "Emitted radiance of the primary hit (filtered around, added back)")->group(kGroupBuffers);
+    cmd->add_option("--out", a->out,
+                    "Output file (.exr, .pfm or .png); with --sequence, an output directory, written only once every "
+                    "frame is denoised (on error it is left as it was). An existing one keeps its other files; this "
+                    "run's frame_NNNN.exr/.png replace the old ones, and those of an earlier run that this run does "
+                    "not write (and an old preview.mp4) are removed, named in a note on stderr")
         ->required();
     cmd->add_option("--method", a->method, "eaw | sure (| svgf with --sequence)")->capture_default_str();
     cmd->add_option("--device", a->device, "cpu | cuda | auto (cuda when a GPU is present)")->capture_default_str();
     EawParams& e = a->opt.eaw;
-    cmd->add_option("--levels", e.levels, "A-trous levels (1..10)")->capture_default_str();
-    cmd->add_option("--sigma-color", e.sigmaColor, "Raw sigma_c (0 = automatic from the variance)")->capture_default_str();
-    cmd->add_option("--color-scale", e.colorScale, "k_c of the automatic sigma_c")->capture_default_str();
-    cmd->add_option("--color-level-factor", e.colorLevelFactor, "sigma_c,i = sigma_c * factor^i")->capture_default_str();
-    cmd->add_option("--sigma-normal", e.sigmaNormal, "sigma_n (0 = no normal stop)")->capture_default_str();
-    cmd->add_flag("--normal-step-scale", a->normalStepScale, "Divide the normal distance by step^2 (paper GLSL)");
+    cmd->add_option("--levels", e.levels, "A-trous levels (1..10)")->capture_default_str()->group(kGroupEawSure);
+    cmd->add_option("--sigma-color", e.sigmaColor, "Raw sigma_c (0 = automatic from the variance)")->capture_default_str()->group(kGroupEawSure);
+    cmd->add_option("--color-scale", e.colorScale, "k_c of the automatic sigma_c")->capture_default_str()->group(kGroupEawSure);
+    cmd->add_option("--color-level-factor", e.colorLevelFactor, "sigma_c,i = sigma_c * factor^i")->capture_default_str()->group(kGroupEawSure);
+    cmd->add_option("--sigma-normal", e.sigmaNormal, "sigma_n (0 = no normal stop)")->capture_default_str()->group(kGroupEawSure);
+    cmd->add_flag("--normal-step-scale", a->normalStepScale, "Divide the normal distance by step^2 (paper GLSL)")->group(kGroupEawSure);
     cmd->add_option("--sigma-position", e.sigmaPosition, "Raw sigma_x (0 = automatic from the pixel footprint)")
-        ->capture_default_str();
-    cmd->add_option("--position-scale", e.positionScale, "k_x of the automatic sigma_x")->capture_default_str();
-    cmd->add_option("--sigma-depth", e.sigmaDepth, "sigma_z on relative depth (0 = off)")->capture_default_str();
-    cmd->add_flag("--no-ids", a->noIds, "Ignore the ids buffer");
+        ->capture_default_str()->group(kGroupEawSure);
+    cmd->add_option("--position-scale", e.positionScale, "k_x of the automatic sigma_x")->capture_default_str()->group(kGroupEawSure);
+    cmd->add_option("--sigma-depth", e.sigmaDepth, "sigma_z on relative depth (0 = off)")->capture_default_str()->group(kGroupEawSure);
+    cmd->add_flag("--no-ids", a->noIds, "Ignore the ids buffer")->group(kGroupEawSure);
     cmd->add_option("--emission-levels", e.emissionLevels,
                     "Levels of the edge-avoiding filter of the emission buffer (0 = add emission back as is)")
-        ->capture_default_str();
+        ->capture_default_str()->group(kGroupEawSure);
     cmd->add_option("--emission-scale", e.emissionScale, "k of the emission filter's sigma^2 = k * 2 min(V_p, V_q)")
-        ->capture_default_str();
-    cmd->add_option("--sure-mode", a->sureMode, "discrete | james-stein")->capture_default_str();
-    cmd->add_option("--sure-candidates", a->sureCandidates, "Comma-separated fractions (default 0,0.2,0.4,0.6,0.8,1)");
+        ->capture_default_str()->group(kGroupEawSure);
+    cmd->add_option("--sure-mode", a->sureMode, "discrete | james-stein")->capture_default_str()->group(kGroupSure);
+    cmd->add_option("--sure-candidates", a->sureCandidates, "Comma-separated fractions (default 0,0.2,0.4,0.6,0.8,1)")->group(kGroupSure);
     cmd->add_option("--sure-window", a->opt.sure.windowRadius, "SURE window radius r ((2r+1)^2 window)")
-        ->capture_default_str();
+        ->capture_default_str()->group(kGroupSure);
     cmd->add_option("--sure-first-level", a->opt.sure.firstLevel,
                     "SURE keeps no detail of levels below this one (0 = the paper's form)")
-        ->capture_default_str();
-    cmd->add_flag("--no-correlated-variance", a->noCorrelated, "Plain independence propagation of the variance");
-    cmd->add_flag("--no-firefly", a->noFirefly, "Disable firefly suppression");
-    cmd->add_option("--firefly-k", a->opt.firefly.k, "Firefly bound: k local standard deviations")->capture_default_str();
-    cmd->add_flag("--no-demodulate", a->noDemodulate, "Do not divide by the albedo");
-    cmd->add_option("--albedo-epsilon", a->opt.albedoEpsilon, "Demodulation floor")->capture_default_str();
+        ->capture_default_str()->group(kGroupSure);
+    cmd->add_flag("--no-correlated-variance", a->noCorrelated, "Plain independence propagation of the variance")->group(kGroupSure);
+    cmd->add_flag("--no-firefly", a->noFirefly, "Disable firefly suppression")->group(kGroupEawSure);
+    cmd->add_option("--firefly-k", a->opt.firefly.k, "Firefly bound: k local standard deviations")->capture_default_str()->group(kGroupEawSure);
+    cmd->add_flag("--no-demodulate", a->noDemodulate, "Do not divide by the albedo")->group(kGroupEawSure);
+    cmd->add_option("--albedo-epsilon", a->opt.albedoEpsilon, "Demodulation floor")->capture_default_str()->group(kGroupEawSure);
     addSvgfOptions(*cmd, a->svgf);
-    cmd->callback([a] { run(*a); });
+    cmd->callback([a, cmd] { run(*a, *cmd); });
 }
 
 }  // namespace atrous::cli
