@@ -197,13 +197,18 @@ void ViewPipeline::renderFrame(const PipelineSettings& s, bool svgf) {
 namespace {
 
 // Every image a functor is about to read or write must live on the device it runs on (a host
-// pointer in a CUDA kernel, or the reverse, is the classic failure): checked before each launch.
-void requireOn(Device d, std::initializer_list<const Image*> images, const char* what) {
-    for (const Image* img : images)
+// pointer in a CUDA kernel, or the reverse, is the classic failure) and have the pipeline's size
+// (the functors index every view with one plane size): checked before each launch.
+void requireOn(Device d, int w, int h, std::initializer_list<const Image*> images, const char* what) {
+    for (const Image* img : images) {
         if (img->empty() || img->device() != d)
             throw RuntimeError(std::string("view pipeline: ") + what + ": a buffer is " +
                                (img->empty() ? "missing" : "on the wrong device") + " (expected " +
                                deviceName(d) + ")");
+        if (img->width() != w || img->height() != h || img->channels() < 3)
+            throw RuntimeError(std::string("view pipeline: ") + what + ": a buffer is not " +
+                               std::to_string(w) + "x" + std::to_string(h) + " with 3 channels");
+    }
 }
 
 }  // namespace
@@ -222,12 +227,12 @@ void ViewPipeline::accumulateFrame(bool accumulate) {
     }
     AccumulateFrame a;
     a.p = makeAccumulateParams(restart, accumulate, mFrames, mSppAccumulated, kBackgroundDepth);
-    requireOn(mDevice,
+    requireOn(mDevice, mWidth, mHeight,
               {&f.color, &f.variance, &f.albedo, &f.normal, &f.position, &f.depth, &f.ids, &mColor,
                &mVariance, &mAlbedo, &mNormal, &mPosition, &mDepth, &mIds, &mEmissionMean, &mMoments,
                &mNormalMean, &mCounts},
               "accumulation");
-    if (mEmissionValid) requireOn(mDevice, {&f.emission}, "accumulation");
+    if (mEmissionValid) requireOn(mDevice, mWidth, mHeight, {&f.emission}, "accumulation");
     a.color = f.color.view(), a.variance = f.variance.view(), a.albedo = f.albedo.view();
     a.normal = f.normal.view(), a.position = f.position.view(), a.depth = f.depth.view();
     a.ids = f.ids.view();
@@ -249,7 +254,7 @@ void ViewPipeline::computeMotion() {
     m.p.moved = mCameraMoved ? 1 : 0;
     m.p.hitDepth = 0.1f * kBackgroundDepth;
     m.p.offscreen = pt::kMotionOffscreen;  // the renderer's "no previous position"
-    requireOn(mDevice, {&frame().depth, &mMotion}, "motion");
+    requireOn(mDevice, mWidth, mHeight, {&frame().depth, &mMotion}, "motion");
     m.depth = frame().depth.view();
     m.motion = mMotion.view();
     runMotionFromDepth(mDevice, m);
