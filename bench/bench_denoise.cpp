@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "atrous/denoise.h"
+#include "bench_cli.h"
 #include "core/timer.h"
 
 using namespace atrous;
@@ -81,25 +82,32 @@ int main(int argc, char** argv) {
     std::vector<std::pair<int, int>> sizes = {{512, 512}, {1920, 1080}};
     std::vector<DenoiseMethod> methods = {DenoiseMethod::Eaw, DenoiseMethod::Sure};
     int threads = 0;  // 0: TBB's default
-    for (int i = 1; i < argc; ++i) {
-        if (!std::strcmp(argv[i], "--runs") && i + 1 < argc) runs = std::max(20, std::atoi(argv[++i]));
-        else if (!std::strcmp(argv[i], "--device") && i + 1 < argc) device = parseDevice(argv[++i]);
-        else if (!std::strcmp(argv[i], "--size") && i + 1 < argc) {
+    std::string deviceText = "cpu", sizeText, methodText;
+    CLI::App app{"Speed of EAW and SURE-A-Trous (defaults: 5 levels, all buffers) at 512x512 and 1920x1080; prints JSON",
+                 "bench_denoise"};
+    app.add_option("--runs", runs, "timed runs after warm-up; fewer than 20 are raised to 20")
+        ->check(CLI::Range(1, 100000))->capture_default_str();
+    app.add_option("--device", deviceText, "cpu | cuda")->check(CLI::IsMember({"cpu", "cuda"}))->capture_default_str();
+    app.add_option("--size", sizeText, "time only this size, WxH (default: 512x512 and 1920x1080)");
+    app.add_option("--method", methodText, "time only this method")->check(CLI::IsMember({"eaw", "sure"}));
+    app.add_option("--threads", threads, "TBB threads (0 = all cores; 1 measures the work alone on a loaded machine)")
+        ->check(CLI::Range(0, 4096))->capture_default_str();
+    app.callback([&] {
+        if (!sizeText.empty()) {
             int w = 0, h = 0;
-            if (std::sscanf(argv[++i], "%dx%d", &w, &h) != 2 || w < 1 || h < 1) {
-                std::fprintf(stderr, "bench_denoise: --size expects WxH, e.g. 512x512\n");
-                return 2;
-            }
+            atrous::bench::parseSize(sizeText, w, h);
             sizes = {{w, h}};
-        } else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) {
-            threads = std::max(1, std::atoi(argv[++i]));
-        } else if (!std::strcmp(argv[i], "--method") && i + 1 < argc) {
-            methods = {parseDenoiseMethod(argv[++i])};
-        } else {
-            std::fprintf(stderr, "bench_denoise: unknown argument '%s'\n", argv[i]);
-            return 2;
         }
+    });
+    if (int rc = atrous::bench::parseArgs(app, argc, argv); rc >= 0) return rc;
+    runs = std::max(20, runs);
+    try {
+        device = parseDevice(deviceText);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "bench_denoise: error: --device: %s\n", e.what());
+        return 2;
     }
+    if (!methodText.empty()) methods = {parseDenoiseMethod(methodText)};
     const int concurrency = threads > 0 ? threads : tbb::info::default_concurrency();
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(concurrency));
     std::printf("{\n  \"benchmark\": \"denoise\",\n  \"device\": \"%s\",\n  \"threads\": %d,\n  \"runs\": %d,\n  \"results\": [\n",

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "atrous/device.h"
+#include "bench_cli.h"
 #include "atrous/render.h"
 #include "core/timer.h"
 #include "render/bvh_render.h"
@@ -38,22 +39,21 @@ int main(int argc, char** argv) {
     s.spp = 16;
     int runs = 5;
     bool skipCpu = false;
-    for (int i = 1; i + 1 < argc; i += 2) {
-        std::string k = argv[i];
-        const char* v = argv[i + 1];
-        if (k == "--scene") sceneName = v;
-        else if (k == "--width") s.width = std::atoi(v);
-        else if (k == "--height") s.height = std::atoi(v);
-        else if (k == "--spp") s.spp = std::atoi(v);
-        else if (k == "--runs") runs = std::atoi(v);
-        else if (k == "--max-depth") s.maxDepth = std::atoi(v);
-        else if (k == "--skip-cpu") skipCpu = std::atoi(v) != 0;
-        else {
-            std::fprintf(stderr, "bench_gpu_render: unknown option %s\n", k.c_str());
-            return 2;
-        }
-    }
+    int skipCpuValue = 0;
+    CLI::App app{"Path-tracing throughput: CUDA BVH renderer, the same functor on CPU threads, and Embree; prints JSON "
+                 "(\"cuda\" is null without a GPU)",
+                 "bench_gpu_render"};
+    app.add_option("--scene", sceneName, "built-in scene or scene .json file")->capture_default_str();
+    app.add_option("--width", s.width, "image width")->capture_default_str();
+    app.add_option("--height", s.height, "image height")->capture_default_str();
+    app.add_option("--spp", s.spp, "samples per pixel")->capture_default_str();
+    app.add_option("--runs", runs, "timed runs after a warm-up (median kept)")->check(CLI::Range(1, 100000))->capture_default_str();
+    app.add_option("--max-depth", s.maxDepth, "maximum bounces")->capture_default_str();
+    app.add_option("--skip-cpu", skipCpuValue, "1: time the CUDA renderer only")->check(CLI::IsMember({0, 1}))->capture_default_str();
+    if (int rc = atrous::bench::parseArgs(app, argc, argv); rc >= 0) return rc;
+    skipCpu = skipCpuValue != 0;
     try {
+        validateRenderSettings(s);  // bad --width/--spp/... exit 2 before the warm-up
         Scene scene = Scene::loadByNameOrFile(sceneName);
         double samples = double(s.width) * s.height * s.spp;
         nlohmann::json out;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "atrous/device.h"
+#include "bench_cli.h"
 #include "atrous/render.h"
 #include "core/timer.h"
 
@@ -30,22 +31,17 @@ int main(int argc, char** argv) {
     s.height = 512;
     s.spp = 4;
     int runs = 7;
-    for (int i = 1; i + 1 < argc; i += 2) {
-        std::string k = argv[i];
-        const char* v = argv[i + 1];
-        if (k == "--scene") scene = v;
-        else if (k == "--width") s.width = std::atoi(v);
-        else if (k == "--height") s.height = std::atoi(v);
-        else if (k == "--spp") s.spp = std::atoi(v);
-        else if (k == "--runs") runs = std::atoi(v);
-        else if (k == "--threads") s.threads = std::atoi(v);
-        else if (k == "--max-depth") s.maxDepth = std::atoi(v);
-        else {
-            std::fprintf(stderr, "bench_render: unknown option %s\n", k.c_str());
-            return 2;
-        }
-    }
+    CLI::App app{"Path-tracing throughput of the Embree CPU renderer (samples/s); prints JSON", "bench_render"};
+    app.add_option("--scene", scene, "built-in scene or scene .json file")->capture_default_str();
+    app.add_option("--width", s.width, "image width")->capture_default_str();
+    app.add_option("--height", s.height, "image height")->capture_default_str();
+    app.add_option("--spp", s.spp, "samples per pixel")->capture_default_str();
+    app.add_option("--runs", runs, "timed runs after a warm-up (median kept)")->check(CLI::Range(1, 100000))->capture_default_str();
+    app.add_option("--threads", s.threads, "worker threads (0 = all cores)")->capture_default_str();
+    app.add_option("--max-depth", s.maxDepth, "maximum bounces")->capture_default_str();
+    if (int rc = atrous::bench::parseArgs(app, argc, argv); rc >= 0) return rc;
     try {
+        atrous::validateRenderSettings(s);  // bad --width/--spp/... exit 2 before the warm-up
         atrous::Scene sc = atrous::Scene::loadByNameOrFile(scene);
         atrous::render(sc, s);  // warm-up: page faults, Embree/TBB start-up
         std::vector<double> times, cpu;

@@ -200,15 +200,19 @@ int main(int argc, char** argv) {
             atrous::cli::addSvgfOptions(app, a.svgf);
             try {
                 app.parse(argc - 1, argv + 1);
-            } catch (const CLI::ParseError& e) {
+            } catch (const CLI::CallForHelp& e) {
                 return app.exit(e);
+            } catch (const CLI::ParseError& e) {
+                std::fprintf(stderr, "svgf_sequence_tool denoise: error: %s (see --help)\n", e.what());
+                return 2;
             }
             return atrous::cli::runSequenceDenoise(a);
         }
-        std::fprintf(stderr, "usage: svgf_sequence_tool denoise --method M --sequence DIR --out OUT | metrics SEQDIR OUTDIR | "
+        const bool help = argc == 2 && (std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0);
+        std::fprintf(help ? stdout : stderr, "usage: svgf_sequence_tool denoise --method M --sequence DIR --out OUT | metrics SEQDIR OUTDIR | "
                      "crop IN.exr OUT.png X Y W H SCALE [EXPOSURE] | errmap X.exr REF.exr OUT.png [SCALE] | "
                      "probe IMG.exr X Y W H [CHANNEL]\n");
-        return 2;
+        return help ? 0 : 2;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "svgf_sequence_tool: error: %s\n", e.what());
         return 2;

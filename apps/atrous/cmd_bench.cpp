@@ -278,8 +278,11 @@ void addBenchCommand(CLI::App& app) {
     cmd->add_option("--sizes", args->sizes, "comma-separated WxH list")->capture_default_str();
     cmd->add_option("--what", args->what, "comma-separated: eaw, sure, svgf, render")->capture_default_str();
     cmd->add_option("--scene", args->scene, "scene whose buffers are denoised")->capture_default_str();
-    cmd->add_option("--runs", args->runs, "timed runs per figure (0: 50 on CUDA, 10 on the CPU)");
-    cmd->add_option("--warmup", args->warmup, "untimed runs first")->capture_default_str();
+    cmd->add_option("--runs", args->runs,
+                    "timed runs per denoiser figure (0: 50 on CUDA, 10 on the CPU); render rows time max(3, runs/10) "
+                    "renders after one warm-up")
+        ->check(CLI::Range(0, 1000000));
+    cmd->add_option("--warmup", args->warmup, "untimed runs first")->check(CLI::Range(0, 1000000))->capture_default_str();
     cmd->add_flag("--json", args->json, "print JSON");
     cmd->callback([args] { run(*args); });
 }
