@@ -6,9 +6,10 @@
 // time per frame (all threads together; robust to other load on a shared machine).
 //
 // With --stages also the median per-stage milliseconds (SvgfReport::stages; the timing itself
-// costs ~1 µs per frame).
+// costs ~1 µs per frame). --avx2 runs the CPU à-trous fast path's AVX2 loops where the CPU has
+// AVX-512 (to compare the two); --generic the per-pixel functor instead of the fast path.
 //
-//   build/bench/bench_svgf [--device cpu|cuda] [--runs N] [--warmup N] [--taa] [--stages]
+//   build/bench/bench_svgf [--device cpu|cuda] [--runs N] [--warmup N] [--taa] [--stages] [--avx2] [--generic]
 #include <time.h>
 
 #include <algorithm>
@@ -25,6 +26,7 @@
 #include "atrous/error.h"
 #include "atrous/svgf.h"
 #include "core/timer.h"
+#include "filters/svgf_atrous.h"
 
 using namespace atrous;
 
@@ -93,8 +95,12 @@ int main(int argc, char** argv) {
             taa = true;
         else if (!std::strcmp(argv[i], "--stages"))
             stages = true;
+        else if (!std::strcmp(argv[i], "--avx2"))
+            svgf::svgfCpuAvx512() = false;
+        else if (!std::strcmp(argv[i], "--generic"))
+            svgf::svgfCpuFastPath() = false;
         else {
-            std::fprintf(stderr, "usage: bench_svgf [--device cpu|cuda] [--runs N] [--warmup N] [--taa] [--stages]\n");
+            std::fprintf(stderr, "usage: bench_svgf [--device cpu|cuda] [--runs N] [--warmup N] [--taa] [--stages] [--avx2] [--generic]\n");
             return 2;
         }
     }
@@ -107,6 +113,8 @@ int main(int argc, char** argv) {
         out["device"] = deviceName(device);
         out["backend"] = deviceToString(device);
         out["params"] = {{"levels", params.levels}, {"taa", params.taa}, {"feedbackTap", params.feedbackTap}};
+        if (device == Device::Cpu)
+            out["atrous_cpu"] = !svgf::svgfCpuFastPath() ? "generic functor" : (svgf::svgfCpuAvx512() ? "avx512" : "avx2");
         out["what"] = "whole SVGF pipeline per frame, inputs and output on the device";
         const int sizes[2][2] = {{512, 512}, {1920, 1080}};
         for (const auto& sz : sizes) {
