@@ -10,12 +10,12 @@
 // AVX-512 (to compare the two); --generic the per-pixel functor instead of the fast path.
 //
 //   build/bench/bench_svgf [--device cpu|cuda] [--runs N] [--warmup N] [--taa] [--stages] [--avx2] [--generic]
+//   (--help: the usage; a bad flag or value exits 2 before any timing)
 #include <time.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <random>
@@ -27,6 +27,7 @@
 #include "atrous/svgf.h"
 #include "core/timer.h"
 #include "filters/svgf_atrous.h"
+#include "bench_cli.h"
 
 using namespace atrous;
 
@@ -83,27 +84,20 @@ double processCpuMs() {
 int main(int argc, char** argv) {
     int runs = 15, warmup = 6;
     std::string deviceName_ = "cpu";
-    bool taa = false, stages = false;
-    for (int i = 1; i < argc; ++i) {
-        if (!std::strcmp(argv[i], "--runs") && i + 1 < argc)
-            runs = std::atoi(argv[++i]);
-        else if (!std::strcmp(argv[i], "--warmup") && i + 1 < argc)
-            warmup = std::atoi(argv[++i]);
-        else if (!std::strcmp(argv[i], "--device") && i + 1 < argc)
-            deviceName_ = argv[++i];
-        else if (!std::strcmp(argv[i], "--taa"))
-            taa = true;
-        else if (!std::strcmp(argv[i], "--stages"))
-            stages = true;
-        else if (!std::strcmp(argv[i], "--avx2"))
-            svgf::svgfCpuAvx512() = false;
-        else if (!std::strcmp(argv[i], "--generic"))
-            svgf::svgfCpuFastPath() = false;
-        else {
-            std::fprintf(stderr, "usage: bench_svgf [--device cpu|cuda] [--runs N] [--warmup N] [--taa] [--stages] [--avx2] [--generic]\n");
-            return 2;
-        }
-    }
+    bool taa = false, stages = false, avx2 = false, generic = false;
+    CLI::App app{"Speed of the whole SVGF pipeline per frame at 512x512 and 1920x1080; prints JSON", "bench_svgf"};
+    app.add_option("--runs", runs, "timed frames after the warm-up")->check(CLI::Range(1, 100000))->capture_default_str();
+    app.add_option("--warmup", warmup, "frames before timing (histories fill)")
+        ->check(CLI::Range(0, 100000))
+        ->capture_default_str();
+    app.add_option("--device", deviceName_, "cpu | cuda")->check(CLI::IsMember({"cpu", "cuda"}))->capture_default_str();
+    app.add_flag("--taa", taa, "with the TAA stage");
+    app.add_flag("--stages", stages, "also the median time of each stage (SvgfReport::stages)");
+    app.add_flag("--avx2", avx2, "CPU: the à-trous fast path's AVX2 loops even where the CPU has AVX-512");
+    app.add_flag("--generic", generic, "CPU: the per-pixel à-trous functor instead of the fast path");
+    if (int rc = atrous::bench::parseArgs(app, argc, argv); rc >= 0) return rc;
+    if (avx2) svgf::svgfCpuAvx512() = false;
+    if (generic) svgf::svgfCpuFastPath() = false;
     try {
         const Device device = parseDevice(deviceName_);
         SvgfParams params;
