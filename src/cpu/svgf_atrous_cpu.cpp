@@ -5,7 +5,10 @@
 // rows a contiguous, branch-free x loop over the interior columns with the 5 taps of that row
 // unrolled. Columns within 2·step of the left/right border run one loop per tap over the columns
 // where that tap is inside the image. The generic functor's `continue`s (tap outside, empty pixel,
-// across an edge) become weight-0 selects, which add exactly nothing to the sums.
+// across an edge) become weight-0 selects, which add exactly nothing to the sums as long as the
+// dropped tap's illumination and variance are finite (0 · Inf = NaN): the pipeline guarantees it
+// (Demodulate replaces non-finite colour and clamps to ±kMaxIllum, every later stage takes
+// weighted means of those values).
 //
 // Where the time went before (scalar functor, 512²: ~24 ms per level on 2 cores):
 // - logf per tap in the normal stop: now the polynomial fastLog, also used by the GPU;
