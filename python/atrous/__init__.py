@@ -273,7 +273,9 @@ class Svgf:
     emission_alpha, emission_motion_alpha.
     """
 
-    def __init__(self, device: str = "cpu", **params: Any) -> None:
+    def __init__(self, device: str = "auto", **params: Any) -> None:
+        """device: "auto" (CUDA when this build has a usable GPU, else the CPU, as everywhere in
+        atrous), "cpu" or "cuda". Frames on another device than the filter's are copied over."""
         self._impl = _core.Svgf(device, dict(params))
 
     def denoise_frame(self, color: Any, *, albedo: Any = None, normal: Any = None, depth: Any = None,

@@ -128,6 +128,12 @@ void applyDenoiseParam(DenoiseOptions& o, const std::string& k, const nb::handle
     else if (k == "firefly") o.firefly.enabled = as<bool>(v, k);
     else if (k == "firefly_k") o.firefly.k = as<float>(v, k);
     else if (k == "demodulate") o.demodulate = as<bool>(v, k);
+    // The CLI's negative switches, accepted under their flag names too: no_firefly=True is
+    // firefly=False, and so on.
+    else if (k == "no_firefly") o.firefly.enabled = !as<bool>(v, k);
+    else if (k == "no_ids") e.useIds = !as<bool>(v, k);
+    else if (k == "no_demodulate") o.demodulate = !as<bool>(v, k);
+    else if (k == "no_correlated_variance") o.sure.correlatedVariance = !as<bool>(v, k);
     else if (k == "albedo_epsilon") o.albedoEpsilon = as<float>(v, k);
     else throw InputError("unknown denoise parameter '" + k + "'");
 }
@@ -280,6 +286,26 @@ void pyWriteImage(const std::string& path, const Array& image) {
     io::writeImage(path, img);
 }
 
+// The library's messages name the CLI's flags ("--width: -1 is out of range"); in Python the same
+// setting is a keyword argument, so "--max-depth" is shown as "max_depth". Only a "--" at the start
+// of a word followed by a lower-case flag name is rewritten (file paths keep theirs).
+std::string pythonMessage(const std::string& msg) {
+    std::string out;
+    out.reserve(msg.size());
+    for (size_t i = 0; i < msg.size();) {
+        const bool wordStart = i == 0 || msg[i - 1] == ' ' || msg[i - 1] == '\'' || msg[i - 1] == '(';
+        if (wordStart && msg.compare(i, 2, "--") == 0 && i + 2 < msg.size() && msg[i + 2] >= 'a' && msg[i + 2] <= 'z') {
+            size_t j = i + 2;
+            while (j < msg.size() && ((msg[j] >= 'a' && msg[j] <= 'z') || (msg[j] >= '0' && msg[j] <= '9') || msg[j] == '-'))
+                out += msg[j] == '-' ? '_' : msg[j], ++j;
+            i = j;
+        } else {
+            out += msg[i++];
+        }
+    }
+    return out;
+}
+
 }  // namespace
 
 NB_MODULE(_core, m) {
@@ -288,9 +314,9 @@ NB_MODULE(_core, m) {
         try {
             std::rethrow_exception(p);
         } catch (const InputError& e) {
-            PyErr_SetString(PyExc_ValueError, e.what());
+            PyErr_SetString(PyExc_ValueError, pythonMessage(e.what()).c_str());
         } catch (const atrous::RuntimeError& e) {
-            PyErr_SetString(PyExc_RuntimeError, e.what());
+            PyErr_SetString(PyExc_RuntimeError, pythonMessage(e.what()).c_str());
         }
     });
     m.def("denoise", &pyDenoise, nb::arg("color"), nb::arg("albedo").none(), nb::arg("normal").none(),

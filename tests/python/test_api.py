@@ -122,6 +122,47 @@ def test_bad_arguments_raise_value_error(bufs):
             atrous.denoise(c, device="cuda")
 
 
+def test_messages_name_keywords_not_cli_flags():
+    # The library's messages name the CLI's flags; Python shows the keyword instead.
+    with pytest.raises(ValueError) as e:
+        atrous.render("cornell", width=-1, height=8, spp=1)
+    assert "width" in str(e.value) and "--width" not in str(e.value), str(e.value)
+    with pytest.raises(ValueError) as e:
+        atrous.render("cornell", width=8, height=8, spp=1, max_depth=-3)
+    assert "--" not in str(e.value), str(e.value)
+
+
+def test_cli_switch_names_are_accepted(bufs):
+    # no_firefly=True is firefly=False, and so on for the CLI's other --no-* switches.
+    c = bufs["color"]
+    kw = dict(normal=bufs["normal"], variance=bufs["variance"], albedo=bufs["albedo"], ids=bufs["ids"])
+    for alias, name in (("no_firefly", "firefly"), ("no_demodulate", "demodulate"), ("no_ids", "use_ids"),
+                        ("no_correlated_variance", "correlated_variance")):
+        a = atrous.denoise(c, method="sure", **kw, **{alias: True})
+        b = atrous.denoise(c, method="sure", **kw, **{name: False})
+        np.testing.assert_array_equal(a, b, err_msg=alias)
+
+
+def test_a_zero_variance_is_ignored(bufs):
+    # What a 1-spp render returns: taken at face value it would mean "noise-free" (no filtering).
+    c = bufs["color"]
+    zero = np.zeros_like(c)
+    a = atrous.denoise(c, variance=zero, normal=bufs["normal"], method="eaw")
+    b = atrous.denoise(c, normal=bufs["normal"], method="eaw")
+    np.testing.assert_array_equal(a, b)
+    assert np.abs(a - c).max() > 1e-3
+
+
+def test_metrics_count_non_finite_pixels(bufs):
+    c = bufs["color"]
+    bad = c.copy()
+    bad[1, 2, 0] = np.nan
+    bad[3, 4, 1] = np.inf
+    m = atrous.metrics(bad, c)
+    assert m["non_finite_pixels"] == 2 and m["reference_non_finite_pixels"] == 0
+    assert np.isfinite(m["mse"])
+
+
 def test_nan_and_inf_in_color_do_not_spread(bufs):
     c = bufs["color"].copy()
     c[10, 10] = np.nan
