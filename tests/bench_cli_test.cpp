@@ -71,3 +71,12 @@ TEST(BenchCli, AtrousBenchRejectsNegativeRuns) {
 }
 
 }  // namespace
+
+// Every subcommand's --device error names the flag (main.cpp adds it where a command does not).
+TEST(BenchCli, UnknownDeviceNamesTheFlagInEveryCommand) {
+    for (const char* args : {"bench --sizes 16x16 --what eaw --device gpu"}) {
+        auto r = atrous::test::runCli(args);
+        EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.output;
+        EXPECT_NE(r.output.find("--device: unknown device 'gpu'"), std::string::npos) << args << "\n" << r.output;
+    }
+}

@@ -83,7 +83,7 @@ void runFrames(const RenderArgs& a) {
     if (!stale.empty())
         std::fprintf(stderr, "render: removed %zu frame director%s of an earlier run from %s (%s%s)\n", stale.size(),
                      stale.size() == 1 ? "y" : "ies", a.out.c_str(), stale.front().c_str(),
-                     stale.size() > 1 ? (" ... " + stale.back()).c_str() : "");
+                     stale.size() > 2 ? (", ..., " + stale.back()).c_str() : stale.size() == 2 ? (", " + stale.back()).c_str() : "");
     Timer total;
     const uint64_t frameSamples = uint64_t(s.width) * uint64_t(s.height) * uint64_t(s.spp + a.referenceSpp);
     ProgressLine progress(!a.quiet && stderrIsTerminal(), "render", frameSamples * uint64_t(a.frames), a.frames);

@@ -191,7 +191,7 @@ public:
         if (!removed.empty()) {
             std::sort(removed.begin(), removed.end());
             std::string list = removed.front();
-            if (removed.size() > 1) list += ", ..., " + removed.back();
+            if (removed.size() > 1) list += (removed.size() > 2 ? ", ..., " : ", ") + removed.back();
             std::fprintf(stderr, "denoise: removed %zu file%s of an earlier run from %s (%s)\n", removed.size(),
                          removed.size() == 1 ? "" : "s", mOut.c_str(), list.c_str());
         }

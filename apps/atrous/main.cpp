@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <exception>
+#include <string>
 
 #include "atrous/error.h"
 #include "commands.h"
@@ -29,7 +30,11 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "atrous: error: %s (see --help)\n", e.what());
         return 2;
     } catch (const atrous::InputError& e) {
-        std::fprintf(stderr, "atrous: error: %s\n", e.what());
+        // parseDevice's message names the value only; every subcommand feeds it from --device
+        // (render and denoise add the flag themselves: apps/atrous/cli_flags.h).
+        const std::string msg = e.what();
+        const char* flag = msg.rfind("unknown device '", 0) == 0 ? "--device: " : "";
+        std::fprintf(stderr, "atrous: error: %s%s\n", flag, msg.c_str());
         return 2;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "atrous: error: %s\n", e.what());
