@@ -110,10 +110,15 @@ void runFrames(const RenderArgs& a) {
         std::error_code ec;
         fs::remove_all(stage, ec);
         io::ensureWritableDirectory(stage);
-        writeBuffers(stage, b, /*withVariance=*/s.spp > 1);
-        io::writeImage((fs::path(stage) / "motion.exr").string(), b.motion);
-        if (!reference.empty()) io::writeImage((fs::path(stage) / "reference.exr").string(), reference);
-        io::writePng((fs::path(stage) / "color.png").string(), b.color);
+        try {
+            writeBuffers(stage, b, /*withVariance=*/s.spp > 1);
+            io::writeImage((fs::path(stage) / "motion.exr").string(), b.motion);
+            if (!reference.empty()) io::writeImage((fs::path(stage) / "reference.exr").string(), reference);
+            io::writePng((fs::path(stage) / "color.png").string(), b.color);
+        } catch (...) {
+            fs::remove_all(stage, ec);  // e.g. disk full: no half-written hidden frame left behind
+            throw;
+        }
         fs::remove_all(dir, ec);
         if (!ec) fs::rename(stage, dir, ec);
         if (ec) throw RuntimeError(dir + ": cannot move the frame into place (" + ec.message() + ")");
