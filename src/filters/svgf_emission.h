@@ -68,14 +68,6 @@ struct AccumulateEmission {
         }
         float fx0 = floorf(px), fy0 = floorf(py);
         int x0 = int(fx0), y0 = int(fy0);
-        float wx[4], wy[4];
-        catmullRomWeights(px - fx0, wx);
-        catmullRomWeights(py - fy0, wy);
-        Vec3 hist(0.0f);
-        for (int j = 0; j < 4; ++j) {
-            int qy = clampi(y0 - 1 + j, 0, h - 1);
-            for (int i = 0; i < 4; ++i) hist += (wx[i] * wy[j]) * readVec3(prevEmission, clampi(x0 - 1 + i, 0, w - 1), qy);
-        }
         // The history length only sets α: the bilinear mean of the inner 2x2 is enough.
         float fx = px - fx0, fy = py - fy0, n = 0.0f;
         for (int j = 0; j < 2; ++j)
@@ -90,6 +82,20 @@ struct AccumulateEmission {
                 lo = minv(lo, q);
                 hi = maxv(hi, q);
             }
+        }
+        // A uniform window (most pixels: no light in reach, or inside a light) collapses the box
+        // to e, so the clamped history is e and so is the blend, exactly: skip the 16 history taps.
+        if (lo.x == hi.x && lo.y == hi.y && lo.z == hi.z) {
+            write(x, y, e, minf(n + 1.0f, historyCap));
+            return;
+        }
+        float wx[4], wy[4];
+        catmullRomWeights(px - fx0, wx);
+        catmullRomWeights(py - fy0, wy);
+        Vec3 hist(0.0f);
+        for (int j = 0; j < 4; ++j) {
+            int qy = clampi(y0 - 1 + j, 0, h - 1);
+            for (int i = 0; i < 4; ++i) hist += (wx[i] * wy[j]) * readVec3(prevEmission, clampi(x0 - 1 + i, 0, w - 1), qy);
         }
         hist = minv(maxv(hist, lo), hi);
         float len = minf(n + 1.0f, historyCap);
