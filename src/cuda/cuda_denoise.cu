@@ -5,8 +5,10 @@
 // device-resident call moves nothing but the few bytes of the reduction back to the host.
 #include <cuda_runtime.h>
 #include <thrust/execution_policy.h>
+#include <thrust/count.h>
 #include <thrust/find.h>
 #include <thrust/iterator/counting_iterator.h>
+#include <thrust/sort.h>
 #include <thrust/transform_reduce.h>
 
 #include <cmath>
@@ -93,7 +95,81 @@ void checkDeviceVariance(const Image& variance) {
     throw negativeVarianceError(value, first % variance.plane(), variance.width());
 }
 
+// Donoho's finest B3 detail |v − (B3 ∗ v)(p)| per channel, exactly as estimateNoiseSigma
+// (denoise.cpp) computes it: the same taps, clamped borders and double sums. Pixels it skips (a
+// non-finite value in the 5×5 window) get +Inf, which sorts after every detail.
+struct MadDetail {
+    ImageView color, detail;  // detail: 3 planes
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        const int w = color.width, h = color.height;
+        for (int c = 0; c < 3; ++c) {
+            float d = INFINITY;
+            const float v = color(x, y, c);
+            if (isFiniteF(v)) {
+                double s = 0, ws = 0;
+                bool ok = true;
+                for (int qy = -2; qy <= 2 && ok; ++qy)
+                    for (int qx = -2; qx <= 2; ++qx) {
+                        const float u = color(clampIdx(x + qx, w - 1), clampIdx(y + qy, h - 1), c);
+                        if (!isFiniteF(u)) {
+                            ok = false;
+                            break;
+                        }
+                        s += double(b3(qx) * b3(qy)) * u;
+                        ws += b3(qx) * b3(qy);
+                    }
+                if (ok) d = fabsf(float(v - s / ws));
+            }
+            detail(x, y, c) = d;
+        }
+    }
+};
+
+struct IsFiniteDetail {
+    ATROUS_HOST_DEVICE bool operator()(float d) const { return d < INFINITY; }
+};
+
+// Fills a 3-channel variance with the constant σ_c² (the estimate of a GPU colour).
+struct FillVariance {
+    float v[3];
+    ImageView out;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        for (int c = 0; c < 3; ++c) out(x, y, c) = v[c];
+    }
+};
+
 }  // namespace
+
+void estimateNoiseSigmaCuda(const Image& color, float sigma[3]) {
+    if (color.device() != Device::Cuda) throw RuntimeError("estimateNoiseSigmaCuda: the colour is not on the GPU");
+    const int w = color.width(), h = color.height();
+    const size_t plane = color.plane();
+    Image detail(w, h, 3, Device::Cuda);
+    const CudaExec exec;
+    exec.forEachPixel(w, h, MadDetail{color.view(), detail.view()});
+    exec.synchronize();
+    // As estimateNoiseSigma: var(d_0) = σ² (1 + Σh² − 2 h(0)) for white noise.
+    const double sumH2 = (70.0 / 256.0) * (70.0 / 256.0), h0 = (6 / 16.0) * (6 / 16.0);
+    const double detailVar = 1.0 + sumH2 - 2.0 * h0;
+    for (int c = 0; c < 3; ++c) {
+        float* d = detail.data() + size_t(c) * plane;
+        size_t n = 0;
+        try {
+            n = size_t(thrust::count_if(thrust::cuda::par, d, d + plane, IsFiniteDetail{}));
+            // The median the host takes with nth_element at n / 2: sort, skipped pixels (+Inf) last.
+            if (n) thrust::sort(thrust::cuda::par, d, d + plane);
+        } catch (const std::exception& e) {
+            throw RuntimeError(std::string("CUDA noise estimate failed: ") + e.what());
+        }
+        if (!n) {
+            sigma[c] = 0;
+            continue;
+        }
+        float mid = 0.0f;
+        ATROUS_CUDA_CHECK(cudaMemcpy(&mid, d + n / 2, sizeof(float), cudaMemcpyDeviceToHost));
+        sigma[c] = float(double(mid) / 0.6745 / std::sqrt(detailVar));
+    }
+}
 
 Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const PreparedInputs& prep, DenoiseReport& rep) {
     const int w = in.color->width(), h = in.color->height();
@@ -109,7 +185,19 @@ Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const Prepar
     };
     DriverInputs di;
     di.color = onDevice(in.color, 0);
-    di.variance = onDevice(in.variance ? in.variance : &prep.estimatedVariance, 1);
+    if (in.variance) {
+        di.variance = onDevice(in.variance, 1);
+    } else if (!prep.estimatedVariance.empty()) {
+        di.variance = onDevice(&prep.estimatedVariance, 1);  // estimated on the host: uploaded
+    } else {
+        // Estimated on the GPU (prepareInputs with a GPU colour): the constant σ² filled there.
+        holders[1] = Image(w, h, 3, Device::Cuda);
+        FillVariance fill{{rep.noiseSigma[0] * rep.noiseSigma[0], rep.noiseSigma[1] * rep.noiseSigma[1],
+                           rep.noiseSigma[2] * rep.noiseSigma[2]},
+                          holders[1].view()};
+        CudaExec{}.forEachPixel(w, h, fill);  // ordered before the driver on the default stream
+        di.variance = holders[1].view();
+    }
     di.albedo = onDevice(in.albedo, 2);
     di.normal = onDevice(in.normal, 3);
     di.position = onDevice(in.position, 4);

@@ -142,16 +142,19 @@ PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, D
         used += ",variance";
         rep.noiseEstimated = false;
     } else {
-        // No variance: Donoho's MAD estimate, constant over the image.
-        const Image colorHost = colorOnHost ? Image() : color.to(Device::Cpu);
-        const Image& ch = colorOnHost ? color : colorHost;
-        estimateNoiseSigma(ch, rep.noiseSigma);
+        // No variance: Donoho's MAD estimate, constant over the image. A GPU colour is estimated
+        // on the GPU, and denoiseCuda fills the constant variance there (estimatedVariance empty).
         rep.noiseEstimated = true;
-        p.estimatedVariance = Image(color.width(), color.height(), 3, Device::Cpu);
-        for (int c = 0; c < 3; ++c) {
-            const float v = rep.noiseSigma[c] * rep.noiseSigma[c];
-            std::fill(p.estimatedVariance.data() + c * p.estimatedVariance.plane(),
-                      p.estimatedVariance.data() + (c + 1) * p.estimatedVariance.plane(), v);
+        if (colorOnHost) {
+            estimateNoiseSigma(color, rep.noiseSigma);
+            p.estimatedVariance = Image(color.width(), color.height(), 3, Device::Cpu);
+            for (int c = 0; c < 3; ++c) {
+                const float v = rep.noiseSigma[c] * rep.noiseSigma[c];
+                std::fill(p.estimatedVariance.data() + c * p.estimatedVariance.plane(),
+                          p.estimatedVariance.data() + (c + 1) * p.estimatedVariance.plane(), v);
+            }
+        } else {
+            estimateNoiseSigmaCuda(color, rep.noiseSigma);
         }
     }
     if (in.albedo) used += o.demodulate ? ",albedo" : ",albedo(unused: demodulation off)";
@@ -279,6 +282,9 @@ Image denoise(const DenoiseInputs& given, const DenoiseOptions& options) {
 #if !defined(ATROUS_HAVE_CUDA)
 namespace atrous::filters {
 Image denoiseCuda(const DenoiseInputs&, const DenoiseOptions&, const PreparedInputs&, DenoiseReport&) {
+    throw InputError("--device cuda: this build of atrous has no CUDA backend");
+}
+void estimateNoiseSigmaCuda(const Image&, float[3]) {
     throw InputError("--device cuda: this build of atrous has no CUDA backend");
 }
 }  // namespace atrous::filters

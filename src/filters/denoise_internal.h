@@ -9,7 +9,9 @@
 namespace atrous::filters {
 
 struct PreparedInputs {
-    Image estimatedVariance;  // constant σ² per channel when no variance buffer was given
+    // Constant σ² per channel when no variance buffer was given and the colour is on the host
+    // (for a GPU colour denoiseCuda fills it on the GPU from DenoiseReport::noiseSigma).
+    Image estimatedVariance;
 };
 
 // Optional extra outputs for tests.
@@ -26,6 +28,9 @@ InputError negativeVarianceError(float value, size_t pixel, int width);
 DriverConfig makeConfig(const DenoiseOptions& o);
 // Per-channel noise standard deviation by Donoho's MAD of the finest B3 detail.
 void estimateNoiseSigma(const Image& color, float sigma[3]);
+// The same estimate of a colour on the GPU, computed there (src/cuda/cuda_denoise.cu): the same
+// details in the same double arithmetic, so the same medians.
+void estimateNoiseSigmaCuda(const Image& color, float sigma[3]);
 Image denoiseCpu(const DenoiseInputs& in, const DenoiseOptions& o, const PreparedInputs& prep, DenoiseReport& rep,
                  DriverDebug* debug);
 Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const PreparedInputs& prep, DenoiseReport& rep);

@@ -166,6 +166,22 @@ TEST(DeviceFrameCuda, DenoiseOnDeviceInputsMatchesHostInputsAndItsReport) {
     EXPECT_NEAR(devRep.meanLuminanceAfterFirefly, cpuRep.meanLuminanceAfterFirefly,
                 1e-5 * std::fabs(cpuRep.meanLuminanceAfterFirefly));  // after: GPU vs CPU clamp, ulps
     EXPECT_EQ(devRep.firefliesClamped, cpuRep.firefliesClamped);
+    // No variance (the viewer's first frame at 1 spp): the MAD noise estimate runs on the GPU for
+    // a GPU colour. Same details in the same double arithmetic; FMA contraction may differ by an
+    // ulp between GCC and nvcc, hence 1e-6 relative on σ and 1e-4 on the results (values ~1).
+    hin.variance = nullptr;
+    din.variance = nullptr;
+    o.report = &hostRep;
+    const Image hostEst = denoise(hin, o);
+    o.report = &devRep;
+    const Image devEst = denoise(din, o);
+    EXPECT_TRUE(devRep.noiseEstimated);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_GT(hostRep.noiseSigma[c], 0.0f);
+        EXPECT_NEAR(devRep.noiseSigma[c], hostRep.noiseSigma[c], 1e-6 * hostRep.noiseSigma[c]) << c;
+    }
+    EXPECT_LT(maxRelDiff(hostEst, devEst), 1e-4);
+    din.variance = &v;
     // A negative variance on the GPU is still an InputError naming the pixel.
     Image badVar = s.variance.clone();
     badVar(5, 7, 2) = -1.0f;
