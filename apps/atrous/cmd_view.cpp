@@ -24,7 +24,7 @@ void addViewCommand(CLI::App& app) {
     cmd->add_option("--height", o.height, "Image height in pixels")->capture_default_str();
     cmd->add_option("--spp", o.spp, "Samples per pixel per frame")->capture_default_str();
     cmd->add_option("--max-depth", o.maxDepth, "Path bounces")->capture_default_str();
-    cmd->add_option("--seed", o.seed, "Base seed (frame k uses a seed derived from it)")
+    cmd->add_option("--seed", o.seed, "Render seed (frame k takes sample indices k*spp.. of each pixel, so frames add fresh samples)")
         ->capture_default_str();
     cmd->add_option("--method", o.method, "Denoiser of the main view: none | eaw | sure | svgf")
         ->capture_default_str();
