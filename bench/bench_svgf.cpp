@@ -86,7 +86,9 @@ int main(int argc, char** argv) {
     std::string deviceName_ = "cpu";
     bool taa = false, stages = false, avx2 = false, generic = false;
     CLI::App app{"Speed of the whole SVGF pipeline per frame at 512x512 and 1920x1080; prints JSON", "bench_svgf"};
-    app.add_option("--runs", runs, "timed frames after the warm-up")->check(CLI::Range(1, 100000))->capture_default_str();
+    app.add_option("--runs", runs, "timed frames after the warm-up")
+        ->check(CLI::Range(1, 100000))
+        ->capture_default_str();
     app.add_option("--warmup", warmup, "frames before timing (histories fill)")
         ->check(CLI::Range(0, 100000))
         ->capture_default_str();
@@ -108,7 +110,8 @@ int main(int argc, char** argv) {
         out["backend"] = deviceToString(device);
         out["params"] = {{"levels", params.levels}, {"taa", params.taa}, {"feedbackTap", params.feedbackTap}};
         if (device == Device::Cpu)
-            out["atrous_cpu"] = !svgf::svgfCpuFastPath() ? "generic functor" : (svgf::svgfCpuAvx512() ? "avx512" : "avx2");
+            out["atrous_cpu"] =
+                !svgf::svgfCpuFastPath() ? "generic functor" : (svgf::svgfCpuAvx512() ? "avx512" : "avx2");
         out["what"] = "whole SVGF pipeline per frame, inputs and output on the device";
         const int sizes[2][2] = {{512, 512}, {1920, 1080}};
         for (const auto& sz : sizes) {
@@ -143,7 +146,8 @@ int main(int argc, char** argv) {
                                 {"ms_median", median(ms)}, {"ms_min", mn}, {"cpu_ms_median", median(cpuMs)}};
             if (stages) {
                 nlohmann::json st = nlohmann::json::array();  // in the pipeline's order
-                for (const std::string& name : stageOrder) st.push_back({{"stage", name}, {"ms_median", median(stageMs[name])}});
+                for (const std::string& name : stageOrder)
+                    st.push_back({{"stage", name}, {"ms_median", median(stageMs[name])}});
                 r["stages"] = st;
             }
             out["results"].push_back(r);

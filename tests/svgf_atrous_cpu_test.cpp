@@ -25,8 +25,14 @@ struct LevelInputs {
     int w, h;
     Image illum, variance, length, depth, normal, depthGrad;
     LevelInputs(int w_, int h_, unsigned seed)
-        : w(w_), h(h_), illum(w_, h_, 3), variance(w_, h_, 1), length(w_, h_, 1), depth(w_, h_, 1),
-          normal(w_, h_, 3), depthGrad(w_, h_, 2) {
+        : w(w_),
+          h(h_),
+          illum(w_, h_, 3),
+          variance(w_, h_, 1),
+          length(w_, h_, 1),
+          depth(w_, h_, 1),
+          normal(w_, h_, 3),
+          depthGrad(w_, h_, 2) {
         std::mt19937 rng(seed);
         std::uniform_real_distribution<float> u(0.0f, 1.0f);
         std::exponential_distribution<float> heavy(1.0f);
@@ -36,7 +42,8 @@ struct LevelInputs {
                 // Illumination: heavy-tailed (1-spp-like), occasionally negative (demodulated
                 // colour minus emission can be) and occasionally 0.
                 const float scale = u(rng) < 0.05f ? 20.0f : 1.0f;
-                for (int c = 0; c < 3; ++c) illum(x, y, c) = scale * heavy(rng) - (u(rng) < 0.05f ? 0.5f : 0.0f);
+                for (int c = 0; c < 3; ++c)
+                    illum(x, y, c) = scale * heavy(rng) - (u(rng) < 0.05f ? 0.5f : 0.0f);
                 // Variance: mostly ~0.1-1, some exactly 0 (then the luminance stop is ~exact).
                 variance(x, y, 0) = u(rng) < 0.1f ? 0.0f : 0.05f + heavy(rng);
                 // History length: ~10% empty pixels.
@@ -46,7 +53,8 @@ struct LevelInputs {
                 const bool bg = (y < h / 5 && x > w / 2) || u(rng) < 0.03f;
                 const bool near = x + y < (w + h) / 2;
                 depth(x, y, 0) = bg ? svgf::kBackgroundDepthValue
-                                    : (near ? 2.0f + 0.01f * float(x) : 6.0f + 0.05f * float(y)) + 0.002f * g(rng);
+                                    : (near ? 2.0f + 0.01f * float(x) : 6.0f + 0.05f * float(y)) +
+                                          0.002f * g(rng);
                 // Normals: unit, jittered around two directions; background ones zero; a few
                 // missing (zero) on surfaces and a few pointing away (n_p·n_q <= 0).
                 float n[3] = {0.0f, 0.0f, 0.0f};
@@ -66,7 +74,8 @@ struct LevelInputs {
             for (int x = 0; x < w; ++x) dg(x, y);
     }
 
-    svgf::Atrous functor(int step, float sigmaL, float sigmaN, float sigmaZ, Image& outIllum, Image& outVar) const {
+    svgf::Atrous functor(int step, float sigmaL, float sigmaN, float sigmaZ, Image& outIllum,
+                         Image& outVar) const {
         svgf::Atrous a;
         a.sigmaL = sigmaL, a.sigmaN = sigmaN, a.sigmaZ = sigmaZ;
         a.step = step;
@@ -125,7 +134,8 @@ TEST(SvgfFastMath, FastLogIsAccurateOnTheUnitInterval) {
     }
     EXPECT_EQ(svgf::fastLog(1.0f), 0.0f);
     EXPECT_GT(worst, 1e-8);  // the measurement ran (a wrong loop would report 0)
-    EXPECT_NEAR(svgf::fastLog(svgf::kMinNormalFloat), std::log(double(svgf::kMinNormalFloat)), 1e-4);
+    EXPECT_NEAR(svgf::fastLog(svgf::kMinNormalFloat), std::log(double(svgf::kMinNormalFloat)),
+                1e-4);
 }
 
 TEST(SvgfFastMath, FastExpIsAccurateAndZeroBelowItsRange) {
@@ -148,12 +158,14 @@ TEST(SvgfFastMath, NormalStopMatchesThePowerItStandsFor) {
     for (float angle : {0.01f, 0.1f, 0.5f, 1.2f}) {
         const Vec3 b(std::sin(angle), 0.0f, std::cos(angle));
         const double ref = 128.0 * std::log(double(dot(a, b)));
-        EXPECT_NEAR(svgf::normalLogWeight(a, b, 128.0f), ref, 3e-7 * std::fabs(ref) + 1e-6) << angle;
+        EXPECT_NEAR(svgf::normalLogWeight(a, b, 128.0f), ref, 3e-7 * std::fabs(ref) + 1e-6)
+            << angle;
     }
     EXPECT_EQ(svgf::normalLogWeight(a, a, 128.0f), 0.0f);
-    EXPECT_EQ(svgf::normalLogWeight(a, Vec3(0.0f, 1.0f, 0.0f), 128.0f), -1e30f);   // perpendicular
-    EXPECT_EQ(svgf::normalLogWeight(a, Vec3(0.0f, 0.0f, -1.0f), 0.0f), -1e30f);    // opposite, even σ_n = 0
-    EXPECT_EQ(svgf::normalLogWeight(zero, zero, 128.0f), 0.0f);                     // background pair
+    EXPECT_EQ(svgf::normalLogWeight(a, Vec3(0.0f, 1.0f, 0.0f), 128.0f), -1e30f);  // perpendicular
+    EXPECT_EQ(svgf::normalLogWeight(a, Vec3(0.0f, 0.0f, -1.0f), 0.0f),
+              -1e30f);                                           // opposite, even σ_n = 0
+    EXPECT_EQ(svgf::normalLogWeight(zero, zero, 128.0f), 0.0f);  // background pair
     EXPECT_EQ(svgf::normalLogWeight(zero, a, 128.0f), -1e30f);
     EXPECT_EQ(svgf::normalLogWeight(a, zero, 128.0f), -1e30f);
 }
@@ -164,8 +176,8 @@ TEST(SvgfFastMath, ScalarAndSelectStopsAreEqual) {
     std::mt19937 rng(11);
     std::uniform_real_distribution<float> u(-1.0f, 1.0f);
     auto randomNormal = [&](int kind) {
-        if (kind == 0) return Vec3(0.0f);                     // missing / background
-        if (kind == 1) return Vec3(0.0f, 0.0f, 1.0f);         // exactly equal pairs
+        if (kind == 0) return Vec3(0.0f);                       // missing / background
+        if (kind == 1) return Vec3(0.0f, 0.0f, 1.0f);           // exactly equal pairs
         return normalize(Vec3(u(rng), u(rng), u(rng) + 2.0f));  // near +z, some pairs at d >= 1
     };
     int cases[4] = {0, 0, 0, 0};  // background pair, mismatch, d >= 1 or d <= 0, 0 < d < 1
@@ -174,7 +186,8 @@ TEST(SvgfFastMath, ScalarAndSelectStopsAreEqual) {
         const Vec3 b = randomNormal(i % 11 == 0 ? 0 : (i % 3 == 0 ? 1 : 2));
         const Vec3 bb = i % 13 == 0 ? -1.0f * b : b;  // some opposite pairs
         for (float sigmaN : {0.0f, 1.0f, 128.0f}) {
-            const float s1 = svgf::normalLogWeight(a, bb, sigmaN), s2 = svgf::normalLogWeightSel(a, bb, sigmaN);
+            const float s1 = svgf::normalLogWeight(a, bb, sigmaN),
+                        s2 = svgf::normalLogWeightSel(a, bb, sigmaN);
             ASSERT_EQ(s1, s2) << i;
         }
         const bool ha = svgf::hasNormal(a), hb = svgf::hasNormal(bb);
@@ -186,7 +199,8 @@ TEST(SvgfFastMath, ScalarAndSelectStopsAreEqual) {
         const float zp = i % 9 == 0 ? 1e30f : 1.0f + 3.0f * (u(rng) + 1.0f);
         const float zq = i % 4 == 0 ? 1e30f : 1.0f + 3.0f * (u(rng) + 1.0f);
         const float gx = u(rng), gy = u(rng), dx = float(i % 5 - 2), dy = float(i % 7 - 3);
-        ASSERT_EQ(svgf::depthLogWeight(zp, zq, gx, gy, dx, dy, 0.7f), svgf::depthLogWeightSel(zp, zq, gx, gy, dx, dy, 0.7f))
+        ASSERT_EQ(svgf::depthLogWeight(zp, zq, gx, gy, dx, dy, 0.7f),
+                  svgf::depthLogWeightSel(zp, zq, gx, gy, dx, dy, 0.7f))
             << i;
     }
 }
@@ -206,11 +220,13 @@ TEST(SvgfAtrousCpu, FastPathEqualsTheGenericFunctor) {
     struct Size {
         int w, h;
     };
-    const Size sizes[] = {{67, 45}, {33, 17}, {17, 70}, {9, 7}, {3, 2}, {1, 1}, {1, 9}, {11, 1}, {40, 40}};
+    const Size sizes[] = {{67, 45}, {33, 17}, {17, 70}, {9, 7},  {3, 2},
+                          {1, 1},   {1, 9},   {11, 1},  {40, 40}};
     struct Sigmas {
         float l, n, z;
     };
-    const Sigmas sigmas[] = {{4.0f, 128.0f, 1.0f}, {0.5f, 1.0f, 0.2f}, {40.0f, 0.0f, 5.0f}, {4.0f, 7.3f, 1.0f}};
+    const Sigmas sigmas[] = {
+        {4.0f, 128.0f, 1.0f}, {0.5f, 1.0f, 0.2f}, {40.0f, 0.0f, 5.0f}, {4.0f, 7.3f, 1.0f}};
     const bool hasAvx512 = svgf::svgfCpuAvx512();
     float worst = 0.0f;
     int cases = 0;
@@ -219,7 +235,8 @@ TEST(SvgfAtrousCpu, FastPathEqualsTheGenericFunctor) {
             LevelInputs in(sz.w, sz.h, unsigned(sz.w * 131 + sz.h));
             for (int step : {1, 2, 4, 8, 16}) {
                 for (const Sigmas& sg : sigmas) {
-                    Image refI(sz.w, sz.h, 3), refV(sz.w, sz.h, 1), gotI(sz.w, sz.h, 3), gotV(sz.w, sz.h, 1);
+                    Image refI(sz.w, sz.h, 3), refV(sz.w, sz.h, 1), gotI(sz.w, sz.h, 3),
+                        gotV(sz.w, sz.h, 1);
                     const svgf::Atrous ref = in.functor(step, sg.l, sg.n, sg.z, refI, refV);
                     for (int y = 0; y < sz.h; ++y)
                         for (int x = 0; x < sz.w; ++x) ref(x, y);
@@ -227,9 +244,10 @@ TEST(SvgfAtrousCpu, FastPathEqualsTheGenericFunctor) {
                     svgf::svgfCpuAvx512() = avx512;
                     svgf::runSvgfAtrous(CpuExec{}, in.functor(step, sg.l, sg.n, sg.z, gotI, gotV));
                     svgf::svgfCpuAvx512() = hasAvx512;
-                    const std::string what = std::to_string(sz.w) + "x" + std::to_string(sz.h) + " step " +
-                                             std::to_string(step) + " sigmaL " + std::to_string(sg.l) + " sigmaN " +
-                                             std::to_string(sg.n) + " avx512 " + std::to_string(avx512);
+                    const std::string what =
+                        std::to_string(sz.w) + "x" + std::to_string(sz.h) + " step " +
+                        std::to_string(step) + " sigmaL " + std::to_string(sg.l) + " sigmaN " +
+                        std::to_string(sg.n) + " avx512 " + std::to_string(avx512);
                     const Diff di = compare(gotI, refI), dv = compare(gotV, refV);
                     EXPECT_TRUE(di.finite && dv.finite) << what;
                     EXPECT_LT(di.maxRel, 1e-6f) << "illumination, " << what;
@@ -240,7 +258,8 @@ TEST(SvgfAtrousCpu, FastPathEqualsTheGenericFunctor) {
             }
         }
     }
-    std::printf("fast path vs functor: %d cases, max relative difference %.3g\n", cases, double(worst));
+    std::printf("fast path vs functor: %d cases, max relative difference %.3g\n", cases,
+                double(worst));
 }
 
 // The inputs must exercise what they claim to: the filter changes the image, and the special
@@ -276,7 +295,8 @@ TEST(SvgfAtrousCpu, PipelineWithAndWithoutTheFastPathAgree) {
             Image color(w, h, 3), motion(w, h, 2);
             for (int y = 0; y < h; ++y)
                 for (int x = 0; x < w; ++x)
-                    for (int c = 0; c < 3; ++c) color(x, y, c) = (0.5f + 0.1f * float(c)) * noise(rng);
+                    for (int c = 0; c < 3; ++c)
+                        color(x, y, c) = (0.5f + 0.1f * float(c)) * noise(rng);
             for (int y = 0; y < h; ++y)
                 for (int x = 0; x < w; ++x) motion(x, y, 0) = 1.0f;
             SvgfFrame f;

@@ -7,7 +7,8 @@
 #define ATROUS_CPU_AVX512 1
 // Row loops compiled for AVX-512 (F/VL/BW/DQ: the subset every AVX-512 core has) with 512-bit
 // vectors; the inlined shared functors take the caller's target, so the math is the same code.
-#define ATROUS_TARGET_AVX512 __attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,prefer-vector-width=512")))
+#define ATROUS_TARGET_AVX512 \
+    __attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,prefer-vector-width=512")))
 #else
 #define ATROUS_CPU_AVX512 0
 #endif

@@ -50,29 +50,31 @@ struct RowBuffers {
 
 // One tap (pixel offset I·step along x, tap row already in dRow) of the output pixel x, added to
 // the running sums sw, sr, sg, sb, sv. GEO: false for the centre tap, whose geometry log-weight is
-// 0 by definition (as in the functor). Needs the centre values lp, zp, npx/y/z, gx, gy, il and dy. Plain floats only: a
-// Vec3 constructed in the loop body is addressable when `omp simd` is lowered (before inlining),
-// becomes a per-lane array, and the loop is not vectorised.
-#define ATROUS_SVGF_TAP(I, GEO)                                                                            \
-    {                                                                                                      \
-        const ptrdiff_t q = ptrdiff_t(x) + (I)*s + dRow;                                                   \
-        const float qr = pr[q], qg = pg[q], qb = pb[q];                                                    \
-        const float lwGeo = (GEO) ? atrousGeometryLogWeight(zp, pz[q], gx, gy, npx, npy, npz, pnx[q], pny[q],  \
-                                                            pnz[q], float((I)*s), dy, sigmaZ, sigmaN)      \
-                                  : 0.0f;                                                                  \
-        const float wq = atrousTapWeight(hy * b3Tap(I), lwGeo, lp, atrousLuminance(qr, qg, qb), il, plen[q]); \
-        sr = fmaf(wq, qr, sr);                                                                             \
-        sg = fmaf(wq, qg, sg);                                                                             \
-        sb = fmaf(wq, qb, sb);                                                                             \
-        sv = fmaf(wq * wq, pv[q], sv);                                                                     \
-        sw += wq;                                                                                          \
+// 0 by definition (as in the functor). Needs the centre values lp, zp, npx/y/z, gx, gy, il and dy.
+// Plain floats only: a Vec3 constructed in the loop body is addressable when `omp simd` is lowered
+// (before inlining), becomes a per-lane array, and the loop is not vectorised.
+#define ATROUS_SVGF_TAP(I, GEO)                                                                  \
+    {                                                                                            \
+        const ptrdiff_t q = ptrdiff_t(x) + (I)*s + dRow;                                         \
+        const float qr = pr[q], qg = pg[q], qb = pb[q];                                          \
+        const float lwGeo =                                                                      \
+            (GEO) ? atrousGeometryLogWeight(zp, pz[q], gx, gy, npx, npy, npz, pnx[q], pny[q],    \
+                                            pnz[q], float((I)*s), dy, sigmaZ, sigmaN)            \
+                  : 0.0f;                                                                        \
+        const float wq =                                                                         \
+            atrousTapWeight(hy * b3Tap(I), lwGeo, lp, atrousLuminance(qr, qg, qb), il, plen[q]); \
+        sr = fmaf(wq, qr, sr);                                                                   \
+        sg = fmaf(wq, qg, sg);                                                                   \
+        sb = fmaf(wq, qb, sb);                                                                   \
+        sv = fmaf(wq * wq, pv[q], sv);                                                           \
+        sw += wq;                                                                                \
     }
 
 // The centre values of pixel x, and the running sums loaded from the row buffers.
-#define ATROUS_SVGF_CENTRE                                                   \
-    const float lp = atrousLuminance(pr[x], pg[x], pb[x]);                   \
-    const float zp = pz[x], gx = pgx[x], gy = pgy[x], il = pil[x];           \
-    const float npx = pnx[x], npy = pny[x], npz = pnz[x];                    \
+#define ATROUS_SVGF_CENTRE                                         \
+    const float lp = atrousLuminance(pr[x], pg[x], pb[x]);         \
+    const float zp = pz[x], gx = pgx[x], gy = pgy[x], il = pil[x]; \
+    const float npx = pnx[x], npy = pny[x], npz = pnz[x];          \
     float sw = aw[x], sr = ar[x], sg = ag[x], sb = ab[x], sv = av[x];
 
 #define ATROUS_SVGF_STORE \
@@ -125,7 +127,8 @@ ATROUS_FORCE_INLINE inline void levelRowsBody(const Atrous& f, int y0, int y1) {
             pil[0] = atrousLumStopRecip(sigmaL, f.prefilteredVariance(0, y));
             pil[w - 1] = atrousLumStopRecip(sigmaL, f.prefilteredVariance(w - 1, y));
         } else {
-            for (int x = 0; x < w; ++x) pil[x] = atrousLumStopRecip(sigmaL, f.prefilteredVariance(x, y));
+            for (int x = 0; x < w; ++x)
+                pil[x] = atrousLumStopRecip(sigmaL, f.prefilteredVariance(x, y));
         }
         for (int x = 0; x < w; ++x) aw[x] = ar[x] = ag[x] = ab[x] = av[x] = 0.0f;
 
@@ -174,15 +177,15 @@ ATROUS_FORCE_INLINE inline void levelRowsBody(const Atrous& f, int y0, int y1) {
             // Border columns (within 2·step of the left/right edge): one loop per tap over the
             // columns where that tap is inside the image, in tap order, so every pixel still sums
             // its taps in the functor's order.
-#define ATROUS_SVGF_BORDER_TAP(I, GEO, XA, XB)                    \
-    {                                                             \
-        const int lo = (XA) > -(I)*s ? (XA) : -(I)*s;             \
-        const int hi = (XB) < w - (I)*s ? (XB) : w - (I)*s;       \
-        _Pragma("omp simd") for (int x = lo; x < hi; ++x) {       \
-            ATROUS_SVGF_CENTRE                                    \
-            ATROUS_SVGF_TAP(I, GEO)                               \
-            ATROUS_SVGF_STORE                                     \
-        }                                                         \
+#define ATROUS_SVGF_BORDER_TAP(I, GEO, XA, XB)              \
+    {                                                       \
+        const int lo = (XA) > -(I)*s ? (XA) : -(I)*s;       \
+        const int hi = (XB) < w - (I)*s ? (XB) : w - (I)*s; \
+        _Pragma("omp simd") for (int x = lo; x < hi; ++x) { \
+            ATROUS_SVGF_CENTRE                              \
+            ATROUS_SVGF_TAP(I, GEO)                         \
+            ATROUS_SVGF_STORE                               \
+        }                                                   \
     }
             for (int side = 0; side < 2; ++side) {
                 const int xa = side == 0 ? 0 : x1, xb = side == 0 ? x0 : w;
@@ -221,10 +224,14 @@ ATROUS_FORCE_INLINE inline void levelRowsBody(const Atrous& f, int y0, int y1) {
 #undef ATROUS_SVGF_CENTRE
 #undef ATROUS_SVGF_STORE
 
-void levelRowsAvx2(const Atrous& f, int y0, int y1) { levelRowsBody(f, y0, y1); }
+void levelRowsAvx2(const Atrous& f, int y0, int y1) {
+    levelRowsBody(f, y0, y1);
+}
 
 #if ATROUS_CPU_AVX512
-ATROUS_TARGET_AVX512 void levelRowsAvx512(const Atrous& f, int y0, int y1) { levelRowsBody(f, y0, y1); }
+ATROUS_TARGET_AVX512 void levelRowsAvx512(const Atrous& f, int y0, int y1) {
+    levelRowsBody(f, y0, y1);
+}
 #endif
 
 }  // namespace

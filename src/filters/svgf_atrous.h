@@ -34,9 +34,9 @@ ATROUS_FORCE_INLINE ATROUS_INLINE float atrousLuminance(float r, float g, float 
 }
 
 // Depth and normal stops of tap q at pixel offset (dx, dy), as one log-weight.
-ATROUS_FORCE_INLINE ATROUS_INLINE float atrousGeometryLogWeight(float zp, float zq, float gx, float gy, float npx, float npy, float npz,
-                                            float nqx, float nqy, float nqz, float dx, float dy, float sigmaZ,
-                                            float sigmaN) {
+ATROUS_FORCE_INLINE ATROUS_INLINE float atrousGeometryLogWeight(float zp, float zq, float gx, float gy, float npx,
+                                                                float npy, float npz, float nqx, float nqy, float nqz,
+                                                                float dx, float dy, float sigmaZ, float sigmaN) {
     return depthLogWeightSel(zp, zq, gx, gy, dx, dy, sigmaZ) +
            normalLogWeightSel(Vec3(npx, npy, npz), Vec3(nqx, nqy, nqz), sigmaN);
 }
@@ -44,7 +44,8 @@ ATROUS_FORCE_INLINE ATROUS_INLINE float atrousGeometryLogWeight(float zp, float 
 // w of tap q: h(q) exp(lwGeo - |l_p - l_q| / (σ_l sqrt(g3x3(var)_p) + ε)), hxy = h(q); 0 where q
 // is empty (history length 0) or across an edge (lwGeo < kAtrousMinLogWeight). lwGeo = 0 for the
 // centre tap.
-ATROUS_FORCE_INLINE ATROUS_INLINE float atrousTapWeight(float hxy, float lwGeo, float lp, float lq, float invLumDenom, float lenq) {
+ATROUS_FORCE_INLINE ATROUS_INLINE float atrousTapWeight(float hxy, float lwGeo, float lp, float lq, float invLumDenom,
+                                                        float lenq) {
     const float lw = fmaf(-fabsf(lp - lq), invLumDenom, lwGeo);
     const float wq = hxy * fastExp(lw);
     return selectF(!(lenq <= 0.0f) & !(lwGeo < kAtrousMinLogWeight), wq, 0.0f);
@@ -108,7 +109,8 @@ struct Atrous {
                     if (lwGeo < kAtrousMinLogWeight) continue;
                 }
                 Vec3 cq = readVec3(illum, qx, qy);
-                float wq = atrousTapWeight(hy * b3Tap(i), lwGeo, lp, atrousLuminance(cq.x, cq.y, cq.z), invLumDenom, lenq);
+                float wq =
+                    atrousTapWeight(hy * b3Tap(i), lwGeo, lp, atrousLuminance(cq.x, cq.y, cq.z), invLumDenom, lenq);
                 sumC = Vec3(fmaf(wq, cq.x, sumC.x), fmaf(wq, cq.y, sumC.y), fmaf(wq, cq.z, sumC.z));
                 sumV = fmaf(wq * wq, variance(qx, qy, 0), sumV);
                 sumW += wq;

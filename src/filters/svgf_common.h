@@ -145,9 +145,9 @@ ATROUS_FORCE_INLINE ATROUS_INLINE float depthLogWeightSel(float zp, float zq, fl
 }
 
 // e^x for the edge-stopping weights, to ~2e-7 relative error (plus 1.6e-8·|x log2 e| from the
-// rounding of the constant log2 e), 0 at or below -87 (and for NaN). Plain arithmetic instead of expf: several times faster
-// on the CPU, identical on host and device so the two backends agree to float rounding, and
-// branch-free (selects, no floorf) so the CPU row loops vectorise.
+// rounding of the constant log2 e), 0 at or below -87 (and for NaN). Plain arithmetic instead of
+// expf: several times faster on the CPU, identical on host and device so the two backends agree to
+// float rounding, and branch-free (selects, no floorf) so the CPU row loops vectorise.
 ATROUS_FORCE_INLINE ATROUS_INLINE float fastExp(float x) {
     const bool keep = x > -87.0f;  // false for NaN
     x = selectF(keep, x, -87.0f);
