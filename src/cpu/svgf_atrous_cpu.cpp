@@ -58,8 +58,8 @@ struct RowBuffers {
         const ptrdiff_t q = ptrdiff_t(x) + (I)*s + dRow;                                         \
         const float qr = pr[q], qg = pg[q], qb = pb[q];                                          \
         const float lwGeo =                                                                      \
-            (GEO) ? atrousGeometryLogWeight(zp, pz[q], gx, gy, npx, npy, npz, pnx[q], pny[q],    \
-                                            pnz[q], float((I)*s), dy, sigmaZ, sigmaN)            \
+            (GEO) ? atrousGeometryLogWeightSel(zp, pz[q], gx, gy, npx, npy, npz, pnx[q], pny[q], \
+                                               pnz[q], float((I)*s), dy, sigmaZ, sigmaN)         \
                   : 0.0f;                                                                        \
         const float wq =                                                                         \
             atrousTapWeight(hy * b3Tap(I), lwGeo, lp, atrousLuminance(qr, qg, qb), il, plen[q]); \

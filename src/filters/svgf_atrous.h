@@ -14,8 +14,8 @@ struct CpuExec;
 namespace atrous::svgf {
 
 // Per-tap math of the à-trous level, shared by Atrous::operator() (both backends) and the CPU
-// fast path (src/cpu/svgf_atrous_cpu.cpp) so that they compute the same thing. Branch-free
-// (selectF) so the CPU row loops vectorise.
+// fast path (src/cpu/svgf_atrous_cpu.cpp) so that they compute the same thing; what the row loops
+// call is branch-free (selectF) so that they vectorise.
 
 // A tap whose geometry log-weight is below this is dropped (weight < 4e-18 of the centre's).
 constexpr float kAtrousMinLogWeight = -40.0f;
@@ -33,10 +33,18 @@ ATROUS_FORCE_INLINE ATROUS_INLINE float atrousLuminance(float r, float g, float 
     return fmaf(0.0722f, b, fmaf(0.7152f, g, 0.2126f * r));  // Rec. 709, as luminance()
 }
 
-// Depth and normal stops of tap q at pixel offset (dx, dy), as one log-weight.
-ATROUS_FORCE_INLINE ATROUS_INLINE float atrousGeometryLogWeight(float zp, float zq, float gx, float gy, float npx,
-                                                                float npy, float npz, float nqx, float nqy, float nqz,
-                                                                float dx, float dy, float sigmaZ, float sigmaN) {
+// Depth and normal stops of tap q at pixel offset (dx, dy), as one log-weight. The functor (one
+// pixel at a time, CPU reference and GPU) uses the scalar stops, which compute only the case that
+// applies; the CPU row loops use the Sel version: the same value, bit for bit, without branches.
+ATROUS_INLINE float atrousGeometryLogWeight(float zp, float zq, float gx, float gy, Vec3 np, Vec3 nq, float dx,
+                                            float dy, float sigmaZ, float sigmaN) {
+    return depthLogWeight(zp, zq, gx, gy, dx, dy, sigmaZ) + normalLogWeight(np, nq, sigmaN);
+}
+
+ATROUS_FORCE_INLINE ATROUS_INLINE float atrousGeometryLogWeightSel(float zp, float zq, float gx, float gy, float npx,
+                                                                   float npy, float npz, float nqx, float nqy,
+                                                                   float nqz, float dx, float dy, float sigmaZ,
+                                                                   float sigmaN) {
     return depthLogWeightSel(zp, zq, gx, gy, dx, dy, sigmaZ) +
            normalLogWeightSel(Vec3(npx, npy, npz), Vec3(nqx, nqy, nqz), sigmaN);
 }
@@ -103,9 +111,8 @@ struct Atrous {
                 float lwGeo = 0.0f;
                 if (i != 0 || j != 0) {
                     // Geometry first: across an edge the tap is dropped without touching its colour.
-                    lwGeo = atrousGeometryLogWeight(zp, depth(qx, qy, 0), gx, gy, np.x, np.y, np.z, normal(qx, qy, 0),
-                                                    normal(qx, qy, 1), normal(qx, qy, 2), float(i * step),
-                                                    float(j * step), sigmaZ, sigmaN);
+                    lwGeo = atrousGeometryLogWeight(zp, depth(qx, qy, 0), gx, gy, np, readVec3(normal, qx, qy),
+                                                    float(i * step), float(j * step), sigmaZ, sigmaN);
                     if (lwGeo < kAtrousMinLogWeight) continue;
                 }
                 Vec3 cq = readVec3(illum, qx, qy);
