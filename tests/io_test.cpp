@@ -92,6 +92,14 @@ TEST(ImageIo, FailedWriteLeavesNothing) {
     EXPECT_THROW(io::writeImage(dir / "nodir/a.exr", ramp(4, 4)), InputError);
     EXPECT_THROW(io::writeImage(dir / "a.bmp", ramp(4, 4)), InputError);
     EXPECT_EQ(atrous::test::countEntries(dir.str()), 0);
+    // A parent that is a regular file is named as such, not as missing.
+    { std::ofstream(dir / "afile") << "x"; }
+    try {
+        io::writeImage(dir / "afile/a.exr", ramp(4, 4));
+        ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("is not a directory"), std::string::npos) << e.what();
+    }
 }
 
 // An EXR whose channels are neither R,G,B nor Y nor a single one: rejected, naming the file and

@@ -246,7 +246,11 @@ void writeFileAtomically(const std::string& path, const std::function<void(const
     fs::path target(path);
     fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
     std::error_code ec;
-    if (!fs::is_directory(dir, ec)) throw InputError(path + ": output directory " + dir.string() + " does not exist");
+    if (!fs::is_directory(dir, ec)) {
+        if (fs::exists(dir, ec))
+            throw InputError(path + ": " + dir.string() + " is not a directory");
+        throw InputError(path + ": output directory " + dir.string() + " does not exist");
+    }
     if (access(dir.c_str(), W_OK | X_OK) != 0) throw InputError(path + ": output directory is not writable");
     // Keep the extension last so libraries that look at it (stb, OpenEXR) still see it.
     std::string tmp = (dir / ("." + target.stem().string() + ".tmp" + std::to_string(getpid()) + target.extension().string())).string();
