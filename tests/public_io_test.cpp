@@ -1,0 +1,58 @@
+// include/atrous/io.h: the image I/O that installed C++ users get (docs/cpp.md). The formats
+// themselves are tested in io_test.cpp; this checks the public entry points keep their promises.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
+
+#include "atrous/error.h"
+#include "atrous/io.h"
+#include "test_util.h"
+
+using namespace atrous;
+using atrous::test::TempDir;
+
+static Image ramp(int w, int h) {
+    Image img(w, h, 3);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c) img(x, y, c) = 0.25f * x - 3.0f * y + 1000.0f * c + 0.125f;
+    return img;
+}
+
+TEST(PublicIo, ExrAndPfmRoundTripsAreExact) {
+    // Both formats store 32-bit floats, so the values come back bit for bit (no tolerance).
+    TempDir dir;
+    const Image img = ramp(11, 5);
+    for (const char* name : {"a.exr", "a.pfm"}) {
+        writeImage(dir / name, img);
+        const Image back = readImage(dir / name);
+        ASSERT_EQ(back.width(), 11);
+        ASSERT_EQ(back.height(), 5);
+        ASSERT_EQ(back.channels(), 3);
+        for (size_t i = 0; i < img.size(); ++i)
+            ASSERT_EQ(back.data()[i], img.data()[i]) << name << " at " << i;
+    }
+}
+
+TEST(PublicIo, ErrorsNameTheFileAndAFailedWriteLeavesNothing) {
+    TempDir dir;
+    try {
+        readImage(dir / "missing.exr");
+        FAIL() << "no InputError";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("missing.exr"), std::string::npos) << e.what();
+    }
+    try {
+        writeImage(dir / "out.tiff", ramp(4, 4));
+        FAIL() << "no InputError";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("out.tiff"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(atrous::test::countEntries(dir.str()), 0);
+    // An existing file survives a write that fails (a 2-channel image: no format takes it).
+    writeImage(dir / "keep.exr", ramp(4, 4));
+    EXPECT_THROW(writeImage(dir / "keep.exr", Image(4, 4, 2)), InputError);
+    EXPECT_EQ(readImage(dir / "keep.exr")(3, 3, 2), ramp(4, 4)(3, 3, 2));
+    EXPECT_EQ(atrous::test::countEntries(dir.str()), 1);  // no temporary left behind
+}
