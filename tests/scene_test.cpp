@@ -99,6 +99,28 @@ TEST(SceneJson, TextureAndMaterialOverride) {
     EXPECT_EQ(s.data().materials[s.materialId("t")].texture, 0);
 }
 
+TEST(SceneJson, MirroringTransformKeepsTheFaceFront) {
+    // A negative scale mirrors the mesh and reverses its winding; the loader swaps two vertices so
+    // the geometric normal (e1 x e2, the renderer's front side) still agrees with the file's
+    // shading normal. Before, a mirrored glass cube refracted inside out and a one-sided emitter
+    // went black.
+    test::TempDir tmp;
+    writeText(tmp / "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\nf 1//1 2//2 3//3\n");
+    for (const char* scale : {"[1, 1, 1]", "[-1, 1, 1]", "[-1, -2, 1]", "[-1, -1, -1]"}) {
+        writeText(tmp / "s.json", std::string(R"({"camera": {"position": [0,0,3], "lookAt": [0,0,0]},
+          "materials": {"m": {"type": "diffuse"}},
+          "objects": [{"type": "mesh", "file": "tri.obj", "material": "m", "transform": {"scale": )") + scale + R"(}}],
+          "lights": [{"type": "point", "position": [0,0,2], "intensity": 1}]})");
+        Scene s = Scene::load(tmp / "s.json");
+        const auto& d = s.data();
+        ASSERT_EQ(d.indices.size(), 3u);
+        const Vec3 a = d.positions[d.indices[0]], b = d.positions[d.indices[1]], c = d.positions[d.indices[2]];
+        const Vec3 ng = cross(b - a, c - a);
+        const Vec3 ns = d.normals[d.indices[0]];
+        EXPECT_GT(dot(ng, ns), 0.0f) << "scale " << scale << ": geometric and shading normal disagree";
+    }
+}
+
 TEST(SceneJson, MtlMaterialsTexturesAndSky) {
     test::TempDir tmp;
     Image tex(2, 2, 3);

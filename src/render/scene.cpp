@@ -583,6 +583,7 @@ void loadObj(const JsonContext& c, SceneBuilder& b, const std::string& path, int
     };
     const size_t numV = a.vertices.size() / 3, numN = a.normals.size() / 3, numT = a.texcoords.size() / 2;
     size_t triangles = 0;
+    const bool mirrored = xf.scale.x * xf.scale.y * xf.scale.z < 0.0f;
     for (const auto& shape : shapes) {
         const auto& idx = shape.mesh.indices;
         for (size_t f = 0; f < shape.mesh.num_face_vertices.size(); ++f) {
@@ -605,7 +606,13 @@ void loadObj(const JsonContext& c, SceneBuilder& b, const std::string& path, int
                 v[k] = b.addVertex(xf.point(p), n, uv);
             }
             int mi = f < shape.mesh.material_ids.size() ? shape.mesh.material_ids[f] : -1;
-            b.addTriangle(v[0], v[1], v[2], materialFor(mi), mesh);
+            // A mirroring transform (an odd number of negative scale factors) reverses the
+            // vertices' winding; swapping two keeps each face's front (which side is outside for
+            // glass, which side a one-sided emitter lights) where the file put it.
+            if (mirrored)
+                b.addTriangle(v[0], v[2], v[1], materialFor(mi), mesh);
+            else
+                b.addTriangle(v[0], v[1], v[2], materialFor(mi), mesh);
             ++triangles;
         }
     }
