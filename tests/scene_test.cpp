@@ -96,6 +96,21 @@ TEST(SceneJson, TextureAndMaterialOverride) {
     Scene s = Scene::load(tmp / "s.json");
     ASSERT_EQ(s.data().textures.size(), 1u);
     EXPECT_EQ(s.data().triMaterial[0], s.materialId("t"));
+    // An albedo texture is a reflectance: texels above 1 are clamped (an environment map is not).
+    Image hot(2, 2, 3);
+    hot.fill(50.0f);
+    io::writeImage(tmp / "hot.exr", hot);
+    writeText(tmp / "h.json", R"({"camera": {"position": [0,0,3], "lookAt": [0,0,0]},
+      "materials": {"t": {"type": "diffuse", "texture": "hot.exr"}},
+      "objects": [{"type": "mesh", "file": "tri.obj", "material": "t"}],
+      "lights": [{"type": "environment", "file": "hot.exr"}]})");
+    Scene h = Scene::load(tmp / "h.json");
+    const auto& hd = h.data();
+    const int albedoTex = hd.materials[h.materialId("t")].texture;
+    ASSERT_GE(albedoTex, 0);
+    EXPECT_EQ(hd.texels[size_t(hd.textures[albedoTex].offset)], 1.0f);
+    ASSERT_GE(hd.env.texture, 0);
+    EXPECT_EQ(hd.texels[size_t(hd.textures[hd.env.texture].offset)], 50.0f);
     EXPECT_EQ(s.data().materials[s.materialId("t")].texture, 0);
 }
 
@@ -169,6 +184,9 @@ TEST(SceneJson, BadFilesNameTheFileAndTheProblem) {
         {R"({"camera": {"position": [0,0,1], "lookAt": [0,0,0]}, "objects": [{"type": "sphere", "center": [0,0,0], "radius": 1, "material": "nope"}]})", "unknown material \"nope\""},
         {R"({"camera": {"position": [0,0,1], "lookAt": [0,0,0]}, "objects": [{"type": "cone"}]})", "unknown object type"},
         {R"({"camera": {"position": [0,0,1], "lookAt": [0,0,0]}, "materials": {"m": {"type": "velvet"}}, "objects": []})", "unknown material type"},
+        // Reflectances above 1 would create energy.
+        {R"({"camera": {"position": [0,0,1], "lookAt": [0,0,0]}, "materials": {"m": {"albedo": 5}}, "objects": []})", "\"albedo\" must be in [0, 1]"},
+        {R"({"camera": {"position": [0,0,1], "lookAt": [0,0,0]}, "materials": {"m": {"checker": {"color1": 10}}}, "objects": []})", "\"color1\" must be in [0, 1]"},
         {R"({"camera": {"position": [0,0,1], "lookAt": [0,0,0]}, "materials": {"m": {}}, "objects": [{"type": "sphere", "center": [0,0,0], "radius": -1, "material": "m"}]})", "radius"},
         {R"({"camera": {"position": [0,0,1], "lookAt": [0,0,0]}, "objects": [{"type": "mesh", "file": "missing.obj"}]})", "missing.obj"},
         {R"({"camera": {"position": [0,0,1], "lookAt": [0,0,0]}, "objects": [{"type": "mesh", "file": "bad.obj"}]})", "bad.obj"},

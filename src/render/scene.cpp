@@ -40,7 +40,10 @@ public:
         d.meshNames.push_back(name);
         return int(d.meshNames.size()) - 1;
     }
-    int addTexture(const Image& img) {
+    // `reflectance`: the texture is an albedo (diffuse colour), so texels are clamped to [0, 1]
+    // like the JSON and MTL colours (a texel of 50 would create energy, and the albedo buffer, which
+    // is clamped, would no longer match the image). Environment maps are radiance: never clamped.
+    int addTexture(const Image& img, bool reflectance = false) {
         Texture t;
         t.offset = int64_t(d.texels.size());
         t.width = img.width();
@@ -48,7 +51,8 @@ public:
         const float* p = img.data();
         for (size_t i = 0; i < size_t(img.width()) * img.height() * 3; ++i) {
             float v = p[i];
-            d.texels.push_back(std::isfinite(v) && v > 0.0f ? v : 0.0f);  // NaN/Inf/negatives never spread
+            v = std::isfinite(v) && v > 0.0f ? v : 0.0f;  // NaN/Inf/negatives never spread
+            d.texels.push_back(reflectance ? std::min(v, 1.0f) : v);
         }
         d.textures.push_back(t);
         return int(d.textures.size()) - 1;
@@ -485,10 +489,15 @@ Material parseMaterial(const JsonContext& c, SceneBuilder& b, const json& j, con
     if (m.roughness < 0.0f || m.roughness > 1.0f) fail(c, where + ": \"roughness\" must be in [0, 1]");
     if (m.ior < 1.0f || m.ior > 4.0f) fail(c, where + ": \"ior\" must be in [1, 4]");
     if (m.emission.x < 0 || m.emission.y < 0 || m.emission.z < 0) fail(c, where + ": \"emission\" must be >= 0");
-    if (m.albedo.x < 0 || m.albedo.y < 0 || m.albedo.z < 0) fail(c, where + ": \"albedo\" must be >= 0");
+    // A reflectance above 1 creates energy (and the albedo buffer, clamped, would not match).
+    auto checkReflectance = [&](Vec3 v, const std::string& what) {
+        if (!(v.x >= 0 && v.y >= 0 && v.z >= 0 && v.x <= 1 && v.y <= 1 && v.z <= 1))
+            fail(c, what + " must be in [0, 1]");
+    };
+    checkReflectance(m.albedo, where + ": \"albedo\"");
     if (j.contains("texture")) {
         std::string path = resolvePath(c, getString(c, j, "texture", where));
-        m.texture = b.addTexture(io::readImage(path));  // InputError names the texture file
+        m.texture = b.addTexture(io::readImage(path), /*reflectance=*/true);  // InputError names the texture file
     }
     if (j.contains("checker")) {
         const json& ch = j.at("checker");
@@ -496,6 +505,8 @@ Material parseMaterial(const JsonContext& c, SceneBuilder& b, const json& j, con
         m.checker = 1;
         m.albedo = getVec3(c, ch, "color1", where + ".checker", Vec3(0.8f));
         m.albedo2 = getVec3(c, ch, "color2", where + ".checker", Vec3(0.2f));
+        checkReflectance(m.albedo, where + ".checker: \"color1\"");
+        checkReflectance(m.albedo2, where + ".checker: \"color2\"");
         m.checkerScale = getFloat(c, ch, "scale", where + ".checker", 8.0f);
     }
     return m;
@@ -575,7 +586,7 @@ void loadObj(const JsonContext& c, SceneBuilder& b, const std::string& path, int
         }
         if (!t.diffuse_texname.empty()) {
             std::string tex = (fs::path(path).parent_path() / t.diffuse_texname).lexically_normal().string();
-            m.texture = b.addTexture(io::readImage(tex));
+            m.texture = b.addTexture(io::readImage(tex), /*reflectance=*/true);
         }
         m.albedo = minv(maxv(m.albedo, Vec3(0.0f)), Vec3(1.0f));
         mtlIds[mtlIndex] = b.addMaterial(t.name, m);
