@@ -432,6 +432,31 @@ TEST(SvgfRobustness, ResetAndSizeChangeStartANewHistory) {
     EXPECT_EQ(maxAbsDiff(other, fresh.denoiseFrame(makeFrame(big, 0).frame())), 0.0f);
 }
 
+TEST(SvgfParamsTest, ZeroLevelsIsTemporalAccumulationWithTheDefaultTap) {
+    // levels 0 ("temporal accumulation only") must work without also setting feedbackTap: the
+    // default tap 0 then means the accumulation, exactly as -1 does.
+    SceneOptions o;
+    o.noiseSigma = 0.2f;
+    SvgfParams p0;
+    p0.levels = 0;
+    SvgfParams pm = p0;
+    pm.feedbackTap = -1;
+    EXPECT_NO_THROW(validateSvgfParams(p0));
+    SvgfDenoiser a(p0), b(pm);
+    for (int t = 0; t < 4; ++t) {
+        Image x = a.denoiseFrame(makeFrame(o, t).frame()), y = b.denoiseFrame(makeFrame(o, t).frame());
+        EXPECT_EQ(maxAbsDiff(x, y), 0.0f) << "frame " << t;
+    }
+    SvgfParams bad = p0;
+    bad.feedbackTap = 1;  // no level 1 to feed back
+    try {
+        validateSvgfParams(bad);
+        ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("got 1 with levels 0"), std::string::npos) << e.what();
+    }
+}
+
 // ---- every parameter matters ------------------------------------------------------------------
 
 TEST(SvgfParamsTest, EveryFieldChangesTheOutput) {

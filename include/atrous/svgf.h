@@ -24,7 +24,8 @@ struct SvgfParams {
     int historyCap = 32;   // history length saturates here (>= 1)
     int levels = 5;        // à-trous levels, step 2^i (0..10; 0 = temporal accumulation only)
     // Which à-trous level's output becomes next frame's colour history: 0 = after the first level
-    // (the paper), -1 = the unfiltered temporal accumulation. In [-1, levels - 1].
+    // (the paper), -1 = the unfiltered temporal accumulation. In [-1, levels - 1]; with levels 0
+    // the default 0 is accepted and means the accumulation, as -1.
     int feedbackTap = 0;
     // Below this history length (frames) the variance comes from a 7x7 spatial bilateral estimate
     // instead of the temporal moments (the paper: 4). >= 1.

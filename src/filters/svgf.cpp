@@ -29,8 +29,12 @@ void validateSvgfParams(const SvgfParams& p) {
     requireRange(p.momentsAlpha > 0.0f && p.momentsAlpha <= 1.0f, "momentsAlpha", "must be in (0, 1]");
     requireRange(p.historyCap >= 1 && p.historyCap <= 1 << 20, "historyCap", "must be in [1, 1048576]");
     requireRange(p.levels >= 0 && p.levels <= 10, "levels", "must be in [0, 10]");
-    requireRange(p.feedbackTap >= -1 && p.feedbackTap < p.levels, "feedbackTap",
-                 "must be in [-1, levels - 1] (-1 = unfiltered accumulation)");
+    // levels 0 (temporal accumulation only) works with the default tap 0: there is no filtered
+    // level to feed back, so the history is the accumulation (as with -1).
+    requireRange(p.feedbackTap >= -1 && (p.feedbackTap < p.levels || (p.levels == 0 && p.feedbackTap == 0)),
+                 "feedbackTap",
+                 "must be in [-1, levels - 1] (-1 = unfiltered accumulation; got " + std::to_string(p.feedbackTap) +
+                     " with levels " + std::to_string(p.levels) + ")");
     requireRange(p.spatialVarianceFrames >= 1 && p.spatialVarianceFrames <= 1 << 20, "spatialVarianceFrames",
                  "must be in [1, 1048576]");
     requireRange(std::isfinite(p.reprojectDepthTolerance) && p.reprojectDepthTolerance >= 0.0f,

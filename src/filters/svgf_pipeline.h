@@ -211,7 +211,9 @@ public:
         }
 
         // This frame becomes the history. Swaps move ownership only; nothing is copied.
-        if (mParams.feedbackTap < 0)
+        // With no à-trous level (levels 0) nothing was filtered: the history is the accumulation
+        // whatever the tap says.
+        if (mParams.feedbackTap < 0 || mParams.levels == 0)
             std::swap(s.histIllum, s.accIllum);
         else
             std::swap(s.histIllum, s.nextHistIllum);
