@@ -114,6 +114,15 @@ TEST(SceneJson, TextureAndMaterialOverride) {
     EXPECT_EQ(s.data().materials[s.materialId("t")].texture, 0);
 }
 
+TEST(SceneJson, UnderscoreKeysAreComments) {
+    test::TempDir tmp;
+    writeText(tmp / "s.json", R"({"_comment": "a test scene", "camera": {"position": [0,0,3], "lookAt": [0,0,0], "_why": "x"},
+      "materials": {"m": {"type": "diffuse", "_note": 1}},
+      "objects": [{"type": "sphere", "center": [0,0,0], "radius": 1, "material": "m", "_todo": []}],
+      "lights": [{"type": "point", "position": [0,0,2], "intensity": 1, "_": 0}]})");
+    EXPECT_NO_THROW(Scene::load(tmp / "s.json"));
+}
+
 TEST(SceneJson, MirroringTransformKeepsTheFaceFront) {
     // A negative scale mirrors the mesh and reverses its winding; the loader swaps two vertices so
     // the geometric normal (e1 x e2, the renderer's front side) still agrees with the file's
@@ -184,6 +193,11 @@ TEST(SceneJson, BadFilesNameTheFileAndTheProblem) {
         {R"({"camera": {"position": [0,0,1], "lookAt": [0,0,0]}, "objects": [{"type": "sphere", "center": [0,0,0], "radius": 1, "material": "nope"}]})", "unknown material \"nope\""},
         {R"({"camera": {"position": [0,0,1], "lookAt": [0,0,0]}, "objects": [{"type": "cone"}]})", "unknown object type"},
         {R"({"camera": {"position": [0,0,1], "lookAt": [0,0,0]}, "materials": {"m": {"type": "velvet"}}, "objects": []})", "unknown material type"},
+        // Unknown keys (typos) are named, with the keys that are allowed there.
+        {R"({"camera": {"position": [0,0,1], "lookAt": [0,0,0]}, "materials": {"m": {"albdo": [1,0,0]}}, "objects": []})", "materials.m: unknown key \"albdo\""},
+        {R"({"camera": {"position": [0,0,1], "lookAt": [0,0,0], "fovy": 30}, "objects": []})", "camera: unknown key \"fovy\""},
+        {R"({"camera": {"position": [0,0,1], "lookAt": [0,0,0]}, "objects": [{"type": "sphere", "center": [0,0,0], "radius": 1, "colour": 1}]})", "objects[0]: unknown key \"colour\""},
+        {R"({"camera": {"position": [0,0,1], "lookAt": [0,0,0]}, "objects": [], "light": []})", "unknown key \"light\""},
         // Reflectances above 1 would create energy.
         {R"({"camera": {"position": [0,0,1], "lookAt": [0,0,0]}, "materials": {"m": {"albedo": 5}}, "objects": []})", "\"albedo\" must be in [0, 1]"},
         {R"({"camera": {"position": [0,0,1], "lookAt": [0,0,0]}, "materials": {"m": {"checker": {"color1": 10}}}, "objects": []})", "\"color1\" must be in [0, 1]"},

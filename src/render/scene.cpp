@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <map>
 #include <sstream>
 
@@ -429,6 +430,23 @@ struct JsonContext {
 
 [[noreturn]] void fail(const JsonContext& c, const std::string& what) { throw InputError(c.source + ": " + what); }
 
+// Every key of the object `j` must be one of `allowed` (a typo such as "albdo" would otherwise be
+// ignored and the default rendered without a word). Keys starting with '_' are comments.
+void checkKeys(const JsonContext& c, const json& j, const std::string& where, std::initializer_list<const char*> allowed) {
+    if (!j.is_object()) return;
+    for (auto it = j.begin(); it != j.end(); ++it) {
+        const std::string& k = it.key();
+        if (!k.empty() && k[0] == '_') continue;
+        bool ok = false;
+        for (const char* a : allowed) ok = ok || k == a;
+        if (!ok) {
+            std::string list;
+            for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
+            fail(c, (where.empty() ? std::string() : where + ": ") + "unknown key \"" + k + "\" (expected " + list + ")");
+        }
+    }
+}
+
 Vec3 getVec3(const JsonContext& c, const json& j, const char* key, const std::string& where, Vec3 def, bool required = false) {
     if (!j.contains(key)) {
         if (required) fail(c, where + ": missing \"" + key + "\"");
@@ -470,6 +488,7 @@ std::string resolvePath(const JsonContext& c, const std::string& p) {
 
 Material parseMaterial(const JsonContext& c, SceneBuilder& b, const json& j, const std::string& where) {
     if (!j.is_object()) fail(c, where + ": must be an object");
+    checkKeys(c, j, where, {"type", "albedo", "emission", "roughness", "ior", "texture", "checker"});
     std::string type = j.contains("type") ? getString(c, j, "type", where) : "diffuse";
     Material m;
     if (type == "diffuse" || type == "lambertian") m.type = MaterialType::Diffuse;
@@ -502,6 +521,7 @@ Material parseMaterial(const JsonContext& c, SceneBuilder& b, const json& j, con
     if (j.contains("checker")) {
         const json& ch = j.at("checker");
         if (!ch.is_object()) fail(c, where + ": \"checker\" must be an object");
+        checkKeys(c, ch, where + ".checker", {"color1", "color2", "scale"});
         m.checker = 1;
         m.albedo = getVec3(c, ch, "color1", where + ".checker", Vec3(0.8f));
         m.albedo2 = getVec3(c, ch, "color2", where + ".checker", Vec3(0.2f));
@@ -534,6 +554,7 @@ Transform parseTransform(const JsonContext& c, const json& j, const std::string&
     if (!j.contains("transform")) return t;
     const json& tj = j.at("transform");
     if (!tj.is_object()) fail(c, where + ": \"transform\" must be an object");
+    checkKeys(c, tj, where + ".transform", {"scale", "rotateY", "translate"});
     t.scale = getVec3(c, tj, "scale", where + ".transform", Vec3(1.0f));
     if (t.scale.x == 0.0f || t.scale.y == 0.0f || t.scale.z == 0.0f) fail(c, where + ".transform: \"scale\" must be non-zero");
     t.rotY = getFloat(c, tj, "rotateY", where + ".transform", 0.0f) * kPi / 180.0f;
@@ -656,6 +677,7 @@ std::vector<CameraKey> parseKeyframes(const JsonContext& c, const json& j, Vec3 
         std::string where = "camera.keyframes[" + std::to_string(i) + "]";
         const json& k = j[i];
         if (!k.is_object()) fail(c, where + ": must be an object");
+        checkKeys(c, k, where, {"t", "position", "target", "lookAt", "up", "fov"});
         CameraKey key;
         key.t = getFloat(c, k, "t", where, 0.0f, true);
         key.position = getVec3(c, k, "position", where, Vec3(0.0f), true);
@@ -685,8 +707,10 @@ std::shared_ptr<SceneData> parseJsonScene(const std::string& text, const JsonCon
     SceneBuilder b(fs::path(c.source).stem().string());
     try {
         // Camera.
+        checkKeys(c, root, "", {"camera", "materials", "objects", "lights"});
         if (!root.contains("camera") || !root["camera"].is_object()) fail(c, "missing \"camera\" object");
         const json& cam = root["camera"];
+        checkKeys(c, cam, "camera", {"position", "lookAt", "up", "fov", "keyframes"});
         Vec3 eye = getVec3(c, cam, "position", "camera", Vec3(0.0f), true);
         Vec3 at = getVec3(c, cam, "lookAt", "camera", Vec3(0.0f), true);
         Vec3 up = getVec3(c, cam, "up", "camera", Vec3(0, 1, 0));
@@ -725,11 +749,13 @@ std::shared_ptr<SceneData> parseJsonScene(const std::string& text, const JsonCon
             std::string name = o.contains("name") ? getString(c, o, "name", where) : type + std::to_string(index - 1);
             const int meshCount = int(b.d.meshNames.size());
             if (type == "sphere") {
+                checkKeys(c, o, where, {"type", "name", "material", "motion", "center", "radius"});
                 Vec3 center = getVec3(c, o, "center", where, Vec3(0.0f), true);
                 float radius = getFloat(c, o, "radius", where, 1.0f, true);
                 if (!(radius > 0.0f)) fail(c, where + ": \"radius\" must be > 0");
                 b.addSphere(center, radius, materialRef(o, where, true), b.addMesh(name));
             } else if (type == "quad") {
+                checkKeys(c, o, where, {"type", "name", "material", "motion", "corner", "edge1", "edge2"});
                 Vec3 p = getVec3(c, o, "corner", where, Vec3(0.0f), true);
                 Vec3 e1 = getVec3(c, o, "edge1", where, Vec3(0.0f), true);
                 Vec3 e2 = getVec3(c, o, "edge2", where, Vec3(0.0f), true);
@@ -737,6 +763,7 @@ std::shared_ptr<SceneData> parseJsonScene(const std::string& text, const JsonCon
                 // Geometric normal = edge1 x edge2 (the side a one-sided emitter lights).
                 b.addQuad(p, p + e1, p + e1 + e2, p + e2, materialRef(o, where, true), b.addMesh(name), cross(e1, e2));
             } else if (type == "mesh") {
+                checkKeys(c, o, where, {"type", "name", "material", "motion", "file", "transform"});
                 std::string file = resolvePath(c, getString(c, o, "file", where));
                 loadObj(c, b, file, materialRef(o, where, false), b.addMesh(name), parseTransform(c, o, where));
             } else {
@@ -767,10 +794,12 @@ std::shared_ptr<SceneData> parseJsonScene(const std::string& text, const JsonCon
                 if (!l.is_object()) fail(c, where + ": must be an object");
                 std::string type = getString(c, l, "type", where);
                 if (type == "point") {
+                    checkKeys(c, l, where, {"type", "intensity", "position"});
                     Vec3 intensity = getVec3(c, l, "intensity", where, Vec3(0.0f), true);
                     if (intensity.x < 0 || intensity.y < 0 || intensity.z < 0) fail(c, where + ": \"intensity\" must be >= 0");
                     b.addPointLight(getVec3(c, l, "position", where, Vec3(0.0f), true), intensity);
                 } else if (type == "environment") {
+                    checkKeys(c, l, where, {"type", "scale", "file", "color"});
                     float scale = getFloat(c, l, "scale", where, 1.0f);
                     if (!(scale >= 0.0f)) fail(c, where + ": \"scale\" must be >= 0");
                     if (l.contains("file")) {
@@ -781,6 +810,7 @@ std::shared_ptr<SceneData> parseJsonScene(const std::string& text, const JsonCon
                         b.setEnvConstant(col * scale);
                     }
                 } else if (type == "sky") {
+                    checkKeys(c, l, where, {"type", "sunDirection", "sunRadius", "sunRadiance", "scale"});
                     Vec3 sun = normalize(getVec3(c, l, "sunDirection", where, Vec3(-0.55f, 0.62f, 0.55f)));
                     if (length(sun) <= 0.0f) fail(c, where + ": \"sunDirection\" must be non-zero");
                     float radiusDeg = getFloat(c, l, "sunRadius", where, 0.5f);
