@@ -27,7 +27,7 @@ output is always finite.
 from __future__ import annotations
 
 import os
-from typing import Any, Dict, Optional, Union
+from typing import Any, Dict, Iterator, Optional, Union
 
 import numpy as np
 
@@ -36,6 +36,7 @@ from . import _core
 __all__ = [
     "denoise",
     "render",
+    "render_sequence",
     "metrics",
     "read_image",
     "write_image",
@@ -223,6 +224,41 @@ def render(
             raise ValueError(f"{name} must be an integer, got {v!r}")
     return dict(_core.render(str(scene), int(width), int(height), int(spp), int(seed), int(max_depth),
                              int(threads)))
+
+
+def render_sequence(
+    scene: str,
+    frames: int,
+    *,
+    width: int = 512,
+    height: int = 512,
+    spp: int = 1,
+    seed: int = 1,
+    camera_path: str = "auto",
+    max_depth: int = 8,
+    threads: int = 0,
+) -> Iterator[Dict[str, Any]]:
+    """Renders the animation of `scene` frame by frame, as `atrous render --frames` does.
+
+    A generator: each item is the dict of :func:`render` plus ``motion`` (H x W x 3, R = dx,
+    G = dy in pixels, previous - current; frame 0 has none) and ``time`` (t in [0, 1]). Frame f is
+    at t = f / (frames - 1), with seed ``seed + f`` (so its samples are fresh), exactly the frames
+    the CLI writes. camera_path: "auto" (the scene's keyframes, else static), "static", "orbit",
+    "dolly" or "keyframes" (docs/scenes.md). Feed the items to :class:`Svgf`::
+
+        s = atrous.Svgf()
+        for b in atrous.render_sequence("cornell-moving", 32, width=256, height=256):
+            out = s.denoise_frame(b["color"], albedo=b["albedo"], normal=b["normal"], depth=b["depth"],
+                                  ids=b["ids"], motion=b["motion"], emission=b["emission"])
+    """
+    for name, v in (("frames", frames), ("width", width), ("height", height), ("spp", spp)):
+        if not isinstance(v, (int, np.integer)) or isinstance(v, bool):
+            raise ValueError(f"{name} must be an integer, got {v!r}")
+    if int(frames) < 1:
+        raise ValueError(f"frames must be at least 1, got {frames}")
+    for f in range(int(frames)):
+        yield dict(_core.render_frame(str(scene), f, int(frames), str(camera_path), int(width), int(height),
+                                      int(spp), int(seed), int(max_depth), int(threads)))
 
 
 def metrics(image: Any, reference: Any) -> Dict[str, float]:

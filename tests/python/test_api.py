@@ -190,3 +190,26 @@ def test_torch_tensors_come_back_as_tensors(bufs):
     out = atrous.denoise(torch.from_numpy(bufs["color"]), method="eaw")
     assert isinstance(out, torch.Tensor)
     np.testing.assert_array_equal(out.numpy(), atrous.denoise(bufs["color"], method="eaw"))
+
+
+def test_render_sequence_gives_frames_with_motion_for_svgf():
+    frames = list(atrous.render_sequence("cornell-moving", 3, width=32, height=24, spp=1, seed=5))
+    assert len(frames) == 3
+    assert [f["time"] for f in frames] == [0.0, 0.5, 1.0]
+    for f in frames:
+        for k in ("color", "albedo", "normal", "depth", "ids", "emission", "motion"):
+            assert f[k].shape == (24, 32, 3) and f[k].dtype == np.float32, k
+    assert np.abs(frames[0]["motion"]).max() < 1e-3  # no previous frame
+    assert np.abs(frames[2]["motion"][..., :2]).max() > 0.1  # the box turns, the sphere slides
+    assert not np.array_equal(frames[0]["color"], frames[1]["color"])  # fresh samples per frame
+    again = next(atrous.render_sequence("cornell-moving", 3, width=32, height=24, spp=1, seed=5))
+    np.testing.assert_array_equal(again["color"], frames[0]["color"])
+    s = atrous.Svgf(device="cpu")
+    for f in frames:
+        out = s.denoise_frame(f["color"], albedo=f["albedo"], normal=f["normal"], depth=f["depth"],
+                              ids=f["ids"], motion=f["motion"], emission=f["emission"])
+        assert out.shape == (24, 32, 3) and np.isfinite(out).all()
+    with pytest.raises(ValueError, match="camera_path"):
+        next(atrous.render_sequence("cornell", 2, width=8, height=8, camera_path="spiral"))
+    with pytest.raises(ValueError, match="frames"):
+        next(atrous.render_sequence("cornell", 0, width=8, height=8))
