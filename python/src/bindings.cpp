@@ -221,8 +221,7 @@ private:
     std::unique_ptr<SvgfDenoiser> mDenoiser;
 };
 
-nb::dict pyRender(const std::string& scene, int width, int height, int spp, uint32_t seed, int maxDepth, int threads) {
-    Scene s = Scene::loadByNameOrFile(scene);
+RenderSettings renderSettings(int width, int height, int spp, uint32_t seed, int maxDepth, int threads) {
     RenderSettings rs;
     rs.width = width;
     rs.height = height;
@@ -230,11 +229,11 @@ nb::dict pyRender(const std::string& scene, int width, int height, int spp, uint
     rs.seed = seed;
     rs.maxDepth = maxDepth;
     rs.threads = threads;
-    RenderBuffers b;
-    {
-        nb::gil_scoped_release release;
-        b = render(s, rs);
-    }
+    return rs;
+}
+
+// The render's buffers as a dict of H x W x 3 arrays (motion only when the render made one).
+nb::dict buffersDict(RenderBuffers&& b) {
     nb::dict d;
     d["color"] = fromImage(std::move(b.color));
     d["variance"] = fromImage(std::move(b.variance));
@@ -244,7 +243,19 @@ nb::dict pyRender(const std::string& scene, int width, int height, int spp, uint
     d["depth"] = fromImage(std::move(b.depth));
     d["ids"] = fromImage(std::move(b.ids));
     d["emission"] = fromImage(std::move(b.emission));
+    if (!b.motion.empty()) d["motion"] = fromImage(std::move(b.motion));
     return d;
+}
+
+nb::dict pyRender(const std::string& scene, int width, int height, int spp, uint32_t seed, int maxDepth, int threads) {
+    Scene s = Scene::loadByNameOrFile(scene);
+    const RenderSettings rs = renderSettings(width, height, spp, seed, maxDepth, threads);
+    RenderBuffers b;
+    {
+        nb::gil_scoped_release release;
+        b = render(s, rs);
+    }
+    return buffersDict(std::move(b));
 }
 
 // Frame `frame` of `frames` of an animated scene (atrous.render_sequence): the CLI's `render
@@ -256,13 +267,7 @@ nb::dict pyRenderFrame(const std::string& scene, int frame, int frames, const st
         throw InputError("frame " + std::to_string(frame) + " is outside 0.." + std::to_string(frames - 1));
     Scene s = Scene::loadByNameOrFile(scene);
     const CameraPath path = parseCameraPath(cameraPath);
-    RenderSettings rs;
-    rs.width = width;
-    rs.height = height;
-    rs.spp = spp;
-    rs.seed = seed + uint32_t(frame);
-    rs.maxDepth = maxDepth;
-    rs.threads = threads;
+    const RenderSettings rs = renderSettings(width, height, spp, seed + uint32_t(frame), maxDepth, threads);
     const float t = frameTime(frame, frames);
     const float tPrev = frame > 0 ? frameTime(frame - 1, frames) : t;
     RenderBuffers b;
@@ -270,16 +275,7 @@ nb::dict pyRenderFrame(const std::string& scene, int frame, int frames, const st
         nb::gil_scoped_release release;
         b = renderFrame(s, path, t, tPrev, rs);
     }
-    nb::dict d;
-    d["color"] = fromImage(std::move(b.color));
-    d["variance"] = fromImage(std::move(b.variance));
-    d["albedo"] = fromImage(std::move(b.albedo));
-    d["normal"] = fromImage(std::move(b.normal));
-    d["position"] = fromImage(std::move(b.position));
-    d["depth"] = fromImage(std::move(b.depth));
-    d["ids"] = fromImage(std::move(b.ids));
-    d["emission"] = fromImage(std::move(b.emission));
-    d["motion"] = fromImage(std::move(b.motion));
+    nb::dict d = buffersDict(std::move(b));
     d["time"] = t;
     return d;
 }
