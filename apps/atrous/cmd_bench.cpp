@@ -163,14 +163,18 @@ void run(const BenchArgs& a) {
                 render(scene, one);
                 return tt.ms();
             });
-            nlohmann::json r = stats(t);
-            r["what"] = "render";
-            r["device"] = "cpu";
-            r["width"] = w;
-            r["height"] = h;
-            r["spp"] = 1;
-            r["msamples_per_s"] = double(w) * h / (median(t) * 1e3);
-            doc["results"].push_back(r);
+            // One JSON row per renderer: stats of the 1-spp times and the sample rate.
+            auto renderRow = [&](const std::vector<double>& times, const char* dev) {
+                nlohmann::json r = stats(times);
+                r["what"] = "render";
+                r["device"] = dev;
+                r["width"] = w;
+                r["height"] = h;
+                r["spp"] = 1;
+                r["msamples_per_s"] = double(w) * h / (median(times) * 1e3);
+                return r;
+            };
+            doc["results"].push_back(renderRow(t, "cpu"));
             if (device == Device::Cuda) {
                 // The CUDA path tracer as the viewer runs it: one persistent renderer (scene and BVH
                 // uploaded once, outside the timing), 1 spp into its device buffers, no download.
@@ -181,13 +185,7 @@ void run(const BenchArgs& a) {
                     cudaRenderer->renderOnDevice(one);
                     return tt.ms();
                 });
-                nlohmann::json rc = stats(tc);
-                rc["what"] = "render";
-                rc["device"] = "cuda";
-                rc["width"] = w;
-                rc["height"] = h;
-                rc["spp"] = 1;
-                rc["msamples_per_s"] = double(w) * h / (median(tc) * 1e3);
+                nlohmann::json rc = renderRow(tc, "cuda");
                 rc["note"] = "BVH traversal of the Embree-built BVH; buffers left on the GPU";
                 doc["results"].push_back(rc);
             }
