@@ -11,20 +11,9 @@
 namespace {
 
 namespace fs = std::filesystem;
+using atrous::test::runShell;
 
 std::string benchPath(const std::string& name) { return (fs::path(ATROUS_CLI).parent_path() / "bench" / name).string(); }
-
-atrous::test::CliResult runShell(const std::string& cmd) {
-    atrous::test::CliResult r;
-    FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
-    if (!pipe) return r;
-    char buf[4096];
-    size_t n;
-    while ((n = fread(buf, 1, sizeof(buf), pipe)) > 0) r.output.append(buf, n);
-    const int status = pclose(pipe);
-    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return r;
-}
 
 int lines(const std::string& s) {
     int n = 0;

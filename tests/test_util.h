@@ -41,9 +41,9 @@ struct CliResult {
     std::string output;  // stdout and stderr together
 };
 
-// Runs `build/atrous <args>` through the shell and captures its output and exit code.
-inline CliResult runCli(const std::string& args) {
-    std::string cmd = std::string(ATROUS_CLI) + " " + args + " 2>&1";
+// Runs a shell command line and captures its output (stdout and stderr) and exit code.
+inline CliResult runShell(const std::string& command) {
+    const std::string cmd = command + " 2>&1";
     CliResult r;
     FILE* pipe = popen(cmd.c_str(), "r");
     if (!pipe) return r;
@@ -54,6 +54,9 @@ inline CliResult runCli(const std::string& args) {
     r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     return r;
 }
+
+// Runs `build/atrous <args>` through the shell and captures its output and exit code.
+inline CliResult runCli(const std::string& args) { return runShell(std::string(ATROUS_CLI) + " " + args); }
 
 // Counts the entries of a directory (to check that a failed command wrote nothing).
 inline int countEntries(const std::string& dir) {

@@ -45,16 +45,8 @@ CliResult runUnderXvfb(const std::string& args) {
     for (int attempt = 0; attempt < 2; ++attempt) {
         const int display = 100 + int((unsigned(getpid()) * 37u + unsigned(calls++) * 7u) % 4000u);
         std::string cmd = "timeout -k 5 120 xvfb-run -a -n " + std::to_string(display) +
-                          " -s '-screen 0 1024x768x24' " + std::string(ATROUS_CLI) + " " + args +
-                          " 2>&1";
-        r = CliResult{};
-        FILE* pipe = popen(cmd.c_str(), "r");
-        if (!pipe) return r;
-        char buf[4096];
-        size_t n;
-        while ((n = fread(buf, 1, sizeof(buf), pipe)) > 0) r.output.append(buf, n);
-        const int status = pclose(pipe);
-        r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+                          " -s '-screen 0 1024x768x24' " + std::string(ATROUS_CLI) + " " + args;
+        r = atrous::test::runShell(cmd);
         if (r.exitCode == 0 || r.output.find("Xvfb failed to start") == std::string::npos) break;
     }
     return r;
