@@ -1,0 +1,63 @@
+"""Shared helpers of the third-party corpus scripts (render side, run in .venv-corpus).
+
+Modes (sizes, sample counts, seeds) live here so both renderers use the same ones.
+"""
+import json
+import os
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+
+# Seeds: noisy renders use one seed per spp, the references an independent one.
+SEED_NOISY = {4: 1, 16: 2}
+SEED_REF = 1000003
+SEED_SEQ = 1          # frame f of a 1-spp sequence uses SEED_SEQ + f
+SEED_SEQ_REF = 2000003  # its reference uses SEED_SEQ_REF + f
+
+MODES = {
+    # CI-sized: 2 stills per renderer plus a 4-frame sequence, small images, 256-spp references.
+    "quick": dict(res=64, spp=[4, 16], ref_spp=256, seq_res=48, seq_frames=4, seq_ref_spp=64),
+    # The corpus proper.
+    "full": dict(res=256, spp=[4, 16], ref_spp=2048, seq_res=128, seq_frames=20, seq_ref_spp=512),
+}
+
+
+def exr_channels(path):
+    """{part name: [channel names]} of an EXR file, via the OpenEXR Python bindings."""
+    import OpenEXR
+
+    out = {}
+    with OpenEXR.File(str(path), separate_channels=True) as f:
+        for i, p in enumerate(f.parts):
+            name = p.name() if p.name() else f"part{i}"
+            out[name] = sorted(p.channels.keys())
+    return out
+
+
+def exr_read_all(path):
+    """{channel name: 2-D float array} over every part of an EXR (Blender 5 writes one part per pass)."""
+    import OpenEXR
+
+    out = {}
+    with OpenEXR.File(str(path), separate_channels=True) as f:
+        for p in f.parts:
+            for k, c in p.channels.items():
+                out[k] = c.pixels
+    return out
+
+
+def write_manifest(path, data):
+    data = dict(data)
+    data["written"] = time.strftime("%Y-%m-%dT%H:%M:%S")
+    tmp = Path(str(path) + ".tmp")
+    tmp.write_text(json.dumps(data, indent=2) + "\n")
+    os.replace(tmp, path)
+
+
+def done(path):
+    return Path(path).exists() and Path(path).stat().st_size > 0
+
+
+def log(*a):
+    print(time.strftime("%H:%M:%S"), *a, flush=True)
