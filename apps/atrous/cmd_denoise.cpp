@@ -1,5 +1,7 @@
 // `atrous denoise`: EAW or SURE-À-Trous on a render directory or on individual EXR/PFM buffers.
+#include <algorithm>
 #include <cstdio>
+#include <iterator>
 #include <filesystem>
 #include <memory>
 #include <sstream>
@@ -11,6 +13,8 @@
 #include "commands.h"
 #include "core/timer.h"
 #include "denoise_sequence.h"
+#include "core/srgb.h"
+#include "io/buffer_set.h"
 #include "io/image_io.h"
 
 namespace atrous::cli {
@@ -19,6 +23,12 @@ namespace {
 
 struct DenoiseArgs {
     std::string inDir, color, albedo, normal, position, depth, variance, ids, emission, out, sequence;
+    std::vector<std::string> passes;   // --pass BUFFER=NAME
+    std::string layer, addPass;        // --layer, --add-pass
+    std::string ldrColor;              // oidnDenoise's --ldr FILE
+    bool ldr = false, srgb = false;    // LDR input: output clamped to [0, 1]; --srgb: sRGB-encoded
+    std::string oidnFilter = "RT", oidnQuality;  // oidnDenoise's -f, -q (accepted; see addOidnFlags)
+    bool oidnCleanAux = false;
     std::string method = "sure", device = "auto", sureMode = "discrete", sureCandidates;
     bool normalStepScale = false, noIds = false, noCorrelated = false, noFirefly = false, noDemodulate = false;
     DenoiseOptions opt;
@@ -113,7 +123,44 @@ void checkOutputFile(const std::string& out) {
     if (fs::is_directory(out, ec)) throw InputError("--out '" + out + "': is a directory (give a file name)");
 }
 
+// The files of one denoise call (io::loadBuffers reads them).
+io::BufferFiles bufferFiles(const DenoiseArgs& a) {
+    io::BufferFiles f;
+    f.in = a.inDir;
+    f.file[int(io::Buffer::Color)] = a.color;
+    f.file[int(io::Buffer::Variance)] = a.variance;
+    f.file[int(io::Buffer::Albedo)] = a.albedo;
+    f.file[int(io::Buffer::Normal)] = a.normal;
+    f.file[int(io::Buffer::Position)] = a.position;
+    f.file[int(io::Buffer::Depth)] = a.depth;
+    f.file[int(io::Buffer::ObjectId)] = a.ids;
+    f.file[int(io::Buffer::Emission)] = a.emission;
+    f.viewLayer = a.layer;
+    for (const std::string& p : a.passes)
+        f.passes.push_back(withFlag("--pass", [&] { return io::parsePassRequest(p); }));
+    return f;
+}
+
+void srgbToLinear(Image& img) {
+    for (size_t i = 0; i < img.plane() * size_t(img.channels()); ++i) img.data()[i] = srgbDecode(img.data()[i]);
+}
+void linearToSrgb(Image& img) {
+    for (size_t i = 0; i < img.plane() * size_t(img.channels()); ++i) img.data()[i] = srgbEncode(img.data()[i]);
+}
+void clampUnit(Image& img) {
+    for (size_t i = 0; i < img.plane() * size_t(img.channels()); ++i)
+        img.data()[i] = std::min(std::max(img.data()[i], 0.0f), 1.0f);
+}
+
 void run(DenoiseArgs& a, const CLI::App& cmd) {
+    if (!a.ldrColor.empty()) {
+        if (!a.color.empty()) throw InputError("--ldr: give the colour once (--color/--hdr or --ldr)");
+        a.color = a.ldrColor;
+        a.ldr = true;
+    }
+    if (a.srgb && !a.ldr) throw InputError("--srgb: only with --ldr (an sRGB-encoded LDR colour)");
+    if (a.oidnFilter != "RT")
+        throw InputError("-f/--filter: '" + a.oidnFilter + "' is not supported (atrous denoises RT images: use RT)");
     DenoiseOptions& o = a.opt;
     const bool sequence = !a.sequence.empty();
     if (a.method != "svgf" && a.method != "eaw" && a.method != "sure")
@@ -153,47 +200,19 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     const std::string ext = io::extensionOf(a.out);
     if (ext != ".exr" && ext != ".pfm" && ext != ".png")
         throw InputError("--out '" + a.out + "': unsupported extension (use .exr, .pfm or .png)");
-    if (a.inDir.empty() == a.color.empty()) throw InputError("give exactly one of --in RENDER_DIR or --color FILE");
+    if (a.inDir.empty() == a.color.empty())
+        throw InputError("give exactly one of --in RENDER_DIR, --in LAYERED.exr or --color FILE (--hdr/--ldr)");
     checkOutputFile(a.out);
-
-    // Buffer paths: --in DIR takes the renderer's file names where present; explicit flags win.
-    auto pick = [&](const std::string& flag, const char* name) -> std::string {
-        if (!flag.empty()) return flag;
-        if (a.inDir.empty()) return "";
-        const std::string p = (std::filesystem::path(a.inDir) / name).string();
-        return std::filesystem::exists(p) ? p : "";
-    };
-    std::string colorPath = a.color;
-    if (!a.inDir.empty()) {
-        if (!std::filesystem::is_directory(a.inDir)) throw InputError("--in '" + a.inDir + "': not a directory");
-        colorPath = (std::filesystem::path(a.inDir) / "color.exr").string();
-        if (!std::filesystem::exists(colorPath)) throw InputError("--in '" + a.inDir + "': no color.exr in it");
-    }
-    Image color = io::readImage(colorPath);
-    constexpr int kBuffers = 7;
-    std::unique_ptr<Image> bufs[kBuffers];
-    const std::string paths[kBuffers] = {pick(a.variance, "variance.exr"), pick(a.albedo, "albedo.exr"),
-                                         pick(a.normal, "normal.exr"),     pick(a.position, "position.exr"),
-                                         pick(a.depth, "depth.exr"),       pick(a.ids, "ids.exr"),
-                                         pick(a.emission, "emission.exr")};
-    const char* names[kBuffers] = {"variance", "albedo", "normal", "position", "depth", "ids", "emission"};
-    for (int i = 0; i < kBuffers; ++i) {
-        if (paths[i].empty()) continue;
-        bufs[i] = std::make_unique<Image>(io::readImage(paths[i]));
-        if (bufs[i]->width() != color.width() || bufs[i]->height() != color.height())
-            throw InputError(std::string(names[i]) + " buffer '" + paths[i] + "' is " + std::to_string(bufs[i]->width()) +
-                             "x" + std::to_string(bufs[i]->height()) + " but the color '" + colorPath + "' is " +
-                             std::to_string(color.width()) + "x" + std::to_string(color.height()));
-    }
-    DenoiseInputs in;
-    in.color = &color;
-    in.variance = bufs[0].get();
-    in.albedo = bufs[1].get();
-    in.normal = bufs[2].get();
-    in.position = bufs[3].get();
-    in.depth = bufs[4].get();
-    in.ids = bufs[5].get();
-    in.emission = bufs[6].get();
+    io::BufferSet set = io::loadBuffers(bufferFiles(a));
+    if (!a.addPass.empty() && (!set.layered || ext != ".exr"))
+        throw InputError("--add-pass '" + a.addPass + "' writes a copy of a layered EXR: give --in FILE.exr and --out COPY.exr");
+    Image& color = set.image[int(io::Buffer::Color)];
+    if (a.srgb) srgbToLinear(color);
+    DenoiseInputs in = set.inputs();
+    static constexpr io::Buffer kLabelled[] = {io::Buffer::Variance, io::Buffer::Albedo, io::Buffer::Normal,
+                                              io::Buffer::Position, io::Buffer::Depth, io::Buffer::ObjectId,
+                                              io::Buffer::Emission};
+    static const char* const kLibraryNames[] = {"variance", "albedo", "normal", "position", "depth", "ids", "emission"};
     DenoiseReport rep;
     o.report = &rep;
     Timer t;
@@ -203,12 +222,19 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     } catch (const InputError& e) {
         // Name the buffer's file: library messages name the buffer ("variance buffer has ...").
         std::string msg = e.what();
-        for (int i = 0; i < kBuffers; ++i)
-            if (!paths[i].empty() && msg.rfind(names[i], 0) == 0) msg = "'" + paths[i] + "': " + msg;
+        for (size_t i = 0; i < std::size(kLabelled); ++i) {
+            const std::string& from = set.from[int(kLabelled[i])];
+            if (!from.empty() && msg.rfind(kLibraryNames[i], 0) == 0) msg = "'" + from + "': " + msg;
+        }
         throw InputError(msg);
     }
     const double ms = t.ms();
-    io::writeImage(a.out, out);
+    if (a.ldr) clampUnit(out);
+    if (a.srgb) linearToSrgb(out);
+    if (!a.addPass.empty())
+        io::writeExrWithLayers(a.out, *set.layered, {io::ExrOutLayer{a.addPass, &out}});
+    else
+        io::writeImage(a.out, out);
     std::printf("denoise: method %s on %s, %dx%d, buffers used: %s\n", denoiseMethodName(o.method),
                 deviceToString(o.device), color.width(), color.height(), rep.buffersUsed.c_str());
     if (rep.noiseEstimated)
@@ -234,25 +260,43 @@ void addDenoiseCommand(CLI::App& app) {
     auto a = std::make_shared<DenoiseArgs>();
     auto* cmd = app.add_subcommand(
         "denoise", "Denoise a render with EAW or SURE-based a-trous wavelets, or an animated sequence (also SVGF)");
-    cmd->add_option("--in", a->inDir, "Render directory (color.exr, variance.exr, albedo.exr, normal.exr, ...)");
+    cmd->add_option("--in", a->inDir,
+                    "Render directory (color.exr, variance.exr, albedo.exr, normal.exr, ...) or a layered EXR "
+                    "(Blender multilayer, Mitsuba aov): its passes are taken by name (atrous inspect FILE shows which)");
+    cmd->add_option("--pass", a->passes,
+                    "BUFFER=NAME: take BUFFER (color, variance, albedo, normal, position, depth, object_id, "
+                    "material_id, emission, motion) from the layer or channel NAME of a layered EXR (repeatable)");
+    cmd->add_option("--layer", a->layer, "View layer of a layered EXR with several (Blender: the ViewLayer name)");
+    cmd->add_option("--add-pass", a->addPass,
+                    "With --in FILE.exr: write --out as a copy of FILE with the denoised colour added as this pass");
     cmd->add_option("--sequence", a->sequence,
                     "Sequence directory of frame_NNNN/ folders (atrous render --frames); --out is then a directory");
-    cmd->add_option("--color", a->color, "Noisy colour (EXR/PFM)");
+    cmd->add_option("--color,--hdr", a->color, "Noisy colour (EXR/PFM; --hdr as in oidnDenoise)");
+    cmd->add_option("--ldr", a->ldrColor, "Noisy LDR colour in [0, 1] (oidnDenoise's --ldr): the output is clamped to [0, 1]");
+    cmd->add_flag("--srgb", a->srgb, "With --ldr: the colour is sRGB-encoded (decoded before, encoded after)");
     cmd->add_option("--variance", a->variance, "Per-channel variance of the pixel mean")->group(kGroupBuffers);
-    cmd->add_option("--albedo", a->albedo, "Albedo buffer")->group(kGroupBuffers);
-    cmd->add_option("--normal", a->normal, "World-space normal buffer")->group(kGroupBuffers);
+    cmd->add_option("--albedo,--alb", a->albedo, "Albedo buffer (a layered EXR: its albedo pass)")->group(kGroupBuffers);
+    cmd->add_option("--normal,--nrm", a->normal, "Normal buffer, world or camera space")->group(kGroupBuffers);
     cmd->add_option("--position", a->position, "World-space position buffer")->group(kGroupBuffers);
     cmd->add_option("--depth", a->depth, "View depth buffer")->group(kGroupBuffers);
     cmd->add_option("--ids", a->ids, "Mesh id (R) / material id (G) buffer")->group(kGroupBuffers);
     cmd->add_option("--emission", a->emission, "Emitted radiance of the primary hit (filtered around, added back)")->group(kGroupBuffers);
-    cmd->add_option("--out", a->out,
+    cmd->add_option("--out,-o", a->out,
                     "Output file (.exr, .pfm or .png); with --sequence, an output directory, written only once every "
                     "frame is denoised (on error it is left as it was). An existing one keeps its other files; this "
                     "run's frame_NNNN.exr/.png replace the old ones, and those of an earlier run that this run does "
                     "not write (and an old preview.mp4) are removed, named in a note on stderr")
         ->required();
     cmd->add_option("--method", a->method, "eaw | sure (| svgf with --sequence)")->capture_default_str();
-    cmd->add_option("--device", a->device, "cpu | cuda | auto (cuda when a GPU is present)")->capture_default_str();
+    cmd->add_option("--device,-d", a->device, "cpu | cuda | auto (cuda when a GPU is present; oidnDenoise's 'default' = auto)")
+        ->capture_default_str()
+        ->transform([](std::string v) { return v == "default" ? std::string("auto") : v; });
+    // oidnDenoise's other flags, so that a script written for it runs unchanged (docs/inputs.md).
+    const char* kGroupOidn = "oidnDenoise compatibility";
+    cmd->add_option("-f,--filter", a->oidnFilter, "oidnDenoise's filter type: RT only")->group(kGroupOidn);
+    cmd->add_option("-q,--quality", a->oidnQuality, "oidnDenoise's quality (accepted, no effect: use --method)")->group(kGroupOidn);
+    cmd->add_flag("--clean_aux", a->oidnCleanAux, "oidnDenoise's noise-free-features flag (accepted: atrous's "
+                  "features are edge stops, never filtered)")->group(kGroupOidn);
     EawParams& e = a->opt.eaw;
     cmd->add_option("--levels", e.levels, "A-trous levels (1..10)")->capture_default_str()->group(kGroupEawSure);
     cmd->add_option("--sigma-color", e.sigmaColor, "Raw sigma_c (0 = automatic from the variance)")->capture_default_str()->group(kGroupEawSure);

@@ -11,5 +11,6 @@ void addDenoiseCommand(CLI::App& app);
 void addCompareCommand(CLI::App& app);
 void addBenchCommand(CLI::App& app);
 void addViewCommand(CLI::App& app);
+void addInspectCommand(CLI::App& app);
 
 }  // namespace atrous::cli

@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
     atrous::cli::addCompareCommand(app);
     atrous::cli::addBenchCommand(app);
     atrous::cli::addViewCommand(app);
+    atrous::cli::addInspectCommand(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

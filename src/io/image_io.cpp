@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "atrous/error.h"
+#include "core/srgb.h"
 
 namespace fs = std::filesystem;
 
@@ -171,11 +172,6 @@ void writePfm(const std::string& path, const Image& img) {
 }
 
 // ---------------------------------------------------------------------------------- PNG & co.
-
-static float srgbEncode(float v) {
-    v = std::min(std::max(v, 0.0f), 1.0f);
-    return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
-}
 
 void writePng(const std::string& path, const Image& img, float exposure) {
     if (img.device() != Device::Cpu) throw InputError(path + ": writePng needs a host image");

@@ -1,0 +1,131 @@
+#include "io/buffer_set.h"
+
+#include <filesystem>
+
+#include "atrous/error.h"
+#include "io/image_io.h"
+
+namespace fs = std::filesystem;
+
+namespace atrous::io {
+
+namespace {
+
+// File names of an atrous render directory, by buffer ("" = none).
+const char* const kDirNames[kBufferCount] = {"color.exr",  "variance.exr", "albedo.exr", "normal.exr", "position.exr",
+                                             "depth.exr",  "ids.exr",      "",           "emission.exr", "motion.exr"};
+
+std::string sizeOf(const Image& i) { return std::to_string(i.width()) + "x" + std::to_string(i.height()); }
+
+// Object and material index passes (1 channel each) as atrous's ids buffer: R object, G material.
+Image composeIds(const Image* object, const Image* material, int w, int h) {
+    Image ids(w, h, 3);
+    const size_t n = ids.plane();
+    std::fill(ids.data(), ids.data() + 3 * n, 0.0f);
+    if (object) std::copy(object->data(), object->data() + n, ids.data());
+    if (material) std::copy(material->data(), material->data() + n, ids.data() + n);
+    return ids;
+}
+
+}  // namespace
+
+DenoiseInputs BufferSet::inputs() const {
+    DenoiseInputs in;
+    in.color = get(Buffer::Color);
+    in.variance = get(Buffer::Variance);
+    in.albedo = get(Buffer::Albedo);
+    in.normal = get(Buffer::Normal);
+    in.position = get(Buffer::Position);
+    in.depth = get(Buffer::Depth);
+    in.ids = get(Buffer::ObjectId);
+    in.emission = get(Buffer::Emission);
+    return in;
+}
+
+Image readBufferFile(const std::string& path, Buffer b, const std::vector<PassRequest>& passes,
+                     const std::string& viewLayer, std::string* from) {
+    if (from) *from = path;
+    if (fs::is_regular_file(path) && isExrFile(path)) {
+        const ExrInfo info = inspectExr(path);
+        if (info.layers.size() > 1) {
+            const PassChoice c = passForFile(info, b, passes, viewLayer);
+            if (from && c.layer >= 0) *from = path + " (layer " + info.layers[size_t(c.layer)].name + ", " + c.rule + ")";
+            return readPass(info, c, b);
+        }
+    }
+    Image img = readImage(path);
+    conformBuffer(b, img);
+    return img;
+}
+
+BufferSet loadBuffers(const BufferFiles& f) {
+    BufferSet s;
+    std::string dir;
+    if (!f.in.empty()) {
+        std::error_code ec;
+        if (!fs::exists(f.in, ec)) throw InputError("--in '" + f.in + "': no such file or directory");
+        if (fs::is_directory(f.in, ec)) {
+            dir = f.in;
+        } else {
+            s.layered = std::make_shared<ExrInfo>(inspectExr(f.in));
+        }
+    }
+    if (s.layered) {
+        const ExrInfo& info = *s.layered;
+        const PassMap m = mapPasses(info, f.passes, f.viewLayer);
+        if (!m[Buffer::Color].found() && f.file[int(Buffer::Color)].empty())
+            throw InputError(f.in + ": no colour pass (layers: " + [&] {
+                std::string l;
+                for (const ExrLayer& x : info.layers) l += (l.empty() ? "" : ", ") + (x.name.empty() ? "(root)" : x.name);
+                return l;
+            }() + "); name one with --pass color=LAYER");
+        Image object, material;
+        for (int b = 0; b < kBufferCount; ++b) {
+            const PassChoice& c = m.pass[size_t(b)];
+            if (!c.found() || !f.file[b].empty()) continue;
+            Image img = readPass(info, c, Buffer(b));
+            const std::string label = c.layer >= 0 ? info.layers[size_t(c.layer)].name : info.channels[size_t(c.channels[0])].fullName;
+            const std::string from = f.in + " (" + (label.empty() ? std::string("root R,G,B") : label) + ", " + c.rule + ")";
+            if (Buffer(b) == Buffer::ObjectId) {
+                object = std::move(img);
+                s.from[b] = from;
+            } else if (Buffer(b) == Buffer::MaterialId) {
+                material = std::move(img);
+                s.from[b] = from;
+            } else {
+                s.image[b] = std::move(img);
+                s.from[b] = from;
+            }
+        }
+        if (!object.empty() || !material.empty()) {
+            const Image& any = object.empty() ? material : object;
+            s.image[int(Buffer::ObjectId)] = composeIds(object.empty() ? nullptr : &object,
+                                                        material.empty() ? nullptr : &material, any.width(), any.height());
+        }
+    }
+    for (int b = 0; b < kBufferCount; ++b) {
+        std::string path = f.file[b];
+        if (path.empty() && !dir.empty() && kDirNames[b][0]) {
+            const std::string p = (fs::path(dir) / kDirNames[b]).string();
+            if (fs::exists(p)) path = p;
+        }
+        if (path.empty()) continue;
+        // A layered file given for the ids takes its object and material passes together.
+        s.image[b] = readBufferFile(path, Buffer(b), f.passes, f.viewLayer, &s.from[b]);
+    }
+    if (s.image[int(Buffer::Color)].empty()) {
+        if (!dir.empty()) throw InputError("--in '" + dir + "': no color.exr in it");
+        throw InputError("no colour given: --color FILE, --in RENDER_DIR or --in LAYERED.exr");
+    }
+    const Image& color = s.image[int(Buffer::Color)];
+    for (int b = 0; b < kBufferCount; ++b) {
+        const Image& img = s.image[b];
+        if (img.empty() || b == int(Buffer::Color)) continue;
+        if (img.width() != color.width() || img.height() != color.height())
+            throw InputError(std::string(bufferName(Buffer(b))) + " buffer '" + s.from[b] + "' is " + sizeOf(img) +
+                             " but the color '" + s.from[int(Buffer::Color)] + "' is " + sizeOf(color));
+    }
+    return s;
+}
+
+}  // namespace atrous::io

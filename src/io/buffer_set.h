@@ -1,0 +1,45 @@
+// The buffers of one denoise call, read from what the user named (docs/inputs.md): a render
+// directory as atrous writes it (color.exr, albedo.exr, ...), a layered EXR (Blender's multilayer
+// file, Mitsuba's aov output), separate files per buffer, or a mix (explicit files win).
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "atrous/denoise.h"
+#include "atrous/image.h"
+#include "io/exr_layers.h"
+#include "io/pass_map.h"
+
+namespace atrous::io {
+
+struct BufferFiles {
+    std::string in;  // a render directory or a layered EXR file (may be empty)
+    // Explicit files by buffer. The object_id slot takes atrous's ids.exr (R = mesh id, G =
+    // material id); material_id has no file of its own.
+    std::string file[kBufferCount];
+    std::vector<PassRequest> passes;  // --pass BUFFER=NAME
+    std::string viewLayer;            // --layer NAME
+};
+
+struct BufferSet {
+    // By buffer; ids in the object_id slot (R = object, G = material id, B = 0). Empty when absent.
+    Image image[kBufferCount];
+    std::string from[kBufferCount];  // where each came from, for messages and `inspect`
+    std::shared_ptr<ExrInfo> layered;  // the layered file given as `in`, if any
+    std::vector<std::string> notes;    // conventions applied, passes not found, ...
+    const Image* get(Buffer b) const { return image[int(b)].empty() ? nullptr : &image[int(b)]; }
+    DenoiseInputs inputs() const;  // colour and features (motion is not a denoise input)
+};
+
+// Reads every buffer that `files` names or that `files.in` holds. Throws InputError naming the
+// file (and part) for a missing colour, an unreadable file, an ambiguous or empty pass mapping, or
+// a buffer whose size differs from the colour's (naming both files).
+BufferSet loadBuffers(const BufferFiles& files);
+
+// Reads one buffer from a file given for it alone: a layered EXR gives the pass of that buffer
+// (passForFile), any other image is read whole (readImage). Conventions applied (conformBuffer).
+Image readBufferFile(const std::string& path, Buffer b, const std::vector<PassRequest>& passes,
+                     const std::string& viewLayer, std::string* from = nullptr);
+
+}  // namespace atrous::io

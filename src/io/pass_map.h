@@ -1,0 +1,67 @@
+// Which layer of a layered EXR is which denoiser buffer (docs/inputs.md). The rules are by pass
+// name, case-insensitive, in tiers: the first tier with a match wins, and inside a tier the first
+// name of the list that matches. Two layers matching the same name under different view layers
+// (two Blender view layers, say) are ambiguous: an InputError unless a view layer is chosen.
+// Explicit choices (`--pass BUFFER=NAME`) win over the rules.
+#pragma once
+#include <array>
+#include <string>
+#include <vector>
+
+#include "atrous/image.h"
+#include "io/exr_layers.h"
+
+namespace atrous::io {
+
+enum class Buffer { Color, Variance, Albedo, Normal, Position, Depth, ObjectId, MaterialId, Emission, Motion };
+constexpr int kBufferCount = 10;
+
+const char* bufferName(Buffer b);  // "color", "variance", ..., "object_id", "material_id", "motion"
+// The buffer of a --pass name ("color", "albedo", ..., also "ids" for object_id); InputError otherwise.
+Buffer parseBufferName(const std::string& name);
+int bufferChannels(Buffer b);  // the components a buffer takes: 1 (depth, ids), 2 (motion) or 3
+
+struct PassRequest {
+    Buffer buffer;
+    std::string name;  // a layer's full name, a layer's pass name, or a full channel name
+};
+
+// "BUFFER=NAME" (e.g. "albedo=ViewLayer.Denoising Albedo"); InputError otherwise.
+PassRequest parsePassRequest(const std::string& spec);
+
+struct PassChoice {
+    int layer = -1;             // index into ExrInfo::layers; -1: absent
+    std::vector<int> channels;  // indices into ExrInfo::channels
+    std::string rule;           // how it was chosen ("pass name 'Denoising Albedo'", "--pass", ...)
+    bool found() const { return !channels.empty(); }
+};
+
+struct PassMap {
+    std::array<PassChoice, kBufferCount> pass;
+    const PassChoice& operator[](Buffer b) const { return pass[size_t(b)]; }
+};
+
+// Maps every buffer of a layered file. `viewLayer` (may be empty) keeps only layers under that
+// prefix (and root layers). Throws InputError naming the file (and the part) for an ambiguous
+// match, a request that names nothing, or a layer with unusable channels.
+PassMap mapPasses(const ExrInfo& info, const std::vector<PassRequest>& requests, const std::string& viewLayer);
+
+// The pass for one buffer of a file given for that buffer alone (`--albedo file.exr`): its only
+// layer when it has one, else the buffer's rules. Throws InputError when it has several layers and
+// none is that buffer's, naming the file and its layers.
+PassChoice passForFile(const ExrInfo& info, Buffer b, const std::vector<PassRequest>& requests,
+                       const std::string& viewLayer);
+
+// Reads a pass as a 3-channel image and brings it to atrous's conventions (conformBuffer).
+Image readPass(const ExrInfo& info, const PassChoice& pass, Buffer b);
+
+// atrous's conventions for a buffer read from anywhere (docs/inputs.md): normals longer than 1 normalised
+// (shorter ones, means across an edge, kept; zero stays zero: background); depth <= 0, non-finite or >= 1e9 becomes the background value 1e30;
+// non-finite positions, ids and motion become 0. Colour, albedo, variance, emission are left as
+// they are (the filters repair non-finite colour).
+void conformBuffer(Buffer b, Image& img);
+
+// One line per layer for `atrous inspect`: name, components, types, part.
+std::string describeLayer(const ExrInfo& info, const ExrLayer& layer);
+
+}  // namespace atrous::io
