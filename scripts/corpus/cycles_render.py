@@ -203,12 +203,12 @@ def scene_glass_mirror(sc):
     add("plane", material("mirror", "metal", color=(0.97, 0.97, 0.97), rough=0.0, index=4),
         loc=(0.2, 1.6, 1.0), rot=(math.radians(80), 0, math.radians(-15)), scale=(1.4, 1.0, 1))
     # visible area light: an emissive panel in view, facing the scene
-    add("plane", material("panel", "emission", color=(1.0, 0.95, 0.85), strength=12, index=5),
+    add("plane", material("panel", "emission", color=(1.0, 0.95, 0.85), strength=30, index=5),
         loc=(-1.3, 1.0, 1.9), rot=(math.radians(-120), 0, math.radians(-30)), scale=(0.5, 0.3, 1))
-    world_constant(sc, (0.02, 0.02, 0.025))
+    world_constant(sc, (0.12, 0.12, 0.14))
     camera(sc, (0.3, -3.6, 1.5), (0, 0.2, 0.55), lens=32)
     return "glass monkey (subdivided), mirror, rough copper, checker floor, visible emissive panel", \
-        "world constant (0.02, 0.02, 0.025)"
+        "world constant (0.12, 0.12, 0.14)"
 
 
 def scene_sunsky_thin(sc):
@@ -219,16 +219,16 @@ def scene_sunsky_thin(sc):
         radius=0.4)
     add("torus", material("glass", "glass", rough=0.05, index=4), loc=(0.0, -0.4, 0.25),
         rot=(math.radians(70), 0, 0.3), major_radius=0.35, minor_radius=0.1)
-    # thin geometry: a fence of 4 mm wires and two rails
+    # thin geometry: a fence of 16 mm wires (< 1 px at 256x256) and two rails (24 and 10 mm)
     wm = material("wire", "metal", color=(0.6, 0.6, 0.62), rough=0.4, index=5)
     for i in range(21):
         x = -1.6 + 0.16 * i
-        wire((x, 1.3, 0), (x, 1.3, 1.1), 0.004, wm)
-    wire((-1.7, 1.3, 1.1), (1.7, 1.3, 1.1), 0.006, wm)
-    wire((-1.7, 1.3, 0.55), (1.7, 1.3, 0.55), 0.003, wm)
+        wire((x, 1.3, 0), (x, 1.3, 1.1), 0.008, wm)
+    wire((-1.7, 1.3, 1.1), (1.7, 1.3, 1.1), 0.012, wm)
+    wire((-1.7, 1.3, 0.55), (1.7, 1.3, 0.55), 0.005, wm)
     sky = world_sky(sc, 35, 140)
     camera(sc, (0.4, -3.8, 1.3), (0, 0.3, 0.5), lens=35)
-    return f"sky texture ({sky}) + sun lamp, rough aluminium/gold, glass torus, wire fence (3-6 mm), " \
+    return f"sky texture ({sky}) + sun lamp, rough aluminium/gold, glass torus, wire fence (10-24 mm wide, about 0.5-1 px), " \
         "fine procedural ground", "sky texture where nothing is hit"
 
 
@@ -273,9 +273,10 @@ def scene_textures_box(sc):
     add("sphere", material("steel", "metal", color=(0.75, 0.75, 0.78), rough=0.2, index=4), loc=(0.7, 0.0, 0.45),
         radius=0.45)
     wm = material("hair", "diffuse", color=(0.9, 0.85, 0.6), index=5)
-    for i in range(30):  # thin "grass" blades: 1.5 mm wires fanning out
+    for i in range(30):  # thin "grass" blades: 8 mm wires (about 0.6 px) fanning out in front
         a = -0.6 + 1.2 * i / 29
-        wire((0.0 + 0.02 * i, -0.8, 0), (0.02 * i + 0.5 * math.sin(a), -0.8 + 0.1 * math.cos(a), 0.7), 0.0015, wm)
+        wire((-0.3 + 0.02 * i, -1.0, 0), (-0.3 + 0.02 * i + 0.5 * math.sin(a), -1.0 + 0.1 * math.cos(a), 0.7),
+             0.004, wm)
     ld = bpy.data.lights.new("Key", "AREA")
     ld.energy = 300
     ld.size = 1.0
@@ -287,7 +288,7 @@ def scene_textures_box(sc):
     world_constant(sc, (0.05, 0.06, 0.08))
     camera(sc, (0.2, -3.4, 1.4), (0, 0.3, 0.5), lens=35)
     sc.cycles.pixel_filter_type = "BOX"
-    return "fine procedural textures (120x checker*noise floor, bricks, 40x checker cube), 1.5 mm blades, " \
+    return "fine procedural textures (120x checker*noise floor, bricks, 40x checker cube), 8 mm blades, " \
         "steel sphere, area lamp; BOX pixel filter", "world constant (0.05, 0.06, 0.08)"
 
 

@@ -54,12 +54,14 @@ def main():
             cmd += ["--scenes", a.scenes]
         t = time.time()
         print(f"[corpus] {r}: {' '.join(cmd)}", flush=True)
-        p = subprocess.run(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-        for line in p.stdout.splitlines():  # Blender prints a line per sample: keep ours and errors
-            if not line.startswith(("Fra:", "0", " ")) or "Error" in line or "rror" in line:
-                print(line, flush=True)
+        tail = []
+        with subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True) as p:
+            for line in p.stdout:  # Blender prints a line per sample: keep ours and errors
+                tail = (tail + [line])[-60:]
+                if not line.startswith(("Fra:", "0", " ")) or "rror" in line:
+                    print(line, end="", flush=True)
         if p.returncode != 0:
-            print(p.stdout[-4000:], file=sys.stderr)
+            print("".join(tail), file=sys.stderr)
             sys.exit(f"[corpus] {r} failed (exit {p.returncode})")
         print(f"[corpus] {r} done in {time.time() - t:.1f}s", flush=True)
     print(f"[corpus] {mode} corpus in {out} ({time.time() - t0:.1f}s)", flush=True)
