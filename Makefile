@@ -6,7 +6,7 @@ CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 # cmake --build runs make again: no "Entering/Leaving directory" lines from the nested makes.
 MAKEFLAGS += --no-print-directory
 
-.PHONY: setup setup-python configure build demo test python bench clean
+.PHONY: setup setup-python configure build demo test python bench gpu-pack clean
 
 setup:
 	@./scripts/setup.sh
@@ -34,6 +34,11 @@ python: setup-python
 
 bench: build
 	@./scripts/bench.sh $(BUILD)
+
+# The GPU check's pack (build-gpu/pack/: sm_90 binaries, their Debian libraries, OIDN), for a session
+# lent a GPU machine; then scripts/gpu-check.sh --dry-run prints the run invocation (docs/benchmarks.md, "GPU").
+gpu-pack:
+	@JOBS=$(JOBS) ./scripts/gpu-pack.sh
 
 clean:
 	rm -rf $(BUILD) $(BUILD).configure.log out

@@ -1,0 +1,162 @@
+#!/usr/bin/env bash
+# make gpu-pack: build, on this machine (no GPU needed), everything scripts/gpu-check.sh runs on a
+# lent GPU machine, and gather it into build-gpu/pack/ (ignored; the one folder a GPU session
+# carries). The GPU machine has the CUDA driver, nvcc, CMake and Python 3.12 but none of the
+# Debian libraries atrous links (Embree, TBB, OpenEXR, ...), so the pack holds:
+#   bin.tar.xz      atrous, the CUDA test binaries (tests/cuda/*_test.cu), bench_gpu_render, the
+#                   copy-bandwidth probe (scripts/gpu_bandwidth.cu), scenes/ (stripped; one solid
+#                   xz archive: the binaries share most of their bytes)
+#   debs/           the Debian packages of every shared library those binaries load that a bare
+#                   Debian/Ubuntu + CUDA image lacks (ldd + dpkg -S + apt-get download);
+#                   debs/fallback/ libstdc++6 and libgcc-s1, used only if the machine's are too old
+#   oidn.tar.gz     Intel Open Image Denoise from the pyoidn wheel, cut to what oidnBenchmark needs
+#                   for its CUDA device (core + CUDA + CPU devices, TBB): the OIDN comparison
+#   tests.txt       the GPU test binaries, one a line;  manifest.json  what is in it, sizes, commit
+# The build is of the committed tree (a `git archive HEAD` snapshot in build-gpu/src), not of the
+# working tree, so that the figures belong to a commit; GPU_PACK_SOURCE=worktree builds the working
+# tree instead. Compiled-in paths (the tests' ATROUS_CLI and ATROUS_SOURCE_DIR) go through
+# /tmp/atrous-gpu/{src,build}, symlinks that gpu-check.sh re-creates on the GPU machine.
+# Env: JOBS (default 2), GPU_PACK_SOURCE (head | worktree), GPU_PACK_OIDN=0 to leave OIDN out.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+ROOT=$PWD
+JOBS=${JOBS:-2}
+SOURCE=${GPU_PACK_SOURCE:-head}
+WITH_OIDN=${GPU_PACK_OIDN:-1}
+G=$ROOT/build-gpu
+CM=$G/cmake
+PACK=$G/pack
+LINK=/tmp/atrous-gpu
+LIMIT=$((64 * 1024 * 1024))
+# Packages of a bare Debian/Ubuntu image (with the CUDA driver): not carried.
+BASE_PKGS=" libc6 libgcc-s1 libstdc++6 zlib1g "
+say() { echo "gpu-pack: $*"; }
+
+command -v nvcc > /dev/null || { echo "gpu-pack: nvcc not found (the pack needs the CUDA backend)" >&2; exit 1; }
+mkdir -p "$G" "$CM" "$LINK"
+
+# ---- sources ----
+if [ "$SOURCE" = worktree ]; then
+  SRC=$ROOT
+  COMMIT="$(git rev-parse HEAD)+worktree"
+else
+  COMMIT=$(git rev-parse HEAD)
+  rm -rf "$G/src.new" && mkdir -p "$G/src.new"
+  git archive --format=tar HEAD | tar -x -C "$G/src.new"
+  python3 scripts/gpu_pack_tool.py sync "$G/src.new" "$G/src"
+  rm -rf "$G/src.new"
+  SRC=$G/src
+fi
+ln -sfn "$SRC" "$LINK/src"
+ln -sfn "$CM" "$LINK/build"
+say "sources: $SOURCE ($COMMIT)"
+
+# ---- configure + build (Release, SASS for sm_90 only, no viewer: the GPU machine has no GL) ----
+cmake -S "$LINK/src" -B "$LINK/build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CUDA_ARCHITECTURES=90 \
+  -DATROUS_BUILD_VIEWER=OFF -DATROUS_INSTALL=OFF -DATROUS_BUILD_PYTHON=OFF \
+  > "$G/configure.log" 2>&1 || { cat "$G/configure.log"; exit 1; }
+grep -q "CUDA backend ON" "$G/configure.log" || { echo "gpu-pack: CUDA backend is OFF (see $G/configure.log)" >&2; exit 1; }
+TESTS=()
+for f in "$SRC"/tests/cuda/*_test.cu; do TESTS+=("$(basename "$f" .cu)"); done
+say "building atrous, ${TESTS[*]}, bench_gpu_render (-j$JOBS; log in $G/build.log)"
+cmake --build "$LINK/build" -j "$JOBS" --target atrous "${TESTS[@]}" bench_gpu_render > "$G/build.log" 2>&1 \
+  || { tail -40 "$G/build.log"; exit 1; }
+nvcc -O2 -arch=sm_90 -o "$CM/gpu_bandwidth" "$ROOT/scripts/gpu_bandwidth.cu" > "$G/bandwidth-build.log" 2>&1 \
+  || { cat "$G/bandwidth-build.log"; exit 1; }
+
+# ---- stage the binaries (the paths below /tmp/atrous-gpu/build that the tests expect) ----
+rm -rf "$PACK" && mkdir -p "$PACK/debs/fallback" "$G/stage"
+ST=$G/stage
+rm -rf "$ST" && mkdir -p "$ST/tests" "$ST/bench" "$ST/src"
+cp "$CM/atrous" "$CM/gpu_bandwidth" "$ST/"
+cp "$CM/bench/bench_gpu_render" "$ST/bench/"
+for t in "${TESTS[@]}"; do cp "$CM/tests/$t" "$ST/tests/"; done
+cp -r "$SRC/scenes" "$ST/src/scenes"
+BINS=("$ST/atrous" "$ST/gpu_bandwidth" "$ST/bench/bench_gpu_render")
+for t in "${TESTS[@]}"; do BINS+=("$ST/tests/$t"); done
+strip --strip-unneeded "${BINS[@]}"
+printf '%s\n' "${TESTS[@]}" > "$PACK/tests.txt"
+python3 scripts/gpu_pack_tool.py fatbin-arch "${BINS[@]}" | sed "s#$ST/##" > "$PACK/fatbin.json"
+if grep -q '"sass": \[\]' "$PACK/fatbin.json" || [ "$(grep -c '"sm_90"' "$PACK/fatbin.json")" -ne "${#BINS[@]}" ]; then
+  echo "gpu-pack: a binary lacks sm_90 code:" >&2; cat "$PACK/fatbin.json" >&2; exit 1
+fi
+say "compressing the binaries (xz, solid)"
+tar -C "$ST" -cf - . | xz -T1 -6 > "$PACK/bin.tar.xz"
+
+# ---- Debian packages of the shared libraries ----
+declare -A PKG=()
+for b in "${BINS[@]}"; do
+  while read -r lib; do
+    p=""
+    for cand in "$lib" "$(readlink -f "$lib")" "/usr$lib" "$(readlink -f "/usr$lib" 2>/dev/null || true)"; do
+      [ -n "$cand" ] || continue
+      p=$(dpkg -S "$cand" 2>/dev/null | head -1 | cut -d: -f1) && [ -n "$p" ] && break
+    done
+    [ -n "$p" ] || { echo "gpu-pack: no Debian package owns $lib (needed by $b)" >&2; exit 1; }
+    PKG[$p]=1
+  done < <(ldd "$b" | awk '$2 == "=>" && $3 ~ /^\// {print $3}')
+done
+CARRY=()
+for p in "${!PKG[@]}"; do case "$BASE_PKGS" in *" $p "*) ;; *) CARRY+=("$p") ;; esac; done
+mkdir -p "$G/deb-cache"
+( cd "$G/deb-cache"
+  for p in "${CARRY[@]}" libstdc++6 libgcc-s1; do
+    ls "${p}"_*.deb > /dev/null 2>&1 || apt-get download "$p" > /dev/null 2>&1 \
+      || { echo "gpu-pack: apt-get download $p failed (apt-get update?)" >&2; exit 1; }
+  done )
+for p in "${CARRY[@]}"; do cp "$G/deb-cache/${p}"_*.deb "$PACK/debs/"; done
+for p in libstdc++6 libgcc-s1; do cp "$G/deb-cache/${p}"_*.deb "$PACK/debs/fallback/"; done
+say "debs: ${CARRY[*]} (+ fallback libstdc++6 libgcc-s1)"
+
+# ---- OIDN (from pyoidn's wheel: the .venv's copy, or a downloaded wheel) ----
+OIDN_NOTE="left out (GPU_PACK_OIDN=0)"
+if [ "$WITH_OIDN" = 1 ]; then
+  OD="" FROM=""
+  for d in "$ROOT"/.venv/lib/python3*/site-packages/pyoidn/oidn; do [ -x "$d/bin/oidnBenchmark" ] && OD=$d FROM=.venv; done
+  if [ -z "$OD" ]; then
+    mkdir -p "$G/whl"
+    ls "$G"/whl/pyoidn-*.whl > /dev/null 2>&1 || python3 -m pip download -q pyoidn --no-deps --only-binary=:all: \
+      --python-version 3.12 --platform manylinux2014_x86_64 -d "$G/whl" > "$G/whl/pip.log" 2>&1 || true
+    whl=$(ls "$G"/whl/pyoidn-*.whl 2>/dev/null | tail -1)
+    if [ -n "$whl" ]; then
+      rm -rf "$G/whl/x" && mkdir -p "$G/whl/x"
+      (cd "$G/whl/x" && python3 -m zipfile -e "$whl" .)
+      chmod +x "$G"/whl/x/pyoidn/oidn/bin/* 2>/dev/null || true
+      OD=$G/whl/x/pyoidn/oidn FROM=$(basename "$whl")
+    fi
+  fi
+  if [ -n "$OD" ]; then
+    rm -rf "$G/oidn-stage" && mkdir -p "$G/oidn-stage/oidn/bin" "$G/oidn-stage/oidn/lib"
+    cp "$OD/bin/oidnBenchmark" "$G/oidn-stage/oidn/bin/"
+    # Only what the CUDA (and, for the dry run, CPU) devices load; SYCL/HIP and their runtimes stay behind.
+    (cd "$OD/lib" && cp -L libOpenImageDenoise.so.2 libOpenImageDenoise_core.so.2.* libOpenImageDenoise_device_cuda.so.2.* \
+       libOpenImageDenoise_device_cpu.so.2.* libtbb.so.12 "$G/oidn-stage/oidn/lib/")
+    tar -C "$G/oidn-stage" -cf - oidn | gzip -6 > "$PACK/oidn.tar.gz"
+    OIDN_NOTE="OIDN $(ls "$OD"/lib/libOpenImageDenoise.so.2.* | sed 's/.*\.so\.//') (oidnBenchmark, core, CUDA + CPU devices, TBB) from pyoidn in $FROM"
+  else
+    OIDN_NOTE="pyoidn wheel not found (.venv or pip download): no OIDN comparison"
+  fi
+fi
+say "oidn: $OIDN_NOTE"
+
+# ---- manifest and size check ----
+GLIBC=$(for b in "${BINS[@]}"; do objdump -T "$b"; done | grep -o 'GLIBC_[0-9.]*' | sort -uV | tail -1)
+GLIBCXX=$(for b in "${BINS[@]}"; do objdump -T "$b"; done | grep -o 'GLIBCXX_[0-9.]*' | sort -uV | tail -1)
+TOTAL=$(du -sb "$PACK" | cut -f1)
+python3 - "$PACK" "$COMMIT" "$TOTAL" "$LIMIT" "$GLIBC" "$GLIBCXX" "$OIDN_NOTE" "$(nvcc --version | tail -1)" <<'EOF'
+import json, os, sys, datetime
+pack, commit, total, limit, glibc, glibcxx, oidn, nvcc = sys.argv[1:]
+files = {os.path.relpath(os.path.join(r, f), pack): os.path.getsize(os.path.join(r, f))
+         for r, _, fs in os.walk(pack) for f in fs}
+json.dump({"commit": commit, "built_utc": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+           "cuda_architectures": "90", "nvcc": nvcc, "needs": [glibc, glibcxx], "oidn": oidn,
+           "total_bytes": int(total), "limit_bytes": int(limit), "files": dict(sorted(files.items()))},
+          open(os.path.join(pack, "manifest.json"), "w"), indent=1)
+EOF
+TOTAL=$(du -sb "$PACK" | cut -f1)
+say "pack: $PACK, $((TOTAL / 1024)) KiB of the 65536 KiB carry limit (binaries need $GLIBC, $GLIBCXX)"
+if [ "$TOTAL" -gt "$LIMIT" ]; then
+  echo "gpu-pack: the pack is over 64 MiB; GPU_PACK_OIDN=0 leaves OIDN out" >&2
+  exit 1
+fi
+say "next: scripts/gpu-check.sh --dry-run (prints the run invocation for a GPU session)"
