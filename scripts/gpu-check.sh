@@ -100,7 +100,7 @@ setup() {
   rm -rf "$WORK" "$PREFIX" "$LINK/oidn" && mkdir -p "$WORK" "$PREFIX"
   if ! tar -xJf "$PACK/bin.tar.xz" -C "$WORK" 2> /dev/null; then
     echo "tar -xJ failed (no xz?): unpacking with Python's tarfile"
-    python3 -c 'import sys, tarfile; tarfile.open(sys.argv[1]).extractall(sys.argv[2])' "$PACK/bin.tar.xz" "$WORK" || return 1
+    $TOOL untar "$PACK/bin.tar.xz" "$WORK" || return 1
   fi
   ln -sfn "$WORK" "$LINK/build"
   ln -sfn "$WORK/src" "$LINK/src"

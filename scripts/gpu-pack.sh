@@ -99,13 +99,17 @@ done
 CARRY=()
 for p in "${!PKG[@]}"; do case "$BASE_PKGS" in *" $p "*) ;; *) CARRY+=("$p") ;; esac; done
 mkdir -p "$G/deb-cache"
+SUDO=""
+[ "$(id -u)" -ne 0 ] && SUDO="sudo"
 ( cd "$G/deb-cache"
   for p in "${CARRY[@]}" libstdc++6 libgcc-s1; do
-    ls "${p}"_*.deb > /dev/null 2>&1 || apt-get download "$p" > /dev/null 2>&1 \
-      || { echo "gpu-pack: apt-get download $p failed (apt-get update?)" >&2; exit 1; }
+    ls "${p}"_*.deb > /dev/null 2>&1 && continue
+    apt-get download "$p" > /dev/null 2>&1 || { $SUDO apt-get update -qq && apt-get download "$p" > /dev/null; } \
+      || { echo "gpu-pack: apt-get download $p failed" >&2; exit 1; }
   done )
-for p in "${CARRY[@]}"; do cp "$G/deb-cache/${p}"_*.deb "$PACK/debs/"; done
-for p in libstdc++6 libgcc-s1; do cp "$G/deb-cache/${p}"_*.deb "$PACK/debs/fallback/"; done
+newest() { ls "$G/deb-cache/${1}"_*.deb | sort -V | tail -1; }  # the cache may hold an older version too
+for p in "${CARRY[@]}"; do cp "$(newest "$p")" "$PACK/debs/"; done
+for p in libstdc++6 libgcc-s1; do cp "$(newest "$p")" "$PACK/debs/fallback/"; done
 say "debs: ${CARRY[*]} (+ fallback libstdc++6 libgcc-s1)"
 
 # ---- OIDN (from pyoidn's wheel: the .venv's copy, or a downloaded wheel) ----

@@ -7,6 +7,7 @@ has Python 3.12 and nothing installed for this project).
   fatbin-arch FILE...       the CUDA code each ELF file embeds, from its .nv_fatbin section
                             (cuobjdump --list-elf without the CUDA toolkit's cuobjdump): JSON
                             {file: {"sass": ["sm_90"], "ptx": [...]}}
+  untar ARCHIVE DIR         tar -x without the tar program's xz (Python's lzma)
   deb-extract DEB DIR       what `dpkg -x DEB DIR` does (ar archive, data.tar.{xz,gz,zst}) where dpkg
                             is missing; zst needs the zstd program
   gtest-count JSON...       tests / failures / skipped of --gtest_output=json files, one JSON line
@@ -21,6 +22,9 @@ import struct
 import subprocess
 import sys
 import tarfile
+
+# Our own archives: keep links and modes as they are (Python 3.14 filters by default).
+TRUSTED = {"filter": "fully_trusted"} if hasattr(tarfile, "fully_trusted_filter") else {}
 
 
 def sync(src, dst):
@@ -125,12 +129,17 @@ def deb_extract(deb, dest):
                     subprocess.run(["tar", "--zstd", "-xf", tmp, "-C", dest], check=True)
                 else:
                     with tarfile.open(tmp) as t:
-                        t.extractall(dest)
+                        t.extractall(dest, **TRUSTED)
             finally:
                 os.remove(tmp)
             return
         off += 60 + size + (size & 1)
     sys.exit(f"{deb}: no data.tar member")
+
+
+def untar(archive, dest):
+    with tarfile.open(archive) as t:
+        t.extractall(dest, **TRUSTED)
 
 
 def gtest_count(paths):
@@ -188,5 +197,5 @@ def summary(tsv, out):
 if __name__ == "__main__":
     cmd, args = sys.argv[1], sys.argv[2:]
     {"sync": lambda: sync(*args), "fatbin-arch": lambda: fatbin_arch(args),
-     "deb-extract": lambda: deb_extract(*args), "gtest-count": lambda: gtest_count(args),
+     "deb-extract": lambda: deb_extract(*args), "untar": lambda: untar(*args), "gtest-count": lambda: gtest_count(args),
      "oidn-json": lambda: oidn_json(args[0]), "summary": lambda: summary(*args)}[cmd]()
