@@ -124,8 +124,10 @@ def rough_metal(material, alpha):
 def sunsky(direction, sun_scale=1.0, sky_scale=1.0):
     d = np.array(direction, float)
     d /= np.linalg.norm(d)
+    # sunsky's sky dome is z-up in its local frame (measured: looking down -z sees 0); our world is
+    # y up, so rotate it. sun_direction stays in world coordinates (the sun is found there either way).
     return {"type": "sunsky", "sun_direction": list(d), "turbidity": 3.0, "albedo": 0.3,
-            "sun_scale": sun_scale, "sky_scale": sky_scale}
+            "sun_scale": sun_scale, "sky_scale": sky_scale, "to_world": T().rotate([1, 0, 0], -90)}
 
 
 # ---------------------------------------------------------------- scenes
@@ -217,7 +219,7 @@ def scene_roughmetal():
     o = {
         "floor": floor(4, {"type": "roughplastic", "diffuse_reflectance": tex, "alpha": 0.3}),
         "back": rect(T().translate([0, 2, -1.5]).scale([4, 2, 1]), diffuse(checker([0.5, 0.5, 0.5], [0.2, 0.2, 0.2], 16))),
-        "disk_light": {"type": "disk", "to_world": T().translate([1.6, 1.6, -1.2]).rotate([0, 1, 0], -40).scale(0.35),
+        "disk_light": {"type": "disk", "to_world": T().translate([0.9, 1.25, -1.0]).rotate([0, 1, 0], -30).scale(0.3),
                        "emitter": area([14, 12, 10])},
         "top_light": rect(T().translate([-0.5, 3.0, 1.0]).rotate([1, 0, 0], 90).scale([0.8, 0.5, 1]),
                           diffuse([0, 0, 0]), area([6, 6.5, 7])),

@@ -138,6 +138,9 @@ def run_methods(b, oidn, want):
     import atrous
     out = {"noisy": b["color"]}
     feats = {k: b.get(k) for k in ("albedo", "normal", "position", "depth", "ids", "emission")}
+    # Cycles' Denoising Albedo carries the emitter's radiance (30 on the visible panel): clip to
+    # [0, 1] as OIDN's wrapper does, so both denoisers get the same albedo.
+    feats["albedo"] = np.ascontiguousarray(np.clip(feats["albedo"], 0.0, 1.0))
     times = {}
     if oidn is not None and "oidn" in want:
         t = time.perf_counter()
