@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The one script a session lent a GPU machine runs there (docs/benchmarks.md, "GPU"), on the pack
 # that `make gpu-pack` built here (build-gpu/pack/, carried to the machine):
-#   setup      unpack the binaries and the Debian libraries (dpkg -x into /tmp/atrous-gpu/prefix,
+#   setup      unpack the binaries and the Debian libraries (dpkg -x into build-gpu/run/prefix,
 #              LD_LIBRARY_PATH), re-create the /tmp/atrous-gpu/{src,build} paths compiled into the tests
 #   info       nvidia-smi;  bandwidth  measured D2D copy bandwidth (gpu_bandwidth) against the peak
 #   tests      every CUDA test binary (tests/cuda/*_test.cu; GoogleTest JSON per binary)
@@ -48,9 +48,13 @@ done
 case $PACK in /*) ;; *) PACK=$ROOT/$PACK ;; esac
 mkdir -p "$OUTDIR" && OUTDIR=$(cd "$OUTDIR" && pwd)
 LINK=/tmp/atrous-gpu
-WORK=$LINK/run          # the binaries; $LINK/build points here (the tests' ATROUS_CLI path)
-PREFIX=$LINK/prefix     # the unpacked Debian libraries
-SCRATCH=$LINK/scratch   # renders for the sanitizer steps
+# Unpacked under the repository's ignored build-gpu/ (not /tmp, which may be mounted noexec);
+# /tmp/atrous-gpu holds only the symlinks whose paths are compiled into the tests.
+RUN=$ROOT/build-gpu/run
+WORK=$RUN/bin           # the binaries; $LINK/build points here (the tests' ATROUS_CLI path)
+PREFIX=$RUN/prefix      # the unpacked Debian libraries
+OIDN=$RUN/oidn          # oidnBenchmark and its libraries
+SCRATCH=$RUN/scratch    # renders for the sanitizer steps
 LOGS=$OUTDIR/logs
 STEPS=$OUTDIR/steps.tsv
 rm -rf "$LOGS" "$OUTDIR/tests" "$OUTDIR/bench" "$OUTDIR/oidn" "$STEPS" "$OUTDIR/summary.json"
@@ -61,7 +65,7 @@ DEADLINE=$((START + BUDGET))
 SIZES="512x512 1280x720 1920x1080 3840x2160"
 TOOL="python3 $ROOT/scripts/gpu_pack_tool.py"
 if [ "$DRY" = 1 ]; then DEV=cpu; else DEV=cuda; fi
-export ROOT DRY PACK OUTDIR LINK WORK PREFIX SCRATCH LOGS DEV TOOL
+export ROOT DRY PACK OUTDIR LINK WORK PREFIX OIDN SCRATCH LOGS DEV TOOL
 say() { echo "gpu-check: $*"; }
 wants() { [ -z "$ONLY" ] || case ",$ONLY," in *",$1,"*) true ;; *) false ;; esac; }
 
@@ -97,13 +101,13 @@ setup() {
   [ -d "$PACK" ] || { echo "no pack at $PACK: run 'make gpu-pack' on the build machine and carry build-gpu/pack"; return 1; }
   for f in bin.tar.xz tests.txt manifest.json; do [ -f "$PACK/$f" ] || { echo "missing $PACK/$f"; bad=1; }; done
   [ "$bad" = 0 ] || return 1
-  rm -rf "$WORK" "$PREFIX" "$LINK/oidn" && mkdir -p "$WORK" "$PREFIX"
+  rm -rf "$RUN" && mkdir -p "$WORK" "$PREFIX" "$LINK" || return 1
   if ! tar -xJf "$PACK/bin.tar.xz" -C "$WORK" 2> /dev/null; then
     echo "tar -xJ failed (no xz?): unpacking with Python's tarfile"
     $TOOL untar "$PACK/bin.tar.xz" "$WORK" || return 1
   fi
-  ln -sfn "$WORK" "$LINK/build"
-  ln -sfn "$WORK/src" "$LINK/src"
+  rm -rf "$LINK/build" "$LINK/src"  # symlinks (rm does not follow them), or left-overs
+  ln -s "$WORK" "$LINK/build" && ln -s "$WORK/src" "$LINK/src" || return 1
   for d in "$PACK"/debs/*.deb; do
     if command -v dpkg > /dev/null; then dpkg -x "$d" "$PREFIX" || return 1
     else $TOOL deb-extract "$d" "$PREFIX" || return 1; fi
@@ -130,7 +134,7 @@ setup() {
     fi
   done
   if [ -f "$PACK/oidn.tar.gz" ]; then
-    tar -xzf "$PACK/oidn.tar.gz" -C "$LINK" || bad=1
+    tar -xzf "$PACK/oidn.tar.gz" -C "$RUN" || bad=1
   fi
   cp "$PACK/manifest.json" "$OUTDIR/manifest.json"
   echo "LD_LIBRARY_PATH=$LD_LIBRARY_PATH"
@@ -247,7 +251,7 @@ bench_render() {
 oidn() {  # WxH
   local w=${1%x*} h=${1#*x} dev=cuda n=20
   [ "$DRY" = 1 ] && { dev=cpu; w=64; h=64; n=1; }
-  LD_LIBRARY_PATH="$LINK/oidn/lib" "$LINK/oidn/bin/oidnBenchmark" -d $dev -r "RT.hdr_alb_nrm.${w}x${h}" -s "$w" "$h" -n $n -q high -v 1 \
+  LD_LIBRARY_PATH="$OIDN/lib" "$OIDN/bin/oidnBenchmark" -d $dev -r "RT.hdr_alb_nrm.${w}x${h}" -s "$w" "$h" -n $n -q high -v 1 \
     > "$LOGS/oidn-$1.out" 2>&1
   local rc=$?
   cat "$LOGS/oidn-$1.out"
@@ -255,7 +259,7 @@ oidn() {  # WxH
   $TOOL oidn-json "$LOGS/oidn-$1.out" > "$OUTDIR/oidn/oidn_${dev}_$1.json"
   grep -q msec_per_image "$OUTDIR/oidn/oidn_${dev}_$1.json" || { echo "no timing line in oidnBenchmark's output"; return 1; }
   if [ "$DRY" = 1 ]; then  # the CUDA device needs the driver: without one, a clean error
-    LD_LIBRARY_PATH="$LINK/oidn/lib" "$LINK/oidn/bin/oidnBenchmark" -d cuda -r RT.hdr_alb_nrm.64x64 -s 64 64 -n 1 2>&1 | tail -1
+    LD_LIBRARY_PATH="$OIDN/lib" "$OIDN/bin/oidnBenchmark" -d cuda -r RT.hdr_alb_nrm.64x64 -s 64 64 -n 1 2>&1 | tail -1
   fi
   return 0
 }
@@ -310,7 +314,7 @@ if [ -x "$WORK/atrous" ]; then
     step bench-gpu-render 60 bench_render
   fi
   if wants oidn; then
-    if [ ! -x "$LINK/oidn/bin/oidnBenchmark" ]; then record oidn skipped "" 0 "" "no oidn.tar.gz in the pack"
+    if [ ! -x "$OIDN/bin/oidnBenchmark" ]; then record oidn skipped "" 0 "" "no oidn.tar.gz in the pack"
     elif [ "$DRY" = 1 ]; then step oidn-dry 60 oidn 64x64
     else for s in $SIZES; do step "oidn-$s" 60 oidn "$s"; done; fi
   fi

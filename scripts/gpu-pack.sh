@@ -47,8 +47,12 @@ else
   rm -rf "$G/src.new"
   SRC=$G/src
 fi
-ln -sfn "$SRC" "$LINK/src"
-ln -sfn "$CM" "$LINK/build"
+for l in src build; do  # symlinks from an earlier pack or dry run (rm does not follow them)
+  if [ -e "$LINK/$l" ] && [ ! -L "$LINK/$l" ]; then echo "gpu-pack: $LINK/$l is not a symlink: remove it" >&2; exit 1; fi
+  rm -f "$LINK/$l"
+done
+ln -s "$SRC" "$LINK/src"
+ln -s "$CM" "$LINK/build"
 say "sources: $SOURCE ($COMMIT)"
 
 # ---- configure + build (Release, SASS for sm_90 only, no viewer: the GPU machine has no GL) ----
