@@ -7,10 +7,10 @@
 #   tests      every CUDA test binary (tests/cuda/*_test.cu; GoogleTest JSON per binary)
 #   bench      atrous bench --device cuda --json (render, EAW, SURE, SVGF) at 512x512, 1280x720,
 #              1920x1080, 3840x2160, one call per size; bench_gpu_render at 1920x1080
-#   oidn       oidnBenchmark on OIDN's CUDA device (RT filter, hdr + albedo + normal, quality high)
-#              at the same four sizes (a CNN: its time does not depend on the pixels)
 #   sanitizer  compute-sanitizer memcheck on a CUDA render (built-in and OBJ scenes), CUDA EAW, SURE
 #              and SVGF denoises; racecheck on the SURE and SVGF denoises
+#   oidn       oidnBenchmark on OIDN's CUDA device (RT filter, hdr + albedo + normal, quality high)
+#              at the same four sizes (a CNN: its time does not depend on the pixels)
 # Each command runs under `timeout`, within a total budget (default 420 s), and the script goes on
 # past a failed step. Everything lands in $OUT (or --out): summary.json (each step's status, rc,
 # seconds, log), bandwidth.json, tests/*.json, bench/*.json, oidn/*.json, logs/*.log, manifest.json.
@@ -243,7 +243,7 @@ bench_size() {  # WxH
     && python3 -m json.tool "$OUTDIR/bench/atrous_bench_cuda_$1.json" > /dev/null
 }
 bench_render() {
-  local args=(--scene cornell --width 1920 --height 1080 --spp 1 --runs 10)
+  local args=(--scene cornell --width 1920 --height 1080 --spp 1 --runs 5)
   [ "$DRY" = 1 ] && args=(--scene cornell --width 64 --height 64 --spp 1 --runs 1)
   "$WORK/bench/bench_gpu_render" "${args[@]}" > "$OUTDIR/bench/bench_gpu_render.json" \
     && python3 -m json.tool "$OUTDIR/bench/bench_gpu_render.json"
@@ -313,16 +313,16 @@ if [ -x "$WORK/atrous" ]; then
     else for s in $SIZES; do step "bench-$s" 120 bench_size "$s"; done; fi
     step bench-gpu-render 60 bench_render
   fi
-  if wants oidn; then
-    if [ ! -x "$OIDN/bin/oidnBenchmark" ]; then record oidn skipped "" 0 "" "no oidn.tar.gz in the pack"
-    elif [ "$DRY" = 1 ]; then step oidn-dry 60 oidn 64x64
-    else for s in $SIZES; do step "oidn-$s" 60 oidn "$s"; done; fi
-  fi
   if wants sanitizer; then
     if step sanitizer-inputs 60 sanitize_prep; then
       for w in render render-obj eaw sure svgf; do step "memcheck-$w" 90 sanitize memcheck "$w"; done
       for w in sure svgf; do step "racecheck-$w" 90 sanitize racecheck "$w"; done
     fi
+  fi
+  if wants oidn; then
+    if [ ! -x "$OIDN/bin/oidnBenchmark" ]; then record oidn skipped "" 0 "" "no oidn.tar.gz in the pack"
+    elif [ "$DRY" = 1 ]; then step oidn-dry 60 oidn 64x64
+    else for s in $SIZES; do step "oidn-$s" 60 oidn "$s"; done; fi
   fi
 fi
 $TOOL summary "$STEPS" "$OUTDIR/summary.json" > "$LOGS/summary.out" 2>&1
