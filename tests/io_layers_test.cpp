@@ -187,6 +187,18 @@ TEST(ExrLayers, CopyWithAnAddedPassKeepsEveryPart) {
     }
 }
 
+TEST(ExrLayers, ReadImageTakesTheColourPassOfALayeredFile) {
+    // `atrous compare --ref blender.exr` and every other reader of a plain image go through readImage.
+    TempDir dir;
+    BlenderLike b;
+    writeLayeredExr(dir / "blender.exr", b.layers("ViewLayer"), true);
+    const Image c = readImage(dir / "blender.exr");
+    EXPECT_FLOAT_EQ(c(2, 3, 2), b.combined(2, 3, 2));
+    const Image albedo = constant(4, 4, 3, 0.5f);
+    writeLayeredExr(dir / "nocolor.exr", {{"albedo", &albedo}, {"nn", &albedo}}, false);
+    EXPECT_THROW(readImage(dir / "nocolor.exr"), InputError);
+}
+
 TEST(ExrLayers, NotAnExrAndUnusableFiles) {
     TempDir dir;
     {

@@ -325,7 +325,10 @@ void addDenoiseCommand(CLI::App& app) {
     cmd->add_flag("--no-firefly", a->noFirefly, "Disable firefly suppression")->group(kGroupEawSure);
     cmd->add_option("--firefly-k", a->opt.firefly.k, "Firefly bound: k local standard deviations")->capture_default_str()->group(kGroupEawSure);
     cmd->add_flag("--no-demodulate", a->noDemodulate, "Do not divide by the albedo")->group(kGroupEawSure);
-    cmd->add_option("--albedo-epsilon", a->opt.albedoEpsilon, "Demodulation floor")->capture_default_str()->group(kGroupEawSure);
+    cmd->add_option("--albedo-epsilon", a->opt.albedoEpsilon, "Smallest albedo divided by")->capture_default_str()->group(kGroupEawSure);
+    cmd->add_option("--albedo-floor", a->opt.albedoFloor,
+                    "Demodulation fades out where the largest albedo channel is below this (black albedo on glass, "
+                    "mirrors, lights; 0 = off)")->capture_default_str()->group(kGroupEawSure);
     addSvgfOptions(*cmd, a->svgf);
     cmd->callback([a, cmd] { run(*a, *cmd); });
 }

@@ -98,6 +98,10 @@ struct DenoiseOptions {
     // variance / max(albedo, ε)², then multiply the result by max(albedo, ε).
     bool demodulate = true;
     float albedoEpsilon = 1e-3f;  // > 0
+    // Where a pixel's largest albedo channel m is below this, demodulation fades out: the divisor
+    // is 1 + t (max(a, ε) - 1) with t = min(m / albedoFloor, 1)² (0 = off: max(a, ε) everywhere).
+    // Other renderers' albedo is 0 on glass, mirrors, emitters and the sky (docs/algorithms.md).
+    float albedoFloor = 0.1f;  // [0, 1]
     DenoiseReport* report = nullptr;  // optional: filled with what the run did
 };
 

@@ -163,7 +163,8 @@ def denoise(
     params: the filter parameters, named as the CLI flags with '_' for '-': levels, sigma_color,
     color_scale, color_level_factor, sigma_normal, normal_step_scale, sigma_position,
     position_scale, sigma_depth, use_ids, sure_mode ("discrete" | "james-stein"), sure_candidates,
-    sure_window, sure_first_level, correlated_variance, emission_levels, emission_scale, firefly, firefly_k, demodulate, albedo_epsilon
+    sure_window, sure_first_level, correlated_variance, emission_levels, emission_scale, firefly, firefly_k, demodulate, albedo_epsilon,
+    albedo_floor
     (docs/denoising.md gives their meaning and defaults).
 
     Returns the denoised H x W x 3 float32 image as the same kind of array as `color`.

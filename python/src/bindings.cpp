@@ -135,6 +135,7 @@ void applyDenoiseParam(DenoiseOptions& o, const std::string& k, const nb::handle
     else if (k == "no_demodulate") o.demodulate = !as<bool>(v, k);
     else if (k == "no_correlated_variance") o.sure.correlatedVariance = !as<bool>(v, k);
     else if (k == "albedo_epsilon") o.albedoEpsilon = as<float>(v, k);
+    else if (k == "albedo_floor") o.albedoFloor = as<float>(v, k);
     else throw InputError("unknown denoise parameter '" + k + "'");
 }
 

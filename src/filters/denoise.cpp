@@ -50,6 +50,7 @@ void validateDenoiseOptions(const DenoiseOptions& o) {
     for (float c : s.candidates) requireRange(std::isfinite(c) && c >= 0 && c <= 1, "sure-candidates must be in [0, 1]");
     requireRange(std::isfinite(o.firefly.k) && o.firefly.k > 0, "firefly-k must be > 0");
     requireRange(std::isfinite(o.albedoEpsilon) && o.albedoEpsilon > 0, "albedo-epsilon must be > 0");
+    requireRange(std::isfinite(o.albedoFloor) && o.albedoFloor >= 0 && o.albedoFloor <= 1, "albedo-floor must be in [0, 1]");
 }
 
 namespace filters {
@@ -175,6 +176,7 @@ DriverConfig makeConfig(const DenoiseOptions& o) {
     cfg.firefly = o.firefly;
     cfg.demodulate = o.demodulate;
     cfg.albedoEpsilon = o.albedoEpsilon;
+    cfg.albedoFloor = o.albedoFloor;
     return cfg;
 }
 

@@ -41,6 +41,7 @@ struct DriverConfig {
     FireflyParams firefly;
     bool demodulate = true;
     float albedoEpsilon = 1e-3f;
+    float albedoFloor = 0.0f;
     bool varianceGiven = true;  // false: the variance is a constant estimate
 };
 
@@ -136,7 +137,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     Image albedoStore;
     if (albedo.valid()) {
         albedo = sanitizedFeature(exec, albedo, w, h, 3, albedoStore);
-        exec.forEachPixel(w, h, Demodulate{cfg.albedoEpsilon, albedo, cA.view(), vA.view()});
+        exec.forEachPixel(w, h, Demodulate{cfg.albedoEpsilon, cfg.albedoFloor, albedo, cA.view(), vA.view()});
     }
     markStage(out.clock, "demodulate");
 
@@ -224,7 +225,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     }
 
     // 6. out = (c_N + Σ s_i d_i) · albedo.
-    exec.forEachPixel(w, h, Recombine{cfg.albedoEpsilon, cur->view(), sure ? acc.view() : ImageView{}, albedo,
+    exec.forEachPixel(w, h, Recombine{cfg.albedoEpsilon, cfg.albedoFloor, cur->view(), sure ? acc.view() : ImageView{}, albedo,
                                       emission, out.out});
     markStage(out.clock, "remodulate");
     exec.synchronize();

@@ -72,4 +72,19 @@ ATROUS_INLINE float sq(float v) { return v * v; }
 ATROUS_INLINE float maxSel(float a, float b) { return a > b ? a : b; }
 ATROUS_INLINE float minSel(float a, float b) { return a < b ? a : b; }
 
+// The albedo that demodulation divides by and remodulation multiplies by (docs/algorithms.md,
+// "Albedo demodulation"), per channel: max(a_c, eps) on surfaces with an albedo, blended toward 1
+// (no demodulation) where the pixel's largest channel m is below `floor`:
+//   a'_c = 1 + t (max(a_c, eps) - 1),  t = min(m / floor, 1)^2.
+// Other renderers write albedo 0 on glass, mirrors, emitters and the sky; dividing there by ~eps
+// multiplied the noise by 1000 and the filter spread it into the rims ("dotted bright rims").
+// The same a'_c on both sides keeps the pair an exact inverse. floor = 0: the plain max(a_c, eps).
+constexpr float kDefaultAlbedoFloor = 0.1f;  // DenoiseOptions::albedoFloor's default; SVGF's value
+ATROUS_INLINE float modulationTerm(float m, float floor) {
+    const float t = floor > 0.0f ? minSel(m / floor, 1.0f) : 1.0f;
+    return finite(t) && t > 0.0f ? t * t : 0.0f;
+}
+ATROUS_INLINE float modulationAlbedo(float a, float t, float eps) { return 1.0f + t * (maxSel(a, eps) - 1.0f); }
+ATROUS_INLINE float maxChannel(float a, float b, float c) { return maxSel(maxSel(a, b), c); }
+
 }  // namespace atrous::filters

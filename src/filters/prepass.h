@@ -105,6 +105,15 @@ struct Copy3 {
 // variance this test is off (ownVariance = 0).
 constexpr float kFireflyOwnStd = 0.5f;  // see FireflyClamp
 
+// Variance of a pixel's luminance from its per-channel variances, taking the channels' noise as
+// fully correlated (Monte Carlo noise is: every sample's path carries all three): σ_L = Σ w_c σ_c.
+// (Σ w_c² v_c, the independent-channel form, understated a white firefly's σ_L by a quarter, so
+// that the own-variance test below kept it as a highlight.)
+ATROUS_INLINE float lumVariance(float vr, float vg, float vb) {
+    const float s = lum(sqrtf(maxSel(vr, 0.0f)), sqrtf(maxSel(vg, 0.0f)), sqrtf(maxSel(vb, 0.0f)));
+    return s * s;
+}
+
 struct FireflyClamp {
     float k = 4.0f;
     int ownVariance = 1;
@@ -119,7 +128,7 @@ struct FireflyClamp {
                 if (dx == 0 && dy == 0) continue;
                 const int xx = clampIdx(x + dx, w - 1), yy = clampIdx(y + dy, h - 1);
                 l[n] = lum(cIn(xx, yy, 0), cIn(xx, yy, 1), cIn(xx, yy, 2));
-                lv[n] = lum(lum(1, 0, 0) * vIn(xx, yy, 0), lum(0, 1, 0) * vIn(xx, yy, 1), lum(0, 0, 1) * vIn(xx, yy, 2));
+                lv[n] = lumVariance(vIn(xx, yy, 0), vIn(xx, yy, 1), vIn(xx, yy, 2));
                 ++n;
             }
         const float clamped = apply(x, y, l, lv);
@@ -151,7 +160,7 @@ struct FireflyClamp {
         const float s2 = maxSel(m2 / 7.0f - m * m, 0.0f);
         const float bound = maxSel(m, 0.0f) + k * sqrtf(s2 + maxSel(vm, 0.0f));
         const float L = lum(cIn(x, y, 0), cIn(x, y, 1), cIn(x, y, 2));
-        const float ownStd = sqrtf(lum(lum(1, 0, 0) * vIn(x, y, 0), lum(0, 1, 0) * vIn(x, y, 1), lum(0, 0, 1) * vIn(x, y, 2)));
+        const float ownStd = sqrtf(lumVariance(vIn(x, y, 0), vIn(x, y, 1), vIn(x, y, 2)));
         // Bitwise & and | on the tests (not && and ||): no branches in the vectorised x loop.
         const bool noisy = (ownVariance == 0) | (ownStd > kFireflyOwnStd * (L - m));
         const bool clamp = (L > bound) & (L > 0.0f) & noisy;
@@ -173,13 +182,14 @@ void runFireflyClamp(const Exec& exec, const FireflyClamp& f) {
 }
 void runFireflyClamp(const CpuExec& exec, const FireflyClamp& f);
 
-// c / max(albedo, ε), var / max(albedo, ε)² (in place).
+// c / a', var / a'² (in place), a' = modulationAlbedo (filter_math.h).
 struct Demodulate {
-    float eps;
+    float eps, floor;
     ImageView albedo, color, var;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        const float t = modulationTerm(maxChannel(albedo(x, y, 0), albedo(x, y, 1), albedo(x, y, 2)), floor);
         for (int c = 0; c < 3; ++c) {
-            const float a = maxSel(albedo(x, y, c), eps);
+            const float a = modulationAlbedo(albedo(x, y, c), t, eps);
             const float ia = 1.0f / a;
             color(x, y, c) *= ia;
             var(x, y, c) *= ia * ia;
@@ -293,15 +303,16 @@ struct SubtractEmission {
     }
 };
 
-// out = (c_N + Σ s_i d_i) · max(albedo, ε) + emission (albedo/emission invalid: skipped).
+// out = (c_N + Σ s_i d_i) · a' + emission (a' as in Demodulate; albedo/emission invalid: skipped).
 struct Recombine {
-    float eps;
+    float eps, floor;
     ImageView cN, detailSum, albedo, emission, out;  // detailSum may be invalid (EAW)
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        const float t = albedo.valid() ? modulationTerm(maxChannel(albedo(x, y, 0), albedo(x, y, 1), albedo(x, y, 2)), floor) : 0.0f;
         for (int c = 0; c < 3; ++c) {
             float v = cN(x, y, c);
             if (detailSum.valid()) v += detailSum(x, y, c);
-            if (albedo.valid()) v *= maxSel(albedo(x, y, c), eps);
+            if (albedo.valid()) v *= modulationAlbedo(albedo(x, y, c), t, eps);
             if (emission.valid()) v += emission(x, y, c);
             out(x, y, c) = v;
         }

@@ -14,7 +14,7 @@ constexpr float kBackgroundDepth = 1e29f;
 constexpr float kBackgroundDepthValue = 1e30f;
 // Motion at least this large (or non-finite) cannot be reprojected: the pixel's history resets.
 constexpr float kMaxMotion = 1e5f;
-// Demodulation divides by max(albedo, kMinAlbedo); remodulation multiplies by the same value so
+// Demodulation divides by modulationAlbedo (max(albedo, kMinAlbedo) on surfaces); remodulation multiplies by the same value so
 // the pair is an identity wherever the filter leaves a pixel alone.
 constexpr float kMinAlbedo = 1e-3f;
 // Illumination magnitudes are clamped here so the second moment (l^2) stays finite in float.
@@ -33,11 +33,14 @@ ATROUS_INLINE void writeVec3(const ImageView& v, int x, int y, Vec3 c) {
 }
 
 // Albedo used for (de)modulation: missing -> 1, non-finite -> 1, else max(a, kMinAlbedo).
+// Blended toward 1 where the albedo is near black, as EAW/SURE do (filters::modulationAlbedo).
 ATROUS_INLINE Vec3 modulationAlbedo(const ImageView& albedo, int x, int y) {
     if (!albedo.valid()) return Vec3(1.0f);
     Vec3 a = readVec3(albedo, x, y);
-    return Vec3(maxf(finiteOr(a.x, 1.0f), kMinAlbedo), maxf(finiteOr(a.y, 1.0f), kMinAlbedo),
-                maxf(finiteOr(a.z, 1.0f), kMinAlbedo));
+    a = Vec3(finiteOr(a.x, 1.0f), finiteOr(a.y, 1.0f), finiteOr(a.z, 1.0f));
+    const float t = filters::modulationTerm(filters::maxChannel(a.x, a.y, a.z), filters::kDefaultAlbedoFloor);
+    return Vec3(filters::modulationAlbedo(a.x, t, kMinAlbedo), filters::modulationAlbedo(a.y, t, kMinAlbedo),
+                filters::modulationAlbedo(a.z, t, kMinAlbedo));
 }
 
 // Emission to subtract/add back: missing or non-finite -> 0.

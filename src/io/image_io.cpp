@@ -21,6 +21,8 @@
 
 #include "atrous/error.h"
 #include "core/srgb.h"
+#include "io/exr_layers.h"
+#include "io/pass_map.h"
 
 namespace fs = std::filesystem;
 
@@ -60,6 +62,14 @@ static Image readExr(const std::string& path) {
             src[0] = src[1] = src[2] = "Y";
         } else if (names.size() == 1) {
             src[0] = src[1] = src[2] = names[0];
+        } else if (names.size() > 1) {
+            // A layered file (Blender's multilayer, Mitsuba's aov): its colour pass (pass_map.h).
+            const ExrInfo info = inspectExr(path);
+            const PassMap m = mapPasses(info, {}, "");
+            if (m[Buffer::Color].found()) return readPass(info, m[Buffer::Color], Buffer::Color);
+            std::string list;
+            for (auto& n : names) list += (list.empty() ? "" : ",") + n;
+            throw InputError(path + ": expected R,G,B (or Y, or a single) channels or a colour pass, found " + list);
         } else {
             std::string list;
             for (auto& n : names) list += (list.empty() ? "" : ",") + n;
