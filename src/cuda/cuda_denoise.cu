@@ -215,6 +215,7 @@ Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const Prepar
     Timer t;
     DriverConfig cfg = makeConfig(o);
     cfg.varianceGiven = in.variance != nullptr;
+    setNoiseEstimate(cfg, rep);
     if (clock) clock->start();
     runDenoise(CudaExec{}, di, cfg, dout);  // ends with a stream synchronisation
     rep.milliseconds = t.ms();

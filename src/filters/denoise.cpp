@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -29,27 +30,33 @@ static void requireRange(bool ok, const std::string& what) {
     if (!ok) throw InputError("parameter out of range: " + what);
 }
 
+// Smallest non-zero σ, scale or ε: their inverse squares (1e12) stay finite; at 1e-20 the whole
+// output was NaN (docs/reliability.md).
+constexpr float kMinFilterParameter = 1e-6f;
+static bool offOrAtLeastMin(float v) { return std::isfinite(v) && (v == 0.0f || v >= kMinFilterParameter); }
+static bool atLeastMin(float v) { return std::isfinite(v) && v >= kMinFilterParameter; }
+
 void validateDenoiseOptions(const DenoiseOptions& o) {
     const EawParams& e = o.eaw;
     requireRange(e.levels >= 1 && e.levels <= filters::kMaxLevels, "levels must be in 1..10");
-    requireRange(std::isfinite(e.sigmaColor) && e.sigmaColor >= 0, "sigma-color must be >= 0 (0 = automatic)");
-    requireRange(std::isfinite(e.colorScale) && e.colorScale > 0, "color-scale must be > 0");
+    requireRange(offOrAtLeastMin(e.sigmaColor), "sigma-color must be 0 (automatic) or >= 1e-6");
+    requireRange(atLeastMin(e.colorScale), "color-scale must be >= 1e-6");
     requireRange(std::isfinite(e.colorLevelFactor) && e.colorLevelFactor > 0 && e.colorLevelFactor <= 1,
                  "color-level-factor must be in (0, 1]");
-    requireRange(std::isfinite(e.sigmaNormal) && e.sigmaNormal >= 0, "sigma-normal must be >= 0 (0 = off)");
-    requireRange(std::isfinite(e.sigmaPosition) && e.sigmaPosition >= 0, "sigma-position must be >= 0 (0 = automatic)");
-    requireRange(std::isfinite(e.positionScale) && e.positionScale > 0, "position-scale must be > 0");
-    requireRange(std::isfinite(e.sigmaDepth) && e.sigmaDepth >= 0, "sigma-depth must be >= 0 (0 = off)");
+    requireRange(offOrAtLeastMin(e.sigmaNormal), "sigma-normal must be 0 (off) or >= 1e-6");
+    requireRange(offOrAtLeastMin(e.sigmaPosition), "sigma-position must be 0 (automatic) or >= 1e-6");
+    requireRange(atLeastMin(e.positionScale), "position-scale must be >= 1e-6");
+    requireRange(offOrAtLeastMin(e.sigmaDepth), "sigma-depth must be 0 (off) or >= 1e-6");
     const SureParams& s = o.sure;
     requireRange(s.windowRadius >= 1 && s.windowRadius <= 10, "sure-window must be in 1..10");
     requireRange(s.firstLevel >= 0 && s.firstLevel <= 16, "sure-first-level must be in 0..16");
     requireRange(o.eaw.emissionLevels >= 0 && o.eaw.emissionLevels <= 10, "emission-levels must be in 0..10");
-    requireRange(std::isfinite(o.eaw.emissionScale) && o.eaw.emissionScale > 0, "emission-scale must be > 0");
+    requireRange(atLeastMin(o.eaw.emissionScale), "emission-scale must be >= 1e-6");
     requireRange(!s.candidates.empty() && int(s.candidates.size()) <= filters::kMaxSureCandidates,
                  "sure-candidates must list 1..8 values");
     for (float c : s.candidates) requireRange(std::isfinite(c) && c >= 0 && c <= 1, "sure-candidates must be in [0, 1]");
-    requireRange(std::isfinite(o.firefly.k) && o.firefly.k > 0, "firefly-k must be > 0");
-    requireRange(std::isfinite(o.albedoEpsilon) && o.albedoEpsilon > 0, "albedo-epsilon must be > 0");
+    requireRange(atLeastMin(o.firefly.k), "firefly-k must be >= 1e-6");
+    requireRange(atLeastMin(o.albedoEpsilon), "albedo-epsilon must be >= 1e-6");
     requireRange(std::isfinite(o.albedoFloor) && o.albedoFloor >= 0 && o.albedoFloor <= 1, "albedo-floor must be in [0, 1]");
 }
 
@@ -103,6 +110,20 @@ static void checkBuffer(const Image* img, const Image& color, const char* name) 
     if (img->channels() < 3) throw InputError(std::string(name) + " buffer needs 3 channels");
 }
 
+// The largest finite colour magnitude and variance the filters take (docs/reliability.md): squares
+// and sums of colours, and variances times the weights, stay finite in float. Beyond them a value
+// is not a measurement (3e38 made the whole output NaN): an error, as a negative variance is.
+constexpr float kMaxInputColor = 1e15f;
+constexpr float kMaxInputVariance = 1e30f;
+
+InputError outOfRangeError(const char* buffer, float value, float limit, size_t pixel, int width) {
+    char v[32], l[32];
+    std::snprintf(v, sizeof v, "%g", double(value));
+    std::snprintf(l, sizeof l, "%g", double(limit));
+    return InputError(std::string(buffer) + " buffer has a value of magnitude " + v + " (above " + l + ") at pixel (" +
+                      std::to_string(pixel % size_t(width)) + ", " + std::to_string(pixel / size_t(width)) + ")");
+}
+
 InputError negativeVarianceError(float value, size_t pixel, int width) {
     return InputError("variance buffer has a negative value (" + std::to_string(value) + ") at pixel (" +
                       std::to_string(pixel % size_t(width)) + ", " + std::to_string(pixel / size_t(width)) + ")");
@@ -127,6 +148,11 @@ PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, D
     const bool colorOnHost = color.device() == Device::Cpu;
     rep.nonFinitePixels = 0;
     if (colorOnHost) {
+        for (size_t i = 0; i < 3 * color.plane(); ++i) {
+            const float v = color.data()[i];
+            if (std::isfinite(v) && std::fabs(v) > kMaxInputColor)
+                throw outOfRangeError("color", v, kMaxInputColor, i % color.plane(), color.width());
+        }
         for (size_t i = 0; i < color.plane(); ++i) {
             if (!std::isfinite(color.data()[i]) || !std::isfinite(color.data()[i + color.plane()]) ||
                 !std::isfinite(color.data()[i + 2 * color.plane()]))
@@ -137,8 +163,11 @@ PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, D
     if (in.variance) {
         if (in.variance->device() == Device::Cpu) {
             const Image& vh = *in.variance;
-            for (size_t i = 0; i < 3 * vh.plane(); ++i)
+            for (size_t i = 0; i < 3 * vh.plane(); ++i) {
                 if (vh.data()[i] < 0) throw negativeVarianceError(vh.data()[i], i % vh.plane(), vh.width());
+                if (std::isfinite(vh.data()[i]) && vh.data()[i] > kMaxInputVariance)
+                    throw outOfRangeError("variance", vh.data()[i], kMaxInputVariance, i % vh.plane(), vh.width());
+            }
         }
         used += ",variance";
         rep.noiseEstimated = false;
@@ -166,6 +195,12 @@ PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, D
     if (in.emission) used += ",emission";
     rep.buffersUsed = used;
     return p;
+}
+
+void setNoiseEstimate(DriverConfig& cfg, const DenoiseReport& rep) {
+    if (cfg.varianceGiven) return;
+    cfg.noiseRadius = kNoiseRadius;
+    for (int c = 0; c < 3; ++c) cfg.noiseFloorVar[c] = kNoiseFloorFraction * rep.noiseSigma[c] * rep.noiseSigma[c];
 }
 
 DriverConfig makeConfig(const DenoiseOptions& o) {
@@ -219,6 +254,7 @@ Image denoiseCpu(const DenoiseInputs& in, const DenoiseOptions& o, const Prepare
     Timer t;
     DriverConfig cfg = makeConfig(o);
     cfg.varianceGiven = in.variance != nullptr;
+    setNoiseEstimate(cfg, rep);
     clock->start();
     runDenoise(CpuExec{}, di, cfg, dout);
     rep.milliseconds = t.ms();

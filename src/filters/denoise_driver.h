@@ -10,6 +10,7 @@
 #include "atrous/image.h"
 #include "filters/eaw.h"
 #include "filters/emission_filter.h"
+#include "filters/noise_estimate.h"
 #include "filters/prepass.h"
 #include "filters/stage_clock.h"
 #include "filters/sure.h"
@@ -43,6 +44,10 @@ struct DriverConfig {
     float albedoEpsilon = 1e-3f;
     float albedoFloor = 0.0f;
     bool varianceGiven = true;  // false: the variance is a constant estimate
+    // Without a variance: the local estimate (noise_estimate.h) over quadrants of this radius
+    // (0 = keep the constant), floored at noiseFloorVar (the global estimate times a fraction).
+    int noiseRadius = 0;
+    float noiseFloorVar[3] = {0, 0, 0};
 };
 
 // α_i = true var(d_i) / independence-propagated var(d_i) for the unweighted B3 cascade on white
@@ -108,10 +113,31 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
                                          emissionA.view(), emissionB.view());
         }
     }
+    // The albedo the demodulation divides by, sanitised once (the noise estimate reads it too).
+    ImageView albedo = cfg.demodulate ? in.albedo : ImageView{};
+    Image albedoStore;
+    if (albedo.valid()) albedo = sanitizedFeature(exec, albedo, w, h, 3, albedoStore);
     const ImageView normal = sanitizedFeature(exec, in.normal, w, h, 3, normalStore);
     const ImageView position = sanitizedFeature(exec, in.position, w, h, 3, positionStore);
     const ImageView depth = sanitizedFeature(exec, in.depth, w, h, 1, depthStore);
     const ImageView ids = sanitizedFeature(exec, in.ids, w, h, 2, idsStore);
+    if (!cfg.varianceGiven && cfg.noiseRadius > 0) {
+        // v_0 from the colour itself (c_0, emission already taken out): noise_estimate.h.
+        Image energy(w, h, 3, dev);
+        exec.forEachPixel(w, h, DetailEnergy{cfg.albedoEpsilon, cfg.albedoFloor, c0.view(), albedo, energy.view(),
+                                             normal, depth});
+        Image rows(w, h, 8, dev);
+        exec.forEachPixel(w, h, QuadrantRows{cfg.noiseRadius, energy.view(), rows.view()});
+        LocalVariance lv;
+        lv.radius = cfg.noiseRadius;
+        for (int c = 0; c < 3; ++c) lv.floorVar[c] = cfg.noiseFloorVar[c];
+        lv.eps = cfg.albedoEpsilon;
+        lv.floor = cfg.albedoFloor;
+        lv.rows = rows.view();
+        lv.albedo = albedo;
+        lv.var = v0.view();
+        exec.forEachPixel(w, h, lv);
+    }
     markStage(out.clock, "sanitize");
 
     // 2. Fireflies (before demodulation: the outlier is in radiance).
@@ -133,10 +159,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     markStage(out.clock, "fireflies");
 
     // 3. Albedo demodulation.
-    ImageView albedo = cfg.demodulate ? in.albedo : ImageView{};
-    Image albedoStore;
     if (albedo.valid()) {
-        albedo = sanitizedFeature(exec, albedo, w, h, 3, albedoStore);
         exec.forEachPixel(w, h, Demodulate{cfg.albedoEpsilon, cfg.albedoFloor, albedo, cA.view(), vA.view()});
     }
     markStage(out.clock, "demodulate");

@@ -1,0 +1,123 @@
+// Per-pixel noise variance when the renderer gave none (docs/algorithms.md, "Noise without a
+// variance buffer"): Blender Cycles and Mitsuba write no variance pass. One number for the whole
+// image (Donoho's MAD) takes a caustic or a speckled rough metal for signal, since their noise is
+// many times the image's typical level. Here the variance at p is the mean energy of the finest
+// B3 detail d_0 = c - B3 * c (of the demodulated colour, so texture edges do not count) over the
+// quietest of the four (r+1)² quadrants that have p as a corner: a geometric edge through p
+// leaves at least one quadrant on one side, while dense noise (a caustic) fills all four. An
+// isolated firefly fills one, so it is left to the firefly pass. Floored at the global estimate
+// (the local one only raises it where the noise is higher). Shared by CPU and CUDA (the driver runs it on its executor).
+#pragma once
+#include "atrous/image.h"
+#include "filters/filter_math.h"
+
+namespace atrous::filters {
+
+// var(d_0) = σ² (1 + Σ h² - 2 h(0)) for white noise under the 5×5 B3 kernel (see estimateNoiseSigma).
+constexpr float kDetailVarFactor = float(1.0 + (70.0 / 256.0) * (70.0 / 256.0) - 2.0 * (6 / 16.0) * (6 / 16.0));
+
+// e_c(p) = d_0,c(p)² / kDetailVarFactor: an unbiased per-pixel estimate of σ_c² on white noise.
+// The B3 taps across a geometric edge (normals further apart than kNoiseNormalDist, or depths
+// more than kNoiseDepthRel apart relative to p's) are left out and the rest renormalised, so a
+// light's edge or a one-pixel strip of wall beside it does not read as noise.
+constexpr float kNoiseNormalDist2 = 0.1f;  // |n_p - n_q|² (about 18 degrees)
+constexpr float kNoiseDepthRel = 0.05f;
+struct DetailEnergy {
+    float eps = 1e-3f, floor = 0.0f;  // modulation albedo (filter_math.h); albedo invalid: none
+    ImageView color, albedo, energy;  // color: c_0 (3 ch), energy: out (3 ch)
+    ImageView normal, depth;          // sanitised (zeros when absent)
+    ATROUS_HOST_DEVICE float demod(int x, int y, int c) const {
+        if (!albedo.valid()) return color(x, y, c);
+        const float t = modulationTerm(maxChannel(albedo(x, y, 0), albedo(x, y, 1), albedo(x, y, 2)), floor);
+        return color(x, y, c) / modulationAlbedo(albedo(x, y, c), t, eps);
+    }
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        const int w = color.width, h = color.height;
+        const float nx = normal(x, y, 0), ny = normal(x, y, 1), nz = normal(x, y, 2), zp = depth(x, y, 0);
+        float s[3] = {0, 0, 0}, ws = 0, w2 = 0;
+        for (int qy = -2; qy <= 2; ++qy)
+            for (int qx = -2; qx <= 2; ++qx) {
+                const int xx = clampIdx(x + qx, w - 1), yy = clampIdx(y + qy, h - 1);
+                const float dn = sq(nx - normal(xx, yy, 0)) + sq(ny - normal(xx, yy, 1)) + sq(nz - normal(xx, yy, 2));
+                const float dz = fabsf(zp - depth(xx, yy, 0));
+                const bool same = (dn <= kNoiseNormalDist2) & (dz <= kNoiseDepthRel * fabsf(zp));
+                const float wt = same ? b3(qx) * b3(qy) : 0.0f;
+                ws += wt;
+                w2 += wt * wt;
+                for (int c = 0; c < 3; ++c) s[c] += wt * demod(xx, yy, c);
+            }
+        // var(c_p - Σ w_q c_q / W) = σ² (1 - 2 w_p/W + Σ w_q²/W²) for white noise: the same
+        // unbiasing as kDetailVarFactor, for the renormalised weights.
+        const float wp = b3(0) * b3(0);
+        const float factor = 1.0f - 2.0f * wp / ws + w2 / (ws * ws);
+        for (int c = 0; c < 3; ++c) {
+            const float d = demod(x, y, c) - s[c] / ws;
+            energy(x, y, c) = factor > 1e-3f ? d * d / factor : 0.0f;
+        }
+    }
+};
+
+// Row half-sums of the energy: left(p) = Σ_{i=0..r} e(x - i, y), right(p) = Σ_{i=0..r} e(x + i, y)
+// (inside the image), per channel, and their tap counts: the first pass of the quadrant sums.
+// rows: 8 channels (left rgb, right rgb, left count, right count).
+struct QuadrantRows {
+    int radius = 5;
+    ImageView energy, rows;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        const int w = energy.width;
+        float l[3] = {0, 0, 0}, r[3] = {0, 0, 0};
+        int nl = 0, nr = 0;
+        for (int i = 0; i <= radius; ++i) {
+            if (x - i >= 0) {
+                for (int c = 0; c < 3; ++c) l[c] += energy(x - i, y, c);
+                ++nl;
+            }
+            if (x + i < w) {
+                for (int c = 0; c < 3; ++c) r[c] += energy(x + i, y, c);
+                ++nr;
+            }
+        }
+        for (int c = 0; c < 3; ++c) rows(x, y, c) = l[c], rows(x, y, 3 + c) = r[c];
+        rows(x, y, 6) = float(nl);
+        rows(x, y, 7) = float(nr);
+    }
+};
+
+// var_c(p) = max(a'_c² × mean of e_c over the quadrant of least total energy, floorVar_c), in the
+// colour's units (a' the modulation albedo): column sums of QuadrantRows over the rows y - r..y
+// and y..y + r. Writes `var` (3 ch).
+struct LocalVariance {
+    int radius = 5;
+    float floorVar[3] = {0, 0, 0};  // in the colour's units
+    float eps = 1e-3f, floor = 0.0f;
+    ImageView rows, albedo, var;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        const int h = rows.height;
+        float q[4][4] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}};  // up-left, up-right, down-left, down-right: rgb, n
+        for (int j = 0; j <= radius; ++j) {
+            for (int half = 0; half < 2; ++half) {  // 0: up (y - j), 1: down (y + j)
+                const int yy = half == 0 ? y - j : y + j;
+                if (yy < 0 || yy >= h) continue;
+                for (int side = 0; side < 2; ++side) {  // 0: left, 1: right
+                    float* t = q[2 * half + side];
+                    for (int c = 0; c < 3; ++c) t[c] += rows(x, yy, 3 * side + c);
+                    t[3] += rows(x, yy, 6 + side);
+                }
+            }
+        }
+        int best = 0;
+        float bestMean = 3.0e38f;
+        for (int k = 0; k < 4; ++k) {
+            const float m = (q[k][0] + q[k][1] + q[k][2]) / q[k][3];  // q[k][3] >= 1: the pixel itself
+            if (m < bestMean) bestMean = m, best = k;
+        }
+        const float t = albedo.valid() ? modulationTerm(maxChannel(albedo(x, y, 0), albedo(x, y, 1), albedo(x, y, 2)), floor) : 0.0f;
+        for (int c = 0; c < 3; ++c) {
+            const float a = albedo.valid() ? modulationAlbedo(albedo(x, y, c), t, eps) : 1.0f;
+            const float v = maxSel(q[best][c] / q[best][3] * a * a, floorVar[c]);
+            var(x, y, c) = finite(v) ? v : floorVar[c];
+        }
+    }
+};
+
+}  // namespace atrous::filters
