@@ -130,7 +130,7 @@ TEST(NoiseEstimate, LocalVarianceFollowsTheNoiseAndNotTheEdges) {
     const int w = 96, h = 64;
     Image energy(w, h, 3), rows(w, h, 8), var(w, h, 3);
     CpuExec exec;
-    exec.forEachPixel(w, h, DetailEnergy{1e-3f, 0.0f, s.noisy.view(), ImageView{}, energy.view(), s.normal.view(), s.depth.view()});
+    exec.forEachPixel(w, h, DetailEnergy{s.noisy.view(), energy.view(), s.normal.view(), s.depth.view()});
     exec.forEachPixel(w, h, QuadrantRows{5, energy.view(), rows.view()});
     LocalVariance lv;
     lv.radius = 5;

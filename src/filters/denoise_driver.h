@@ -123,9 +123,9 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     const ImageView ids = sanitizedFeature(exec, in.ids, w, h, 2, idsStore);
     if (!cfg.varianceGiven && cfg.noiseRadius > 0) {
         // v_0 from the colour itself (c_0, emission already taken out): noise_estimate.h.
-        Image energy(w, h, 3, dev);
-        exec.forEachPixel(w, h, DetailEnergy{cfg.albedoEpsilon, cfg.albedoFloor, c0.view(), albedo, energy.view(),
-                                             normal, depth});
+        Image demod(w, h, 3, dev), energy(w, h, 3, dev);
+        exec.forEachPixel(w, h, DemodulatedCopy{cfg.albedoEpsilon, cfg.albedoFloor, c0.view(), albedo, demod.view()});
+        exec.forEachPixel(w, h, DetailEnergy{demod.view(), energy.view(), normal, depth});
         Image rows(w, h, 8, dev);
         exec.forEachPixel(w, h, QuadrantRows{cfg.noiseRadius, energy.view(), rows.view()});
         LocalVariance lv;

@@ -16,6 +16,17 @@ namespace atrous::filters {
 // var(d_0) = σ² (1 + Σ h² - 2 h(0)) for white noise under the 5×5 B3 kernel (see estimateNoiseSigma).
 constexpr float kDetailVarFactor = float(1.0 + (70.0 / 256.0) * (70.0 / 256.0) - 2.0 * (6 / 16.0) * (6 / 16.0));
 
+// out = c / a' (a' the modulation albedo, filter_math.h; albedo invalid: a copy).
+struct DemodulatedCopy {
+    float eps = 1e-3f, floor = 0.0f;
+    ImageView color, albedo, out;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        const float t = albedo.valid() ? modulationTerm(maxChannel(albedo(x, y, 0), albedo(x, y, 1), albedo(x, y, 2)), floor) : 0.0f;
+        for (int c = 0; c < 3; ++c)
+            out(x, y, c) = albedo.valid() ? color(x, y, c) / modulationAlbedo(albedo(x, y, c), t, eps) : color(x, y, c);
+    }
+};
+
 // e_c(p) = d_0,c(p)² / kDetailVarFactor: an unbiased per-pixel estimate of σ_c² on white noise.
 // The B3 taps across a geometric edge (normals further apart than kNoiseNormalDist, or depths
 // more than kNoiseDepthRel apart relative to p's) are left out and the rest renormalised, so a
@@ -23,14 +34,8 @@ constexpr float kDetailVarFactor = float(1.0 + (70.0 / 256.0) * (70.0 / 256.0) -
 constexpr float kNoiseNormalDist2 = 0.1f;  // |n_p - n_q|² (about 18 degrees)
 constexpr float kNoiseDepthRel = 0.05f;
 struct DetailEnergy {
-    float eps = 1e-3f, floor = 0.0f;  // modulation albedo (filter_math.h); albedo invalid: none
-    ImageView color, albedo, energy;  // color: c_0 (3 ch), energy: out (3 ch)
-    ImageView normal, depth;          // sanitised (zeros when absent)
-    ATROUS_HOST_DEVICE float demod(int x, int y, int c) const {
-        if (!albedo.valid()) return color(x, y, c);
-        const float t = modulationTerm(maxChannel(albedo(x, y, 0), albedo(x, y, 1), albedo(x, y, 2)), floor);
-        return color(x, y, c) / modulationAlbedo(albedo(x, y, c), t, eps);
-    }
+    ImageView color, energy;  // color: c_0 demodulated (DemodulatedCopy), energy: out (3 ch)
+    ImageView normal, depth;  // sanitised (zeros when absent)
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         const int w = color.width, h = color.height;
         const float nx = normal(x, y, 0), ny = normal(x, y, 1), nz = normal(x, y, 2), zp = depth(x, y, 0);
@@ -44,14 +49,14 @@ struct DetailEnergy {
                 const float wt = same ? b3(qx) * b3(qy) : 0.0f;
                 ws += wt;
                 w2 += wt * wt;
-                for (int c = 0; c < 3; ++c) s[c] += wt * demod(xx, yy, c);
+                for (int c = 0; c < 3; ++c) s[c] += wt * color(xx, yy, c);
             }
         // var(c_p - Σ w_q c_q / W) = σ² (1 - 2 w_p/W + Σ w_q²/W²) for white noise: the same
         // unbiasing as kDetailVarFactor, for the renormalised weights.
         const float wp = b3(0) * b3(0);
         const float factor = 1.0f - 2.0f * wp / ws + w2 / (ws * ws);
         for (int c = 0; c < 3; ++c) {
-            const float d = demod(x, y, c) - s[c] / ws;
+            const float d = color(x, y, c) - s[c] / ws;
             energy(x, y, c) = factor > 1e-3f ? d * d / factor : 0.0f;
         }
     }
