@@ -143,7 +143,10 @@ TEST(Animation, EmissionBufferHoldsTheVisibleLight) {
 }
 
 TEST(Animation, CameraPaths) {
-    const pt::SceneData& d = Scene::builtin("cornell").data();
+    // Keep the Scene alive: data() is a reference into it (a reference into the temporary read
+    // freed memory under ASan).
+    const Scene scene = Scene::builtin("cornell");
+    const pt::SceneData& d = scene.data();
     // Orbit: t = 1/2 is the rest camera; the ends are +-10 degrees about the target's vertical axis.
     pt::Camera mid = pt::cameraAtTime(d, CameraPath::Orbit, 0.5f);
     EXPECT_NEAR(length(mid.position - d.camera.position), 0.0f, 1e-5f);

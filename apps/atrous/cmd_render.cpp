@@ -22,6 +22,10 @@
 namespace atrous::cli {
 namespace {
 
+// CLI11 reads an empty value ("--max-depth ''") as 0 without a word (found by tests/fuzz).
+const CLI::Validator kNonEmptyNumber(
+    [](std::string& v) { return v.empty() ? std::string("an empty value is not a number") : std::string(); }, "", "non-empty");
+
 struct RenderArgs {
     std::string scene;
     std::string out;
@@ -215,18 +219,18 @@ void addRenderCommand(CLI::App& app) {
                     "Output directory (created if missing). With --frames, OUT/frame_NNNN/ is replaced whole, and "
                     "frame_NNNN/ directories of an earlier run with NNNN >= --frames are removed (one note on stderr)")
         ->required();
-    cmd->add_option("--width", args->settings.width, "Image width in pixels")->capture_default_str();
-    cmd->add_option("--height", args->settings.height, "Image height in pixels")->capture_default_str();
-    cmd->add_option("--spp", args->settings.spp, "Samples per pixel")->capture_default_str();
-    cmd->add_option("--seed", args->settings.seed, "Random seed (same seed, same image)")->capture_default_str();
-    cmd->add_option("--max-depth", args->settings.maxDepth, "Maximum bounces (1 = direct light only)")->capture_default_str();
-    cmd->add_option("--threads", args->settings.threads, "Worker threads (0 = all cores)")->capture_default_str();
+    cmd->add_option("--width", args->settings.width, "Image width in pixels")->check(kNonEmptyNumber)->capture_default_str();
+    cmd->add_option("--height", args->settings.height, "Image height in pixels")->check(kNonEmptyNumber)->capture_default_str();
+    cmd->add_option("--spp", args->settings.spp, "Samples per pixel")->check(kNonEmptyNumber)->capture_default_str();
+    cmd->add_option("--seed", args->settings.seed, "Random seed (same seed, same image)")->check(kNonEmptyNumber)->capture_default_str();
+    cmd->add_option("--max-depth", args->settings.maxDepth, "Maximum bounces (1 = direct light only)")->check(kNonEmptyNumber)->capture_default_str();
+    cmd->add_option("--threads", args->settings.threads, "Worker threads (0 = all cores)")->check(kNonEmptyNumber)->capture_default_str();
     cmd->add_option("--device", args->device, "cpu, cuda or auto (cuda when a GPU is present; the GPU path tracer runs over a BVH built by Embree)")
         ->capture_default_str();
     cmd->add_option("--denoise", args->denoise, "Also denoise with these methods (comma list: eaw,sure)");
     auto* frames = cmd->add_option("--frames", args->frames,
-                                   "Render an animation of this many frames into OUT/frame_NNNN/ (time t = f / max(F-1, 1))");
-    cmd->add_option("--reference-spp", args->referenceSpp, "With --frames: also write reference.exr per frame at this spp (other seed)");
+                                   "Render an animation of this many frames into OUT/frame_NNNN/ (time t = f / max(F-1, 1))")->check(kNonEmptyNumber);
+    cmd->add_option("--reference-spp", args->referenceSpp, "With --frames: also write reference.exr per frame at this spp (other seed)")->check(kNonEmptyNumber);
     cmd->add_option("--camera-path", args->cameraPath, "With --frames: auto, static, orbit, dolly or keyframes")->capture_default_str();
     cmd->add_flag("--quiet", args->quiet,
                   "No progress line on stderr (it is shown only when stderr is a terminal: per frame with an ETA "

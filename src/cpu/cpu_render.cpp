@@ -201,7 +201,10 @@ void validateRenderSettings(const RenderSettings& s) {
     if (s.spp <= 0) throw InputError("--spp: must be at least 1 (got " + std::to_string(s.spp) + ")");
     if (s.maxDepth < 0 || s.maxDepth > 1024)
         throw InputError("--max-depth: " + std::to_string(s.maxDepth) + " is out of range (0..1024)");
-    if (s.threads < 0) throw InputError("--threads: must be 0 (all cores) or more (got " + std::to_string(s.threads) + ")");
+    // A ceiling: tbb::task_arena aborts in its destructor from 65537 threads on (docs/reliability.md).
+    constexpr int kMaxThreads = 4096;
+    if (s.threads < 0 || s.threads > kMaxThreads)
+        throw InputError("--threads: must be in 0..4096 (0 = all cores; got " + std::to_string(s.threads) + ")");
 }
 
 namespace {

@@ -17,14 +17,15 @@ void requireRange(bool ok, const char* field, const std::string& rule) {
     if (!ok) throw InputError(std::string("SVGF parameter ") + field + " " + rule);
 }
 
-bool finitePositive(float v) { return std::isfinite(v) && v > 0.0f; }
+// At least 1e-6: σ's inverse squares stay finite (at 1e-20 the whole output was NaN).
+bool finitePositive(float v) { return std::isfinite(v) && v >= 1e-6f; }
 
 }  // namespace
 
 void validateSvgfParams(const SvgfParams& p) {
-    requireRange(finitePositive(p.sigmaL), "sigmaL", "must be a finite number > 0");
+    requireRange(finitePositive(p.sigmaL), "sigmaL", "must be a finite number >= 1e-6");
     requireRange(std::isfinite(p.sigmaN) && p.sigmaN >= 0.0f, "sigmaN", "must be a finite number >= 0");
-    requireRange(finitePositive(p.sigmaZ), "sigmaZ", "must be a finite number > 0");
+    requireRange(finitePositive(p.sigmaZ), "sigmaZ", "must be a finite number >= 1e-6");
     requireRange(p.alpha > 0.0f && p.alpha <= 1.0f, "alpha", "must be in (0, 1]");
     requireRange(p.momentsAlpha > 0.0f && p.momentsAlpha <= 1.0f, "momentsAlpha", "must be in (0, 1]");
     requireRange(p.historyCap >= 1 && p.historyCap <= 1 << 20, "historyCap", "must be in [1, 1048576]");

@@ -5,6 +5,8 @@
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
+#include <ImfRgbaFile.h>
+#include <ImfArray.h>
 #include <stb_image.h>
 #include <stb_image_write.h>
 #include <unistd.h>
@@ -34,7 +36,15 @@ std::string extensionOf(const std::string& path) {
     return ext;
 }
 
+// A path with a NUL byte (possible from Python) would name another file at the C layer ("a\0b.exr"
+// opens "a"): refused.
+static void requireNoNul(const std::string& path) {
+    const size_t nul = path.find('\0');
+    if (nul != std::string::npos) throw InputError(path.substr(0, nul) + "...: the path contains a NUL byte");
+}
+
 static void requireFile(const std::string& path) {
+    requireNoNul(path);
     std::error_code ec;
     if (!fs::exists(path, ec)) throw InputError(path + ": file not found");
     if (fs::is_directory(path, ec)) throw InputError(path + ": is a directory, not an image file");
@@ -44,6 +54,45 @@ static void requireFile(const std::string& path) {
 
 // ---------------------------------------------------------------------------------------- EXR
 
+static uintmax_t fileSize(const std::string& path) {
+    std::error_code ec;
+    const uintmax_t n = fs::file_size(path, ec);
+    return ec ? 0 : n;
+}
+
+// The most bytes of decoded pixels one byte of an EXR file can hold, by compression (a lying
+// header then costs memory in proportion to the file, not to its data window): deflate peaks near
+// 1032:1 (ZIP, ZIPS, PXR24), PIZ's Huffman run codes and DWA's zipped DC near a few thousand,
+// B44 stays below 16:1, RLE below 64:1.
+static double exrMaxExpansion(Imf::Compression c) {
+    switch (c) {
+    case Imf::NO_COMPRESSION: return 1.0;
+    case Imf::RLE_COMPRESSION: return 64.0;
+    case Imf::B44_COMPRESSION:
+    case Imf::B44A_COMPRESSION: return 16.0;
+    case Imf::ZIPS_COMPRESSION:
+    case Imf::ZIP_COMPRESSION:
+    case Imf::PXR24_COMPRESSION: return 1100.0;
+    default: return 8192.0;  // PIZ, DWAA, DWAB
+    }
+}
+
+// Throws unless a file of `bytes` bytes can hold the header's data window (before any allocation).
+static void requireExrSizeFits(const std::string& path, const Imf::Header& header, long w, long h) {
+    double bytesPerPixel = 0.0;
+    for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+        const Imf::Channel& ch = it.channel();
+        const double sampling = double(std::max(1, ch.xSampling)) * std::max(1, ch.ySampling);
+        bytesPerPixel += (ch.type == Imf::HALF ? 2.0 : 4.0) / sampling;
+    }
+    const double decoded = double(w) * double(h) * bytesPerPixel;
+    const double bytes = double(fileSize(path));
+    if (decoded > bytes * exrMaxExpansion(header.compression()) + 65536.0)
+        throw InputError(path + ": truncated or corrupt EXR (the header's " + std::to_string(w) + "x" + std::to_string(h) +
+                         " data window needs more pixel data than the file's " + std::to_string(uintmax_t(bytes)) +
+                         " bytes can hold)");
+}
+
 static Image readExr(const std::string& path) {
     try {
         Imf::InputFile file(path.c_str());
@@ -51,6 +100,7 @@ static Image readExr(const std::string& path) {
         const long w = long(dw.max.x) - dw.min.x + 1, h = long(dw.max.y) - dw.min.y + 1;
         if (w <= 0 || h <= 0 || w > kMaxImageDim || h > kMaxImageDim)
             throw InputError(path + ": unsupported image size " + std::to_string(w) + "x" + std::to_string(h));
+        requireExrSizeFits(path, file.header(), w, h);
         const Imf::ChannelList& channels = file.header().channels();
         std::vector<std::string> names;
         for (auto it = channels.begin(); it != channels.end(); ++it) names.push_back(it.name());
@@ -58,6 +108,21 @@ static Image readExr(const std::string& path) {
         std::string src[3];
         if (has("R") && has("G") && has("B")) {
             src[0] = "R", src[1] = "G", src[2] = "B";
+        } else if (has("Y") && (has("RY") || has("BY"))) {
+            // Luminance/chroma (Y, RY, BY): OpenEXR's RGBA interface converts it to RGB.
+            Imf::RgbaInputFile rgba(path.c_str());
+            Imf::Array2D<Imf::Rgba> px(h, w);
+            rgba.setFrameBuffer(&px[0][0] - dw.min.x - dw.min.y * w, 1, size_t(w));
+            rgba.readPixels(dw.min.y, dw.max.y);
+            Image img(int(w), int(h), 3);
+            for (long y = 0; y < h; ++y)
+                for (long x = 0; x < w; ++x) {
+                    const Imf::Rgba& p = px[y][x];
+                    img(int(x), int(y), 0) = float(p.r);
+                    img(int(x), int(y), 1) = float(p.g);
+                    img(int(x), int(y), 2) = float(p.b);
+                }
+            return img;
         } else if (has("Y")) {
             src[0] = src[1] = src[2] = "Y";
         } else if (names.size() == 1) {
@@ -139,6 +204,13 @@ static Image readPfm(const std::string& path) {
     if (scale == 0 || !std::isfinite(scale)) throw InputError(path + ": PFM scale must be a non-zero number");
     in.get();  // the single whitespace byte after the scale
     const int nc = magic == "PF" ? 3 : 1;
+    // Before allocating: a 20-byte file may declare 16384x16384 (3 GB).
+    const uintmax_t need = uintmax_t(w) * uintmax_t(h) * uintmax_t(nc) * sizeof(float);
+    const std::streamoff at = in.tellg();
+    const uintmax_t have = fileSize(path);
+    if (at < 0 || have < uintmax_t(at) || have - uintmax_t(at) < need)
+        throw InputError(path + ": truncated PFM (expected " + std::to_string(need) + " bytes of pixels, found " +
+                         std::to_string(at < 0 || have < uintmax_t(at) ? 0 : have - uintmax_t(at)) + ")");
     std::vector<float> raw(size_t(w) * size_t(h) * nc);
     in.read(reinterpret_cast<char*>(raw.data()), std::streamsize(raw.size() * sizeof(float)));
     if (size_t(in.gcount()) != raw.size() * sizeof(float))
@@ -199,8 +271,82 @@ void writePng(const std::string& path, const Image& img, float exposure) {
     });
 }
 
+// A Radiance .hdr must hold every scanline: stb fills a truncated file's missing pixels with
+// black without a word. Walks the scanlines (flat or new-style RLE) without decoding them.
+static void requireHdrComplete(const std::string& path, int w, int h) {
+    std::ifstream in(path, std::ios::binary);
+    std::string line;
+    while (std::getline(in, line) && !line.empty() && line != "\r") {}  // header, up to the blank line
+    if (!std::getline(in, line)) throw InputError(path + ": truncated HDR (no resolution line)");
+    auto truncated = [&](int y) {
+        return InputError(path + ": truncated HDR (scanline " + std::to_string(y) + " of " + std::to_string(h) + " is incomplete)");
+    };
+    std::vector<unsigned char> buf;
+    for (int y = 0; y < h; ++y) {
+        unsigned char head[4];
+        if (!in.read(reinterpret_cast<char*>(head), 4)) throw truncated(y);
+        const bool rle = w >= 8 && w < 32768 && head[0] == 2 && head[1] == 2 && !(head[2] & 0x80);
+        if (!rle && y == 0) return;  // flat pixels: readStb checks the file's size instead
+        // stb loops for ever on a zero-length run at the end of the data (EOF reads as 0): every
+        // structural fault is refused here.
+        auto corrupt = [&](const char* what) {
+            return InputError(path + ": corrupt HDR (scanline " + std::to_string(y) + ": " + what + ")");
+        };
+        if (!rle) throw corrupt("not run-length encoded like the first");
+        if (((head[2] << 8) | head[3]) != w) throw corrupt("its length is not the image width");
+        for (int c = 0; c < 4; ++c)
+            for (int x = 0; x < w;) {
+                const int count = in.get();
+                if (count == EOF) throw truncated(y);
+                if (count > 128) {
+                    if (in.get() == EOF) throw truncated(y);
+                    if (count - 128 > w - x) throw corrupt("a run past the end of the line");
+                    x += count - 128;
+                } else {
+                    if (count == 0) throw corrupt("a zero-length run");
+                    if (count > w - x) throw corrupt("a run past the end of the line");
+                    buf.resize(size_t(count));
+                    if (!in.read(reinterpret_cast<char*>(buf.data()), count)) throw truncated(y);
+                    x += count;
+                }
+            }
+    }
+}
+
+// At most this many pixels per byte of a PNG/JPEG/HDR/BMP/TGA file (a 1-bit PNG at deflate's
+// 1032:1 holds ~8256): a lying header is refused before stb allocates for it.
+constexpr double kMaxPixelsPerByte = 8448.0;
+
 static Image readStb(const std::string& path) {
     int w = 0, h = 0, n = 0;
+    if (stbi_info(path.c_str(), &w, &h, &n)) {
+        if (w <= 0 || h <= 0 || w > kMaxImageDim || h > kMaxImageDim)
+            throw InputError(path + ": unsupported image size " + std::to_string(w) + "x" + std::to_string(h) + " (at most " +
+                             std::to_string(kMaxImageDim) + " per side)");
+        const uintmax_t bytes = fileSize(path);
+        if (double(w) * double(h) > double(bytes) * kMaxPixelsPerByte + 65536.0)
+            throw InputError(path + ": truncated or corrupt image (" + std::to_string(w) + "x" + std::to_string(h) +
+                             " pixels cannot fit in " + std::to_string(bytes) + " bytes)");
+        if (extensionOf(path) == ".hdr") {
+            requireHdrComplete(path, w, h);
+            std::ifstream probe(path, std::ios::binary);
+            std::string l;
+            // A flat (uncompressed) .hdr needs 4 bytes per pixel after its header.
+            size_t headerBytes = 0;
+            int blank = 0;
+            while (std::getline(probe, l)) {
+                headerBytes += l.size() + 1;
+                if (blank) break;  // the resolution line
+                if (l.empty() || l == "\r") blank = 1;
+            }
+            unsigned char first[2] = {0, 0};
+            probe.read(reinterpret_cast<char*>(first), 2);
+            const bool rle = w >= 8 && w < 32768 && first[0] == 2 && first[1] == 2;
+            if (!rle && bytes < headerBytes + uintmax_t(w) * uintmax_t(h) * 4)
+                throw InputError(path + ": truncated HDR (expected " + std::to_string(uintmax_t(w) * h * 4) +
+                                 " bytes of pixels, found " + std::to_string(bytes > headerBytes ? bytes - headerBytes : 0) + ")");
+        }
+    }
     // stbi_loadf converts 8-bit sRGB to linear (gamma 2.2) and reads Radiance .hdr as is.
     float* data = stbi_loadf(path.c_str(), &w, &h, &n, 3);
     if (!data) throw InputError(path + ": cannot read image (" + stbi_failure_reason() + ")");
@@ -229,6 +375,7 @@ Image readImage(const std::string& path) {
 }
 
 void writeImage(const std::string& path, const Image& img) {
+    requireNoNul(path);
     const std::string ext = extensionOf(path);
     if (ext == ".exr") return writeExr(path, img);
     if (ext == ".pfm") return writePfm(path, img);

@@ -17,6 +17,7 @@
 #include "render/lights.h"
 #include "render/sampling.h"
 #include "render/scene_data.h"
+#include "render/scene_limits.h"
 
 namespace atrous::pt {
 
@@ -41,6 +42,8 @@ struct PathSample {
     bool primaryHit = false;
 };
 
+ATROUS_INLINE float finiteOr0(float v) { return isFiniteF(v) ? v : 0.0f; }
+
 ATROUS_INLINE Vec3 clamp01(Vec3 v) {
     return Vec3(clampf(v.x, 0.0f, 1.0f), clampf(v.y, 0.0f, 1.0f), clampf(v.z, 0.0f, 1.0f));
 }
@@ -52,7 +55,10 @@ ATROUS_INLINE Bsdf makeBsdf(const SceneView& s, const Material& m, Vec2 uv, bool
     if (m.texture >= 0) {
         b.albedo = sampleTexture(s, m.texture, uv);
     } else if (m.checker) {
-        int cx = int(floorf(uv.x * m.checkerScale)), cy = int(floorf(uv.y * m.checkerScale));
+        // Clamped before the conversion: uv * scale beyond int's range is undefined behaviour
+        // (scene_limits.h bounds both; the clamp keeps any uv finite here).
+        const long long cx = (long long)clampf(floorf(uv.x * m.checkerScale), -1e15f, 1e15f);
+        const long long cy = (long long)clampf(floorf(uv.y * m.checkerScale), -1e15f, 1e15f);
         b.albedo = ((cx + cy) & 1) ? m.albedo2 : m.albedo;
     }
     b.alpha = clampf(m.roughness, 0.002f, 1.0f);
@@ -274,7 +280,8 @@ struct PathTraceKernel {
             Vec3 dir = cameraRayDirection(scene.camera, float(x) + jx, float(y) + jy, width, height);
             PathSample ps = tracePath(scene, tracer, scene.camera.position, dir, rng, maxDepth, lightSampling);
             // A NaN/Inf sample (numerical accident) counts as black rather than poisoning the pixel.
-            Vec3 v = isFinite(ps.radiance) ? ps.radiance : Vec3(0.0f);
+            // A sample beyond kMaxSampleRadiance is clamped so its square (the variance) stays finite.
+            Vec3 v = isFinite(ps.radiance) ? minv(ps.radiance, Vec3(kMaxSampleRadiance)) : Vec3(0.0f);
             Vec3 delta = v - mean;
             mean += delta / float(i + 1);
             m2 += delta * (v - mean);
@@ -302,17 +309,18 @@ struct PathTraceKernel {
         Vec3 normal = featureHits > 0 ? normalize(normalSum) : Vec3(0.0f);
         Vec3 position = featureHits > 0 ? positionSum / float(featureHits) : Vec3(0.0f);
         float depth = depthHits > 0 ? depthSum / float(depthHits) : backgroundDepth;
+        // The last guard of the NaN rule (docs/reliability.md): no buffer ever holds NaN or Inf.
         for (int c = 0; c < 3; ++c) {
-            out.color(x, y, c) = mean[c];
-            out.variance(x, y, c) = maxf(0.0f, var[c]);
-            out.albedo(x, y, c) = albedo[c];
-            out.normal(x, y, c) = normal[c];
-            out.position(x, y, c) = position[c];
-            out.depth(x, y, c) = depth;
+            out.color(x, y, c) = finiteOr0(mean[c]);
+            out.variance(x, y, c) = finiteOr0(maxf(0.0f, var[c]));
+            out.albedo(x, y, c) = finiteOr0(albedo[c]);
+            out.normal(x, y, c) = finiteOr0(normal[c]);
+            out.position(x, y, c) = finiteOr0(position[c]);
+            out.depth(x, y, c) = isFiniteF(depth) ? depth : backgroundDepth;
         }
         for (int c = 0; c < 3; ++c) {
-            if (out.motion.data) out.motion(x, y, c) = motionSum[c] / n;
-            if (out.emission.data) out.emission(x, y, c) = emissionSum[c] / n;
+            if (out.motion.data) out.motion(x, y, c) = finiteOr0(motionSum[c] / n);
+            if (out.emission.data) out.emission(x, y, c) = finiteOr0(emissionSum[c] / n);
         }
         out.ids(x, y, 0) = float(mesh);
         out.ids(x, y, 1) = float(material);

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
@@ -19,6 +20,7 @@
 #include "render/lights.h"
 #include "render/sampling.h"
 #include "render/scene_data.h"
+#include "render/scene_limits.h"
 
 namespace atrous {
 namespace pt {
@@ -447,29 +449,51 @@ void checkKeys(const JsonContext& c, const json& j, const std::string& where, st
     }
 }
 
-Vec3 getVec3(const JsonContext& c, const json& j, const char* key, const std::string& where, Vec3 def, bool required = false) {
+// A number of the scene file under `rule` (scene_limits.h), read as a double so that a value beyond
+// float's range (1e39) is rejected instead of turning into Inf.
+float checkedNumber(const JsonContext& c, const json& v, const std::string& where, const char* key, const ValueRule& rule) {
+    const double d = v.get<double>();
+    if (!allowed(rule, d)) fail(c, where + ": \"" + key + "\" " + rule.text + " (got " + formatValue(d) + ")");
+    return float(d);
+}
+
+// A triple: an array of 3 numbers, or one number for all three; each component under `rule`.
+Vec3 getVec3(const JsonContext& c, const json& j, const char* key, const std::string& where, Vec3 def,
+             const ValueRule& rule, bool required = false) {
     if (!j.contains(key)) {
         if (required) fail(c, where + ": missing \"" + key + "\"");
         return def;
     }
     const json& v = j.at(key);
-    if (v.is_number()) return Vec3(v.get<float>());
+    if (v.is_number()) return Vec3(checkedNumber(c, v, where, key, rule));
     if (!v.is_array() || v.size() != 3 || !v[0].is_number() || !v[1].is_number() || !v[2].is_number())
         fail(c, where + ": \"" + key + "\" must be a number or an array of 3 numbers");
-    Vec3 r(v[0].get<float>(), v[1].get<float>(), v[2].get<float>());
-    if (!isFinite(r)) fail(c, where + ": \"" + key + "\" is not finite");
-    return r;
+    return Vec3(checkedNumber(c, v[0], where, key, rule), checkedNumber(c, v[1], where, key, rule),
+                checkedNumber(c, v[2], where, key, rule));
 }
 
-float getFloat(const JsonContext& c, const json& j, const char* key, const std::string& where, float def, bool required = false) {
+float getFloat(const JsonContext& c, const json& j, const char* key, const std::string& where, float def,
+               const ValueRule& rule, bool required = false) {
     if (!j.contains(key)) {
         if (required) fail(c, where + ": missing \"" + key + "\"");
         return def;
     }
     if (!j.at(key).is_number()) fail(c, where + ": \"" + key + "\" must be a number");
-    float v = j.at(key).get<float>();
-    if (!std::isfinite(v)) fail(c, where + ": \"" + key + "\" is not finite");
-    return v;
+    return checkedNumber(c, j.at(key), where, key, rule);
+}
+
+// A point computed from checked values (a quad's far corner, a transformed vertex) is checked again.
+void checkCoordinate(const JsonContext& c, Vec3 p, const std::string& what) {
+    if (!allowed(kCoordinateRule, p.x) || !allowed(kCoordinateRule, p.y) || !allowed(kCoordinateRule, p.z))
+        fail(c, what + " " + kCoordinateRule.text + " (got " + formatValue(p.x) + ", " + formatValue(p.y) + ", " +
+                    formatValue(p.z) + ")");
+}
+
+// The look-at test, written so that NaN fails it (a NaN compared with <= is false).
+bool usableLookAt(Vec3 eye, Vec3 target, Vec3 up) {
+    const Vec3 f = target - eye;
+    const float lf = length(f), lu = length(up);
+    return lf > 0.0f && lu > 0.0f && length(cross(f, up)) > 1e-6f * lf * lu;
 }
 
 std::string getString(const JsonContext& c, const json& j, const char* key, const std::string& where, bool required = true) {
@@ -500,11 +524,11 @@ Material parseMaterial(const JsonContext& c, SceneBuilder& b, const json& j, con
     else fail(c, where + ": unknown material type \"" + type + "\" (diffuse, mirror, dielectric, conductor, plastic, emissive)");
     Vec3 defAlbedo = (m.type == MaterialType::Diffuse || m.type == MaterialType::Plastic) ? Vec3(0.8f) : Vec3(1.0f);
     if (type == "emissive" || type == "light") defAlbedo = Vec3(0.0f);
-    m.albedo = getVec3(c, j, "albedo", where, defAlbedo);
-    m.emission = getVec3(c, j, "emission", where, Vec3(0.0f));
+    m.albedo = getVec3(c, j, "albedo", where, defAlbedo, kReflectanceRule);
+    m.emission = getVec3(c, j, "emission", where, Vec3(0.0f), kRadianceRule);
     if ((type == "emissive" || type == "light") && !j.contains("emission")) fail(c, where + ": missing \"emission\"");
-    m.roughness = getFloat(c, j, "roughness", where, 0.2f);
-    m.ior = getFloat(c, j, "ior", where, 1.5f);
+    m.roughness = getFloat(c, j, "roughness", where, 0.2f, kRoughnessRule);
+    m.ior = getFloat(c, j, "ior", where, 1.5f, kIorRule);
     if (m.roughness < 0.0f || m.roughness > 1.0f) fail(c, where + ": \"roughness\" must be in [0, 1]");
     if (m.ior < 1.0f || m.ior > 4.0f) fail(c, where + ": \"ior\" must be in [1, 4]");
     if (m.emission.x < 0 || m.emission.y < 0 || m.emission.z < 0) fail(c, where + ": \"emission\" must be >= 0");
@@ -523,11 +547,12 @@ Material parseMaterial(const JsonContext& c, SceneBuilder& b, const json& j, con
         if (!ch.is_object()) fail(c, where + ": \"checker\" must be an object");
         checkKeys(c, ch, where + ".checker", {"color1", "color2", "scale"});
         m.checker = 1;
-        m.albedo = getVec3(c, ch, "color1", where + ".checker", Vec3(0.8f));
-        m.albedo2 = getVec3(c, ch, "color2", where + ".checker", Vec3(0.2f));
+        m.albedo = getVec3(c, ch, "color1", where + ".checker", Vec3(0.8f), kReflectanceRule);
+        m.albedo2 = getVec3(c, ch, "color2", where + ".checker", Vec3(0.2f), kReflectanceRule);
         checkReflectance(m.albedo, where + ".checker: \"color1\"");
         checkReflectance(m.albedo2, where + ".checker: \"color2\"");
-        m.checkerScale = getFloat(c, ch, "scale", where + ".checker", 8.0f);
+        m.checkerScale = getFloat(c, ch, "scale", where + ".checker", 8.0f, kCheckerScaleRule);
+        if (!(m.checkerScale > 0.0f)) fail(c, where + ".checker: \"scale\" must be in (0, 1e6] (got 0)");
     }
     return m;
 }
@@ -555,11 +580,128 @@ Transform parseTransform(const JsonContext& c, const json& j, const std::string&
     const json& tj = j.at("transform");
     if (!tj.is_object()) fail(c, where + ": \"transform\" must be an object");
     checkKeys(c, tj, where + ".transform", {"scale", "rotateY", "translate"});
-    t.scale = getVec3(c, tj, "scale", where + ".transform", Vec3(1.0f));
+    t.scale = getVec3(c, tj, "scale", where + ".transform", Vec3(1.0f), kTransformScaleRule);
     if (t.scale.x == 0.0f || t.scale.y == 0.0f || t.scale.z == 0.0f) fail(c, where + ".transform: \"scale\" must be non-zero");
-    t.rotY = getFloat(c, tj, "rotateY", where + ".transform", 0.0f) * kPi / 180.0f;
-    t.translate = getVec3(c, tj, "translate", where + ".transform", Vec3(0.0f));
+    t.rotY = getFloat(c, tj, "rotateY", where + ".transform", 0.0f, kAngleRule) * kPi / 180.0f;
+    t.translate = getVec3(c, tj, "translate", where + ".transform", Vec3(0.0f), kCoordinateRule);
     return t;
+}
+
+// An environment map's texels are radiance: NaN/Inf and negatives become 0 (addTexture), and a
+// finite texel beyond kMaxRadiance (after the light's scale) is an error naming the file.
+void checkEnvMap(const JsonContext& c, const Image& img, const std::string& file, float scale) {
+    const float* p = img.data();
+    for (size_t i = 0; i < size_t(img.width()) * img.height() * 3; ++i)
+        if (std::isfinite(p[i]) && double(p[i]) * scale > kMaxRadiance) {
+            const size_t px = i % (size_t(img.width()) * img.height());
+            fail(c, file + ": environment texel (" + std::to_string(px % img.width()) + ", " +
+                        std::to_string(px / img.width()) + ") times \"scale\" " + kRadianceRule.text + " (got " +
+                        formatValue(double(p[i]) * scale) + ")");
+        }
+}
+
+// What tinyobjloader does not check, read from the OBJ text before it parses it: a face index
+// beyond int's range (atoi wraps 99999999999999999999 to -1, the last vertex), a face with more
+// than kMaxFaceVertices vertices (its ear clipping is quadratic: a 200k-vertex face ran for
+// minutes), and the mtllib names (tinyobjloader only warns when one is missing).
+std::vector<std::string> prescanObj(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::vector<std::string> mtllibs;
+    std::string line;
+    size_t lineNo = 0;
+    while (std::getline(in, line)) {
+        ++lineNo;
+        size_t i = line.find_first_not_of(" \t");
+        if (i == std::string::npos) continue;
+        const bool face = line.compare(i, 2, "f ") == 0 || line.compare(i, 2, "f\t") == 0;
+        const bool lib = line.compare(i, 7, "mtllib ") == 0 || line.compare(i, 7, "mtllib\t") == 0;
+        // v, vt, vn: every value a finite number (tinyobjloader reads "nan" or "x" as 0 and 1e39 as Inf).
+        const size_t vlen = line.compare(i, 2, "v ") == 0 ? 2 : (line.compare(i, 3, "vt ") == 0 || line.compare(i, 3, "vn ") == 0) ? 3 : 0;
+        if (vlen) {
+            std::istringstream vals(line.substr(i + vlen));
+            std::string tok;
+            while (vals >> tok) {
+                char* end = nullptr;
+                const double x = std::strtod(tok.c_str(), &end);
+                if (end == tok.c_str() || *end != '\0' || !std::isfinite(x) || std::fabs(x) > 3.0e38)
+                    throw InputError(path + ": line " + std::to_string(lineNo) + ": \"" + tok + "\" is not a finite number");
+            }
+            continue;
+        }
+        if (lib) {
+            std::istringstream names(line.substr(i + 7));
+            std::string n;
+            while (names >> n) mtllibs.push_back(n);
+            continue;
+        }
+        if (!face) continue;
+        size_t count = 0;
+        for (size_t k = i + 1; k < line.size();) {
+            while (k < line.size() && (line[k] == ' ' || line[k] == '\t' || line[k] == '\r')) ++k;
+            if (k >= line.size()) break;
+            const size_t tokenStart = k;
+            while (k < line.size() && line[k] != ' ' && line[k] != '\t' && line[k] != '\r') ++k;
+            ++count;
+            // Each of v/vt/vn: an optional sign and digits; more than 10 digits or above INT_MAX is out of range.
+            const std::string token = line.substr(tokenStart, k - tokenStart);
+            size_t p = 0;
+            while (p <= token.size()) {
+                size_t q = token.find('/', p);
+                if (q == std::string::npos) q = token.size();
+                std::string num = token.substr(p, q - p);
+                if (!num.empty() && (num[0] == '-' || num[0] == '+')) num.erase(0, 1);
+                size_t digits = num.find_first_not_of("0123456789");
+                if (digits == std::string::npos) digits = num.size();
+                const std::string d = num.substr(0, digits);
+                const size_t nz = d.find_first_not_of('0');
+                const std::string sig = nz == std::string::npos ? "" : d.substr(nz);
+                if (sig.size() > 10 || (sig.size() == 10 && sig > "2147483647"))
+                    throw InputError(path + ": line " + std::to_string(lineNo) + ": face index \"" + token +
+                                     "\" is out of range");
+                p = q + 1;
+            }
+            if (count > size_t(kMaxFaceVertices))
+                throw InputError(path + ": line " + std::to_string(lineNo) + ": face with more than " +
+                                 std::to_string(kMaxFaceVertices) + " vertices");
+        }
+    }
+    return mtllibs;
+}
+
+// An MTL file's numbers, before tinyobjloader reads them ("nan" or "x" as 0, 1e39 as Inf): every
+// value of a colour or scalar statement is a finite number.
+void prescanMtl(const std::string& mtl, const std::string& objPath) {
+    static const char* const kNumeric[] = {"Ka", "Kd", "Ks", "Ke", "Kt", "Tf", "Ni", "Ns", "d", "Tr",
+                                           "Pr", "Pm", "Ps", "Pc", "Pcr", "aniso", "anisor"};
+    std::ifstream in(mtl, std::ios::binary);
+    std::string line;
+    size_t lineNo = 0;
+    while (std::getline(in, line)) {
+        ++lineNo;
+        std::istringstream words(line);
+        std::string key, tok;
+        if (!(words >> key)) continue;
+        bool numeric = false;
+        for (const char* k : kNumeric) numeric = numeric || key == k;
+        if (!numeric) continue;
+        while (words >> tok) {
+            if (tok == "spectral" || tok == "xyz") break;
+            char* end = nullptr;
+            const double x = std::strtod(tok.c_str(), &end);
+            if (end == tok.c_str() || *end != '\0' || !std::isfinite(x) || std::fabs(x) > 3.0e38)
+                throw InputError(mtl + ": line " + std::to_string(lineNo) + ": " + key + " value \"" + tok +
+                                 "\" is not a finite number (material file of " + objPath + ")");
+        }
+    }
+}
+
+// The rule of scene_limits.h for one MTL value: the same ranges as the JSON scene's.
+void checkMtlValue(const std::string& objPath, const std::string& mtl, const std::string& material, const char* key,
+                   const float* v, int n, const ValueRule& rule) {
+    for (int i = 0; i < n; ++i)
+        if (!allowed(rule, v[i]))
+            throw InputError(objPath + ": material \"" + material + "\" (" + mtl + "): " + key + " " + rule.text +
+                             " (got " + formatValue(v[i]) + ")");
 }
 
 void loadObj(const JsonContext& c, SceneBuilder& b, const std::string& path, int overrideMaterial, int mesh,
@@ -571,6 +713,16 @@ void loadObj(const JsonContext& c, SceneBuilder& b, const std::string& path, int
     tinyobj::ObjReader reader;
     std::error_code ec;
     if (!fs::is_regular_file(path, ec)) throw InputError(path + ": cannot open OBJ file (referenced by " + c.source + ")");
+    const std::vector<std::string> mtllibs = prescanObj(path);
+    std::string mtlNames;
+    for (const std::string& m : mtllibs) {
+        const std::string full = (fs::path(path).parent_path() / m).lexically_normal().string();
+        if (!fs::is_regular_file(full, ec))
+            throw InputError(path + ": mtllib " + m + ": material file not found (" + full + ")");
+        prescanMtl(full, path);
+        mtlNames += (mtlNames.empty() ? "" : ", ") + full;
+    }
+    if (mtlNames.empty()) mtlNames = "no mtllib";
     if (!reader.ParseFromFile(path, cfg)) {
         std::string err = reader.Error();
         while (!err.empty() && (err.back() == '\n' || err.back() == '\r')) err.pop_back();
@@ -580,7 +732,8 @@ void loadObj(const JsonContext& c, SceneBuilder& b, const std::string& path, int
     const auto& shapes = reader.GetShapes();
     const auto& mtls = reader.GetMaterials();
     // MTL materials -> ours: Kd (and map_Kd), Ke, illum 3 = mirror, illum 7 or d < 1 = glass (Ni),
-    // PBR metallic > 0.5 = conductor (Pr roughness).
+    // PBR metallic > 0.5 = conductor (Pr roughness). Values follow the JSON scene's rules
+    // (scene_limits.h): Kd, Ks in [0, 1], Ke in [0, 1e8], Ni in [1, 4] when set, Pr in [0, 1].
     std::vector<int> mtlIds(mtls.size(), -1);
     int defaultMaterial = -1;
     auto materialFor = [&](int mtlIndex) -> int {
@@ -591,23 +744,35 @@ void loadObj(const JsonContext& c, SceneBuilder& b, const std::string& path, int
         }
         if (mtlIds[mtlIndex] >= 0) return mtlIds[mtlIndex];
         const tinyobj::material_t& t = mtls[mtlIndex];
+        checkMtlValue(path, mtlNames, t.name, "Kd", t.diffuse, 3, kReflectanceRule);
+        checkMtlValue(path, mtlNames, t.name, "Ke", t.emission, 3, kRadianceRule);
+        checkMtlValue(path, mtlNames, t.name, "d", &t.dissolve, 1, kAnyFiniteRule);
+        checkMtlValue(path, mtlNames, t.name, "Pm", &t.metallic, 1, kAnyFiniteRule);
         Material m = diffuse(Vec3(t.diffuse[0], t.diffuse[1], t.diffuse[2]));
         m.emission = Vec3(t.emission[0], t.emission[1], t.emission[2]);
         if (t.illum == 3 || t.illum == 5) {
+            checkMtlValue(path, mtlNames, t.name, "Ks", t.specular, 3, kReflectanceRule);
             m.type = MaterialType::Mirror;
             m.albedo = Vec3(t.specular[0], t.specular[1], t.specular[2]);
             if (maxComponent(m.albedo) <= 0.0f) m.albedo = Vec3(1.0f);
         } else if (t.illum == 7 || t.dissolve < 1.0f) {
+            if (t.ior > 1.0f) checkMtlValue(path, mtlNames, t.name, "Ni", &t.ior, 1, kIorRule);
             m.type = MaterialType::Dielectric;
             m.albedo = Vec3(1.0f);
             m.ior = t.ior > 1.0f ? t.ior : 1.5f;
         } else if (t.metallic > 0.5f) {
+            checkMtlValue(path, mtlNames, t.name, "Pr", &t.roughness, 1, kRoughnessRule);
             m.type = MaterialType::Conductor;
             m.roughness = t.roughness > 0.0f ? t.roughness : 0.2f;
         }
         if (!t.diffuse_texname.empty()) {
             std::string tex = (fs::path(path).parent_path() / t.diffuse_texname).lexically_normal().string();
-            m.texture = b.addTexture(io::readImage(tex), /*reflectance=*/true);
+            try {
+                m.texture = b.addTexture(io::readImage(tex), /*reflectance=*/true);
+            } catch (const InputError& e) {
+                throw InputError(std::string(e.what()) + " (map_Kd of material \"" + t.name + "\" in " + mtlNames +
+                                 ", used by " + path + ")");
+            }
         }
         m.albedo = minv(maxv(m.albedo, Vec3(0.0f)), Vec3(1.0f));
         mtlIds[mtlIndex] = b.addMaterial(t.name, m);
@@ -627,15 +792,27 @@ void loadObj(const JsonContext& c, SceneBuilder& b, const std::string& path, int
                     throw InputError(path + ": malformed OBJ (face " + std::to_string(f + 1) + " refers to a missing vertex)");
                 Vec3 p(a.vertices[3 * ix.vertex_index], a.vertices[3 * ix.vertex_index + 1], a.vertices[3 * ix.vertex_index + 2]);
                 if (!isFinite(p)) throw InputError(path + ": malformed OBJ (vertex is not a finite number)");
+                const Vec3 world = xf.point(p);
+                if (!allowed(kCoordinateRule, world.x) || !allowed(kCoordinateRule, world.y) || !allowed(kCoordinateRule, world.z))
+                    throw InputError(path + ": vertex " + std::to_string(ix.vertex_index + 1) + " after the transform " +
+                                     kCoordinateRule.text + " (got " + formatValue(world.x) + ", " + formatValue(world.y) +
+                                     ", " + formatValue(world.z) + ")");
+                if (size_t(ix.normal_index + 1) > numN || size_t(ix.texcoord_index + 1) > numT)
+                    throw InputError(path + ": malformed OBJ (face " + std::to_string(f + 1) + " refers to a missing " +
+                                     (size_t(ix.normal_index + 1) > numN ? "normal)" : "texture coordinate)"));
                 Vec3 n(0.0f);
                 if (ix.normal_index >= 0 && size_t(ix.normal_index) < numN) {
                     n = xf.normal(Vec3(a.normals[3 * ix.normal_index], a.normals[3 * ix.normal_index + 1], a.normals[3 * ix.normal_index + 2]));
                     if (!isFinite(n)) n = Vec3(0.0f);
                 }
                 Vec2 uv;
-                if (ix.texcoord_index >= 0 && size_t(ix.texcoord_index) < numT)
+                if (ix.texcoord_index >= 0 && size_t(ix.texcoord_index) < numT) {
                     uv = Vec2(a.texcoords[2 * ix.texcoord_index], a.texcoords[2 * ix.texcoord_index + 1]);
-                v[k] = b.addVertex(xf.point(p), n, uv);
+                    if (!allowed(kTexcoordRule, uv.x) || !allowed(kTexcoordRule, uv.y))
+                        throw InputError(path + ": texture coordinate (vt) " + std::to_string(ix.texcoord_index + 1) + " " +
+                                         kTexcoordRule.text + " (got " + formatValue(uv.x) + " " + formatValue(uv.y) + ")");
+                }
+                v[k] = b.addVertex(world, n, uv);
             }
             int mi = f < shape.mesh.material_ids.size() ? shape.mesh.material_ids[f] : -1;
             // A mirroring transform (an odd number of negative scale factors) reverses the
@@ -679,15 +856,14 @@ std::vector<CameraKey> parseKeyframes(const JsonContext& c, const json& j, Vec3 
         if (!k.is_object()) fail(c, where + ": must be an object");
         checkKeys(c, k, where, {"t", "position", "target", "lookAt", "up", "fov"});
         CameraKey key;
-        key.t = getFloat(c, k, "t", where, 0.0f, true);
-        key.position = getVec3(c, k, "position", where, Vec3(0.0f), true);
+        key.t = getFloat(c, k, "t", where, 0.0f, kCoordinateRule, true);
+        key.position = getVec3(c, k, "position", where, Vec3(0.0f), kCoordinateRule, true);
         const char* targetKey = k.contains("target") ? "target" : "lookAt";
-        key.target = getVec3(c, k, targetKey, where, Vec3(0.0f), true);
-        key.up = getVec3(c, k, "up", where, up);
-        key.fovDeg = getFloat(c, k, "fov", where, fov);
+        key.target = getVec3(c, k, targetKey, where, Vec3(0.0f), kCoordinateRule, true);
+        key.up = getVec3(c, k, "up", where, up, kCoordinateRule);
+        key.fovDeg = getFloat(c, k, "fov", where, fov, kAnyFiniteRule);
         if (!(key.fovDeg > 0.5f && key.fovDeg < 179.0f)) fail(c, where + ": \"fov\" must be in (0.5, 179) degrees");
-        Vec3 f = key.target - key.position;
-        if (length(f) <= 0.0f || length(cross(f, key.up)) <= 1e-6f * length(f) * length(key.up))
+        if (!usableLookAt(key.position, key.target, key.up))
             fail(c, where + ": \"target\" must differ from \"position\" and not be along \"up\"");
         if (!keys.empty() && !(key.t > keys.back().t))
             fail(c, where + ": \"t\" must be greater than the previous keyframe's (" + std::to_string(keys.back().t) + ")");
@@ -711,12 +887,12 @@ std::shared_ptr<SceneData> parseJsonScene(const std::string& text, const JsonCon
         if (!root.contains("camera") || !root["camera"].is_object()) fail(c, "missing \"camera\" object");
         const json& cam = root["camera"];
         checkKeys(c, cam, "camera", {"position", "lookAt", "up", "fov", "keyframes"});
-        Vec3 eye = getVec3(c, cam, "position", "camera", Vec3(0.0f), true);
-        Vec3 at = getVec3(c, cam, "lookAt", "camera", Vec3(0.0f), true);
-        Vec3 up = getVec3(c, cam, "up", "camera", Vec3(0, 1, 0));
-        float fov = getFloat(c, cam, "fov", "camera", 40.0f);
+        Vec3 eye = getVec3(c, cam, "position", "camera", Vec3(0.0f), kCoordinateRule, true);
+        Vec3 at = getVec3(c, cam, "lookAt", "camera", Vec3(0.0f), kCoordinateRule, true);
+        Vec3 up = getVec3(c, cam, "up", "camera", Vec3(0, 1, 0), kCoordinateRule);
+        float fov = getFloat(c, cam, "fov", "camera", 40.0f, kAnyFiniteRule);
         if (!(fov > 0.5f && fov < 179.0f)) fail(c, "camera: \"fov\" must be in (0.5, 179) degrees");
-        if (length(at - eye) <= 0.0f || length(cross(at - eye, up)) <= 1e-6f * length(at - eye) * length(up))
+        if (!usableLookAt(eye, at, up))
             fail(c, "camera: \"lookAt\" must differ from \"position\" and not be along \"up\"");
         b.setCamera(eye, at, up, fov, at);
         if (cam.contains("keyframes")) b.d.cameraKeys = parseKeyframes(c, cam.at("keyframes"), up, fov);
@@ -750,16 +926,19 @@ std::shared_ptr<SceneData> parseJsonScene(const std::string& text, const JsonCon
             const int meshCount = int(b.d.meshNames.size());
             if (type == "sphere") {
                 checkKeys(c, o, where, {"type", "name", "material", "motion", "center", "radius"});
-                Vec3 center = getVec3(c, o, "center", where, Vec3(0.0f), true);
-                float radius = getFloat(c, o, "radius", where, 1.0f, true);
+                Vec3 center = getVec3(c, o, "center", where, Vec3(0.0f), kCoordinateRule, true);
+                float radius = getFloat(c, o, "radius", where, 1.0f, kCoordinateRule, true);
                 if (!(radius > 0.0f)) fail(c, where + ": \"radius\" must be > 0");
                 b.addSphere(center, radius, materialRef(o, where, true), b.addMesh(name));
             } else if (type == "quad") {
                 checkKeys(c, o, where, {"type", "name", "material", "motion", "corner", "edge1", "edge2"});
-                Vec3 p = getVec3(c, o, "corner", where, Vec3(0.0f), true);
-                Vec3 e1 = getVec3(c, o, "edge1", where, Vec3(0.0f), true);
-                Vec3 e2 = getVec3(c, o, "edge2", where, Vec3(0.0f), true);
-                if (length(cross(e1, e2)) <= 0.0f) fail(c, where + ": \"edge1\" and \"edge2\" span no area");
+                Vec3 p = getVec3(c, o, "corner", where, Vec3(0.0f), kCoordinateRule, true);
+                Vec3 e1 = getVec3(c, o, "edge1", where, Vec3(0.0f), kCoordinateRule, true);
+                Vec3 e2 = getVec3(c, o, "edge2", where, Vec3(0.0f), kCoordinateRule, true);
+                checkCoordinate(c, p + e1 + e2, where + ": the far corner (corner + edge1 + edge2)");
+                checkCoordinate(c, p + e1, where + ": corner + edge1");
+                checkCoordinate(c, p + e2, where + ": corner + edge2");
+                if (!(length(cross(e1, e2)) > 0.0f)) fail(c, where + ": \"edge1\" and \"edge2\" span no area");
                 // Geometric normal = edge1 x edge2 (the side a one-sided emitter lights).
                 b.addQuad(p, p + e1, p + e1 + e2, p + e2, materialRef(o, where, true), b.addMesh(name), cross(e1, e2));
             } else if (type == "mesh") {
@@ -776,10 +955,10 @@ std::shared_ptr<SceneData> parseJsonScene(const std::string& text, const JsonCon
                     if (it.key() != "translate" && it.key() != "rotateY" && it.key() != "pivot")
                         fail(c, where + ".motion: unknown key \"" + it.key() + "\" (translate, rotateY, pivot)");
                 MeshMotion m;
-                m.translate = getVec3(c, mj, "translate", where + ".motion", Vec3(0.0f));
-                m.rotateYDeg = getFloat(c, mj, "rotateY", where + ".motion", 0.0f);
+                m.translate = getVec3(c, mj, "translate", where + ".motion", Vec3(0.0f), kCoordinateRule);
+                m.rotateYDeg = getFloat(c, mj, "rotateY", where + ".motion", 0.0f, kAngleRule);
                 // Default pivot: the centre of the object's bounding box.
-                m.pivot = mj.contains("pivot") ? getVec3(c, mj, "pivot", where + ".motion", Vec3(0.0f))
+                m.pivot = mj.contains("pivot") ? getVec3(c, mj, "pivot", where + ".motion", Vec3(0.0f), kCoordinateRule)
                                                 : meshBoundsCentre(b.d, meshCount);
                 b.setMotion(meshCount, m);
             }
@@ -795,28 +974,37 @@ std::shared_ptr<SceneData> parseJsonScene(const std::string& text, const JsonCon
                 std::string type = getString(c, l, "type", where);
                 if (type == "point") {
                     checkKeys(c, l, where, {"type", "intensity", "position"});
-                    Vec3 intensity = getVec3(c, l, "intensity", where, Vec3(0.0f), true);
+                    Vec3 intensity = getVec3(c, l, "intensity", where, Vec3(0.0f), kRadianceRule, true);
                     if (intensity.x < 0 || intensity.y < 0 || intensity.z < 0) fail(c, where + ": \"intensity\" must be >= 0");
-                    b.addPointLight(getVec3(c, l, "position", where, Vec3(0.0f), true), intensity);
+                    b.addPointLight(getVec3(c, l, "position", where, Vec3(0.0f), kCoordinateRule, true), intensity);
                 } else if (type == "environment") {
                     checkKeys(c, l, where, {"type", "scale", "file", "color"});
-                    float scale = getFloat(c, l, "scale", where, 1.0f);
-                    if (!(scale >= 0.0f)) fail(c, where + ": \"scale\" must be >= 0");
+                    float scale = getFloat(c, l, "scale", where, 1.0f, kScaleRule);
                     if (l.contains("file")) {
-                        b.setEnvMap(io::readImage(resolvePath(c, getString(c, l, "file", where))), scale);
+                        const std::string file = resolvePath(c, getString(c, l, "file", where));
+                        Image map = io::readImage(file);
+                        checkEnvMap(c, map, file, scale);
+                        b.setEnvMap(map, scale);
                     } else {
-                        Vec3 col = getVec3(c, l, "color", where, Vec3(0.0f), true);
+                        Vec3 col = getVec3(c, l, "color", where, Vec3(0.0f), kRadianceRule, true);
+                        if (!allowed(kRadianceRule, maxComponent(col) * scale))
+                            fail(c, where + ": \"color\" times \"scale\" " + kRadianceRule.text + " (got " +
+                                        formatValue(double(maxComponent(col)) * scale) + ")");
                         if (col.x < 0 || col.y < 0 || col.z < 0) fail(c, where + ": \"color\" must be >= 0");
                         b.setEnvConstant(col * scale);
                     }
                 } else if (type == "sky") {
                     checkKeys(c, l, where, {"type", "sunDirection", "sunRadius", "sunRadiance", "scale"});
-                    Vec3 sun = normalize(getVec3(c, l, "sunDirection", where, Vec3(-0.55f, 0.62f, 0.55f)));
-                    if (length(sun) <= 0.0f) fail(c, where + ": \"sunDirection\" must be non-zero");
-                    float radiusDeg = getFloat(c, l, "sunRadius", where, 0.5f);
+                    Vec3 sunIn = getVec3(c, l, "sunDirection", where, Vec3(-0.55f, 0.62f, 0.55f), kCoordinateRule);
+                    Vec3 sun = normalize(sunIn);
+                    if (!(length(sunIn) > 0.0f) || !isFinite(sun)) fail(c, where + ": \"sunDirection\" must be non-zero");
+                    float radiusDeg = getFloat(c, l, "sunRadius", where, 0.5f, kAnyFiniteRule);
                     if (!(radiusDeg > 0.0f && radiusDeg < 45.0f)) fail(c, where + ": \"sunRadius\" must be in (0, 45) degrees");
-                    Vec3 sunL = getVec3(c, l, "sunRadiance", where, Vec3(1.0f, 0.93f, 0.82f) * 20000.0f);
-                    float scale = getFloat(c, l, "scale", where, 1.0f);
+                    Vec3 sunL = getVec3(c, l, "sunRadiance", where, Vec3(1.0f, 0.93f, 0.82f) * 20000.0f, kRadianceRule);
+                    float scale = getFloat(c, l, "scale", where, 1.0f, kScaleRule);
+                    if (!allowed(kRadianceRule, maxComponent(sunL) * scale))
+                        fail(c, where + ": \"sunRadiance\" times \"scale\" " + kRadianceRule.text + " (got " +
+                                    formatValue(double(maxComponent(sunL)) * scale) + ")");
                     b.setEnvMap(makeSkyMap(1024, 512, sun, radiusDeg * kPi / 180.0f, sunL), scale);
                 } else {
                     fail(c, where + ": unknown light type \"" + type + "\" (point, environment, sky)");
@@ -856,6 +1044,8 @@ Scene Scene::builtin(const std::string& name) {
 }
 
 Scene Scene::load(const std::string& path) {
+    if (path.find('\0') != std::string::npos)
+        throw InputError(path.substr(0, path.find('\0')) + "...: the scene path contains a NUL byte");
     std::ifstream in(path, std::ios::binary);
     std::error_code ec;
     if (!in || std::filesystem::is_directory(path, ec)) throw InputError(path + ": cannot open scene file");
