@@ -32,6 +32,7 @@
 #include <nlohmann/json.hpp>
 
 #include "../apps/atrous/denoise_sequence.cpp"  // runSequenceDenoise without the CLI wiring
+#include "../apps/atrous/sequence_checks.cpp"
 #include "atrous/error.h"
 #include "atrous/metrics.h"
 #include "io/image_io.h"

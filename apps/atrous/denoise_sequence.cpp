@@ -15,6 +15,7 @@
 #include "core/timer.h"
 #include "io/image_io.h"
 #include "io/sequence.h"
+#include "sequence_checks.h"
 
 namespace fs = std::filesystem;
 
@@ -216,7 +217,7 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
     // (a truncated EXR) fails inside the loop, before anything reaches OUTDIR (StagedOutput).
     std::vector<std::string> frames = io::listSequenceFrames(args.sequenceDir);
     int width = 0, height = 0;
-    io::validateSequence(frames, width, height);
+    const std::vector<std::string> present = io::validateSequence(frames, width, height);
     std::unique_ptr<SvgfDenoiser> svgfDenoiser;
     DenoiseOptions options = args.frameOptions;
     if (svgf) {
@@ -229,45 +230,73 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
     StagedOutput staged(args.outDir);
     const std::string stage = staged.stage();
 
+    auto img = [](const Image& i) { return i.empty() ? nullptr : &i; };
     int firstIndex = -1;
-    for (const auto& dir : frames) {
-        io::SequenceFrame f = io::loadSequenceFrame(dir);
+    bool idsTrusted = true, warnedSign = false, notedMotion = false;
+    io::SequenceFrame prev;
+    for (const auto& path : frames) {
+        io::SequenceFrame f = io::loadSequenceFrame(path, present);
         if (firstIndex < 0) firstIndex = f.index;
+        std::string name = io::sequenceFrameName(f.index);
+        // Other renderers' sequences: how much reprojects, with which sign, and whether ids hold.
+        ReprojectionCheck check;
+        if (firstIndex != f.index)
+            check = checkReprojection(f.depth, f.normal, f.ids, f.motion, prev.depth, prev.normal, prev.ids);
+        if (svgf && f.motion.empty() && !notedMotion) {
+            std::fprintf(stderr, "denoise: note: the frames have no motion vectors: SVGF assumes nothing moves on screen\n");
+            notedMotion = true;
+        }
+        if (check.tested >= 64 && !warnedSign && check.keptNegated > check.kept + 0.2 && check.keptNegated > 0.5) {
+            std::fprintf(stderr,
+                         "denoise: warning: %s: the motion vectors look like the opposite sign convention (%.0f%% of the "
+                         "frame reprojects as given, %.0f%% negated); atrous wants previous - current, in pixels, y down\n",
+                         name.c_str(), 100 * check.kept, 100 * check.keptNegated);
+            warnedSign = true;
+        }
+        if (idsTrusted && !f.ids.empty() && check.tested >= 64 && check.kept > 0.2 && check.idsAgree < 0.9) {
+            std::fprintf(stderr,
+                         "denoise: note: %s: the ids change between frames (%.0f%% agree after reprojection): not used "
+                         "from here on (Mitsuba renumbers shapes when a scene is loaded)\n",
+                         name.c_str(), 100 * check.idsAgree);
+            idsTrusted = false;
+        }
         Timer timer;
         Image out;
         if (svgf) {
             SvgfFrame in;
             in.color = &f.color;
-            in.albedo = &f.albedo;
-            in.normal = &f.normal;
-            in.depth = &f.depth;
-            in.ids = &f.ids;
-            in.motion = &f.motion;
-            in.emission = f.emission.empty() ? nullptr : &f.emission;
+            in.albedo = img(f.albedo);
+            in.normal = img(f.normal);
+            in.depth = img(f.depth);
+            in.ids = idsTrusted ? img(f.ids) : nullptr;
+            in.motion = img(f.motion);
+            in.emission = img(f.emission);
             out = svgfDenoiser->denoiseFrame(in);
         } else {
             DenoiseInputs in;
             in.color = &f.color;
-            in.variance = f.variance.empty() ? nullptr : &f.variance;
-            in.albedo = &f.albedo;
-            in.normal = &f.normal;
-            in.position = &f.position;
-            in.depth = &f.depth;
-            in.ids = &f.ids;
+            in.variance = img(f.variance);
+            in.albedo = img(f.albedo);
+            in.normal = img(f.normal);
+            in.position = img(f.position);
+            in.depth = img(f.depth);
+            in.ids = idsTrusted ? img(f.ids) : nullptr;
+            in.emission = img(f.emission);
             out = denoise(in, options);
         }
         double ms = timer.ms();
-        std::string name = io::sequenceFrameName(f.index);
         io::writeImage((fs::path(stage) / (name + ".exr")).string(), out);
         io::writePng((fs::path(stage) / (name + ".png")).string(), out, args.exposure);
         if (!args.quiet) {
             std::printf("%s: %s %.1f ms", name.c_str(), args.method.c_str(), ms);
+            if (check.tested > 0) std::printf(", %.0f%% reprojects onto the previous frame", 100 * check.kept);
             if (!f.reference.empty())
                 std::printf(", MSE vs reference %.6g (input %.6g)", meanSquaredError(out, f.reference),
                             meanSquaredError(f.color, f.reference));
             std::printf("\n");
             std::fflush(stdout);
         }
+        prev = std::move(f);
     }
     if (args.preview) writeAnimatedPreview(stage, firstIndex, args.quiet, args.outDir);
     staged.commit();

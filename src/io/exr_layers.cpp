@@ -134,6 +134,12 @@ std::vector<int> pickComponents(const ExrInfo& info, const ExrLayer& layer, int 
     }
     static const char* const kTriples[][3] = {{"R", "G", "B"}, {"X", "Y", "Z"}, {"r", "g", "b"},
                                               {"x", "y", "z"}, {"U", "V", "W"}, {"u", "v", "w"}};
+    if (count == 2) {
+        for (const auto& t : kTriples) {
+            const int a = find(t[0]), b = find(t[1]);
+            if (a >= 0 && b >= 0) return {a, b};
+        }
+    }
     for (const auto& t : kTriples) {
         const int a = find(t[0]), b = find(t[1]), c = find(t[2]);
         if (a >= 0 && b >= 0 && c >= 0) return {a, b, c};

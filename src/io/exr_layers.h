@@ -52,8 +52,9 @@ bool isExrFile(const std::string& path);
 // Reads the headers only. Throws InputError naming the file when it is not a readable EXR.
 ExrInfo inspectExr(const std::string& path);
 
-// Picks `count` (1 or 3) components of a layer for a buffer: R,G,B / X,Y,Z / U,V,W (either case)
-// for 3, otherwise the first non-alpha components in file order; a one-component layer is repeated.
+// Picks `count` (1, 2 or 3) components of a layer for a buffer: R,G,B / X,Y,Z / U,V,W (either
+// case; their first two for 2), otherwise the first non-alpha components in file order; a
+// one-component layer is repeated.
 // For 1: "Z", "V", "Y", "R" or "X" when present, else the first non-alpha component. Empty when the
 // layer has no usable component (only A), or fewer than `count` but more than one.
 std::vector<int> pickComponents(const ExrInfo& info, const ExrLayer& layer, int count);

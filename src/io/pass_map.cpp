@@ -74,9 +74,8 @@ bool inViewLayer(const ExrLayer& l, const std::string& viewLayer) {
 
 // The channels of `layer` for buffer b, or an InputError naming the file and the layer.
 std::vector<int> channelsFor(const ExrInfo& info, const ExrLayer& layer, Buffer b) {
-    const int want = bufferChannels(b) == 1 ? 1 : 3;
-    std::vector<int> ch = pickComponents(info, layer, want);
-    if (b == Buffer::Motion && ch.size() == 3) ch.resize(2);  // Blender's Vector: X, Y (to previous), Z, W
+    // Motion: X, Y of Blender's Vector (to the previous frame; Z, W point to the next one).
+    std::vector<int> ch = pickComponents(info, layer, bufferChannels(b));
     if (ch.empty())
         throw InputError(info.path + where(info, layer) + ": layer " + layerLabel(layer) + " has no usable channels for " +
                          kNames[int(b)] + " (it has " + std::to_string(layer.components.size()) + ")");
@@ -94,7 +93,7 @@ int matchRules(const ExrInfo& info, Buffer b, const std::string& viewLayer, std:
                 const bool root = l.name.empty();
                 const bool match = name.empty() ? root : !root && norm(l.passName()) == name;
                 if (!match) continue;
-                if (pickComponents(info, l, bufferChannels(b) == 1 ? 1 : 3).empty()) continue;  // e.g. alpha only
+                if (pickComponents(info, l, bufferChannels(b)).empty()) continue;  // e.g. alpha only
                 if (found >= 0)
                     throw InputError(info.path + ": ambiguous " + std::string(kNames[int(b)]) + " pass: both " +
                                      layerLabel(info.layers[size_t(found)]) + where(info, info.layers[size_t(found)]) +
@@ -196,7 +195,7 @@ PassChoice passForFile(const ExrInfo& info, Buffer b, const std::vector<PassRequ
         if (r.buffer == b) return requested(info, r);
     std::vector<int> usable;
     for (size_t i = 0; i < info.layers.size(); ++i)
-        if (!pickComponents(info, info.layers[i], bufferChannels(b) == 1 ? 1 : 3).empty()) usable.push_back(int(i));
+        if (!pickComponents(info, info.layers[i], bufferChannels(b)).empty()) usable.push_back(int(i));
     PassChoice c;
     if (usable.size() == 1) {
         c.layer = usable[0];
@@ -244,6 +243,11 @@ void conformBuffer(Buffer b, Image& img) {
                 const float z = r[i];
                 if (!(z > 0.0f) || !(z < 1e9f)) r[i] = 1e30f;  // NaN, Inf, 0 or the 1e10 of Cycles: background
             }
+            break;
+        case Buffer::Albedo:
+            // Cycles' Denoising Albedo carries a visible emitter's radiance (30 on a panel light) and
+            // its background's colour: a reflectance is at most 1 (non-finite: 1, no demodulation).
+            for (size_t i = 0; i < img.channels() * n; ++i) r[i] = std::isfinite(r[i]) ? std::min(std::max(r[i], 0.0f), 1.0f) : 1.0f;
             break;
         case Buffer::Position:
         case Buffer::ObjectId:

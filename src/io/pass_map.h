@@ -57,8 +57,9 @@ Image readPass(const ExrInfo& info, const PassChoice& pass, Buffer b);
 
 // atrous's conventions for a buffer read from anywhere (docs/inputs.md): normals longer than 1 normalised
 // (shorter ones, means across an edge, kept; zero stays zero: background); depth <= 0, non-finite or >= 1e9 becomes the background value 1e30;
-// non-finite positions, ids and motion become 0. Colour, albedo, variance, emission are left as
-// they are (the filters repair non-finite colour).
+// non-finite positions, ids and motion become 0; albedo is clamped to [0, 1] (Cycles writes an
+// emitter's radiance there). Colour, variance, emission are left as they are (the filters repair
+// non-finite colour).
 void conformBuffer(Buffer b, Image& img);
 
 // One line per layer for `atrous inspect`: name, components, types, part.

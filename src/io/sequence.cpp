@@ -6,21 +6,37 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <utility>
 
 #include "atrous/error.h"
+#include "io/buffer_set.h"
+#include "io/exr_layers.h"
 #include "io/image_io.h"
 
 namespace fs = std::filesystem;
 
 namespace atrous::io {
 
-const char* const kSequenceBuffers[7] = {"color", "albedo", "normal", "position", "depth", "ids", "motion"};
+const char* const kSequenceBuffers[10] = {"color", "albedo",   "normal",   "position", "depth",
+                                          "ids",   "motion",   "emission", "variance", "reference"};
 
 namespace {
 
-const char* const kOptionalBuffers[3] = {"reference", "emission", "variance"};
+// The io::Buffer each frame-directory file is read as (reference: as a colour).
+const Buffer kFileBuffer[10] = {Buffer::Color,  Buffer::Albedo, Buffer::Normal,   Buffer::Position, Buffer::Depth,
+                                Buffer::ObjectId, Buffer::Motion, Buffer::Emission, Buffer::Variance, Buffer::Color};
+
+bool isLayeredFrame(const std::string& path) { return fs::path(path).extension() == ".exr"; }
+
+// A layered frame's companion file (<stem>_motion.exr), or "" when there is none.
+std::string companion(const std::string& frame, const char* what) {
+    const fs::path p(frame);
+    const fs::path c = p.parent_path() / (p.stem().string() + "_" + what + ".exr");
+    std::error_code ec;
+    return fs::is_regular_file(c, ec) ? c.string() : std::string();
+}
 
 std::string sizeText(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
 
@@ -78,26 +94,61 @@ std::string sequenceFrameName(int index) {
     return buf;
 }
 
+int parseLayeredFrameName(const std::string& fileName, std::string* prefix) {
+    const fs::path p(fileName);
+    if (p.extension() != ".exr") return -1;
+    const std::string stem = p.stem().string();
+    for (const char* suffix : {"_motion", "_reference"})
+        if (stem.size() >= std::strlen(suffix) && stem.compare(stem.size() - std::strlen(suffix), std::string::npos, suffix) == 0)
+            return -1;
+    size_t i = stem.size();
+    while (i > 0 && std::isdigit(static_cast<unsigned char>(stem[i - 1]))) --i;
+    if (i == stem.size() || stem.size() - i > 8) return -1;
+    if (prefix) *prefix = stem.substr(0, i);
+    return std::stoi(stem.substr(i));
+}
+
 std::vector<std::string> listSequenceFrames(const std::string& dir) {
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) throw InputError("sequence " + dir + ": not a directory");
-    std::vector<std::pair<int, std::string>> frames;
+    std::vector<std::pair<int, std::string>> frames, files;
+    std::string prefix, firstFile;
     for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
         std::error_code ec2;
-        if (!it->is_directory(ec2)) continue;
-        int index = parseSequenceFrameName(it->path().filename().string());
-        if (index >= 0) frames.emplace_back(index, it->path().string());
+        const std::string name = it->path().filename().string();
+        if (it->is_directory(ec2)) {
+            const int index = parseSequenceFrameName(name);
+            if (index >= 0) frames.emplace_back(index, it->path().string());
+        } else if (it->is_regular_file(ec2)) {
+            std::string pre;
+            const int index = parseLayeredFrameName(name, &pre);
+            if (index < 0) continue;
+            if (!files.empty() && pre != prefix)
+                throw InputError("sequence " + dir + ": numbered EXR files with two prefixes ('" + firstFile + "' and '" + name +
+                                 "'): keep one sequence per directory");
+            prefix = pre;
+            if (firstFile.empty()) firstFile = name;
+            files.emplace_back(index, it->path().string());
+        }
     }
     if (ec) throw InputError("sequence " + dir + ": cannot list the directory (" + ec.message() + ")");
-    if (frames.empty()) throw InputError("sequence " + dir + ": no frame_NNNN directories");
+    if (!frames.empty() && !files.empty())
+        throw InputError("sequence " + dir + ": holds both frame_NNNN directories and numbered EXR files (" + firstFile +
+                         "): keep one layout per directory");
+    const bool layered = frames.empty();
+    if (layered) frames = files;
+    if (frames.empty()) throw InputError("sequence " + dir + ": no frame_NNNN directories or numbered EXR files");
     std::sort(frames.begin(), frames.end());
+    auto label = [&](int index) {
+        return layered ? prefix + std::to_string(index) + " (a numbered EXR file)" : sequenceFrameName(index);
+    };
     std::vector<std::string> out;
     for (size_t i = 0; i < frames.size(); ++i) {
         if (i > 0 && frames[i].first == frames[i - 1].first)
             throw InputError("sequence " + dir + ": frame " + std::to_string(frames[i].first) + " appears twice (" +
                              frames[i - 1].second + ", " + frames[i].second + ")");
         if (i > 0 && frames[i].first != frames[i - 1].first + 1)
-            throw InputError("sequence " + dir + ": " + sequenceFrameName(frames[i - 1].first + 1) + " is missing (gap between " +
+            throw InputError("sequence " + dir + ": " + label(frames[i - 1].first + 1) + " is missing (gap between " +
                              fs::path(frames[i - 1].second).filename().string() + " and " +
                              fs::path(frames[i].second).filename().string() + ")");
         out.push_back(frames[i].second);
@@ -105,58 +156,97 @@ std::vector<std::string> listSequenceFrames(const std::string& dir) {
     return out;
 }
 
-void validateSequence(const std::vector<std::string>& frameDirs, int& width, int& height) {
+std::vector<std::string> validateSequence(const std::vector<std::string>& frames, int& width, int& height) {
     std::string firstFile;
     width = height = 0;
-    for (const auto& dir : frameDirs) {
-        auto checkFile = [&](const std::string& path) {
-            int w = 0, h = 0;
-            exrSize(path, w, h);
-            if (firstFile.empty()) {
-                firstFile = path;
-                width = w;
-                height = h;
-            } else if (w != width || h != height) {
-                throw InputError("sequence frames differ in size: " + path + " is " + sizeText(w, h) + " but " + firstFile +
-                                 " is " + sizeText(width, height));
-            }
-        };
+    auto checkSize = [&](const std::string& path, int w, int h) {
+        if (firstFile.empty()) {
+            firstFile = path;
+            width = w;
+            height = h;
+        } else if (w != width || h != height) {
+            throw InputError("sequence frames differ in size: " + path + " is " + sizeText(w, h) + " but " + firstFile +
+                             " is " + sizeText(width, height));
+        }
+    };
+    auto checkFile = [&](const std::string& path) {
+        int w = 0, h = 0;
+        exrSize(path, w, h);
+        checkSize(path, w, h);
+    };
+    std::vector<std::string> present;
+    for (size_t i = 0; i < frames.size(); ++i) {
+        const std::string& frame = frames[i];
         std::error_code ec;
+        if (isLayeredFrame(frame)) {
+            const ExrInfo info = inspectExr(frame);
+            checkSize(frame, info.width, info.height);
+            const std::string motion = companion(frame, "motion");
+            if (!motion.empty()) checkFile(motion);
+            continue;
+        }
+        std::vector<std::string> here;
         for (const char* name : kSequenceBuffers) {
-            std::string path = (fs::path(dir) / (std::string(name) + ".exr")).string();
-            if (!fs::is_regular_file(path, ec)) throw InputError(path + ": missing (every frame needs " + name + ".exr)");
-            checkFile(path);
+            const std::string path = (fs::path(frame) / (std::string(name) + ".exr")).string();
+            if (fs::is_regular_file(path, ec)) {
+                checkFile(path);
+                here.push_back(name);
+            } else if (std::string(name) == "color") {
+                throw InputError(path + ": missing (every frame needs color.exr)");
+            }
         }
-        for (const char* name : kOptionalBuffers) {
-            std::string path = (fs::path(dir) / (std::string(name) + ".exr")).string();
-            if (fs::exists(path, ec)) checkFile(path);
+        if (i == 0) {
+            present = here;
+            continue;
         }
+        for (const auto& name : present)
+            if (std::find(here.begin(), here.end(), name) == here.end())
+                throw InputError((fs::path(frame) / (name + ".exr")).string() + ": missing, but " + frames[0] + " has " + name +
+                                 ".exr (a buffer must be in every frame or in none)");
+        for (const auto& name : here)
+            if (std::find(present.begin(), present.end(), name) == present.end())
+                throw InputError((fs::path(frames[0]) / (name + ".exr")).string() + ": missing, but " + frame + " has " + name +
+                                 ".exr (a buffer must be in every frame or in none)");
     }
+    return present;
 }
 
-SequenceFrame loadSequenceFrame(const std::string& frameDir) {
+SequenceFrame loadSequenceFrame(const std::string& frame, const std::vector<std::string>& expected) {
     SequenceFrame f;
-    f.dir = frameDir;
-    f.index = parseSequenceFrameName(fs::path(frameDir).filename().string());
-    Image* required[7] = {&f.color, &f.albedo, &f.normal, &f.position, &f.depth, &f.ids, &f.motion};
+    f.dir = frame;
+    Image* slot[10] = {&f.color, &f.albedo, &f.normal, &f.position, &f.depth, &f.ids, &f.motion, &f.emission, &f.variance,
+                       &f.reference};
+    if (isLayeredFrame(frame)) {
+        f.index = parseLayeredFrameName(fs::path(frame).filename().string());
+        BufferFiles files;
+        files.in = frame;
+        files.file[int(Buffer::Motion)] = companion(frame, "motion");
+        BufferSet set = loadBuffers(files);
+        const Buffer from[9] = {Buffer::Color,    Buffer::Albedo, Buffer::Normal,   Buffer::Position, Buffer::Depth,
+                                Buffer::ObjectId, Buffer::Motion, Buffer::Emission, Buffer::Variance};
+        for (int i = 0; i < 9; ++i) *slot[i] = std::move(set.image[int(from[i])]);
+        return f;
+    }
+    f.index = parseSequenceFrameName(fs::path(frame).filename().string());
     std::string firstPath;
-    auto load = [&](const std::string& name, Image& dst) {
-        std::string path = (fs::path(frameDir) / (name + ".exr")).string();
+    for (int i = 0; i < 10; ++i) {
+        const std::string name = kSequenceBuffers[i];
+        const std::string path = (fs::path(frame) / (name + ".exr")).string();
         std::error_code ec;
-        if (!fs::is_regular_file(path, ec)) throw InputError(path + ": missing (every frame needs " + name + ".exr)");
+        if (!fs::is_regular_file(path, ec)) {
+            const bool wanted = i == 0 || std::find(expected.begin(), expected.end(), name) != expected.end();
+            if (wanted) throw InputError(path + ": missing (every frame of this sequence has " + name + ".exr)");
+            continue;
+        }
+        Image& dst = *slot[i];
         dst = readImage(path);
+        conformBuffer(kFileBuffer[i], dst);
         if (firstPath.empty()) {
             firstPath = path;
         } else if (dst.width() != f.color.width() || dst.height() != f.color.height()) {
             throw InputError("frame buffers differ in size: " + path + " is " + sizeText(dst.width(), dst.height()) + " but " +
                              firstPath + " is " + sizeText(f.color.width(), f.color.height()));
         }
-    };
-    for (int i = 0; i < 7; ++i) load(kSequenceBuffers[i], *required[i]);
-    Image* optional[3] = {&f.reference, &f.emission, &f.variance};
-    for (int i = 0; i < 3; ++i) {
-        std::error_code ec;
-        if (fs::exists(fs::path(frameDir) / (std::string(kOptionalBuffers[i]) + ".exr"), ec)) load(kOptionalBuffers[i], *optional[i]);
     }
     return f;
 }

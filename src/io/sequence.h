@@ -1,11 +1,17 @@
-// Frame sequences for the temporal denoiser (SVGF) and per-frame denoising of animations.
+// Frame sequences for the temporal denoiser (SVGF) and per-frame denoising of animations
+// (docs/inputs.md, "Sequences").
 //
-// Layout: a sequence directory holds frame_0000/, frame_0001/, ... (four or more digits, numbered
-// without gaps from the first one present), each with
-//   color.exr albedo.exr normal.exr position.exr depth.exr ids.exr motion.exr   (required)
-//   reference.exr emission.exr variance.exr                                     (optional)
-// as the renderer writes them (ALGORITHMS.md §1: depth in R (1e30 = background), ids R = mesh id
-// (-1 = background), motion R = dx, G = dy in pixels, previous - current). Other entries are ignored.
+// Two layouts:
+// - atrous's: frame_0000/, frame_0001/, ... (four or more digits, numbered without gaps from the
+//   first one present), each with color.exr and any of albedo.exr normal.exr position.exr
+//   depth.exr ids.exr motion.exr emission.exr variance.exr reference.exr, as `atrous render
+//   --frames` writes them (depth in R, 1e30 = background; ids R = mesh id, -1 = background;
+//   motion R = dx, G = dy in pixels, previous - current, y down).
+// - other renderers': numbered layered EXR files (Blender's render0001.exr, ..., Mitsuba's aov
+//   output 0000.exr, ...: one common prefix, the number last), each read as `atrous denoise --in
+//   FILE.exr` reads it; motion from the file's motion pass (Blender's Vector: see buffer_set.cpp)
+//   or from a companion <stem>_motion.exr.
+// A buffer must be in every frame or in none. Other entries are ignored.
 #pragma once
 #include <functional>
 #include <string>
@@ -15,37 +21,40 @@
 
 namespace atrous::io {
 
-// The buffers every frame must have, in the order they are checked.
-extern const char* const kSequenceBuffers[7];
+// The buffers of a frame directory, in the order they are checked (color first: required).
+extern const char* const kSequenceBuffers[10];
 
 struct SequenceFrame {
     int index = 0;
-    std::string dir;
-    Image color, albedo, normal, position, depth, ids, motion;  // 3-channel host images
-    Image reference;  // empty when reference.exr is absent
-    Image emission;   // empty when emission.exr is absent
-    Image variance;   // empty when variance.exr is absent (per-frame EAW/SURE use it when given)
+    std::string dir;  // the frame directory or layered file
+    // 3-channel host images; empty when the frame has no such buffer.
+    Image color, albedo, normal, position, depth, ids, motion, reference, emission, variance;
 };
 
-// The frame directories of `dir`, sorted by number. Throws InputError when `dir` is not a
-// readable directory, holds no frame_NNNN directory, or the numbering has a gap (the message
-// names the first missing frame).
+// The frames of `dir` (frame directories or numbered layered files), sorted by number. Throws
+// InputError when `dir` is not a readable directory, holds no frame, or the numbering has a gap
+// (the message names the first missing frame).
 std::vector<std::string> listSequenceFrames(const std::string& dir);
 
-// Checks every frame without decoding pixels: each required buffer exists and every buffer of
-// every frame (optional ones included) has the first frame's size, read from the EXR headers.
-// Throws InputError naming the missing file, or both files whose sizes differ. Returns the size.
-void validateSequence(const std::vector<std::string>& frameDirs, int& width, int& height);
+// Checks every frame without decoding pixels: each has a colour, every buffer is in every frame or
+// in none, and every buffer of every frame has the first frame's size (read from the EXR headers).
+// Throws InputError naming the missing file, or both files whose sizes differ. Returns the size
+// and the buffers present (names of kSequenceBuffers).
+std::vector<std::string> validateSequence(const std::vector<std::string>& frames, int& width, int& height);
 
-// Loads one frame directory. Throws InputError naming the file when a required buffer is missing
-// or unreadable, or naming both files when two buffers differ in size.
-SequenceFrame loadSequenceFrame(const std::string& frameDir);
+// Loads one frame. Throws InputError naming the file when a buffer is unreadable, when one of
+// `expected` (validateSequence's list; empty: no check) is missing, or naming both files when two
+// buffers differ in size.
+SequenceFrame loadSequenceFrame(const std::string& frame, const std::vector<std::string>& expected = {});
 
 // "frame_0007" for 7 (at least four digits).
 std::string sequenceFrameName(int index);
 
 // The number of a "frame_NNNN" name (four to eight digits), or -1 when `name` is not one.
 int parseSequenceFrameName(const std::string& name);
+// The number at the end of a layered frame file's stem ("render0012.exr" -> 12, at least one
+// digit), and its prefix; -1 for companions (<stem>_motion.exr, <stem>_reference.exr) and others.
+int parseLayeredFrameName(const std::string& fileName, std::string* prefix = nullptr);
 
 // Removes the entries of `dir` named frame_NNNN + `suffix` ("" for the frame directories of
 // `atrous render --frames`, ".exr"/".png" for the files of `atrous denoise --sequence`) for which
