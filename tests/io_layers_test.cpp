@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -317,4 +318,59 @@ TEST(LayeredCli, OidnDenoiseCommandLine) {
     EXPECT_LE(hi, 1.0f);
     TempDir none;
     expectCleanFailure("denoise -f RTLightmap --hdr " + (in / "color.pfm") + " -o " + (none / "x.pfm"), "RTLightmap", none);
+}
+
+// ------------------------------------------------------------------------- layered sequences
+
+namespace {
+
+// Three Blender-like frames of a camera pan: content moves 1 px left per frame (motion = previous
+// - current = +1 in x), depth in 3-px stripes that move with it, Vector X = +1 (times `vectorSign`),
+// object ids constant (or renumbered every frame).
+void writePanSequence(const std::string& dir, float vectorSign, bool renumberIds) {
+    const int w = 48, h = 32;
+    for (int t = 0; t < 3; ++t) {
+        Image color(w, h, 3), depth(w, h, 1), normal(w, h, 3), vec(w, h, 4), ids(w, h, 1);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const int u = x + t;
+                for (int c = 0; c < 3; ++c) color(x, y, c) = 0.3f + 0.2f * float((u / 5) % 2) + 0.01f * float((x * 7 + y * 3 + t) % 5);
+                depth(x, y, 0) = (u / 3) % 2 ? 2.0f : 4.0f;
+                normal(x, y, 0) = normal(x, y, 1) = 0.0f, normal(x, y, 2) = 1.0f;
+                vec(x, y, 0) = vectorSign, vec(x, y, 1) = vec(x, y, 2) = vec(x, y, 3) = 0.0f;
+                ids(x, y, 0) = renumberIds ? float(t + 1) : 1.0f;
+            }
+        char name[32];
+        std::snprintf(name, sizeof(name), "/render%04d.exr", t + 1);
+        writeLayeredExr(dir + name, {{"ViewLayer.Combined", &color}, {"ViewLayer.Depth", &depth, {"Z"}},
+                                     {"ViewLayer.Normal", &normal, {"X", "Y", "Z"}},
+                                     {"ViewLayer.Vector", &vec, {"X", "Y", "Z", "W"}},
+                                     {"ViewLayer.Object Index", &ids, {"X"}}},
+                        true);
+    }
+}
+
+}  // namespace
+
+TEST(LayeredCli, SequenceOfLayeredFilesWithSignAndIdChecks) {
+    TempDir a, b, c, out;
+    writePanSequence(a.str(), 1.0f, false);
+    CliResult r = runCli("denoise --method svgf --sequence " + a.str() + " --out " + (out / "a"));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("frame_0002: svgf"), std::string::npos) << r.output;
+    // 47 of 48 columns: the last one moves out of the image.
+    EXPECT_NE(r.output.find("98% reprojects onto the previous frame"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("opposite sign"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("ids change"), std::string::npos) << r.output;
+    EXPECT_TRUE(std::filesystem::exists(out / "a/frame_0003.exr"));
+    // The other sign convention: named in a warning.
+    writePanSequence(b.str(), -1.0f, false);
+    r = runCli("denoise --method svgf --sequence " + b.str() + " --out " + (out / "b"));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("motion vectors look like the opposite sign convention"), std::string::npos) << r.output;
+    // Ids renumbered every frame: detected and dropped.
+    writePanSequence(c.str(), 1.0f, true);
+    r = runCli("denoise --method eaw --sequence " + c.str() + " --out " + (out / "c"));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("the ids change between frames"), std::string::npos) << r.output;
 }
