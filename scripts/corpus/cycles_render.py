@@ -258,7 +258,7 @@ def scene_interior(sc):
         loc=(-0.3, 0.6, 0.35), radius=0.35)
     add("cube", material("table", "diffuse", color=(0.8, 0.8, 0.75), index=6), loc=(0.6, -0.3, 0.4),
         scale=(0.35, 0.35, 0.4))
-    sky = world_sky(sc, 30, 250)
+    sky = world_sky(sc, 30, 70)  # the sun shines in through the window (from +x, 30 degrees up)
     camera(sc, (-1.6, -1.85, 1.3), (0.4, 0.9, 0.8), lens=20)
     return f"closed room lit by sun + sky ({sky}) through a window in the right wall (mostly indirect)", \
         "sky texture seen through the window"
