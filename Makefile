@@ -6,7 +6,7 @@ CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 # cmake --build runs make again: no "Entering/Leaving directory" lines from the nested makes.
 MAKEFLAGS += --no-print-directory
 
-.PHONY: setup setup-python configure build demo test python bench gpu-pack clean
+.PHONY: setup setup-python configure build demo test python bench gpu-pack fuzz sanitize clean
 
 setup:
 	@./scripts/setup.sh
@@ -39,6 +39,18 @@ bench: build
 # lent a GPU machine; then scripts/gpu-check.sh --dry-run prints the run invocation (docs/benchmarks.md, "GPU").
 gpu-pack:
 	@JOBS=$(JOBS) ./scripts/gpu-pack.sh
+
+# The fuzz harness at full size (docs/reliability.md): FUZZ_CASES CLI cases plus a sixth as many
+# Python-binding cases, seeded (FUZZ_SEED) and reproducible. `make test` runs its CI subset.
+FUZZ_CASES ?= 2000
+FUZZ_SEED ?= 1
+fuzz: build setup-python
+	@JOBS=$(JOBS) ./scripts/python_install.sh
+	@python3 tests/fuzz/fuzz.py --cli $(BUILD)/atrous --cases $(FUZZ_CASES) --seed $(FUZZ_SEED) --jobs $(JOBS)
+
+# AddressSanitizer + UBSan build in build-asan/: the ctest suite and the fuzz CI subset (docs/reliability.md).
+sanitize: setup
+	@JOBS=$(JOBS) ./scripts/sanitize.sh build-asan
 
 clean:
 	rm -rf $(BUILD) $(BUILD).configure.log out

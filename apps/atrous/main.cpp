@@ -8,6 +8,18 @@
 #include "atrous/error.h"
 #include "commands.h"
 
+namespace {
+
+// Error messages are one line: control characters that a file's bytes put into a message (a
+// mangled EXR channel name with a newline) are written as '?' (found by tests/fuzz).
+std::string oneLine(std::string s) {
+    for (char& c : s)
+        if ((unsigned char)c < 0x20 || c == 0x7f) c = '?';
+    return s;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
     CLI::App app{"atrous: Monte Carlo path tracing and fast wavelet denoising (EAW, SURE, SVGF)"};
     app.require_subcommand(1);
@@ -28,17 +40,17 @@ int main(int argc, char** argv) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
         // Bad flags are bad input: one line, exit code 2.
-        std::fprintf(stderr, "atrous: error: %s (see --help)\n", e.what());
+        std::fprintf(stderr, "atrous: error: %s (see --help)\n", oneLine(e.what()).c_str());
         return 2;
     } catch (const atrous::InputError& e) {
         // parseDevice's message names the value only; every subcommand feeds it from --device
         // (render and denoise add the flag themselves: apps/atrous/cli_flags.h).
-        const std::string msg = e.what();
+        const std::string msg = oneLine(e.what());
         const char* flag = msg.rfind("unknown device '", 0) == 0 ? "--device: " : "";
         std::fprintf(stderr, "atrous: error: %s%s\n", flag, msg.c_str());
         return 2;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "atrous: error: %s\n", e.what());
+        std::fprintf(stderr, "atrous: error: %s\n", oneLine(e.what()).c_str());
         return 2;
     }
     return 0;

@@ -609,6 +609,7 @@ std::vector<std::string> prescanObj(const std::string& path) {
     std::vector<std::string> mtllibs;
     std::string line;
     size_t lineNo = 0;
+    long long counts[3] = {0, 0, 0};  // v, vt, vn so far: a relative (negative) index must stay within them
     while (std::getline(in, line)) {
         ++lineNo;
         size_t i = line.find_first_not_of(" \t");
@@ -618,6 +619,7 @@ std::vector<std::string> prescanObj(const std::string& path) {
         // v, vt, vn: every value a finite number (tinyobjloader reads "nan" or "x" as 0 and 1e39 as Inf).
         const size_t vlen = line.compare(i, 2, "v ") == 0 ? 2 : (line.compare(i, 3, "vt ") == 0 || line.compare(i, 3, "vn ") == 0) ? 3 : 0;
         if (vlen) {
+            ++counts[vlen == 2 ? 0 : (line[i + 1] == 't' ? 1 : 2)];
             std::istringstream vals(line.substr(i + vlen));
             std::string tok;
             while (vals >> tok) {
@@ -645,6 +647,7 @@ std::vector<std::string> prescanObj(const std::string& path) {
             // Each of v/vt/vn: an optional sign and digits; more than 10 digits or above INT_MAX is out of range.
             const std::string token = line.substr(tokenStart, k - tokenStart);
             size_t p = 0;
+            int part = 0;
             while (p <= token.size()) {
                 size_t q = token.find('/', p);
                 if (q == std::string::npos) q = token.size();
@@ -658,6 +661,12 @@ std::vector<std::string> prescanObj(const std::string& path) {
                 if (sig.size() > 10 || (sig.size() == 10 && sig > "2147483647"))
                     throw InputError(path + ": line " + std::to_string(lineNo) + ": face index \"" + token +
                                      "\" is out of range");
+                const long long value = sig.empty() ? 0 : std::stoll(sig);
+                const bool negative = q > p && token[p] == '-';
+                if (part < 3 && !d.empty() && (value == 0 || (negative && value > counts[part])))
+                    throw InputError(path + ": line " + std::to_string(lineNo) + ": face index \"" + token +
+                                     "\" refers to a missing " + (part == 0 ? "vertex" : part == 1 ? "texture coordinate" : "normal"));
+                ++part;
                 p = q + 1;
             }
             if (count > size_t(kMaxFaceVertices))
