@@ -182,7 +182,11 @@ TEST(Reliability, ObjAndMtlValuesFollowTheSceneRules) {
     msg = load("v 0 0 0\nv nan 1 0\nv 1 1 0\nf 1 2 3\n", "");
     EXPECT_NE(msg.find("m.obj: line 2: \"nan\" is not a finite number"), std::string::npos) << msg;
     msg = load("v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nf 1/1 2/1 3/9\n", "");
-    EXPECT_NE(msg.find("refers to a missing texture coordinate"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("line 5: face index \"3/9\" refers to a missing texture coordinate"), std::string::npos) << msg;
+    msg = load("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 999 3\n", "");  // tinyobjloader dropped the face
+    EXPECT_NE(msg.find("face index \"999\" refers to a missing vertex (the file has 3)"), std::string::npos) << msg;
+    msg = load("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 -99 3\n", "");
+    EXPECT_NE(msg.find("face index \"-99\" refers to a missing vertex"), std::string::npos) << msg;
     msg = load("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 99999999999999999999\n", "");
     EXPECT_NE(msg.find("m.obj: line 4: face index \"99999999999999999999\" is out of range"), std::string::npos) << msg;
     fs::remove(dir / "m.mtl");

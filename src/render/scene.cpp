@@ -610,6 +610,9 @@ std::vector<std::string> prescanObj(const std::string& path) {
     std::string line;
     size_t lineNo = 0;
     long long counts[3] = {0, 0, 0};  // v, vt, vn so far: a relative (negative) index must stay within them
+    long long maxIndex[3] = {0, 0, 0};  // the largest absolute index, checked against the totals at the end
+    size_t maxLine[3] = {0, 0, 0};
+    std::string maxToken[3];
     while (std::getline(in, line)) {
         ++lineNo;
         size_t i = line.find_first_not_of(" \t");
@@ -666,6 +669,11 @@ std::vector<std::string> prescanObj(const std::string& path) {
                 if (part < 3 && !d.empty() && (value == 0 || (negative && value > counts[part])))
                     throw InputError(path + ": line " + std::to_string(lineNo) + ": face index \"" + token +
                                      "\" refers to a missing " + (part == 0 ? "vertex" : part == 1 ? "texture coordinate" : "normal"));
+                if (part < 3 && !negative && value > maxIndex[part]) {
+                    maxIndex[part] = value;
+                    maxLine[part] = lineNo;
+                    maxToken[part] = token;
+                }
                 ++part;
                 p = q + 1;
             }
@@ -674,6 +682,11 @@ std::vector<std::string> prescanObj(const std::string& path) {
                                  std::to_string(kMaxFaceVertices) + " vertices");
         }
     }
+    for (int k = 0; k < 3; ++k)
+        if (maxIndex[k] > counts[k])
+            throw InputError(path + ": line " + std::to_string(maxLine[k]) + ": face index \"" + maxToken[k] +
+                             "\" refers to a missing " + (k == 0 ? "vertex" : k == 1 ? "texture coordinate" : "normal") +
+                             " (the file has " + std::to_string(counts[k]) + ")");
     return mtllibs;
 }
 

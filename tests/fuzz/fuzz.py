@@ -736,7 +736,10 @@ def python_cases(rng, n, work):
                 args[key] = v
                 zero_ok = key in ("sigma_color", "sigma_normal", "sigma_position", "sigma_depth", "albedo_floor")
                 hi = 1.0 if key in ("albedo_floor", "color_level_factor") else 3e38
-                must_fail = not (math.isfinite(v) and ((zero_ok and v == 0) or (1e-6 <= v <= hi)))
+                lo = 1e-38 if key == "color_level_factor" else 1e-6
+                if key in ("color_scale", "position_scale", "emission_scale"):
+                    hi = 1e6
+                must_fail = not (math.isfinite(v) and ((zero_ok and v == 0) or (lo <= v <= hi)))
                 if key == "color_level_factor" and v == 0:
                     must_fail = True
                 if key == "albedo_floor" and 0 <= v <= 1:

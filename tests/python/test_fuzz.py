@@ -1,0 +1,21 @@
+"""The fuzz harness's Python-binding cases (tests/fuzz/fuzz.py, docs/reliability.md): seeded
+calls of render, render_sequence, denoise, read_image and write_image with out-of-range values,
+special floats and odd paths, each in a child interpreter (a crash there is a finding, not the end
+of this run). None may crash, hang, raise anything but ValueError/TypeError, return NaN/Inf, or
+accept a value outside its documented range."""
+import os
+import random
+import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "fuzz"))
+import fuzz  # noqa: E402
+
+
+def test_python_binding_cases(tmp_path):
+    os.makedirs(tmp_path / "seeds")
+    fuzz.write_pfm(str(tmp_path / "seeds" / "env.pfm"), 8, 4, [0.5] * 96)
+    fuzz.write_png(str(tmp_path / "seeds" / "tex.png"), 8, 8, [100] * 192)
+    cases = fuzz.python_cases(random.Random(14), 60, str(tmp_path))
+    res = fuzz.run_python_cases(sys.executable, cases, 120)
+    bad = [(c["kind"], c["args"], res[c["id"]]) for c in cases if res[c["id"]] in fuzz.FAILURES]
+    assert not bad, bad
