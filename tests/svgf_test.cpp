@@ -490,6 +490,7 @@ TEST(SvgfParamsTest, EveryFieldChangesTheOutput) {
         {"taaAlpha", [](SvgfParams& p) { p.taa = true, p.taaAlpha = 0.5f; }, &taaOut},
         {"emissionAlpha", [](SvgfParams& p) { p.emissionAlpha = 0.5f; }, &base},
         {"emissionMotionAlpha", [](SvgfParams& p) { p.emissionMotionAlpha = 0.0f; }, &base},
+        {"historyClip", [](SvgfParams& p) { p.historyClip = 0.0f; }, &base},
     };
     for (const auto& c : cases) {
         SvgfParams p;

@@ -92,6 +92,7 @@ void validateSvgfFlags(const SvgfParams& p, const CLI::App& cmd) {
         {"alpha", "--svgf-alpha"},
         {"momentsAlpha", "--svgf-moments-alpha"},
         {"historyCap", "--svgf-history-cap"},
+        {"historyClip", "--svgf-history-clip"},
         {"levels", "--svgf-levels"},
         {"feedbackTap", "--svgf-feedback-tap"},
         {"spatialVarianceFrames", "--svgf-spatial-variance-frames"},

@@ -84,6 +84,9 @@ void addSvgfOptions(CLI::App& cmd, SvgfParams& p) {
     cmd.add_option("--svgf-moments-alpha", p.momentsAlpha, "minimum temporal blend factor of the moments, (0, 1]")
         ->capture_default_str()->group(g);
     cmd.add_option("--svgf-history-cap", p.historyCap, "maximum history length in frames")->capture_default_str()->group(g);
+    cmd.add_option("--svgf-history-clip", p.historyClip,
+                   "clip the reprojected history into mean +- this many std of the current 3x3 samples (0 = off)")
+        ->capture_default_str()->group(g);
     cmd.add_option("--svgf-levels", p.levels, "à-trous levels (0 = temporal accumulation only)")->capture_default_str()->group(g);
     cmd.add_option("--svgf-feedback-tap", p.feedbackTap, "level whose output becomes the colour history (-1 = unfiltered)")
         ->capture_default_str()->group(g);

@@ -22,6 +22,10 @@ struct SvgfParams {
     float alpha = 0.2f;
     float momentsAlpha = 0.2f;
     int historyCap = 32;   // history length saturates here (>= 1)
+    // History clipping: the reprojected illumination is scaled into m ± historyClip·s of the
+    // current frame's 3x3 luminance samples before the blend, so a moving highlight leaves no
+    // trail (other renderers' glossy metals). >= 0; 0 = off. Default measured (docs/svgf.md).
+    float historyClip = 1.0f;
     int levels = 5;        // à-trous levels, step 2^i (0..10; 0 = temporal accumulation only)
     // Which à-trous level's output becomes next frame's colour history: 0 = after the first level
     // (the paper), -1 = the unfiltered temporal accumulation. In [-1, levels - 1]; with levels 0

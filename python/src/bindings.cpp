@@ -182,6 +182,7 @@ void applySvgfParam(SvgfParams& p, const std::string& k, const nb::handle& v) {
     else if (k == "taa_alpha") p.taaAlpha = as<float>(v, k);
     else if (k == "emission_alpha") p.emissionAlpha = as<float>(v, k);
     else if (k == "emission_motion_alpha") p.emissionMotionAlpha = as<float>(v, k);
+    else if (k == "history_clip") p.historyClip = as<float>(v, k);
     else throw InputError("unknown SVGF parameter '" + k + "'");
 }
 

@@ -42,6 +42,7 @@ void validateSvgfParams(const SvgfParams& p) {
                  "reprojectDepthTolerance", "must be a finite number >= 0");
     requireRange(p.reprojectNormalCos >= -1.0f && p.reprojectNormalCos <= 1.0f, "reprojectNormalCos", "must be in [-1, 1]");
     requireRange(p.taaAlpha > 0.0f && p.taaAlpha <= 1.0f, "taaAlpha", "must be in (0, 1]");
+    requireRange(std::isfinite(p.historyClip) && p.historyClip >= 0.0f, "historyClip", "must be a finite number >= 0 (0 = off)");
     requireRange(p.emissionAlpha > 0.0f && p.emissionAlpha <= 1.0f, "emissionAlpha", "must be in (0, 1]");
     requireRange(std::isfinite(p.emissionMotionAlpha) && p.emissionMotionAlpha >= 0.0f, "emissionMotionAlpha",
                  "must be a finite number >= 0");

@@ -145,6 +145,7 @@ public:
         acc.alpha = mParams.alpha;
         acc.momentsAlpha = mParams.momentsAlpha;
         acc.historyCap = float(mParams.historyCap);
+        acc.historyClip = mParams.historyClip;
         acc.illum = s.illum.view(), acc.valid = s.valid.view();
         acc.histIllum = s.reprojIllum.view(), acc.histMoments = s.reprojMoments.view(), acc.histLength = s.reprojLength.view();
         acc.outIllum = s.accIllum.view(), acc.outMoments = s.accMoments.view(), acc.outLength = s.accLength.view();

@@ -53,7 +53,8 @@ bool sameSvgfParams(const SvgfParams& a, const SvgfParams& b) {
            a.spatialVarianceFrames == b.spatialVarianceFrames &&
            a.reprojectDepthTolerance == b.reprojectDepthTolerance &&
            a.reprojectNormalCos == b.reprojectNormalCos && a.taa == b.taa &&
-           a.taaAlpha == b.taaAlpha;
+           a.taaAlpha == b.taaAlpha && a.emissionAlpha == b.emissionAlpha &&
+           a.emissionMotionAlpha == b.emissionMotionAlpha && a.historyClip == b.historyClip;
 }
 
 constexpr float kPi = 3.14159265358979f;
