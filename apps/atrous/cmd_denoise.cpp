@@ -210,10 +210,10 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     Image& color = set.image[int(io::Buffer::Color)];
     if (a.srgb) srgbToLinear(color);
     DenoiseInputs in = set.inputs();
-    static constexpr io::Buffer kLabelled[] = {io::Buffer::Variance, io::Buffer::Albedo, io::Buffer::Normal,
-                                              io::Buffer::Position, io::Buffer::Depth, io::Buffer::ObjectId,
-                                              io::Buffer::Emission};
-    static const char* const kLibraryNames[] = {"variance", "albedo", "normal", "position", "depth", "ids", "emission"};
+    static constexpr io::Buffer kLabelled[] = {io::Buffer::Color,    io::Buffer::Variance, io::Buffer::Albedo,
+                                              io::Buffer::Normal,   io::Buffer::Position, io::Buffer::Depth,
+                                              io::Buffer::ObjectId, io::Buffer::Emission};
+    static const char* const kLibraryNames[] = {"color", "variance", "albedo", "normal", "position", "depth", "ids", "emission"};
     DenoiseReport rep;
     o.report = &rep;
     Timer t;
@@ -331,6 +331,12 @@ void addDenoiseCommand(CLI::App& app) {
                     "Demodulation fades out where the largest albedo channel is below this (black albedo on glass, "
                     "mirrors, lights; 0 = off)")->capture_default_str()->group(kGroupEawSure);
     addSvgfOptions(*cmd, a->svgf);
+    // CLI11 reads an empty value ("--sigma-depth ''") as 0 without a word (found by tests/fuzz):
+    // every option that takes a value refuses an empty one.
+    static const CLI::Validator kNonEmpty(
+        [](std::string& v) { return v.empty() ? std::string("an empty value") : std::string(); }, "", "non-empty");
+    for (CLI::Option* opt : cmd->get_options())
+        if (opt->get_expected_min() > 0) opt->check(kNonEmpty);
     cmd->callback([a, cmd] { run(*a, *cmd); });
 }
 
