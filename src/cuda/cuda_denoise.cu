@@ -95,36 +95,6 @@ void checkDeviceVariance(const Image& variance) {
     throw negativeVarianceError(value, first % variance.plane(), variance.width());
 }
 
-// Donoho's finest B3 detail |v − (B3 ∗ v)(p)| per channel, exactly as estimateNoiseSigma
-// (denoise.cpp) computes it: the same taps, clamped borders and double sums. Pixels it skips (a
-// non-finite value in the 5×5 window) get +Inf, which sorts after every detail.
-struct MadDetail {
-    ImageView color, detail;  // detail: 3 planes
-    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        const int w = color.width, h = color.height;
-        for (int c = 0; c < 3; ++c) {
-            float d = INFINITY;
-            const float v = color(x, y, c);
-            if (isFiniteF(v)) {
-                double s = 0, ws = 0;
-                bool ok = true;
-                for (int qy = -2; qy <= 2 && ok; ++qy)
-                    for (int qx = -2; qx <= 2; ++qx) {
-                        const float u = color(clampIdx(x + qx, w - 1), clampIdx(y + qy, h - 1), c);
-                        if (!isFiniteF(u)) {
-                            ok = false;
-                            break;
-                        }
-                        s += double(b3(qx) * b3(qy)) * u;
-                        ws += b3(qx) * b3(qy);
-                    }
-                if (ok) d = fabsf(float(v - s / ws));
-            }
-            detail(x, y, c) = d;
-        }
-    }
-};
-
 struct IsFiniteDetail {
     ATROUS_HOST_DEVICE bool operator()(float d) const { return d < INFINITY; }
 };
@@ -140,13 +110,22 @@ struct FillVariance {
 
 }  // namespace
 
-void estimateNoiseSigmaCuda(const Image& color, float sigma[3]) {
+void estimateNoiseSigmaCuda(const Image& color, const Image* albedo, float eps, float floor, float sigma[3]) {
     if (color.device() != Device::Cuda) throw RuntimeError("estimateNoiseSigmaCuda: the colour is not on the GPU");
     const int w = color.width(), h = color.height();
     const size_t plane = color.plane();
-    Image detail(w, h, 3, Device::Cuda);
+    Image detail(w, h, 3, Device::Cuda), albedoHolder;
     const CudaExec exec;
-    exec.forEachPixel(w, h, MadDetail{color.view(), detail.view()});
+    MadDetail f;
+    f.color = color.view();
+    if (albedo) {
+        if (albedo->device() != Device::Cuda) albedoHolder = albedo->to(Device::Cuda);
+        f.albedo = albedoHolder.empty() ? albedo->view() : albedoHolder.view();
+    }
+    f.detail = detail.view();
+    f.eps = eps;
+    f.floor = floor;
+    exec.forEachPixel(w, h, f);
     exec.synchronize();
     // As estimateNoiseSigma: var(d_0) = σ² (1 + Σh² − 2 h(0)) for white noise.
     const double sumH2 = (70.0 / 256.0) * (70.0 / 256.0), h0 = (6 / 16.0) * (6 / 16.0);

@@ -14,6 +14,7 @@
 #include "core/timer.h"
 #include "filters/denoise_driver.h"
 #include "filters/denoise_internal.h"
+#include "filters/noise_estimate.h"
 #include "filters/stage_clock.h"
 
 namespace atrous {
@@ -64,41 +65,33 @@ void validateDenoiseOptions(const DenoiseOptions& o) {
 
 namespace filters {
 
-// Donoho's estimator on the finest detail of the unweighted B3 à-trous: σ_d = median|d_0| / 0.6745;
-// for white noise var(d_0) = σ² (1 + Σh² - 2 h(0)) (see sureDetailVarianceFactors), so
-// σ = σ_d / sqrt(0.7900...). Per channel, over finite pixels.
-void estimateNoiseSigma(const Image& color, float sigma[3]) {
+// Donoho's estimator on the finest detail of the unweighted B3 à-trous (MadDetail, noise_estimate.h):
+// σ_d = median|d_0| / 0.6745; for white noise var(d_0) = σ² (1 + Σh² - 2 h(0)), so
+// σ = σ_d / sqrt(0.7900...). Per channel, over finite pixels; of the demodulated colour when an
+// albedo is given.
+void estimateNoiseSigma(const Image& color, const Image* albedo, float eps, float floor, float sigma[3]) {
     const int w = color.width(), h = color.height();
-    const double sumH2 = (70.0 / 256.0) * (70.0 / 256.0), h0 = (6 / 16.0) * (6 / 16.0);
-    const double detailVar = 1.0 + sumH2 - 2.0 * h0;
+    Image detail(w, h, 3, Device::Cpu);
+    MadDetail f;
+    f.color = color.view();
+    f.albedo = albedo ? albedo->view() : ImageView{};
+    f.detail = detail.view();
+    f.eps = eps;
+    f.floor = floor;
+    CpuExec{}.forEachPixel(w, h, f);
     for (int c = 0; c < 3; ++c) {
         std::vector<float> d;
-        d.reserve(size_t(w) * h);
-        for (int y = 0; y < h; ++y)
-            for (int x = 0; x < w; ++x) {
-                const float v = color(x, y, c);
-                if (!std::isfinite(v)) continue;
-                double s = 0, ws = 0;
-                bool ok = true;
-                for (int qy = -2; qy <= 2 && ok; ++qy)
-                    for (int qx = -2; qx <= 2; ++qx) {
-                        const float u = color(clampIdx(x + qx, w - 1), clampIdx(y + qy, h - 1), c);
-                        if (!std::isfinite(u)) {
-                            ok = false;
-                            break;
-                        }
-                        s += double(b3(qx) * b3(qy)) * u;
-                        ws += b3(qx) * b3(qy);
-                    }
-                if (ok) d.push_back(std::fabs(float(v - s / ws)));
-            }
+        d.reserve(detail.plane());
+        const float* p = detail.data() + size_t(c) * detail.plane();
+        for (size_t i = 0; i < detail.plane(); ++i)
+            if (p[i] < INFINITY) d.push_back(p[i]);
         if (d.empty()) {
             sigma[c] = 0;
             continue;
         }
         auto mid = d.begin() + d.size() / 2;
         std::nth_element(d.begin(), mid, d.end());
-        sigma[c] = float(double(*mid) / 0.6745 / std::sqrt(detailVar));
+        sigma[c] = float(double(*mid) / 0.6745 / std::sqrt(double(kDetailVarFactor)));
     }
 }
 
@@ -178,7 +171,8 @@ PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, D
         // on the GPU, and denoiseCuda fills the constant variance there (estimatedVariance empty).
         rep.noiseEstimated = true;
         if (colorOnHost) {
-            estimateNoiseSigma(color, rep.noiseSigma);
+            const Image* albedo = o.demodulate && in.albedo && in.albedo->device() == Device::Cpu ? in.albedo : nullptr;
+            estimateNoiseSigma(color, albedo, o.albedoEpsilon, o.albedoFloor, rep.noiseSigma);
             p.estimatedVariance = Image(color.width(), color.height(), 3, Device::Cpu);
             for (int c = 0; c < 3; ++c) {
                 const float v = rep.noiseSigma[c] * rep.noiseSigma[c];
@@ -186,7 +180,7 @@ PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, D
                           p.estimatedVariance.data() + (c + 1) * p.estimatedVariance.plane(), v);
             }
         } else {
-            estimateNoiseSigmaCuda(color, rep.noiseSigma);
+            estimateNoiseSigmaCuda(color, o.demodulate ? in.albedo : nullptr, o.albedoEpsilon, o.albedoFloor, rep.noiseSigma);
         }
     }
     if (in.albedo) used += o.demodulate ? ",albedo" : ",albedo(unused: demodulation off)";
@@ -324,7 +318,7 @@ namespace atrous::filters {
 Image denoiseCuda(const DenoiseInputs&, const DenoiseOptions&, const PreparedInputs&, DenoiseReport&) {
     throw InputError("--device cuda: this build of atrous has no CUDA backend");
 }
-void estimateNoiseSigmaCuda(const Image&, float[3]) {
+void estimateNoiseSigmaCuda(const Image&, const Image*, float, float, float[3]) {
     throw InputError("--device cuda: this build of atrous has no CUDA backend");
 }
 }  // namespace atrous::filters

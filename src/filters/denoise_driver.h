@@ -45,7 +45,8 @@ struct DriverConfig {
     float albedoFloor = 0.0f;
     bool varianceGiven = true;  // false: the variance is a constant estimate
     // Without a variance: the local estimate (noise_estimate.h) over quadrants of this radius
-    // (0 = keep the constant), floored at noiseFloorVar (the global estimate times a fraction).
+    // (0 = keep the constant), floored at noiseFloorVar (the global estimate times a fraction) and
+    // capped at kNoiseCapMul times it.
     int noiseRadius = 0;
     float noiseFloorVar[3] = {0, 0, 0};
 };
@@ -130,6 +131,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         exec.forEachPixel(w, h, QuadrantRows{cfg.noiseRadius, energy.view(), rows.view()});
         LocalVariance lv;
         lv.radius = cfg.noiseRadius;
+        lv.capMul = kNoiseCapMul;
         for (int c = 0; c < 3; ++c) lv.floorVar[c] = cfg.noiseFloorVar[c];
         lv.eps = cfg.albedoEpsilon;
         lv.floor = cfg.albedoFloor;

@@ -33,11 +33,12 @@ DriverConfig makeConfig(const DenoiseOptions& o);
 constexpr int kNoiseRadius = 5;
 constexpr float kNoiseFloorFraction = 1.0f;
 void setNoiseEstimate(DriverConfig& cfg, const DenoiseReport& rep);
-// Per-channel noise standard deviation by Donoho's MAD of the finest B3 detail.
-void estimateNoiseSigma(const Image& color, float sigma[3]);
+// Per-channel noise standard deviation by Donoho's MAD of the finest B3 detail of the colour
+// divided by the modulation albedo (albedo null: of the colour itself).
+void estimateNoiseSigma(const Image& color, const Image* albedo, float eps, float floor, float sigma[3]);
 // The same estimate of a colour on the GPU, computed there (src/cuda/cuda_denoise.cu): the same
-// details in the same double arithmetic, so the same medians.
-void estimateNoiseSigmaCuda(const Image& color, float sigma[3]);
+// MadDetail functor, so the same medians. A host albedo is uploaded for it.
+void estimateNoiseSigmaCuda(const Image& color, const Image* albedo, float eps, float floor, float sigma[3]);
 Image denoiseCpu(const DenoiseInputs& in, const DenoiseOptions& o, const PreparedInputs& prep, DenoiseReport& rep,
                  DriverDebug* debug);
 Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const PreparedInputs& prep, DenoiseReport& rep);
