@@ -6,7 +6,7 @@ CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 # cmake --build runs make again: no "Entering/Leaving directory" lines from the nested makes.
 MAKEFLAGS += --no-print-directory
 
-.PHONY: setup setup-python configure build demo test python bench gpu-pack fuzz sanitize clean
+.PHONY: setup setup-python configure build demo test quality python bench gpu-pack fuzz sanitize clean
 
 setup:
 	@./scripts/setup.sh
@@ -28,6 +28,14 @@ demo: configure
 test: build setup-python
 	@cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 	@JOBS=$(JOBS) ./scripts/python_test.sh
+	@./scripts/corpus_check.sh $(BUILD)
+
+# The full third-party corpus (~40 min to render the first time) and its quality tables
+# (docs/quality.md, "Other renderers' output").
+quality: build setup-python
+	@python3 scripts/corpus/render.py --full
+	@python3 scripts/corpus/cli_quality.py --corpus out/corpus/full --atrous $(BUILD)/atrous --json out/corpus/full/cli_quality.json
+	@.venv/bin/python scripts/corpus/quality.py --corpus out/corpus/full --crops
 
 python: setup-python
 	@JOBS=$(JOBS) ./scripts/python_install.sh

@@ -3,10 +3,12 @@
 hands it over (`atrous denoise --in FILE.exr` or `--in DIR`), against the corpus's reference.
 
   scripts/corpus/cli_quality.py [--corpus out/corpus/quick] [--atrous build/atrous] [--json OUT]
-      [--methods eaw,sure] [--max-ratio R]
+      [--methods eaw,sure] [--max-ratio R] [--bounds FILE] [--write-bounds FILE --margin M]
 
 Needs only the CLI and the rendered corpus (scripts/corpus/render.py), not Mitsuba or Blender.
-With --max-ratio R it exits 1 when any filter's relMSE is above R times the noisy input's.
+With --max-ratio R it exits 1 when any filter's relMSE is above R times the noisy input's; with
+--bounds FILE when any relMSE is above its bound there ("scene/spp/method": relMSE); the CI check
+(scripts/corpus_check.sh) uses the bounds. --write-bounds writes today's figures times M.
 """
 import argparse
 import glob
@@ -51,6 +53,9 @@ def main():
     ap.add_argument("--json")
     ap.add_argument("--max-ratio", type=float)
     ap.add_argument("--extra", default="", help="extra denoise flags, e.g. '--no-firefly'")
+    ap.add_argument("--bounds", help="JSON of bounds: {\"scene/spp/method\": relMSE}")
+    ap.add_argument("--write-bounds", help="write today's relMSE x --margin as a bounds file")
+    ap.add_argument("--margin", type=float, default=1.25)
     a = ap.parse_args()
     methods = a.methods.split(",")
     rows, worst = [], 0.0
@@ -79,10 +84,34 @@ def main():
     print(f"worst filter/noisy ratio: {worst:.3f}")
     if a.json:
         json.dump({"corpus": a.corpus, "rows": rows, "worst_ratio": worst}, open(a.json, "w"), indent=1)
+    worse = [f"{r['scene']}/{r['spp']}/{m}" for r in rows for m in methods if r[m] >= r["noisy"]]
+    if worse:
+        print("worse than the noisy input: " + ", ".join(worse))
+    if a.write_bounds:
+        b = {f"{r['scene']}/{r['spp']}/{m}": float(f"{r[m] * a.margin:.4g}") for r in rows for m in methods}
+        json.dump(b, open(a.write_bounds, "w"), indent=1, sort_keys=True)
+    failed = False
+    if a.bounds:
+        bounds = json.load(open(a.bounds))
+        seen = set()
+        for r in rows:
+            for m in methods:
+                key = f"{r['scene']}/{r['spp']}/{m}"
+                if key not in bounds:
+                    continue
+                seen.add(key)
+                if r[m] > bounds[key]:
+                    print(f"FAIL: {key}: relMSE {r[m]:.4g} above its bound {bounds[key]}", file=sys.stderr)
+                    failed = True
+        missing = sorted(set(bounds) - seen)
+        if missing:
+            print("FAIL: not measured: " + ", ".join(missing), file=sys.stderr)
+            failed = True
+        print(f"{len(seen)} bounds checked, {'some failed' if failed else 'all held'}")
     if a.max_ratio is not None and worst > a.max_ratio:
         print(f"FAIL: a filter's relMSE is {worst:.3f}x the noisy input's (bound {a.max_ratio})", file=sys.stderr)
-        return 1
-    return 0
+        failed = True
+    return 1 if failed else 0
 
 
 if __name__ == "__main__":

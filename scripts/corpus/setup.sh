@@ -12,6 +12,8 @@ PY="${PYTHON:-python3}"
 # back to scalar_rgb.
 if ! ls /usr/lib/x86_64-linux-gnu/libLLVM-19.so* >/dev/null 2>&1 && command -v apt-get >/dev/null; then
   SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo -n"
+  # A fresh machine may have no package lists yet: update once when the package is unknown.
+  apt-cache show libllvm19 >/dev/null 2>&1 || $SUDO apt-get update -qq >/dev/null 2>&1 || true
   $SUDO apt-get install -y -q libllvm19 >/dev/null 2>&1 || echo "setup.sh: libllvm19 not installed; Mitsuba uses scalar_rgb" >&2
 fi
 if [ -x "$VENV/bin/python" ] && "$VENV/bin/python" -c 'import mitsuba, bpy, OpenEXR, numpy' 2>/dev/null; then
