@@ -98,6 +98,21 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     // 1. Non-finite samples and features.
     Image c0(w, h, 3, dev), v0(w, h, 3, dev);
     runSanitizeColor(exec, SanitizeColor{in.color, in.variance, c0.view(), v0.view()});
+    // The albedo the demodulation divides by, sanitised once (the noise estimate reads it too).
+    ImageView albedo = cfg.demodulate ? in.albedo : ImageView{};
+    Image albedoStore;
+    if (albedo.valid()) albedo = sanitizedFeature(exec, albedo, w, h, 3, albedoStore);
+    if (!cfg.varianceGiven && cfg.noiseRadius > 0 && albedo.valid()) {
+        // The global estimate is of the demodulated colour: in the colour's units it scales with
+        // the albedo (noise_estimate.h). Without an albedo the constant given is that already.
+        GlobalVariance gv;
+        for (int c = 0; c < 3; ++c) gv.floorVar[c] = cfg.noiseFloorVar[c];
+        gv.eps = cfg.albedoEpsilon;
+        gv.floor = cfg.albedoFloor;
+        gv.albedo = albedo;
+        gv.var = v0.view();
+        exec.forEachPixel(w, h, gv);
+    }
     // Features: sanitised copies (on the CPU the buffers themselves when already clean), zeros
     // when absent.
     Image emissionStore, normalStore, positionStore, depthStore, idsStore, emissionA, emissionB;
@@ -114,32 +129,10 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
                                          emissionA.view(), emissionB.view());
         }
     }
-    // The albedo the demodulation divides by, sanitised once (the noise estimate reads it too).
-    ImageView albedo = cfg.demodulate ? in.albedo : ImageView{};
-    Image albedoStore;
-    if (albedo.valid()) albedo = sanitizedFeature(exec, albedo, w, h, 3, albedoStore);
     const ImageView normal = sanitizedFeature(exec, in.normal, w, h, 3, normalStore);
     const ImageView position = sanitizedFeature(exec, in.position, w, h, 3, positionStore);
     const ImageView depth = sanitizedFeature(exec, in.depth, w, h, 1, depthStore);
     const ImageView ids = sanitizedFeature(exec, in.ids, w, h, 2, idsStore);
-    if (!cfg.varianceGiven && cfg.noiseRadius > 0) {
-        // v_0 from the colour itself (c_0, emission already taken out): noise_estimate.h.
-        Image demod(w, h, 3, dev), energy(w, h, 3, dev);
-        exec.forEachPixel(w, h, DemodulatedCopy{cfg.albedoEpsilon, cfg.albedoFloor, c0.view(), albedo, demod.view()});
-        exec.forEachPixel(w, h, DetailEnergy{demod.view(), energy.view(), normal, depth});
-        Image rows(w, h, 8, dev);
-        exec.forEachPixel(w, h, QuadrantRows{cfg.noiseRadius, energy.view(), rows.view()});
-        LocalVariance lv;
-        lv.radius = cfg.noiseRadius;
-        lv.capMul = kNoiseCapMul;
-        for (int c = 0; c < 3; ++c) lv.floorVar[c] = cfg.noiseFloorVar[c];
-        lv.eps = cfg.albedoEpsilon;
-        lv.floor = cfg.albedoFloor;
-        lv.rows = rows.view();
-        lv.albedo = albedo;
-        lv.var = v0.view();
-        exec.forEachPixel(w, h, lv);
-    }
     markStage(out.clock, "sanitize");
 
     // 2. Fireflies (before demodulation: the outlier is in radiance).
@@ -159,6 +152,25 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         exec.forEachPixel(w, h, Copy3{cA.view(), out.afterFirefly});
     }
     markStage(out.clock, "fireflies");
+    if (!cfg.varianceGiven && cfg.noiseRadius > 0) {
+        // The variance from the colour itself (after the emission is taken out and the fireflies
+        // clamped with the constant estimate, so that they do not raise it): noise_estimate.h.
+        Image demod(w, h, 3, dev), energy(w, h, 3, dev);
+        exec.forEachPixel(w, h, DemodulatedCopy{cfg.albedoEpsilon, cfg.albedoFloor, cA.view(), albedo, demod.view()});
+        exec.forEachPixel(w, h, DetailEnergy{demod.view(), energy.view(), normal, depth});
+        Image rows(w, h, 8, dev);
+        exec.forEachPixel(w, h, QuadrantRows{cfg.noiseRadius, energy.view(), rows.view()});
+        LocalVariance lv;
+        lv.radius = cfg.noiseRadius;
+        lv.capMul = kNoiseCapMul;
+        for (int c = 0; c < 3; ++c) lv.floorVar[c] = cfg.noiseFloorVar[c];
+        lv.eps = cfg.albedoEpsilon;
+        lv.floor = cfg.albedoFloor;
+        lv.rows = rows.view();
+        lv.albedo = albedo;
+        lv.var = vA.view();
+        exec.forEachPixel(w, h, lv);
+    }
 
     // 3. Albedo demodulation.
     if (albedo.valid()) {

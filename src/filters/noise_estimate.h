@@ -109,6 +109,22 @@ struct DetailEnergy {
     }
 };
 
+// The global estimate in the colour's units: var_c(p) = floorVar_c · a'_c(p)² (the floor is of the
+// demodulated colour). The variance the firefly pass and the emission filter see before the local
+// estimate replaces it.
+struct GlobalVariance {
+    float floorVar[3] = {0, 0, 0};
+    float eps = 1e-3f, floor = 0.0f;
+    ImageView albedo, var;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        const float t = albedo.valid() ? modulationTerm(maxChannel(albedo(x, y, 0), albedo(x, y, 1), albedo(x, y, 2)), floor) : 0.0f;
+        for (int c = 0; c < 3; ++c) {
+            const float a = albedo.valid() ? modulationAlbedo(albedo(x, y, c), t, eps) : 1.0f;
+            var(x, y, c) = floorVar[c] * a * a;
+        }
+    }
+};
+
 // Row half-sums of the energy: left(p) = Σ_{i=0..r} e(x - i, y), right(p) = Σ_{i=0..r} e(x + i, y)
 // (inside the image), per channel, and their tap counts: the first pass of the quadrant sums.
 // rows: 8 channels (left rgb, right rgb, left count, right count).
