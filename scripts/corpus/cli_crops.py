@@ -1,0 +1,72 @@
+#!/usr/bin/env python3
+"""Side-by-side images of the CLI's output on the third-party corpus: noisy | EAW | SURE | reference,
+tonemapped (x / (1 + x), sRGB-like gamma), one PNG per scene and spp.
+
+  .venv/bin/python scripts/corpus/cli_crops.py --corpus out/corpus/full --out docs/images \\
+      --scenes mi_glass,cy_glass_mirror --spp 16 [--atrous build/atrous]
+
+Runs in the project venv (numpy, Pillow from matplotlib) with OpenEXR from .venv-corpus, as
+quality.py does; each input is denoised as a user hands it over (`atrous denoise --in FILE`).
+"""
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+from PIL import Image
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+from cli_quality import stills  # noqa: E402
+import quality  # noqa: E402,F401  (puts .venv-corpus's OpenEXR on the path)
+import OpenEXR  # noqa: E402
+
+
+def rgb(path):
+    with OpenEXR.File(str(path), separate_channels=True) as f:
+        ch = {}
+        for part in f.parts:
+            for k, c in part.channels.items():
+                ch[k] = np.asarray(c.pixels, np.float32)
+    for pre in ("", "ViewLayer.Combined."):
+        if pre + "R" in ch:
+            return np.stack([ch[pre + "R"], ch[pre + "G"], ch[pre + "B"]], -1)
+    raise SystemExit(f"{path}: no R,G,B")
+
+
+def tonemap(x):
+    x = np.maximum(np.nan_to_num(x), 0.0)
+    return (np.clip(x / (1.0 + x), 0.0, 1.0) ** (1 / 2.2) * 255.0 + 0.5).astype(np.uint8)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--corpus", default="out/corpus/full")
+    ap.add_argument("--out", default="docs/images")
+    ap.add_argument("--atrous", default="build/atrous")
+    ap.add_argument("--scenes", default="")
+    ap.add_argument("--spp", type=int, default=16)
+    a = ap.parse_args()
+    want = set(a.scenes.split(",")) if a.scenes else None
+    with tempfile.TemporaryDirectory() as tmp:
+        for scene, _, spp, inp, ref in stills(a.corpus):
+            if spp != a.spp or (want and scene not in want):
+                continue
+            outs = []
+            for m in ("eaw", "sure"):
+                o = os.path.join(tmp, m + ".exr")
+                subprocess.run([a.atrous, "denoise", "--in", inp, "--method", m, "--out", o], check=True,
+                               capture_output=True)
+                outs.append(rgb(o))
+            noisy = rgb(inp if inp.endswith(".exr") else os.path.join(inp, "color.exr"))
+            strip = np.concatenate([tonemap(x) for x in [noisy] + outs + [rgb(ref)]], 1)
+            path = Path(a.out) / f"corpus_{scene}_{spp}spp.png"
+            Image.fromarray(strip).save(path)
+            print(path)
+
+
+if __name__ == "__main__":
+    main()
