@@ -239,8 +239,9 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     std::printf("denoise: method %s on %s, %dx%d, buffers used: %s\n", denoiseMethodName(o.method),
                 deviceToString(o.device), color.width(), color.height(), rep.buffersUsed.c_str());
     if (rep.noiseEstimated)
-        std::printf("denoise: no variance buffer: noise estimated from the image (Donoho MAD), sigma = %.4g %.4g %.4g\n",
-                    rep.noiseSigma[0], rep.noiseSigma[1], rep.noiseSigma[2]);
+        std::printf("denoise: no variance buffer: noise estimated from the image, per pixel (docs/algorithms.md), at least "
+                    "the global MAD sigma = %.4g %.4g %.4g%s\n",
+                    rep.noiseSigma[0], rep.noiseSigma[1], rep.noiseSigma[2], in.albedo && o.demodulate ? " (of the demodulated colour)" : "");
     if (rep.nonFinitePixels > 0)
         std::printf("denoise: %d pixels had NaN/Inf colour, treated as missing\n", rep.nonFinitePixels);
     if (o.firefly.enabled)

@@ -107,11 +107,13 @@ struct DenoiseOptions {
 
 // What a denoise() call did, for the CLI and for measurements.
 struct DenoiseReport {
-    bool noiseEstimated = false;  // no variance buffer: noise estimated by Donoho's MAD
+    // No variance buffer: the noise was estimated from the image, per pixel, floored at Donoho's
+    // MAD of the (demodulated, with an albedo) colour (docs/algorithms.md).
+    bool noiseEstimated = false;
     // A variance buffer was given but was zero everywhere (a 1-spp render has no variance
     // estimate): it was ignored and the noise estimated as without one.
     bool varianceIgnored = false;
-    float noiseSigma[3] = {0, 0, 0};  // the estimated per-channel standard deviation
+    float noiseSigma[3] = {0, 0, 0};  // the global MAD estimate, per channel (the per-pixel floor)
     int nonFinitePixels = 0;          // colour samples that were NaN/Inf (treated as missing)
     int firefliesClamped = 0;
     double meanLuminanceIn = 0;        // mean luminance of the (finite) input colour
