@@ -46,7 +46,7 @@ void runFireflyClamp(const CpuExec& exec, const FireflyClamp& f) {
 #pragma omp simd
                 for (int x = 0; x < w; ++x) {
                     L[x] = lum(cr[x], cg[x], cb[x]);
-                    V[x] = lumVariance(vr[x], vg[x], vb[x]);
+                    V[x] = lumVarianceIndependent(vr[x], vg[x], vb[x]);
                 }
             }
             const float* ATROUS_RESTRICT L0 = rowsL.data();
