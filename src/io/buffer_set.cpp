@@ -119,7 +119,8 @@ BufferSet loadBuffers(const BufferFiles& f) {
             if (fs::exists(p)) path = p;
         }
         if (path.empty()) continue;
-        // A layered file given for the ids takes its object and material passes together.
+        // A layered file given for the ids (`--ids aovs.exr`) gives its object-index pass only;
+        // atrous's own ids.exr (root R, G) is read whole: mesh and material ids.
         s.image[b] = readBufferFile(path, Buffer(b), f.passes, f.viewLayer, &s.from[b]);
     }
     if (s.image[int(Buffer::Color)].empty()) {

@@ -185,7 +185,6 @@ PassMap mapPasses(const ExrInfo& info, const std::vector<PassRequest>& requests,
         c.layer = matchRules(info, Buffer(b), viewLayer, c.rule);
         if (c.layer >= 0) c.channels = channelsFor(info, info.layers[size_t(c.layer)], Buffer(b));
     }
-    // Layers taken twice are a rule clash (e.g. a root layer taken as colour and as something else).
     return m;
 }
 
