@@ -317,6 +317,25 @@ static void requireHdrComplete(const std::string& path, int w, int h) {
 // 1032:1 holds ~8256): a lying header is refused before stb allocates for it.
 constexpr double kMaxPixelsPerByte = 8448.0;
 
+// A PNG must end with its IEND chunk (with its CRC): stb skips CRCs and decodes a file cut short
+// inside or after its last data chunk without a word (found by tests/fuzz, seed 90210). Data after
+// IEND (some tools append it) is allowed: the chunk is looked for in the last 4 KiB.
+static void requirePngComplete(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    unsigned char magic[8] = {0};
+    in.read(reinterpret_cast<char*>(magic), 8);
+    static const unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    if (in.gcount() != 8 || std::memcmp(magic, kPng, 8) != 0) return;
+    const uintmax_t bytes = fileSize(path);
+    const uintmax_t tail = std::min<uintmax_t>(bytes, 4096);
+    std::string data(size_t(tail), '\0');
+    in.seekg(std::streamoff(bytes - tail));
+    in.read(&data[0], std::streamsize(tail));
+    static const char kIend[8] = {'I', 'E', 'N', 'D', char(0xAE), char(0x42), char(0x60), char(0x82)};
+    if (data.find(std::string(kIend, 8)) == std::string::npos)
+        throw InputError(path + ": truncated PNG (no complete IEND chunk at its end)");
+}
+
 static Image readStb(const std::string& path) {
     int w = 0, h = 0, n = 0;
     if (stbi_info(path.c_str(), &w, &h, &n)) {
@@ -347,6 +366,7 @@ static Image readStb(const std::string& path) {
                                  " bytes of pixels, found " + std::to_string(bytes > headerBytes ? bytes - headerBytes : 0) + ")");
         }
     }
+    requirePngComplete(path);
     // stbi_loadf converts 8-bit sRGB to linear (gamma 2.2) and reads Radiance .hdr as is.
     float* data = stbi_loadf(path.c_str(), &w, &h, &n, 3);
     if (!data) throw InputError(path + ": cannot read image (" + stbi_failure_reason() + ")");
