@@ -75,11 +75,7 @@ BufferSet loadBuffers(const BufferFiles& f) {
         const ExrInfo& info = *s.layered;
         const PassMap m = mapPasses(info, f.passes, f.viewLayer);
         if (!m[Buffer::Color].found() && f.file[int(Buffer::Color)].empty())
-            throw InputError(f.in + ": no colour pass (layers: " + [&] {
-                std::string l;
-                for (const ExrLayer& x : info.layers) l += (l.empty() ? "" : ", ") + (x.name.empty() ? "(root)" : x.name);
-                return l;
-            }() + "); name one with --pass color=LAYER");
+            throw InputError(f.in + ": no colour pass (layers: " + layerList(info) + "); name one with --pass color=LAYER");
         Image object, material;
         for (int b = 0; b < kBufferCount; ++b) {
             const PassChoice& c = m.pass[size_t(b)];

@@ -62,11 +62,6 @@ std::string where(const ExrInfo& info, const ExrLayer& layer) {
 
 std::string layerLabel(const ExrLayer& l) { return l.name.empty() ? "(root)" : "'" + l.name + "'"; }
 
-std::string layerList(const ExrInfo& info) {
-    std::string s;
-    for (const ExrLayer& l : info.layers) s += (s.empty() ? "" : ", ") + (l.name.empty() ? std::string("(root)") : l.name);
-    return s;
-}
 
 bool inViewLayer(const ExrLayer& l, const std::string& viewLayer) {
     return viewLayer.empty() || l.prefix().empty() || l.prefix() == viewLayer;
@@ -143,6 +138,12 @@ PassChoice requested(const ExrInfo& info, const PassRequest& r) {
 }  // namespace
 
 const char* bufferName(Buffer b) { return kNames[int(b)]; }
+
+std::string layerList(const ExrInfo& info) {
+    std::string s;
+    for (const ExrLayer& l : info.layers) s += (s.empty() ? "" : ", ") + (l.name.empty() ? std::string("(root)") : l.name);
+    return s;
+}
 
 Buffer parseBufferName(const std::string& name) {
     if (name == "ids") return Buffer::ObjectId;

@@ -62,6 +62,9 @@ Image readPass(const ExrInfo& info, const PassChoice& pass, Buffer b);
 // non-finite colour).
 void conformBuffer(Buffer b, Image& img);
 
+// The file's layer names, comma-separated ("(root)" for the root layer), for messages.
+std::string layerList(const ExrInfo& info);
+
 // One line per layer for `atrous inspect`: name, components, types, part.
 std::string describeLayer(const ExrInfo& info, const ExrLayer& layer);
 
