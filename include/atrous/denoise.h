@@ -1,6 +1,6 @@
 // Denoising API: EAW (Dammertz et al. 2010) and SURE-based À-Trous (Kim, Moon, Yoon 2016).
 // The names below are used by the render command (`atrous render --denoise eaw,sure`), the CLI
-// (`atrous denoise`) and the benchmarks. The math is ALGORITHMS.md sections 2, 3, 3a; the
+// (`atrous denoise`) and the benchmarks. The math is docs/denoising.md; the
 // parameters and how their defaults are derived are documented in docs/denoising.md.
 #pragma once
 #include <string>
@@ -14,7 +14,7 @@ namespace atrous {
 
 enum class DenoiseMethod { Eaw, Sure };
 
-// Per-pixel buffers, each a 3-channel planar Image of the colour's size (see ALGORITHMS.md 1).
+// Per-pixel buffers, each a 3-channel planar Image of the colour's size (see docs/rendering.md, "The buffers").
 // Only `color` is required; a missing feature simply removes its edge stop.
 struct DenoiseInputs {
     const Image* color = nullptr;     // mean radiance, linear HDR
@@ -31,7 +31,7 @@ struct DenoiseInputs {
     const Image* emission = nullptr;
 };
 
-// Edge-avoiding à-trous cascade (ALGORITHMS.md 2). Also the cascade that SURE runs on.
+// Edge-avoiding à-trous cascade (docs/denoising.md). Also the cascade that SURE runs on.
 // Edge-stopping weight of a tap: w = exp(-(Δc²/σ_c,i² + Δn²/σ_n,i² + Δx²/σ_x² + (Δz/(σ_z z))² + ids)).
 struct EawParams {
     int levels = 5;  // 1..10; five levels reach ±62 pixels
@@ -64,7 +64,7 @@ struct EawParams {
 
 enum class SureMode { Discrete, JamesStein };
 
-// SURE-based choice of the fraction s_i(p) of each detail d_i kept (ALGORITHMS.md 3).
+// SURE-based choice of the fraction s_i(p) of each detail d_i kept (docs/denoising.md, "SURE details").
 struct SureParams {
     SureMode mode = SureMode::Discrete;
     std::vector<float> candidates = {0.0f, 0.2f, 0.4f, 0.6f, 0.8f, 1.0f};  // 1..8 values in [0,1]
@@ -78,7 +78,7 @@ struct SureParams {
     int firstLevel = 2;
 };
 
-// Firefly suppression before either filter (ALGORITHMS.md 3a): a pixel whose luminance exceeds
+// Firefly suppression before either filter (docs/denoising.md, "Fireflies"): a pixel whose luminance exceeds
 // m + k·sqrt(s² + v) (m, s² the mean and variance of its 3×3 neighbours' luminance without the
 // brightest one, v their mean luminance variance) is scaled down to that bound.
 struct FireflyParams {

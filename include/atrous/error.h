@@ -1,4 +1,4 @@
-// Errors at the boundary (ARCHITECTURE.md principle 5). Library code throws; the CLI turns an
+// Errors at the boundary (docs/architecture.md, principle 5). Library code throws; the CLI turns an
 // exception into one line on stderr and exit code 2, Python into ValueError / RuntimeError.
 #pragma once
 #include <stdexcept>

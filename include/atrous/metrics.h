@@ -1,4 +1,4 @@
-// Image-quality metrics against a reference (ALGORITHMS.md 5). All inputs are linear HDR RGB
+// Image-quality metrics against a reference (docs/eval.md, "What is measured"). All inputs are linear HDR RGB
 // host images of the same size; non-finite pixels count as errors (they are replaced by 0 before
 // comparing, so a NaN in the image shows up as a large error instead of poisoning the mean).
 #pragma once

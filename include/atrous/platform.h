@@ -1,4 +1,4 @@
-// The one place that asks which compiler is looking (ARCHITECTURE.md): every per-pixel function
+// The one place that asks which compiler is looking (docs/architecture.md, principle 1): every per-pixel function
 // is marked ATROUS_HOST_DEVICE so the same body compiles for TBB threads and CUDA kernels.
 #pragma once
 

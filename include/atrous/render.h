@@ -1,6 +1,6 @@
 // Rendering API: a physically based CPU path tracer (Embree 3 intersection, TBB threads) that
 // writes the noisy colour together with the per-pixel buffers the denoisers use
-// (ALGORITHMS.md section 1, docs/rendering.md).
+// (docs/rendering.md, "The buffers").
 #pragma once
 #include <atomic>
 #include <cstdint>
@@ -36,7 +36,7 @@ struct RenderSettings {
     std::atomic<uint64_t>* samplesDone = nullptr;
 };
 
-// All buffers are 3-channel planar host images of width x height (ALGORITHMS.md section 1):
+// All buffers are 3-channel planar host images of width x height (docs/rendering.md, "The buffers"):
 //   color     mean radiance of the pixel's samples, linear HDR (W sr^-1 m^-2 per channel)
 //   variance  variance of that mean, per channel: (E[y^2] - E[y]^2) / (n - 1); 0 at spp = 1
 //   albedo    directional reflectance in [0,1] of the first non-delta surface (delta-bounce

@@ -1,6 +1,6 @@
 // Spatiotemporal variance-guided filtering (Schied et al. 2017, "SVGF"): a temporal accumulation
 // of 1-spp frames followed by an edge-avoiding à-trous wavelet filter whose luminance edge stop is
-// scaled by the estimated per-pixel standard deviation. See docs/svgf.md and ALGORITHMS.md §4.
+// scaled by the estimated per-pixel standard deviation. See docs/svgf.md.
 #pragma once
 #include <memory>
 
@@ -65,7 +65,7 @@ void validateSvgfParams(const SvgfParams& p);
 // that pixel (a non-finite colour is no sample; non-finite motion means "no history").
 struct SvgfFrame {
     const Image* color = nullptr;     // 1 spp radiance, linear HDR, 3 channels
-    const Image* albedo = nullptr;    // 3 channels, [0, 1]; demodulation divides by max(albedo, 1e-3)
+    const Image* albedo = nullptr;    // 3 channels, [0, 1]; demodulation divides by max(albedo, 1e-3), fading to 1 below 0.1
     const Image* normal = nullptr;    // world-space unit normal, 3 channels (0 = background)
     const Image* depth = nullptr;     // view depth in channel 0 (>= 1e29 = background, e.g. 1e30)
     const Image* ids = nullptr;       // mesh id in channel 0, -1 for background

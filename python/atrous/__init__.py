@@ -263,7 +263,7 @@ def render_sequence(
 
 
 def metrics(image: Any, reference: Any) -> Dict[str, float]:
-    """MSE, relMSE, PSNR (tonemapped) and SSIM of `image` against `reference` (ALGORITHMS.md 5).
+    """MSE, relMSE, PSNR (tonemapped) and SSIM of `image` against `reference` (docs/eval.md, "What is measured").
 
     NaN/Inf pixels count as 0 in the figures; their numbers are returned as ``non_finite_pixels``
     (in `image`) and ``reference_non_finite_pixels``, so a broken image cannot pass for a good one.

@@ -1,4 +1,4 @@
-// The CPU half of the one dispatcher (ARCHITECTURE.md principle 1). A per-pixel functor has
+// The CPU half of the one dispatcher (docs/architecture.md, principle 1). A per-pixel functor has
 // `void operator()(int x, int y) const`; CpuExec runs it on TBB threads, CudaExec
 // (src/cuda/cuda_exec.cuh) as a CUDA kernel. Drivers that chain several functors are templates on
 // the executor, so the level loop of a filter is written once as well.

@@ -1,6 +1,6 @@
 // Deterministic random numbers. The stream of every sample is a pure function of
 // (pixel, sample index, seed, dimension), so the output does not depend on the thread count or
-// the order in which tiles run (ARCHITECTURE.md principle 6).
+// the order in which tiles run (docs/architecture.md, principle 6).
 #pragma once
 #include <cstdint>
 

@@ -1,4 +1,4 @@
-// Every CUDA call is checked (ARCHITECTURE.md principle 3).
+// Every CUDA call is checked (docs/architecture.md, principle 3).
 #pragma once
 #include <cuda_runtime.h>
 

@@ -1,4 +1,4 @@
-// Owner of a typed array in GPU memory (ARCHITECTURE.md principle 3: memory has one owner).
+// Owner of a typed array in GPU memory (docs/architecture.md, principle 3).
 // Allocation goes through detail::cudaAllocate / cudaRelease (src/cuda/cuda_memory.cu), the only
 // place that calls cudaMalloc; copies through detail::cudaCopy, which checks every call.
 #pragma once

@@ -1,4 +1,4 @@
-// One level of the edge-avoiding à-trous cascade (Dammertz et al. 2010, ALGORITHMS.md 2) as a
+// One level of the edge-avoiding à-trous cascade (Dammertz et al. 2010, docs/denoising.md) as a
 // per-pixel functor shared by the CPU and CUDA backends, plus the tap-weight math that the CPU
 // fast path (src/cpu/eaw_cpu.cpp) reuses so both compute the same thing.
 #pragma once

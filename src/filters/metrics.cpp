@@ -1,4 +1,4 @@
-// Metrics of ALGORITHMS.md 5 (MSE, relMSE, tonemapped PSNR, SSIM of tonemapped luminance).
+// Metrics of docs/eval.md, "What is measured" (MSE, relMSE, tonemapped PSNR, SSIM of tonemapped luminance).
 #include "atrous/metrics.h"
 
 #include <cmath>

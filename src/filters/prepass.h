@@ -1,5 +1,5 @@
 // Per-pixel passes that prepare the cascade's inputs (shared by CPU and CUDA): non-finite
-// samples, fireflies (ALGORITHMS.md 3a), albedo demodulation, the colour scale of the automatic
+// samples, fireflies (docs/denoising.md, "Fireflies"), albedo demodulation, the colour scale of the automatic
 // σ_c, the pixel footprint of the automatic σ_x, and the final recombination.
 #pragma once
 #include "atrous/image.h"

@@ -1,4 +1,4 @@
-// SURE-based choice of the detail fractions s_i(p) (Kim, Moon, Yoon 2016; ALGORITHMS.md 3).
+// SURE-based choice of the detail fractions s_i(p) (Kim, Moon, Yoon 2016; docs/denoising.md, "SURE details").
 // SURE(s) summed over a window W(p) and the channels is
 //     Σ_W [(1 - s)² d² + (2s - 1) v] = (1 - s)² ΣD + (2s - 1) ΣV,
 // so the window pass only needs two box sums (ΣD = Σ d², ΣV = Σ v) per level: a horizontal pass

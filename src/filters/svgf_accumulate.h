@@ -1,4 +1,4 @@
-// SVGF stage 3: temporal accumulation (ALGORITHMS.md §4.3). An exponential moving average whose
+// SVGF stage 3: temporal accumulation (docs/svgf.md, "Stages"). An exponential moving average whose
 // weight starts as a plain running mean: α = max(alpha, 1/n) with n the (capped) history length,
 // for the illumination and for the first and second moments of its luminance.
 #pragma once

@@ -1,4 +1,4 @@
-// SVGF stage 5: one level of the variance-guided à-trous wavelet filter (ALGORITHMS.md §4.5).
+// SVGF stage 5: one level of the variance-guided à-trous wavelet filter (docs/svgf.md, "Stages").
 // 5x5 B3 kernel at step 2^i; per tap q
 //   w = h(q) exp(-|l_p - l_q| / (σ_l sqrt(g3x3(var)_p) + ε) - |z_p - z_q| / (σ_z |∇z_p·(p - q)| + ε))
 //       * max(0, n_p·n_q)^σ_n

@@ -1,4 +1,4 @@
-// Helpers shared by the SVGF stage functors (ALGORITHMS.md §4): sanitising rules for the
+// Helpers shared by the SVGF stage functors (docs/svgf.md): sanitising rules for the
 // G-buffer and the three edge-stopping terms. Host/device, no STL.
 #pragma once
 #include <cstring>

@@ -1,5 +1,5 @@
-// SVGF stage 1: demodulation (ALGORITHMS.md §4.1). Filtering the illumination instead of the
-// colour keeps texture detail out of the blur: illumination = (color - emission) / max(albedo, 1e-3).
+// SVGF stage 1: demodulation (docs/svgf.md, "Stages"). Filtering the illumination instead of the
+// colour keeps texture detail out of the blur: illumination = (color - emission) / modulationAlbedo (svgf_common.h).
 #pragma once
 #include "filters/svgf_common.h"
 

@@ -13,7 +13,7 @@
 //     that moved away, a disocclusion) is rejected at once; on the edge the window spans both and
 //     the history is kept, so the edge converges to its coverage-weighted mean.
 // Blend: e_out = lerp(clamp(e_hist), e, α), α = max(alpha, 1/n, κ|m·ĝ|): n the capped history
-// length (the colour's rule, ALGORITHMS.md §4.3); the last term raises α where the light's edge
+// length (the colour's rule, docs/svgf.md, "Stages"); the last term raises α where the light's edge
 // moves across pixels (m the motion, ĝ the direction of the history's emission gradient), since
 // there the resampled history lags (measured on cornell orbit: a halo on the ceiling beside the
 // light's edge without it). alpha = 1 reproduces the raw emission.

@@ -1,4 +1,4 @@
-// SVGF stage 6: remodulation (ALGORITHMS.md §4.6): colour = illumination × albedo + emission,
+// SVGF stage 6: remodulation (docs/svgf.md, "Stages"): colour = illumination × albedo + emission,
 // with the same clamped albedo the demodulation divided by. The final guard maps anything
 // non-finite to 0 so that no NaN leaves the filter whatever came in.
 #pragma once

@@ -1,4 +1,4 @@
-// SVGF stage 2: reprojection (ALGORITHMS.md §4.2). Fetches last frame's accumulated illumination,
+// SVGF stage 2: reprojection (docs/svgf.md, "Stages"). Fetches last frame's accumulated illumination,
 // luminance moments and history length at p + motion(p) with a bilinear 2x2 footprint whose taps
 // are kept only where depth, normal and mesh id agree with the current pixel; if no tap survives,
 // a 3x3 search around the reprojected position; if that fails too the history is reset

@@ -1,4 +1,4 @@
-// SVGF stage 4: variance estimate (ALGORITHMS.md §4.4). Where the history holds at least
+// SVGF stage 4: variance estimate (docs/svgf.md, "Stages"). Where the history holds at least
 // `spatialFrames` frames, the temporal moments give var = μ2 - μ1²; younger pixels (just
 // disoccluded, or the first frames) use a 7x7 spatial bilateral estimate of the same moments,
 // weighted by depth and normal similarity only (a luminance weight would exclude exactly the

@@ -47,7 +47,7 @@ struct AccumulateParams {
     int withinFrame = 0;
     float invN = 1.0f;  // 1 / N, N = frames in the mean including this one
     // var = varWithin · v̄ + varBetween · M2 with n = N s samples:
-    // M2_total = N s (s − 1) v̄ + s M2 (ALGORITHMS.md pooled variance), var = M2_total / (n (n − 1)),
+    // M2_total = N s (s − 1) v̄ + s M2 (the pooled variance of two sample sets), var = M2_total / (n (n − 1)),
     // so varWithin = (s − 1) / (n − 1) and varBetween = s / (n (n − 1)) (computed in double by
     // makeAccumulateParams).
     float varWithin = 0.0f, varBetween = 0.0f;
@@ -181,7 +181,7 @@ struct MotionParams {
     float offscreen = -1.0e4f;      // pt::kMotionOffscreen: "no previous position"
 };
 
-// Screen-space motion of the primary hit, previous − current, in pixels (ALGORITHMS.md 1), for a
+// Screen-space motion of the primary hit, previous − current, in pixels (docs/rendering.md, "The buffers"), for a
 // renderer that wrote depth but no motion. The hit point is rebuilt from the depth (distance along
 // the forward axis) on the pixel centre's ray; background pixels move like directions (points at
 // infinity). Channel 2 is 0.

@@ -1,6 +1,6 @@
 // Unidirectional path tracing with next-event estimation and multiple importance sampling (power
 // heuristic), Russian roulette, and the denoiser features that follow delta bounces
-// (ALGORITHMS.md section 1). The per-pixel functor is a template on the intersector, so the CPU
+// (docs/rendering.md, "The buffers"). The per-pixel functor is a template on the intersector, so the CPU
 // backend plugs in Embree and a GPU backend its own BVH; everything here is host/device code with
 // no STL, no virtuals and no exceptions.
 //
@@ -119,7 +119,7 @@ ATROUS_HOST_DEVICE PathSample tracePath(const SceneView& s, const Tracer& tracer
         Vec3 ns = front ? si.ns : -si.ns;
         Bsdf b = makeBsdf(s, m, si.uv, front);
         bool delta = isDelta(m.type);
-        // Emission follows delta bounces like the features (ALGORITHMS.md 1): a light or the sun
+        // Emission follows delta bounces like the features (docs/rendering.md, "The buffers"): a light or the sun
         // seen in a mirror or through glass is emission, which the denoisers add back rather than
         // filter (measured at 256², 16 spp over 8 seeds: EAW MSE of sphere-env 56.3 -> 40.0, its
         // noisy input 48.3; relMSE of cornell-spheres 0.0105 -> 0.0097).

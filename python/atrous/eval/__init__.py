@@ -154,7 +154,7 @@ def _flip():
 
 
 def score(image: np.ndarray, reference: np.ndarray, want_map: bool = False) -> Dict[str, Any]:
-    """relMSE, PSNR, SSIM, MSE (atrous.metrics, ALGORITHMS.md 5) and mean HDR-FLIP.
+    """relMSE, PSNR, SSIM, MSE (atrous.metrics, docs/eval.md, "What is measured") and mean HDR-FLIP.
 
     FLIP's HDR mode needs non-negative finite input: negatives and NaN become 0 for FLIP only.
     With want_map, "flip_map" holds FLIP's magma-coloured error map (H x W x 3 in [0, 1]).
@@ -236,7 +236,7 @@ def run_eval(cfg: EvalConfig) -> Dict[str, Any]:
     for s in cfg.spp:
         if cfg.ref_spp < 64 * s:
             notes.append(f"the reference ({cfg.ref_spp} spp) has only {cfg.ref_spp // s}x the samples of "
-                         f"the {s}-spp input (ALGORITHMS.md asks for >= 64x): its own noise, listed as "
+                         f"the {s}-spp input (a reference should have >= 64x the samples): its own noise, listed as "
                          "the reference floor, is part of every relMSE at that spp")
             break
     w, h = cfg.width, cfg.height
