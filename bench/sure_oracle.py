@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """How much can per-pixel, per-level detail selection gain over EAW? (run by hand; docs/quality.md)
 
-SURE-À-Trous (ALGORITHMS.md 3) outputs c_N + Σ_i s_i(p) d_i(p) with s_i(p) from a candidate set,
+SURE-À-Trous (docs/denoising.md, "SURE details") outputs c_N + Σ_i s_i(p) d_i(p) with s_i(p) from a candidate set,
 d_i = c_i − c_{i+1} the details of the EAW cascade. This script measures, on a rendered scene:
 
 - the EAW output after k levels, k = 0..5 (c_k; c_0 is the input after the firefly pass),

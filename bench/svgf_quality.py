@@ -6,7 +6,7 @@ For each scene (NAME:CAMERA_PATH) it renders a 1-spp sequence with per-frame ref
 (`atrous denoise --sequence`, or bench/svgf_sequence_tool where the CLI lacks --sequence), and
 measures per frame
   relMSE    mean((x - r)^2 / (r^2 + 0.01))                       (atrous compare --json)
-  temporal  relMSE of x_f - x_{f-1} against r_f - r_{f-1}        (ALGORITHMS.md 5; tool metrics)
+  temporal  relMSE of x_f - x_{f-1} against r_f - r_{f-1}        (docs/eval.md, "What is measured"; tool metrics)
   temporal_no_emitters  the same without the pixels that see a light (emission.exr > 0 in either
             frame, dilated by 1 px): at 1 spp their jittered edges flicker and dominate `temporal`
             unless the emission is accumulated (SVGF); this column is the rest of the image

@@ -5,7 +5,7 @@
 //   svgf_sequence_tool metrics SEQDIR OUTDIR
 //       JSON per frame: relMSE of OUTDIR/frame_NNNN.exr against SEQDIR/frame_NNNN/reference.exr and
 //       the temporal error, the relMSE of the frame-to-frame difference (x_f - x_{f-1}) against the
-//       references' difference (r_f - r_{f-1}) (ALGORITHMS.md section 5); null for frame 0; and
+//       references' difference (r_f - r_{f-1}) (docs/eval.md, "What is measured"); null for frame 0; and
 //       "temporal_no_emitters", the same leaving out pixels whose emission.exr is non-zero in
 //       either frame or in one of their 8 neighbours (partly covered light-edge pixels). At 1 spp
 //       the jittered sample of a pixel on a light's edge hits the light (radiance 17) or the

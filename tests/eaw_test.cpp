@@ -1,4 +1,4 @@
-// EAW (ALGORITHMS.md 2 and 6): unit weights = plain B3 à-trous, constants stay constant, no
+// EAW (docs/denoising.md): unit weights = plain B3 à-trous, constants stay constant, no
 // energy gain, CPU fast path = generic functor, every parameter matters, the fast exp is accurate.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// Firefly suppression (ALGORITHMS.md 3a) and non-finite samples: fireflies are brought down to
+// Firefly suppression (docs/denoising.md, "Fireflies") and non-finite samples: fireflies are brought down to
 // the local bound, ordinary noise is left alone, NaN/Inf never reach the output.
 #include <gtest/gtest.h>
 
@@ -96,7 +96,7 @@ TEST(Firefly, TwoPixelClusterIsClamped) {
 
 TEST(Firefly, BrightPixelWithLowOwnVarianceIsSignal) {
     // The sun seen directly: very bright, but its own standard deviation (here 10% of its excess)
-    // says most samples agree, so it is kept (ALGORITHMS.md 3a: only implausible pixels).
+    // says most samples agree, so it is kept (docs/denoising.md, "Fireflies": only implausible pixels).
     Flat f(32, 32, 5);
     for (int c = 0; c < 3; ++c) {
         f.color(16, 16, c) = 1000.0f;

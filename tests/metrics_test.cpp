@@ -1,4 +1,4 @@
-// Metrics (ALGORITHMS.md 5) against hand-computed values.
+// Metrics (docs/eval.md, "What is measured") against hand-computed values.
 #include <gtest/gtest.h>
 
 #include <cmath>

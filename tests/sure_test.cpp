@@ -1,4 +1,4 @@
-// SURE-À-Trous (ALGORITHMS.md 3 and 6): SURE is unbiased, the propagated variance against Monte
+// SURE-À-Trous (docs/denoising.md, "SURE details"): SURE is unbiased, the propagated variance against Monte
 // Carlo (how far the independence assumption is off), s = 0 is EAW and s = 1 the input, every
 // parameter matters, noise estimation without a variance buffer, and a quality bound.
 #include <gtest/gtest.h>

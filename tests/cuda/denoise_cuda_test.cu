@@ -1,4 +1,4 @@
-// CPU vs CUDA parity of EAW and SURE (ALGORITHMS.md 6): the same functors and driver run on both
+// CPU vs CUDA parity of EAW and SURE (docs/architecture.md, principle 1): the same functors and driver run on both
 // backends. Skipped without a GPU.
 #include <gtest/gtest.h>
 
