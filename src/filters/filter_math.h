@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "atrous/image.h"
 #include "atrous/platform.h"
 
 // Host-only forced inlining for the shared per-pixel math called from the CPU row loops: a call
@@ -86,5 +87,21 @@ ATROUS_INLINE float modulationTerm(float m, float floor) {
 }
 ATROUS_INLINE float modulationAlbedo(float a, float t, float eps) { return 1.0f + t * (maxSel(a, eps) - 1.0f); }
 ATROUS_INLINE float maxChannel(float a, float b, float c) { return maxSel(maxSel(a, b), c); }
+
+// a'_c of pixel (x, y), c = 0..2, from an albedo view (non-finite values read as 0); an invalid
+// view gives 1 (no demodulation). The one place the filters turn an albedo pixel into divisors.
+ATROUS_INLINE void pixelModulationAlbedo(const ImageView& albedo, int x, int y, float eps, float floor, float (&a)[3]) {
+    if (!albedo.valid()) {
+        a[0] = a[1] = a[2] = 1.0f;
+        return;
+    }
+    float v[3];
+    for (int c = 0; c < 3; ++c) {
+        const float u = albedo(x, y, c);
+        v[c] = finite(u) ? u : 0.0f;
+    }
+    const float t = modulationTerm(maxChannel(v[0], v[1], v[2]), floor);
+    for (int c = 0; c < 3; ++c) a[c] = modulationAlbedo(v[c], t, eps);
+}
 
 }  // namespace atrous::filters

@@ -33,10 +33,9 @@ struct MadDetail {
     float eps = 1e-3f, floor = 0.0f;
     ATROUS_HOST_DEVICE float value(int x, int y, int c) const {
         if (!albedo.valid()) return color(x, y, c);
-        const float a0 = albedo(x, y, 0), a1 = albedo(x, y, 1), a2 = albedo(x, y, 2);
-        const float t = modulationTerm(maxChannel(finite(a0) ? a0 : 0.0f, finite(a1) ? a1 : 0.0f, finite(a2) ? a2 : 0.0f), floor);
-        const float a = albedo(x, y, c);
-        return color(x, y, c) / modulationAlbedo(finite(a) ? a : 0.0f, t, eps);
+        float m[3];
+        pixelModulationAlbedo(albedo, x, y, eps, floor, m);
+        return color(x, y, c) / m[c];
     }
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         const int w = color.width, h = color.height;
@@ -68,9 +67,9 @@ struct DemodulatedCopy {
     float eps = 1e-3f, floor = 0.0f;
     ImageView color, albedo, out;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        const float t = albedo.valid() ? modulationTerm(maxChannel(albedo(x, y, 0), albedo(x, y, 1), albedo(x, y, 2)), floor) : 0.0f;
-        for (int c = 0; c < 3; ++c)
-            out(x, y, c) = albedo.valid() ? color(x, y, c) / modulationAlbedo(albedo(x, y, c), t, eps) : color(x, y, c);
+        float m[3];
+        pixelModulationAlbedo(albedo, x, y, eps, floor, m);
+        for (int c = 0; c < 3; ++c) out(x, y, c) = albedo.valid() ? color(x, y, c) / m[c] : color(x, y, c);
     }
 };
 
@@ -117,9 +116,10 @@ struct GlobalVariance {
     float eps = 1e-3f, floor = 0.0f;
     ImageView albedo, var;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        const float t = albedo.valid() ? modulationTerm(maxChannel(albedo(x, y, 0), albedo(x, y, 1), albedo(x, y, 2)), floor) : 0.0f;
+        float m[3];
+        pixelModulationAlbedo(albedo, x, y, eps, floor, m);
         for (int c = 0; c < 3; ++c) {
-            const float a = albedo.valid() ? modulationAlbedo(albedo(x, y, c), t, eps) : 1.0f;
+            const float a = m[c];
             var(x, y, c) = floorVar[c] * a * a;
         }
     }
@@ -180,9 +180,10 @@ struct LocalVariance {
             const float m = (q[k][0] + q[k][1] + q[k][2]) / q[k][3];  // q[k][3] >= 1: the pixel itself
             if (m < bestMean) bestMean = m, best = k;
         }
-        const float t = albedo.valid() ? modulationTerm(maxChannel(albedo(x, y, 0), albedo(x, y, 1), albedo(x, y, 2)), floor) : 0.0f;
+        float m[3];
+        pixelModulationAlbedo(albedo, x, y, eps, floor, m);
         for (int c = 0; c < 3; ++c) {
-            const float a = albedo.valid() ? modulationAlbedo(albedo(x, y, c), t, eps) : 1.0f;
+            const float a = m[c];
             const float v = minSel(maxSel(q[best][c] / q[best][3], floorVar[c]), capMul * floorVar[c]) * a * a;
             var(x, y, c) = finite(v) ? v : floorVar[c] * a * a;
         }

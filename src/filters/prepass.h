@@ -193,10 +193,10 @@ struct Demodulate {
     float eps, floor;
     ImageView albedo, color, var;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        const float t = modulationTerm(maxChannel(albedo(x, y, 0), albedo(x, y, 1), albedo(x, y, 2)), floor);
+        float m[3];
+        pixelModulationAlbedo(albedo, x, y, eps, floor, m);
         for (int c = 0; c < 3; ++c) {
-            const float a = modulationAlbedo(albedo(x, y, c), t, eps);
-            const float ia = 1.0f / a;
+            const float ia = 1.0f / m[c];
             color(x, y, c) *= ia;
             var(x, y, c) *= ia * ia;
         }
@@ -314,11 +314,12 @@ struct Recombine {
     float eps, floor;
     ImageView cN, detailSum, albedo, emission, out;  // detailSum may be invalid (EAW)
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        const float t = albedo.valid() ? modulationTerm(maxChannel(albedo(x, y, 0), albedo(x, y, 1), albedo(x, y, 2)), floor) : 0.0f;
+        float m[3];
+        pixelModulationAlbedo(albedo, x, y, eps, floor, m);
         for (int c = 0; c < 3; ++c) {
             float v = cN(x, y, c);
             if (detailSum.valid()) v += detailSum(x, y, c);
-            if (albedo.valid()) v *= modulationAlbedo(albedo(x, y, c), t, eps);
+            if (albedo.valid()) v *= m[c];
             if (emission.valid()) v += emission(x, y, c);
             out(x, y, c) = v;
         }
