@@ -76,11 +76,15 @@ BufferSet loadBuffers(const BufferFiles& f) {
         const PassMap m = mapPasses(info, f.passes, f.viewLayer);
         if (!m[Buffer::Color].found() && f.file[int(Buffer::Color)].empty())
             throw InputError(f.in + ": no colour pass (layers: " + layerList(info) + "); name one with --pass color=LAYER");
+        std::vector<std::pair<Buffer, const PassChoice*>> wanted;
+        for (int b = 0; b < kBufferCount; ++b)
+            if (m.pass[size_t(b)].found() && f.file[b].empty()) wanted.emplace_back(Buffer(b), &m.pass[size_t(b)]);
+        std::vector<Image> images = readPasses(info, wanted);
         Image object, material;
-        for (int b = 0; b < kBufferCount; ++b) {
-            const PassChoice& c = m.pass[size_t(b)];
-            if (!c.found() || !f.file[b].empty()) continue;
-            Image img = readPass(info, c, Buffer(b));
+        for (size_t k = 0; k < wanted.size(); ++k) {
+            const int b = int(wanted[k].first);
+            const PassChoice& c = *wanted[k].second;
+            Image& img = images[k];
             if (Buffer(b) == Buffer::Motion && c.layer >= 0 && info.layers[size_t(c.layer)].passName() == "Vector") {
                 // Blender's Vector pass: X, Y = offset to the pixel's position in the previous frame
                 // with y up; atrous's motion has y down (rows). Measured on the corpus's Cycles orbit
@@ -90,17 +94,9 @@ BufferSet loadBuffers(const BufferFiles& f) {
                 s.notes.push_back("motion: Blender's Vector pass (X, -Y: y up in Blender, down in atrous)");
             }
             const std::string label = c.layer >= 0 ? info.layers[size_t(c.layer)].name : info.channels[size_t(c.channels[0])].fullName;
-            const std::string from = f.in + " (" + (label.empty() ? std::string("root R,G,B") : label) + ", " + c.rule + ")";
-            if (Buffer(b) == Buffer::ObjectId) {
-                object = std::move(img);
-                s.from[b] = from;
-            } else if (Buffer(b) == Buffer::MaterialId) {
-                material = std::move(img);
-                s.from[b] = from;
-            } else {
-                s.image[b] = std::move(img);
-                s.from[b] = from;
-            }
+            s.from[b] = f.in + " (" + (label.empty() ? std::string("root R,G,B") : label) + ", " + c.rule + ")";
+            Image& dst = Buffer(b) == Buffer::ObjectId ? object : Buffer(b) == Buffer::MaterialId ? material : s.image[b];
+            dst = std::move(img);
         }
         if (!object.empty() || !material.empty()) {
             const Image& any = object.empty() ? material : object;

@@ -149,27 +149,47 @@ std::vector<int> pickComponents(const ExrInfo& info, const ExrLayer& layer, int 
     return {};
 }
 
-Image readExrChannels(const ExrInfo& info, const std::vector<int>& channels, const std::string& what) {
-    if (channels.empty() || channels.size() > 3) throw InputError(info.path + ": " + what + ": no channels to read");
+std::vector<Image> readExrChannelSets(const ExrInfo& info, const std::vector<std::vector<int>>& sets,
+                                      const std::vector<std::string>& whats) {
     const int w = info.width, h = info.height;
-    Image img(w, h, 3);
+    std::vector<Image> images;
+    for (size_t k = 0; k < sets.size(); ++k) {
+        if (sets[k].empty() || sets[k].size() > 3)
+            throw InputError(info.path + ": " + whats[k] + ": no channels to read");
+        images.emplace_back(w, h, 3);
+    }
+    // A channel taken by two sets is read once and copied: (source plane, destination plane).
+    std::vector<std::pair<const float*, float*>> copies;
+    std::map<int, const float*> readInto;
+    std::string what;
     try {
         Imf::MultiPartInputFile file(info.path.c_str());
-        // One frame buffer per part: a pass may (in principle) spread over parts.
+        // One frame buffer per part: each part is decoded once for all the sets.
         std::map<int, Imf::FrameBuffer> buffers;
-        for (size_t k = 0; k < channels.size(); ++k) {
-            const ExrChannelInfo& ch = info.channels.at(size_t(channels[k]));
-            const ExrPartInfo& part = info.parts[size_t(ch.part)];
-            if (part.width != w || part.height != h)
-                throw InputError(info.path + ": part '" + part.name + "' (" + what + ") is " +
-                                 describeSize(part.width, part.height) + " but the first part is " + describeSize(w, h));
-            if (part.type.rfind("deep", 0) == 0)
-                throw InputError(info.path + ": part '" + part.name + "' (" + what + ") is a deep image, which atrous cannot read");
-            const Imath::Box2i dw = file.header(ch.part).dataWindow();
-            const size_t xs = sizeof(float), ys = sizeof(float) * size_t(w);
-            char* base = reinterpret_cast<char*>(img.view().channel(int(k))) - dw.min.x * long(xs) - dw.min.y * long(ys);
-            buffers[ch.part].insert(ch.name.c_str(), Imf::Slice(Imf::FLOAT, base, xs, ys, 1, 1, 0.0));
+        for (size_t k = 0; k < sets.size(); ++k) {
+            what = whats[k];
+            for (size_t j = 0; j < sets[k].size(); ++j) {
+                const ExrChannelInfo& ch = info.channels.at(size_t(sets[k][j]));
+                const ExrPartInfo& part = info.parts[size_t(ch.part)];
+                if (part.width != w || part.height != h)
+                    throw InputError(info.path + ": part '" + part.name + "' (" + what + ") is " +
+                                     describeSize(part.width, part.height) + " but the first part is " + describeSize(w, h));
+                if (part.type.rfind("deep", 0) == 0)
+                    throw InputError(info.path + ": part '" + part.name + "' (" + what + ") is a deep image, which atrous cannot read");
+                float* plane = images[k].view().channel(int(j));
+                auto seen = readInto.find(sets[k][j]);
+                if (seen != readInto.end()) {
+                    copies.emplace_back(seen->second, plane);
+                    continue;
+                }
+                readInto.emplace(sets[k][j], plane);
+                const Imath::Box2i dw = file.header(ch.part).dataWindow();
+                const size_t xs = sizeof(float), ys = sizeof(float) * size_t(w);
+                char* base = reinterpret_cast<char*>(plane) - dw.min.x * long(xs) - dw.min.y * long(ys);
+                buffers[ch.part].insert(ch.name.c_str(), Imf::Slice(Imf::FLOAT, base, xs, ys, 1, 1, 0.0));
+            }
         }
+        what = sets.size() == 1 ? whats[0] : "its passes";
         for (auto& [p, fb] : buffers) {
             Imf::InputPart part(file, p);
             part.setFrameBuffer(fb);
@@ -181,14 +201,22 @@ Image readExrChannels(const ExrInfo& info, const std::vector<int>& channels, con
     } catch (const std::exception& e) {
         throw InputError(info.path + ": cannot read " + what + " (" + e.what() + ")");
     }
-    const size_t plane = img.plane();
-    if (channels.size() == 1) {
-        std::copy(img.data(), img.data() + plane, img.data() + plane);
-        std::copy(img.data(), img.data() + plane, img.data() + 2 * plane);
-    } else if (channels.size() == 2) {
-        std::fill(img.data() + 2 * plane, img.data() + 3 * plane, 0.0f);
+    const size_t plane = size_t(w) * size_t(h);
+    for (const auto& [from, to] : copies) std::copy(from, from + plane, to);
+    for (size_t k = 0; k < sets.size(); ++k) {
+        float* d = images[k].data();
+        if (sets[k].size() == 1) {
+            std::copy(d, d + plane, d + plane);
+            std::copy(d, d + plane, d + 2 * plane);
+        } else if (sets[k].size() == 2) {
+            std::fill(d + 2 * plane, d + 3 * plane, 0.0f);
+        }
     }
-    return img;
+    return images;
+}
+
+Image readExrChannels(const ExrInfo& info, const std::vector<int>& channels, const std::string& what) {
+    return std::move(readExrChannelSets(info, {channels}, {what})[0]);
 }
 
 namespace {

@@ -63,6 +63,10 @@ std::vector<int> pickComponents(const ExrInfo& info, const ExrLayer& layer, int 
 // part's size) into a 3-channel host Image; one channel is repeated into all three, two fill R,G
 // (B = 0). Half and uint channels are converted to float. `what` names the buffer in messages.
 Image readExrChannels(const ExrInfo& info, const std::vector<int>& channels, const std::string& what);
+// The same for several buffers at once: the file is opened and each part decoded once (a
+// single-part file such as Mitsuba's holds every pass in the same chunks). whats[k] names set k.
+std::vector<Image> readExrChannelSets(const ExrInfo& info, const std::vector<std::vector<int>>& sets,
+                                      const std::vector<std::string>& whats);
 
 // A layer to write: a full layer name ("" for the root) and a host image with at least as many
 // channels as `components` names (channel i is written as component i).

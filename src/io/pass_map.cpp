@@ -211,13 +211,20 @@ PassChoice passForFile(const ExrInfo& info, Buffer b, const std::vector<PassRequ
     return c;
 }
 
-Image readPass(const ExrInfo& info, const PassChoice& pass, Buffer b) {
-    const std::string what = std::string(bufferName(b)) + " pass" +
-                             (pass.layer >= 0 ? " " + layerLabel(info.layers[size_t(pass.layer)]) : std::string());
-    Image img = readExrChannels(info, pass.channels, what);
-    conformBuffer(b, img);
-    return img;
+std::vector<Image> readPasses(const ExrInfo& info, const std::vector<std::pair<Buffer, const PassChoice*>>& passes) {
+    std::vector<std::vector<int>> sets;
+    std::vector<std::string> whats;
+    for (const auto& [b, pass] : passes) {
+        sets.push_back(pass->channels);
+        whats.push_back(std::string(bufferName(b)) + " pass" +
+                        (pass->layer >= 0 ? " " + layerLabel(info.layers[size_t(pass->layer)]) : std::string()));
+    }
+    std::vector<Image> images = readExrChannelSets(info, sets, whats);
+    for (size_t k = 0; k < images.size(); ++k) conformBuffer(passes[k].first, images[k]);
+    return images;
 }
+
+Image readPass(const ExrInfo& info, const PassChoice& pass, Buffer b) { return std::move(readPasses(info, {{b, &pass}})[0]); }
 
 void conformBuffer(Buffer b, Image& img) {
     const size_t n = img.plane();

@@ -6,6 +6,7 @@
 #pragma once
 #include <array>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "atrous/image.h"
@@ -54,6 +55,8 @@ PassChoice passForFile(const ExrInfo& info, Buffer b, const std::vector<PassRequ
 
 // Reads a pass as a 3-channel image and brings it to atrous's conventions (conformBuffer).
 Image readPass(const ExrInfo& info, const PassChoice& pass, Buffer b);
+// The same for several passes, decoding the file once (readExrChannelSets).
+std::vector<Image> readPasses(const ExrInfo& info, const std::vector<std::pair<Buffer, const PassChoice*>>& passes);
 
 // atrous's conventions for a buffer read from anywhere (docs/inputs.md): normals longer than 1 normalised
 // (shorter ones, means across an edge, kept; zero stays zero: background); depth <= 0, non-finite or >= 1e9 becomes the background value 1e30;
