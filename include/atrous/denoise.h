@@ -121,7 +121,8 @@ struct DenoiseReport {
     std::string buffersUsed;           // e.g. "color,variance,normal,position"
     double milliseconds = 0;           // filter time (excluding validation)
     // Per-stage times of the filter, in order: sanitize (NaN/Inf repair, the emission split and,
-    // with an emission buffer, the emission filter), fireflies, demodulate, sigma scales, then
+    // with an emission buffer, the emission filter), fireflies, demodulate (without a variance buffer
+    // also the per-pixel noise estimate, docs/algorithms.md), sigma scales, then
     // "level i" (and for SURE "sure i": the window sums and the choice of s_i) per level, then
     // remodulate. CPU: wall clock; CUDA: cudaEvents on the stream (GPU time, no extra syncs).
     std::vector<StageTime> stages;

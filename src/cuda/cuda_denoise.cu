@@ -114,18 +114,15 @@ void estimateNoiseSigmaCuda(const Image& color, const Image* albedo, float eps, 
     if (color.device() != Device::Cuda) throw RuntimeError("estimateNoiseSigmaCuda: the colour is not on the GPU");
     const int w = color.width(), h = color.height();
     const size_t plane = color.plane();
-    Image detail(w, h, 3, Device::Cuda), albedoHolder;
+    Image detail(w, h, 3, Device::Cuda), albedoHolder, demod;
     const CudaExec exec;
-    MadDetail f;
-    f.color = color.view();
     if (albedo) {
         if (albedo->device() != Device::Cuda) albedoHolder = albedo->to(Device::Cuda);
-        f.albedo = albedoHolder.empty() ? albedo->view() : albedoHolder.view();
+        demod = Image(w, h, 3, Device::Cuda);
+        exec.forEachPixel(w, h, DemodulatedCopy{eps, floor, color.view(),
+                                                albedoHolder.empty() ? albedo->view() : albedoHolder.view(), demod.view()});
     }
-    f.detail = detail.view();
-    f.eps = eps;
-    f.floor = floor;
-    exec.forEachPixel(w, h, f);
+    exec.forEachPixel(w, h, MadDetail{albedo ? demod.view() : color.view(), detail.view()});
     exec.synchronize();
     // As estimateNoiseSigma: var(d_0) = σ² (1 + Σh² − 2 h(0)) for white noise.
     const double sumH2 = (70.0 / 256.0) * (70.0 / 256.0), h0 = (6 / 16.0) * (6 / 16.0);

@@ -71,14 +71,13 @@ namespace filters {
 // albedo is given.
 void estimateNoiseSigma(const Image& color, const Image* albedo, float eps, float floor, float sigma[3]) {
     const int w = color.width(), h = color.height();
-    Image detail(w, h, 3, Device::Cpu);
-    MadDetail f;
-    f.color = color.view();
-    f.albedo = albedo ? albedo->view() : ImageView{};
-    f.detail = detail.view();
-    f.eps = eps;
-    f.floor = floor;
-    CpuExec{}.forEachPixel(w, h, f);
+    Image detail(w, h, 3, Device::Cpu), demod;
+    const CpuExec exec;
+    if (albedo) {
+        demod = Image(w, h, 3, Device::Cpu);
+        exec.forEachPixel(w, h, DemodulatedCopy{eps, floor, color.view(), albedo->view(), demod.view()});
+    }
+    exec.forEachPixel(w, h, MadDetail{albedo ? demod.view() : color.view(), detail.view()});
     for (int c = 0; c < 3; ++c) {
         std::vector<float> d;
         d.reserve(detail.plane());

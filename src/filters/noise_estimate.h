@@ -23,20 +23,14 @@ constexpr float kNoiseCapMul = 128.0f;
 // var(d_0) = σ² (1 + Σ h² - 2 h(0)) for white noise under the 5×5 B3 kernel (see estimateNoiseSigma).
 constexpr float kDetailVarFactor = float(1.0 + (70.0 / 256.0) * (70.0 / 256.0) - 2.0 * (6 / 16.0) * (6 / 16.0));
 
-// Donoho's finest B3 detail |v − (B3 ∗ v)(p)| per channel of the demodulated colour v = c / a'
-// (a' the modulation albedo; albedo invalid: v = c), over clamped borders in double sums: the
-// global estimate's input on the CPU (estimateNoiseSigma) and the GPU (estimateNoiseSigmaCuda)
-// alike. Pixels with a non-finite value in their 5×5 window get +Inf (sorted after every detail).
-// Demodulated, so that texture (which the filters never see) does not read as noise.
+// Donoho's finest B3 detail |v − (B3 ∗ v)(p)| per channel of v (the demodulated colour:
+// DemodulatedCopy, so that texture, which the filters never see, does not read as noise), over
+// clamped borders in double sums: the global estimate's input on the CPU (estimateNoiseSigma) and
+// the GPU (estimateNoiseSigmaCuda) alike. Pixels with a non-finite value in their 5×5 window get
+// +Inf (sorted after every detail).
 struct MadDetail {
-    ImageView color, albedo, detail;  // detail: 3 planes
-    float eps = 1e-3f, floor = 0.0f;
-    ATROUS_HOST_DEVICE float value(int x, int y, int c) const {
-        if (!albedo.valid()) return color(x, y, c);
-        float m[3];
-        pixelModulationAlbedo(albedo, x, y, eps, floor, m);
-        return color(x, y, c) / m[c];
-    }
+    ImageView color, detail;  // color: v; detail: 3 planes
+    ATROUS_HOST_DEVICE float value(int x, int y, int c) const { return color(x, y, c); }
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         const int w = color.width, h = color.height;
         for (int c = 0; c < 3; ++c) {
