@@ -1,0 +1,218 @@
+// SVGF sequences on disk: sequence I/O (listing, loading, the errors of a bad sequence) and the
+// sequence denoise command, on the synthetic sequences of svgf_test_util.h.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "atrous/error.h"
+#include "atrous/svgf.h"
+#include "core/parallel.h"
+#include "filters/svgf_pipeline.h"
+#include "io/image_io.h"
+#include "io/sequence.h"
+#include "svgf_test_util.h"
+#include "test_util.h"
+
+// The sequence command lives in the CLI's sources, which are not part of atrous_lib; compile its
+// translation unit into this test so it can be tested as a function.
+#include "../apps/atrous/denoise_sequence.cpp"
+#include "../apps/atrous/sequence_checks.cpp"
+
+using namespace atrous;
+using namespace atrous::svgf_test;
+
+// ---- sequence I/O -------------------------------------------------------------------------------
+
+namespace {
+
+// Writes frames [first, first + count) of the scene as a sequence directory.
+void writeSequence(const std::string& dir, const SceneOptions& o, int count, int first = 0, bool reference = true) {
+    for (int t = 0; t < count; ++t) {
+        SynthFrame f = makeFrame(o, t);
+        std::string fd = dir + "/" + io::sequenceFrameName(first + t);
+        std::filesystem::create_directories(fd);
+        Image position(o.width, o.height, 3);
+        io::writeImage(fd + "/color.exr", f.color);
+        io::writeImage(fd + "/albedo.exr", f.albedo);
+        io::writeImage(fd + "/normal.exr", f.normal);
+        io::writeImage(fd + "/position.exr", position);
+        io::writeImage(fd + "/depth.exr", f.depth);
+        io::writeImage(fd + "/ids.exr", f.ids);
+        io::writeImage(fd + "/motion.exr", f.motion);
+        if (reference) io::writeImage(fd + "/reference.exr", f.truth);
+    }
+}
+
+std::string errorOf(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "(no InputError)";
+}
+
+}  // namespace
+
+TEST(SvgfSequence, ListsAndLoadsFramesInOrder) {
+    test::TempDir dir;
+    SceneOptions o;
+    o.width = 24, o.height = 16;
+    writeSequence(dir.str(), o, 3, 8);
+    std::filesystem::create_directories(dir / "not_a_frame");
+    auto frames = io::listSequenceFrames(dir.str());
+    ASSERT_EQ(frames.size(), 3u);
+    EXPECT_NE(frames[0].find("frame_0008"), std::string::npos);
+    EXPECT_NE(frames[2].find("frame_0010"), std::string::npos);
+    int w = 0, h = 0;
+    io::validateSequence(frames, w, h);
+    EXPECT_EQ(w, 24);
+    EXPECT_EQ(h, 16);
+    io::SequenceFrame f = io::loadSequenceFrame(frames[1]);
+    EXPECT_EQ(f.index, 9);
+    SynthFrame truth = makeFrame(o, 1);
+    EXPECT_EQ(maxAbsDiff(f.color, truth.color), 0.0f);
+    EXPECT_EQ(f.depth(0, 0, 0), 1e30f);
+    EXPECT_EQ(f.motion(boxX0(o, 1) + 1, boxY0(o) + 1, 0), -o.boxSpeed);
+    EXPECT_FALSE(f.reference.empty());
+    EXPECT_TRUE(f.emission.empty());
+}
+
+TEST(SvgfSequence, GapsMissingBuffersAndSizeMismatchesAreNamed) {
+    SceneOptions o;
+    o.width = 16, o.height = 12;
+    {
+        test::TempDir dir;
+        writeSequence(dir.str(), o, 1, 0);
+        writeSequence(dir.str(), o, 1, 2);
+        std::string msg = errorOf([&] { io::listSequenceFrames(dir.str()); });
+        EXPECT_NE(msg.find("frame_0001"), std::string::npos) << msg;
+    }
+    {
+        test::TempDir dir;
+        EXPECT_NE(errorOf([&] { io::listSequenceFrames(dir.str()); }).find("no frame"), std::string::npos);
+        EXPECT_NE(errorOf([&] { io::listSequenceFrames(dir / "absent"); }).find("absent"), std::string::npos);
+    }
+    {
+        test::TempDir dir;
+        writeSequence(dir.str(), o, 2);
+        std::filesystem::remove(dir / "frame_0001/motion.exr");
+        auto frames = io::listSequenceFrames(dir.str());
+        int w, h;
+        // A buffer in some frames only: named in the check of the whole sequence and, given the
+        // sequence's buffer list, when the frame is loaded.
+        std::string msg = errorOf([&] { io::validateSequence(frames, w, h); });
+        EXPECT_NE(msg.find("frame_0001/motion.exr"), std::string::npos) << msg;
+        const std::vector<std::string> all(io::kSequenceBuffers, io::kSequenceBuffers + 7);
+        msg = errorOf([&] { io::loadSequenceFrame(frames[1], all); });
+        EXPECT_NE(msg.find("frame_0001/motion.exr"), std::string::npos) << msg;
+    }
+    {
+        test::TempDir dir;
+        writeSequence(dir.str(), o, 1, 0);
+        SceneOptions big = o;
+        big.width = 20;
+        writeSequence(dir.str(), big, 1, 1);
+        auto frames = io::listSequenceFrames(dir.str());
+        int w, h;
+        std::string msg = errorOf([&] { io::validateSequence(frames, w, h); });
+        EXPECT_NE(msg.find("frame_0001/color.exr"), std::string::npos) << msg;
+        EXPECT_NE(msg.find("frame_0000/color.exr"), std::string::npos) << msg;
+        // Within one frame as well.
+        io::writeImage(dir / "frame_0000/ids.exr", Image(20, 12, 3));
+        msg = errorOf([&] { io::loadSequenceFrame(frames[0]); });
+        EXPECT_NE(msg.find("ids.exr"), std::string::npos) << msg;
+        EXPECT_NE(msg.find("color.exr"), std::string::npos) << msg;
+    }
+}
+
+TEST(SvgfSequence, DenoiseCommandWritesEveryFrameAndBeatsTheInput) {
+    test::TempDir dir;
+    SceneOptions o;
+    o.width = 48, o.height = 32;
+    o.noiseSigma = 0.2f;
+    writeSequence(dir / "seq", o, 4);
+    cli::SequenceDenoiseArgs args;
+    args.sequenceDir = dir / "seq";
+    args.outDir = dir / "out";
+    args.quiet = true;
+    EXPECT_EQ(cli::runSequenceDenoise(args), 0);
+    for (int t = 0; t < 4; ++t) {
+        std::string name = io::sequenceFrameName(t);
+        ASSERT_TRUE(std::filesystem::exists(dir / ("out/" + name + ".png")));
+        Image out = io::readImage(dir / ("out/" + name + ".exr"));
+        SynthFrame f = makeFrame(o, t);
+        ASSERT_TRUE(allFinite(out));
+        // The denoised frame is closer to the truth than the noisy input (measured ~5-20x).
+        EXPECT_LT(mse(out, f.truth), 0.5 * mse(f.color, f.truth)) << name;
+    }
+    if (cli::findOnPath("ffmpeg").empty())
+        EXPECT_FALSE(std::filesystem::exists(dir / "out/preview.mp4"));
+    else
+        EXPECT_TRUE(std::filesystem::exists(dir / "out/preview.mp4"));
+}
+
+TEST(SvgfSequence, EveryParamHasAFlag) {
+    SvgfParams p;
+    CLI::App app;
+    cli::addSvgfOptions(app, p);
+    const char* argv[] = {"x", "--svgf-sigma-l", "2", "--svgf-sigma-n", "64", "--svgf-sigma-z", "3", "--svgf-alpha", "0.3",
+                          "--svgf-moments-alpha", "0.4", "--svgf-history-cap", "16", "--svgf-levels", "4",
+                          "--svgf-feedback-tap", "1", "--svgf-spatial-variance-frames", "2", "--svgf-depth-tolerance", "5",
+                          "--svgf-normal-cos", "0.5", "--taa", "--taa-alpha", "0.25", "--svgf-emission-alpha", "0.5",
+                          "--svgf-emission-motion-alpha", "0.75"};
+    app.parse(int(sizeof(argv) / sizeof(argv[0])), argv);
+    EXPECT_EQ(p.sigmaL, 2.0f);
+    EXPECT_EQ(p.sigmaN, 64.0f);
+    EXPECT_EQ(p.sigmaZ, 3.0f);
+    EXPECT_EQ(p.alpha, 0.3f);
+    EXPECT_EQ(p.momentsAlpha, 0.4f);
+    EXPECT_EQ(p.historyCap, 16);
+    EXPECT_EQ(p.levels, 4);
+    EXPECT_EQ(p.feedbackTap, 1);
+    EXPECT_EQ(p.spatialVarianceFrames, 2);
+    EXPECT_EQ(p.reprojectDepthTolerance, 5.0f);
+    EXPECT_EQ(p.reprojectNormalCos, 0.5f);
+    EXPECT_TRUE(p.taa);
+    EXPECT_EQ(p.taaAlpha, 0.25f);
+    EXPECT_EQ(p.emissionAlpha, 0.5f);
+    EXPECT_EQ(p.emissionMotionAlpha, 0.75f);
+}
+
+TEST(SvgfSequence, PerFrameEawAlsoRuns) {
+    test::TempDir dir;
+    SceneOptions o;
+    o.width = 32, o.height = 24;
+    o.noiseSigma = 0.2f;
+    writeSequence(dir / "seq", o, 2);
+    cli::SequenceDenoiseArgs args;
+    args.method = "eaw";
+    args.sequenceDir = dir / "seq";
+    args.outDir = dir / "out";
+    args.quiet = true;
+    args.preview = false;
+    EXPECT_EQ(cli::runSequenceDenoise(args), 0);
+    EXPECT_TRUE(std::filesystem::exists(dir / "out/frame_0001.exr"));
+}
+
+TEST(SvgfSequence, BadSequencesWriteNothing) {
+    test::TempDir dir;
+    SceneOptions o;
+    o.width = 16, o.height = 12;
+    writeSequence(dir / "seq", o, 3);
+    std::filesystem::remove(dir / "seq/frame_0002/albedo.exr");
+    cli::SequenceDenoiseArgs args;
+    args.sequenceDir = dir / "seq";
+    args.outDir = dir / "out";
+    args.quiet = true;
+    std::string msg = errorOf([&] { cli::runSequenceDenoise(args); });
+    EXPECT_NE(msg.find("frame_0002/albedo.exr"), std::string::npos) << msg;
+    EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+    args.method = "median";
+    EXPECT_NE(errorOf([&] { cli::runSequenceDenoise(args); }).find("median"), std::string::npos);
+}
