@@ -3,6 +3,19 @@
 # OpenGL 3 backends, as Debian's libimgui-dev ships them) are found; otherwise `atrous view`
 # exists and says how to get it.
 option(ATROUS_BUILD_VIEWER "Build the interactive viewer when GLFW, OpenGL and imgui are found" ON)
+
+# The viewer's parts without GL: the frame pipeline (view_pipeline.h: rendering with a movable
+# camera, accumulation, motion, the filter slots, debug buffers), the buffer views' tonemapping
+# (buffer_view.h) and the timings with their JSON line (frame_timing.h). A library of its own,
+# built with or without the viewer, which the viewer and the tests (view_pipeline_test.cpp,
+# view_timing_test.cpp) link.
+set(ATROUS_VIEW_CORE_SOURCES ${CMAKE_CURRENT_LIST_DIR}/view_pipeline.cpp ${CMAKE_CURRENT_LIST_DIR}/buffer_view.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/frame_timing.cpp)
+add_library(atrous_view_core STATIC ${ATROUS_VIEW_CORE_SOURCES})
+target_include_directories(atrous_view_core PUBLIC ${CMAKE_CURRENT_LIST_DIR}/..)
+target_link_libraries(atrous_view_core PUBLIC atrous_internal)
+target_compile_options(atrous_view_core PRIVATE -Wall -Wextra ${ATROUS_CPU_ARCH_FLAGS})
+
 set(ATROUS_HAVE_VIEWER OFF)
 if(ATROUS_BUILD_VIEWER)
   find_package(glfw3 QUIET)
@@ -16,10 +29,11 @@ endif()
 message(STATUS "atrous: viewer ${ATROUS_HAVE_VIEWER}")
 if(ATROUS_HAVE_VIEWER)
   file(GLOB ATROUS_VIEW_SOURCES CONFIGURE_DEPENDS ${CMAKE_CURRENT_LIST_DIR}/*.cpp)
+  list(REMOVE_ITEM ATROUS_VIEW_SOURCES ${ATROUS_VIEW_CORE_SOURCES})
   target_sources(atrous PRIVATE ${ATROUS_VIEW_SOURCES})
   target_include_directories(atrous PRIVATE ${CMAKE_CURRENT_LIST_DIR}/..)
   target_compile_definitions(atrous PRIVATE ATROUS_HAVE_VIEWER=1)
-  target_link_libraries(atrous PRIVATE PkgConfig::IMGUI glfw OpenGL::GL ${CMAKE_DL_LIBS})
+  target_link_libraries(atrous PRIVATE atrous_view_core PkgConfig::IMGUI glfw OpenGL::GL ${CMAKE_DL_LIBS})
   if(ATROUS_HAVE_CUDA)
     # CUDA-OpenGL interop for --device cuda (cuda_display.h; cuda_display_stub.cpp otherwise).
     # Its own small library: the executable's host flags (-Wall, -march) are not nvcc's.
