@@ -1,7 +1,8 @@
 // The viewer's frame pipeline without any windowing: progressive path tracing with a movable
 // camera, accumulation of the buffers over frames, screen-space motion vectors for SVGF, the
 // denoisers of the two comparison slots, and the debug buffers (per-level detail, SURE's s_i).
-// Kept apart from the GLFW/ImGui code so its logic reads (and could be tested) on its own.
+// Kept apart from the GLFW/ImGui code so its logic reads and is tested on its own
+// (tests/view_pipeline_test.cpp, linking the library atrous_view_core).
 #pragma once
 #include <cstdint>
 #include <memory>
