@@ -1,4 +1,4 @@
-"""The fuzz harness's Python-binding cases (tests/fuzz/fuzz.py, docs/reliability.md): seeded
+"""The fuzz harness's Python-binding cases (tests/fuzz/fuzz_python.py, docs/reliability.md): seeded
 calls of render, render_sequence, denoise, read_image and write_image with out-of-range values,
 special floats and odd paths, each in a child interpreter (a crash there is a finding, not the end
 of this run). None may crash, hang, raise anything but ValueError/TypeError, return NaN/Inf, or

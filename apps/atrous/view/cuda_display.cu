@@ -13,7 +13,7 @@ namespace atrous::view {
 
 namespace {
 
-// The host path's tonemapping (viewer.cpp, srgb3): v · exposure, sRGB-encoded, 8 bits. The host
+// The host path's tonemapping (buffer_view.cpp, srgb3): v · exposure, sRGB-encoded, 8 bits. The host
 // quantises through a 4096-entry table first, so the two paths may differ by one code value.
 __device__ unsigned char encodeSrgb(float v) {
     if (!(v > 0.0f)) return 0;  // also NaN
