@@ -206,7 +206,10 @@ def _follow(man: Manifest, todo: List[Item], out: Path, bar: Progress, cpus: flo
     starts: Dict[str, int] = {}
     try:
         while pending:
-            ready, _ = ray.wait(list(pending), num_returns=len(pending), timeout=0.25)
+            waiting = list(pending)
+            ready, rest = ray.wait(waiting, num_returns=1, timeout=0.25)
+            if ready and rest:  # and every other result that is in already
+                ready += ray.wait(rest, num_returns=len(rest), timeout=0)[0]
             for ref in ready:
                 item_id = pending.pop(ref)
                 try:
