@@ -80,6 +80,36 @@ def test_twelve_renders_equal_the_cli_bit_for_bit(cluster, tmp_path):
     no_partial_left(out)
 
 
+def test_frames_and_svgf_equal_the_cli(cluster, tmp_path):
+    cli = _cli()
+    if cli is None:
+        pytest.skip("no atrous CLI (set ATROUS_CLI or build build/atrous)")
+    out, seq = tmp_path / "farm", tmp_path / "cli"
+    r = farm(["render", "--scenes", "cornell-moving", "--spp", "1", "--frames", "3", "--reference-spp", "4",
+              "--width", "24", "--height", "16", "--address", cluster.address, "--out", str(out), "--quiet"],
+             env=cluster.env)
+    assert r.returncode == 0, r.stderr
+    assert len(manifest(out)["items"]) == 3
+    c = subprocess.run([cli, "render", "--scene", "cornell-moving", "--spp", "1", "--frames", "3", "--reference-spp",
+                        "4", "--width", "24", "--height", "16", "--quiet", "--out", str(seq)],
+                       capture_output=True, text=True, timeout=120)
+    assert c.returncode == 0, c.stderr
+    got = out / "cornell-moving_spp1"
+    assert files_of(got) == files_of(seq) and "frame_0002/reference.exr" in files_of(seq)
+    for f in files_of(seq):
+        assert (got / f).read_bytes() == (seq / f).read_bytes(), f
+    dn = tmp_path / "svgf"
+    r = farm(["denoise", "--in", str(got), "--method", "svgf", "--address", cluster.address, "--out", str(dn),
+              "--quiet"], env=cluster.env)
+    assert r.returncode == 0, r.stderr
+    c = subprocess.run([cli, "denoise", "--sequence", str(seq), "--method", "svgf", "--device", "cpu",
+                        "--out", str(tmp_path / "cli-svgf")], capture_output=True, text=True, timeout=120)
+    assert c.returncode == 0, c.stderr
+    for f in range(3):
+        name = f"frame_{f:04d}.exr"
+        assert (dn / "cornell-moving_spp1" / name).read_bytes() == (tmp_path / "cli-svgf" / name).read_bytes()
+
+
 def test_a_killed_worker_costs_a_retry_not_the_job(cluster, tmp_path):
     out = tmp_path / "farm"
     args = ["render", "--scenes", "cornell", "--spp", "256", "--seeds", "1,2,3,4,5,6", "--width", "64", "--height",

@@ -141,7 +141,7 @@ def _write_results(man: Manifest, extra: Any) -> None:
         if e["status"] != "done":
             failed.append({"id": e["id"], "error": e.get("error")})
         elif e["kind"] == "reference":
-            refs[e["params"]["scene"]] = e["result"]
+            refs[e["id"].split("/", 1)[1]] = e["result"]
         elif e.get("result"):
             rows.append(e["result"])
     data = {"job": man.data["job"], "config": man.data["spec"], "references": refs, "results": rows,
