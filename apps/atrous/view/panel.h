@@ -3,8 +3,6 @@
 // and camera controls, method and buffer choice, each filter's parameters, snapshots). What the
 // panel edits lives in ViewerState; what it only shows comes in PanelInfo.
 #pragma once
-#include <GLFW/glfw3.h>
-
 #include <string>
 
 #include "view/buffer_view.h"
