@@ -1,8 +1,11 @@
-"""A real Ray cluster on loopback for the farm tests: `ray start --head` plus worker nodes, each a
-`ray start --block` process of this test run (stopped by SIGTERM to that process, which ends its
+"""A real Ray cluster on this machine for the farm tests: `ray start --head` plus worker nodes, each
+a `ray start --block` process of this test run (stopped by SIGTERM to that process, which ends its
 raylet and workers; nothing else on the machine is touched).
 
-The head has no CPUs, so every item runs on a worker node; each worker node has one CPU, so two
+The nodes are started with --node-ip-address=127.0.0.1 and the jobs join at 127.0.0.1:PORT, but
+Ray 2.60 registers a node given a loopback address under the machine's reachable one instead
+(ray._private.services.resolve_ip_for_localhost), so the manifest's `node` is that address. The
+head has no CPUs, so every item runs on a worker node; each worker node has one CPU, so two
 workers run two items at once. The cluster's token (Ray's token authentication) and its temp
 directory are private to the run.
 """

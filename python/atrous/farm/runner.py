@@ -81,6 +81,12 @@ def connect(address: str, num_cpus: Optional[int] = None) -> bool:
             ray.init(address=address, **kw)
         except (ConnectionError, RuntimeError, ValueError) as e:
             first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
+            chain, c = [], e
+            while c is not None and len(chain) < 5:
+                chain.append(f"{type(c).__name__} {c}")
+                c = c.__cause__ or c.__context__
+            if any("Authentication" in x or "auth token" in x.lower() for x in chain):
+                first += "; the cluster wants its token: RAY_AUTH_TOKEN_PATH or ~/.ray/auth_token"
             raise FarmInputError(f"--address {address}: cannot join the Ray cluster ({first})")
     return True
 
@@ -186,6 +192,7 @@ def _follow(man: Manifest, todo: List[Item], out: Path, bar: Progress, cpus: flo
     import ray
 
     nodes = [n for n in ray.nodes() if n.get("Alive")]
+    node_ip = {n.get("NodeID"): n.get("NodeManagerAddress") for n in nodes}
     info = {"nodes": len(nodes), "cluster_cpus": ray.cluster_resources().get("CPU", 0.0),
             "cluster_gpus": ray.cluster_resources().get("GPU", 0.0), "ray": ray.__version__}
     tracker = _tracker_class().remote()
@@ -217,7 +224,8 @@ def _follow(man: Manifest, todo: List[Item], out: Path, bar: Progress, cpus: flo
                 except Exception as e:  # retries used up, or a bug in the task
                     res = {"status": "failed", "error": _error_of(e), "error_kind": "runtime", "result": None}
                 man.set(item_id, status=res["status"], error=res.get("error"), error_kind=res.get("error_kind"),
-                        result=res.get("result"), node=res.get("node"), node_id=res.get("node_id"), pid=res.get("pid"),
+                        result=res.get("result"), node=node_ip.get(res.get("node_id"), res.get("node")),
+                        node_id=res.get("node_id"), pid=res.get("pid"),
                         seconds=res.get("seconds"), started_utc=res.get("started_utc"), finished_utc=utc_now())
             try:
                 starts = ray.get(tracker.snapshot.remote(), timeout=5)
