@@ -326,6 +326,14 @@ void addDenoiseCommand(CLI::App& app) {
     cmd->add_flag("--no-correlated-variance", a->noCorrelated, "Plain independence propagation of the variance")->group(kGroupSure);
     cmd->add_flag("--no-firefly", a->noFirefly, "Disable firefly suppression")->group(kGroupEawSure);
     cmd->add_option("--firefly-k", a->opt.firefly.k, "Firefly bound: k local standard deviations")->capture_default_str()->group(kGroupEawSure);
+    cmd->add_flag("--safety-net", a->opt.safety.enabled,
+                  "Where SURE estimates the output worse than the input, move it back toward the input "
+                  "(for a trusted variance buffer; docs/algorithms.md)")->group(kGroupEawSure);
+    cmd->add_option("--safety-window", a->opt.safety.windowRadius, "Radius of the safety net's SURE window")
+        ->capture_default_str()->group(kGroupEawSure);
+    cmd->add_option("--safety-trigger", a->opt.safety.trigger,
+                    "The safety net acts where the residual's energy exceeds this many times the input's variance")
+        ->capture_default_str()->group(kGroupEawSure);
     cmd->add_flag("--no-demodulate", a->noDemodulate, "Do not divide by the albedo")->group(kGroupEawSure);
     cmd->add_option("--albedo-epsilon", a->opt.albedoEpsilon, "Smallest albedo divided by")->capture_default_str()->group(kGroupEawSure);
     cmd->add_option("--albedo-floor", a->opt.albedoFloor,

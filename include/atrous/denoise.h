@@ -75,6 +75,8 @@ struct SureParams {
     // Levels i < firstLevel keep none of their detail (s_i = 0); 0 is the paper's form. The default
     // 2 is measured (docs/quality.md "SURE"): fine levels' detail noise is strongly correlated
     // across levels, which the per-level risk ignores, and an oracle keeps ~0% of them anyway.
+    // On other renderers' output 1 wins on fine texture and loses on the geometric mean
+    // (docs/quality.md, "Other renderers' output").
     int firstLevel = 2;
 };
 
@@ -86,6 +88,19 @@ struct FireflyParams {
     float k = 4.0f;  // > 0
 };
 
+// The safety net after either filter (docs/algorithms.md, "The safety net"), off by default: per
+// pixel, SURE on the residual between the input and the filter's output chooses how much of the
+// residual to give back, where that residual's energy is above `trigger` times the input's
+// variance (the filter is then estimated worse than its input). Measured on the corpus
+// (docs/quality.md): with a rendered variance it changes little (±1%); with an estimated one
+// (other renderers' output) the local variance is too uncertain for it, and it costs more than it
+// saves, so it is a choice for inputs whose variance is trusted.
+struct SafetyNetParams {
+    bool enabled = false;
+    int windowRadius = 3;  // the window is (2r+1)², 1..10
+    float trigger = 2.0f;  // τ >= 0: act where ΣD > τ ΣV (2: the SURE risk of the output is above the input's)
+};
+
 struct DenoiseReport;
 
 struct DenoiseOptions {
@@ -94,6 +109,7 @@ struct DenoiseOptions {
     EawParams eaw;
     SureParams sure;
     FireflyParams firefly;
+    SafetyNetParams safety;
     // Albedo demodulation (when an albedo buffer is given): filter color / max(albedo, ε) with
     // variance / max(albedo, ε)², then multiply the result by max(albedo, ε).
     bool demodulate = true;
@@ -101,7 +117,8 @@ struct DenoiseOptions {
     // Where a pixel's largest albedo channel m is below this, demodulation fades out: the divisor
     // is 1 + t (max(a, ε) - 1) with t = min(m / albedoFloor, 1)² (0 = off: max(a, ε) everywhere).
     // Other renderers' albedo is 0 on glass, mirrors, emitters and the sky (docs/algorithms.md).
-    float albedoFloor = 0.1f;  // [0, 1]
+    // 0.05 is measured on the corpus (docs/quality.md): 0.1 half-demodulated dark texture.
+    float albedoFloor = 0.05f;  // [0, 1]
     DenoiseReport* report = nullptr;  // optional: filled with what the run did
 };
 
@@ -124,7 +141,7 @@ struct DenoiseReport {
     // with an emission buffer, the emission filter), fireflies, demodulate (without a variance buffer
     // also the per-pixel noise estimate, docs/algorithms.md), sigma scales, then
     // "level i" (and for SURE "sure i": the window sums and the choice of s_i) per level, then
-    // remodulate. CPU: wall clock; CUDA: cudaEvents on the stream (GPU time, no extra syncs).
+    // "safety net" (when on) and remodulate. CPU: wall clock; CUDA: cudaEvents on the stream (GPU time, no extra syncs).
     std::vector<StageTime> stages;
 };
 

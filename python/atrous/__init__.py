@@ -164,7 +164,7 @@ def denoise(
     color_scale, color_level_factor, sigma_normal, normal_step_scale, sigma_position,
     position_scale, sigma_depth, use_ids, sure_mode ("discrete" | "james-stein"), sure_candidates,
     sure_window, sure_first_level, correlated_variance, emission_levels, emission_scale, firefly, firefly_k, demodulate, albedo_epsilon,
-    albedo_floor
+    albedo_floor, safety_net, safety_window, safety_trigger
     (docs/denoising.md gives their meaning and defaults).
 
     Returns the denoised H x W x 3 float32 image as the same kind of array as `color`.

@@ -128,6 +128,9 @@ void applyDenoiseParam(DenoiseOptions& o, const std::string& k, const nb::handle
     else if (k == "firefly") o.firefly.enabled = as<bool>(v, k);
     else if (k == "firefly_k") o.firefly.k = as<float>(v, k);
     else if (k == "demodulate") o.demodulate = as<bool>(v, k);
+    else if (k == "safety_net") o.safety.enabled = as<bool>(v, k);
+    else if (k == "safety_window") o.safety.windowRadius = as<int>(v, k);
+    else if (k == "safety_trigger") o.safety.trigger = as<float>(v, k);
     // The CLI's negative switches, accepted under their flag names too: no_firefly=True is
     // firefly=False, and so on.
     else if (k == "no_firefly") o.firefly.enabled = !as<bool>(v, k);

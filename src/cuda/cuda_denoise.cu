@@ -110,6 +110,23 @@ struct FillVariance {
 
 }  // namespace
 
+float medianFinite(const CudaExec&, const ImageView& v) {
+    float* d = v.data;
+    const size_t plane = v.plane();
+    size_t n = 0;
+    try {
+        // +Inf and NaN (neither below +Inf) sort after every finite value.
+        n = size_t(thrust::count_if(thrust::cuda::par, d, d + plane, IsFiniteDetail{}));
+        if (n) thrust::sort(thrust::cuda::par, d, d + plane);
+    } catch (const std::exception& e) {
+        throw RuntimeError(std::string("CUDA safety-net median failed: ") + e.what());
+    }
+    if (!n) return 1.0f;
+    float mid = 0.0f;
+    ATROUS_CUDA_CHECK(cudaMemcpy(&mid, d + n / 2, sizeof(float), cudaMemcpyDeviceToHost));
+    return mid;
+}
+
 void estimateNoiseSigmaCuda(const Image& color, const Image* albedo, float eps, float floor, float sigma[3]) {
     if (color.device() != Device::Cuda) throw RuntimeError("estimateNoiseSigmaCuda: the colour is not on the GPU");
     const int w = color.width(), h = color.height();

@@ -59,6 +59,9 @@ void validateDenoiseOptions(const DenoiseOptions& o) {
                  "sure-candidates must list 1..8 values");
     for (float c : s.candidates) requireRange(std::isfinite(c) && c >= 0 && c <= 1, "sure-candidates must be in [0, 1]");
     requireRange(atLeastMin(o.firefly.k), "firefly-k must be >= 1e-6");
+    requireRange(o.safety.windowRadius >= 1 && o.safety.windowRadius <= 10, "safety-window must be in 1..10");
+    requireRange(std::isfinite(o.safety.trigger) && o.safety.trigger >= 0 && o.safety.trigger <= 1e6f,
+                 "safety-trigger must be in [0, 1e6]");
     requireRange(atLeastMin(o.albedoEpsilon), "albedo-epsilon must be >= 1e-6");
     requireRange(std::isfinite(o.albedoFloor) && o.albedoFloor >= 0 && o.albedoFloor <= 1, "albedo-floor must be in [0, 1]");
 }
@@ -92,6 +95,16 @@ void estimateNoiseSigma(const Image& color, const Image* albedo, float eps, floa
         std::nth_element(d.begin(), mid, d.end());
         sigma[c] = float(double(*mid) / 0.6745 / std::sqrt(double(kDetailVarFactor)));
     }
+}
+
+float medianFinite(const CpuExec&, const ImageView& v) {
+    float* d = v.data;
+    const size_t n = size_t(v.width) * size_t(v.height);
+    float* end = std::partition(d, d + n, [](float a) { return a < INFINITY && a == a; });
+    const size_t m = size_t(end - d);
+    if (!m) return 1.0f;
+    std::nth_element(d, d + m / 2, end);
+    return d[m / 2];
 }
 
 static void checkBuffer(const Image* img, const Image& color, const char* name) {
@@ -204,6 +217,7 @@ DriverConfig makeConfig(const DenoiseOptions& o) {
     cfg.eaw = o.eaw;
     cfg.sure = o.sure;
     cfg.firefly = o.firefly;
+    cfg.safety = o.safety;
     cfg.demodulate = o.demodulate;
     cfg.albedoEpsilon = o.albedoEpsilon;
     cfg.albedoFloor = o.albedoFloor;

@@ -12,6 +12,7 @@
 #include "filters/emission_filter.h"
 #include "filters/noise_estimate.h"
 #include "filters/prepass.h"
+#include "filters/safety_net.h"
 #include "filters/stage_clock.h"
 #include "filters/sure.h"
 
@@ -40,6 +41,7 @@ struct DriverConfig {
     EawParams eaw;
     SureParams sure;
     FireflyParams firefly;
+    SafetyNetParams safety;
     bool demodulate = true;
     float albedoEpsilon = 1e-3f;
     float albedoFloor = 0.0f;
@@ -176,6 +178,14 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     if (albedo.valid()) {
         exec.forEachPixel(w, h, Demodulate{cfg.albedoEpsilon, cfg.albedoFloor, albedo, cA.view(), vA.view()});
     }
+    // The safety net's input y and its summed variance, kept before the cascade overwrites them.
+    Image safetyIn, safetyVar;
+    if (cfg.safety.enabled) {
+        safetyIn = Image(w, h, 3, dev);
+        safetyVar = Image(w, h, 1, dev);
+        exec.forEachPixel(w, h, Copy3{cA.view(), safetyIn.view()});
+        exec.forEachPixel(w, h, SafetyVariance{vA.view(), safetyVar.view()});
+    }
     markStage(out.clock, "demodulate");
 
     // 4. Per-pixel scales of the automatic σ_c and σ_x.
@@ -261,8 +271,35 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         std::swap(cur, nxt);
     }
 
-    // 6. out = (c_N + Σ s_i d_i) · albedo.
-    exec.forEachPixel(w, h, Recombine{cfg.albedoEpsilon, cfg.albedoFloor, cur->view(), sure ? acc.view() : ImageView{}, albedo,
+    // 6. The safety net: F' = F + s (y - F), s chosen by SURE on the residual (safety_net.h).
+    ImageView detailSum = sure ? acc.view() : ImageView{};
+    if (cfg.safety.enabled) {
+        if (!sure) {
+            detail = Image(w, h, 2, dev);
+            boxH = Image(w, h, 2, dev);
+        }
+        SureChoiceParams sp;
+        sp.radius = cfg.safety.windowRadius;
+        exec.forEachPixel(w, h, SafetyDetail{safetyIn.view(), cur->view(), detailSum, safetyVar.view(), detail.view()});
+        runSureBoxH(exec, SureBoxH{sp.radius, detail.view(), boxH.view()});
+        // κ: an estimated variance (no variance buffer) can be off by a factor (spatially
+        // correlated noise from a pixel filter wider than a pixel, the quietest-quadrant rule), so
+        // it is calibrated on the image itself: where the filter only removed noise E[ΣD] ≈ ΣV,
+        // and that is most of an image. κ = the median window ratio ΣD/ΣV (at least 1), so the net
+        // acts where the residual is out of line with the rest. A given variance is trusted (κ = 1).
+        float kappa = 1.0f;
+        if (!cfg.varianceGiven) {
+            Image ratio(w, h, 1, dev);
+            exec.forEachPixel(w, h, SafetyRatio{sp.radius, boxH.view(), ratio.view()});
+            kappa = std::fmax(1.0f, medianFinite(exec, ratio.view()));
+        }
+        exec.forEachPixel(w, h, SafetyBlend{sp, kappa, cfg.safety.trigger, boxH.view(), safetyIn.view(), cur->view(), detailSum, ImageView{}});
+        detailSum = ImageView{};
+        markStage(out.clock, "safety net");
+    }
+
+    // 7. out = (c_N + Σ s_i d_i) · albedo.
+    exec.forEachPixel(w, h, Recombine{cfg.albedoEpsilon, cfg.albedoFloor, cur->view(), detailSum, albedo,
                                       emission, out.out});
     markStage(out.clock, "remodulate");
     exec.synchronize();

@@ -80,7 +80,17 @@ ATROUS_INLINE float minSel(float a, float b) { return a < b ? a : b; }
 // Other renderers write albedo 0 on glass, mirrors, emitters and the sky; dividing there by ~eps
 // multiplied the noise by 1000 and the filter spread it into the rims ("dotted bright rims").
 // The same a'_c on both sides keeps the pair an exact inverse. floor = 0: the plain max(a_c, eps).
-constexpr float kDefaultAlbedoFloor = 0.1f;  // DenoiseOptions::albedoFloor's default; SVGF's value
+// SVGF's floor. The still filters' default (DenoiseOptions::albedoFloor) is 0.05: on the corpus
+// a floor of 0.1 half-demodulated a 40x checker's dark squares (albedo ~0.09), so the filter saw
+// the texture as signal to smooth (Cycles textures at 16 spp, SURE: 0.021 -> 0.011; docs/quality.md).
+constexpr float kDefaultAlbedoFloor = 0.1f;
+// Beside a black-albedo pixel (max channel below kBlackAlbedoFraction · floor) the floor is
+// kRimFloorMul times higher: such a pixel is on the rim of glass or a mirror, partly covered by the
+// surface behind, so its small albedo explains little of its colour (dividing by it amplified the
+// reflection into a bright rim). Measured on the corpus (docs/quality.md): the quick set's mirror
+// scene at 4 spp 0.058 -> 0.043 (floor 0.05 alone had lost 32% there against 0.1); 2 and 4 equal.
+constexpr float kRimFloorMul = 2.0f;
+constexpr float kBlackAlbedoFraction = 0.1f;
 ATROUS_INLINE float modulationTerm(float m, float floor) {
     const float t = floor > 0.0f ? minSel(m / floor, 1.0f) : 1.0f;
     return finite(t) && t > 0.0f ? t * t : 0.0f;
@@ -100,7 +110,20 @@ ATROUS_INLINE void pixelModulationAlbedo(const ImageView& albedo, int x, int y, 
         const float u = albedo(x, y, c);
         v[c] = finite(u) ? u : 0.0f;
     }
-    const float t = modulationTerm(maxChannel(v[0], v[1], v[2]), floor);
+    // On the rim of a black-albedo surface (a 3x3 neighbour below kBlackAlbedoFraction · floor)
+    // the floor is kRimFloorMul times higher.
+    float nearBlack = 0.0f;
+    if (floor > 0.0f) {
+        float mn = 1e30f;
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const int xx = clampIdx(x + dx, albedo.width - 1), yy = clampIdx(y + dy, albedo.height - 1);
+                const float m = maxChannel(albedo(xx, yy, 0), albedo(xx, yy, 1), albedo(xx, yy, 2));
+                mn = minSel(mn, finite(m) ? m : 0.0f);
+            }
+        nearBlack = mn < kBlackAlbedoFraction * floor ? 1.0f : 0.0f;
+    }
+    const float t = modulationTerm(maxChannel(v[0], v[1], v[2]), floor * (1.0f + nearBlack * (kRimFloorMul - 1.0f)));
     for (int c = 0; c < 3; ++c) a[c] = modulationAlbedo(v[c], t, eps);
 }
 
