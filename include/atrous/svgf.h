@@ -14,7 +14,10 @@ namespace atrous {
 // each field changes the output (tests/svgf_test.cpp checks that).
 struct SvgfParams {
     // À-trous edge stops (paper's σ_l, σ_n, σ_z).
-    float sigmaL = 4.0f;    // luminance: exp(-|l_p - l_q| / (σ_l sqrt(g3x3(var_p)) + ε))
+    // luminance: exp(-|l_p - l_q| / (σ_l sqrt(g3x3(var_p)) + ε)). 2 with historyClip 0.5, measured
+    // together (docs/quality.md, "Other renderers' output"): the paper's 4 with a clip of 2 kept
+    // cornell's orbit 4% lower but lost to per-frame EAW on Mitsuba's and Cycles' orbits by 1.4x.
+    float sigmaL = 2.0f;
     float sigmaN = 128.0f;  // normal: max(0, n_p·n_q)^σ_n
     float sigmaZ = 1.0f;    // depth: exp(-|z_p - z_q| / (σ_z |∇z_p·(p - q)| + ε))
     // Temporal accumulation: blend factor α = max(alpha, 1/historyLength) for colour and
@@ -24,10 +27,10 @@ struct SvgfParams {
     int historyCap = 32;   // history length saturates here (>= 1)
     // History clipping: the reprojected illumination is scaled into m ± historyClip·s of the
     // current frame's 3x3 luminance samples before the blend, so a moving highlight leaves no
-    // trail (other renderers' glossy metals). >= 0; 0 = off. Measured (docs/svgf.md): 2 keeps
-    // cornell's 512^2 orbit within 1.2% of no clipping and cuts Mitsuba's orbit error 3.1x; 1 cuts it
-    // 3.9x but costs cornell 5%.
-    float historyClip = 2.0f;
+    // trail (other renderers' glossy metals). >= 0; 0 = off. Measured with σ_l (docs/quality.md):
+    // 0.5 and σ_l 2 against the former 2 and 4: Mitsuba's orbit 0.088 -> 0.054, Cycles' 0.027 ->
+    // 0.018 (per-frame EAW 0.061, 0.019), cornell's 256^2 orbit 0.0160 -> 0.0166.
+    float historyClip = 0.5f;
     int levels = 5;        // à-trous levels, step 2^i (0..10; 0 = temporal accumulation only)
     // Which à-trous level's output becomes next frame's colour history: 0 = after the first level
     // (the paper), -1 = the unfiltered temporal accumulation. In [-1, levels - 1]; with levels 0
