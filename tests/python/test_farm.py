@@ -276,6 +276,7 @@ def test_evaluate_sweep_dataset_and_denoise_jobs(cluster, tmp_path):
     (["render", "--scenes", "cornell", "--width", "0"], "width"),
     (["render", "--scenes", "cornell", "--address", "nowhere"], "--address"),
     (["render", "--scenes", "cornell", "--cpus-per-task", "0"], "--cpus-per-task"),
+    (["render", "--scenes", "cornell", "--address", "127.0.0.1:1"], "no Ray head answers"),
     (["render", "--dataset", "SPEC"], "SPEC"),
     (["denoise", "--in", "IN", "--method", "bilateral"], "bilateral"),
     (["denoise", "--in", "IN", "--param", "sigma_colour=1"], "sigma_colour"),

@@ -7,6 +7,7 @@ from __future__ import annotations
 import fcntl
 import os
 import shutil
+import socket
 import sys
 import time
 from dataclasses import dataclass, field
@@ -77,6 +78,14 @@ def connect(address: str, num_cpus: Optional[int] = None) -> bool:
         os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")
         ray.init(num_cpus=num_cpus, include_dashboard=False, **kw)
     else:
+        if address != "auto":
+            # ray.init waits for minutes on an address where nothing listens: ask the port first.
+            host, _, port = address.rpartition(":")
+            try:
+                socket.create_connection((host.strip("[]"), int(port)), timeout=10).close()
+            except (OSError, ValueError) as e:
+                raise FarmInputError(f"--address {address}: no Ray head answers there "
+                                     f"({getattr(e, 'strerror', None) or e})")
         try:
             ray.init(address=address, **kw)
         except (ConnectionError, RuntimeError, ValueError) as e:
@@ -153,21 +162,28 @@ def run_job(job: str, spec: Dict[str, Any], items: List[Item], out: Path, *, add
         raise FarmInputError(f"--address: expected local, auto or HOST:PORT, got '{address}'")
     out = Path(out).absolute()
     check_out_dir(out)
-    earlier = load(out, job)
     t_start = time.perf_counter()
-    out.mkdir(parents=True, exist_ok=True)
-    lock = _Lock(out)
+    # Ray first: a cluster that cannot be joined is bad input, and nothing is written then.
     started_ray = False
+    if len(Manifest(out, job, spec, items, load(out, job)).skipped) < len(items):
+        started_ray = connect(address, num_cpus)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        lock = _Lock(out)
+    except BaseException:
+        _shutdown(started_ray)
+        raise
     try:
         shutil.rmtree(out / PARTIAL, ignore_errors=True)  # stray attempts of a killed earlier run
-        man = Manifest(out, job, spec, items, earlier)
+        man = Manifest(out, job, spec, items, load(out, job))  # read again, under the lock
         run: Dict[str, Any] = {"started_utc": utc_now(), "address": address, "cpus_per_task": cpus_per_task,
                                "gpus_per_task": gpus_per_task, "items": len(items), "skipped": len(man.skipped)}
         man.data["runs"].append(run)
         todo = [it for it in items if it.id not in man.skipped]
-        bar = Progress(len(items), len(man.skipped), enabled=progress)
-        if todo:
+        if todo and not started_ray:
             started_ray = connect(address, num_cpus)
+        bar = Progress(len(items), len(man.skipped), enabled=progress)  # its clock starts with the items
+        if todo:
             run.update(_follow(man, todo, out, bar, cpus_per_task, gpus_per_task, max_retries))
         c = man.counts()
         bar.update(c["done"], c["failed"], 0, final=True)
@@ -179,12 +195,16 @@ def run_job(job: str, spec: Dict[str, Any], items: List[Item], out: Path, *, add
         man.write()
     finally:
         lock.release()
-        if started_ray:
-            import ray
-
-            ray.shutdown()
+        _shutdown(started_ray)
     entries = [man.entries[it.id] for it in items]
     return JobResult(job, out, man.path, entries, time.perf_counter() - t_start, run)
+
+
+def _shutdown(started_ray: bool) -> None:
+    if started_ray:
+        import ray
+
+        ray.shutdown()
 
 
 def _follow(man: Manifest, todo: List[Item], out: Path, bar: Progress, cpus: float, gpus: float,
