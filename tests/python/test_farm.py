@@ -256,7 +256,7 @@ def test_evaluate_sweep_dataset_and_denoise_jobs(cluster, tmp_path):
     assert random_scene(9, 0) != random_scene(9, 1)
 
     dn = tmp_path / "dn"
-    r = farm(["denoise", "--in", str(ds / "scene_000000"), "--method", "eaw", "--param", "levels=3",
+    r = farm(["denoise", "--in", str(ds), "--method", "eaw", "--param", "levels=3",
               "--address", cluster.address, "--out", str(dn), "--quiet"], env=env)
     assert r.returncode == 0, r.stderr
     cli = _cli()
@@ -265,9 +265,10 @@ def test_evaluate_sweep_dataset_and_denoise_jobs(cluster, tmp_path):
                             "--levels", "3", "--device", "cpu", "--out", str(tmp_path / "cli.exr")],
                            capture_output=True, text=True, timeout=60)
         assert c.returncode == 0, c.stderr
-        assert (dn / "spp_2" / "denoised_eaw.exr").read_bytes() == (tmp_path / "cli.exr").read_bytes()
-    assert sorted(files_of(dn)) == [".farm.lock", "manifest.json", "spp_1/denoised_eaw.exr", "spp_1/denoised_eaw.png",
-                                    "spp_2/denoised_eaw.exr", "spp_2/denoised_eaw.png"]
+        got = (dn / "scene_000000" / "spp_2" / "denoised_eaw.exr").read_bytes()
+        assert got == (tmp_path / "cli.exr").read_bytes()
+    want = [f"scene_00000{i}/spp_{n}/denoised_eaw.{ext}" for i in (0, 1) for n in (1, 2) for ext in ("exr", "png")]
+    assert files_of(dn) == [".farm.lock", "manifest.json"] + want
 
 
 @pytest.mark.parametrize("args,needle", [

@@ -171,28 +171,36 @@ def _is_sequence(d: Path) -> bool:
     return any(p.is_dir() and _FRAME.match(p.name) for p in d.iterdir())
 
 
+def _inputs_below(d: Path, depth: int) -> List[Path]:
+    level = [d]
+    for _ in range(depth):
+        level = sorted(p for q in level for p in q.iterdir() if p.is_dir() and not p.name.startswith("."))
+    return [p for p in level if (p / "color.exr").is_file() or _is_sequence(p)]
+
+
 def discover_inputs(paths: Sequence[str], flag: str = "--in") -> List[Dict[str, Any]]:
     """Render directories (color.exr and its buffers, as `atrous render --out` writes) and frame
-    sequences (frame_NNNN/, `atrous render --frames`) given directly or one level down (a farm
-    render job's output directory). Returns [{"name", "kind": render|sequence, "path", "frames"}]."""
+    sequences (frame_NNNN/, `atrous render --frames`) given directly, or one level down (a farm
+    render job's output directory), or two (a dataset's: scene_NNNNNN/spp_N/). Returns [{"name", "kind": render|sequence, "path", "frames"}]."""
     found: List[Dict[str, Any]] = []
     for raw in paths:
         d = Path(raw)
         if not d.is_dir():
             raise FarmInputError(f"{flag} '{raw}': not a directory")
-        if (d / "color.exr").is_file():
-            cands = [d]
-        elif _is_sequence(d):
-            cands = [d]
+        if (d / "color.exr").is_file() or _is_sequence(d):
+            cands, base = [d], d.parent
         else:
-            cands = sorted(p for p in d.iterdir() if p.is_dir() and not p.name.startswith(".")
-                           and ((p / "color.exr").is_file() or _is_sequence(p)))
+            # A render job's --out (render directories one level down) or a dataset's (two levels:
+            # scene_NNNNNN/spp_N/); names are the paths below d, so they stay apart.
+            base = d
+            cands = _inputs_below(d, 1) or _inputs_below(d, 2)
             if not cands:
                 raise FarmInputError(f"{flag} '{raw}': no color.exr, frame_NNNN/ directory or render "
-                                     "directory (one level down) in it")
+                                     "directory (one or two levels down) in it")
         for c in cands:
+            name = str(c.relative_to(base)) if base != d.parent else c.name
             if (c / "color.exr").is_file():
-                found.append({"name": c.name, "kind": "render", "path": str(c.resolve()), "frames": []})
+                found.append({"name": name, "kind": "render", "path": str(c.resolve()), "frames": []})
                 continue
             frames = sorted((int(m.group(1)), p) for p in c.iterdir() if p.is_dir() and (m := _FRAME.match(p.name)))
             for (a, _), (b, pb) in zip(frames, frames[1:]):
@@ -201,7 +209,7 @@ def discover_inputs(paths: Sequence[str], flag: str = "--in") -> List[Dict[str, 
             for _, p in frames:
                 if not (p / "color.exr").is_file():
                     raise FarmInputError(f"{flag}: {p / 'color.exr'}: missing")
-            found.append({"name": c.name, "kind": "sequence", "path": str(c.resolve()),
+            found.append({"name": name, "kind": "sequence", "path": str(c.resolve()),
                           "frames": [p.name for _, p in frames]})
     names = [f["name"] for f in found]
     dup = sorted({x for x in names if names.count(x) > 1})
