@@ -137,7 +137,8 @@ def test_a_killed_worker_costs_a_retry_not_the_job(cluster, tmp_path):
     assert sorted(ids) == sorted(f"cornell_spp256_seed{k}" for k in range(1, 7))  # each once
     assert all(e["status"] == "done" for e in m["items"])
     retried = [e for e in m["items"] if e["attempts"] >= 2]
-    assert retried, ("the killed item should have been started again", killed, [(e["id"], e["attempts"], e["pid"]) for e in m["items"]], stderr)
+    assert retried, ("the killed item should have been started again", killed,
+                     [(e["id"], e["attempts"], e["pid"]) for e in m["items"]])
     assert all(e["pid"] != killed for e in m["items"])  # every result came from a live worker
     assert len({e["node_id"] for e in m["items"]}) == 2  # both worker nodes took items
     no_partial_left(out)

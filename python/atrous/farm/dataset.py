@@ -92,12 +92,15 @@ def random_scene(seed: int, index: int) -> Dict[str, Any]:
         "ceiling": {"type": "diffuse", "albedo": _rgb(r, 0.5, 0.9)},
     }
     x0, x1 = -W / 2, W / 2
+    def wall(name: str, corner: List[float], e1: List[float], e2: List[float]) -> Dict[str, Any]:
+        return {"type": "quad", "name": name, "corner": corner, "edge1": e1, "edge2": e2, "material": name}
+
     objects: List[Dict[str, Any]] = [
-        {"type": "quad", "name": "floor", "corner": [x0, 0, -D], "edge1": [0, 0, D], "edge2": [W, 0, 0], "material": "floor"},
-        {"type": "quad", "name": "ceiling", "corner": [x0, H, -D], "edge1": [W, 0, 0], "edge2": [0, 0, D], "material": "ceiling"},
-        {"type": "quad", "name": "back", "corner": [x0, 0, -D], "edge1": [W, 0, 0], "edge2": [0, H, 0], "material": "back"},
-        {"type": "quad", "name": "left", "corner": [x0, 0, -D], "edge1": [0, H, 0], "edge2": [0, 0, D], "material": "left"},
-        {"type": "quad", "name": "right", "corner": [x1, 0, -D], "edge1": [0, 0, D], "edge2": [0, H, 0], "material": "right"},
+        wall("floor", [x0, 0, -D], [0, 0, D], [W, 0, 0]),
+        wall("ceiling", [x0, H, -D], [W, 0, 0], [0, 0, D]),
+        wall("back", [x0, 0, -D], [W, 0, 0], [0, H, 0]),
+        wall("left", [x0, 0, -D], [0, H, 0], [0, 0, D]),
+        wall("right", [x1, 0, -D], [0, 0, D], [0, H, 0]),
     ]
     for k in range(r.randint(2, 6)):
         rad = r.uniform(0.25, 0.9)
@@ -120,6 +123,7 @@ def random_scene(seed: int, index: int) -> Dict[str, Any]:
                                                      round(r.uniform(-D * 0.8, -D * 0.2), 3)],
                        "intensity": [round(r.uniform(5, 25) * c, 3) for c in _rgb(r, 0.7, 1.0)]})
     cam = [round(r.uniform(x0 * 0.4, x1 * 0.4), 3), round(r.uniform(0.8, H * 0.8), 3), round(r.uniform(1.5, 4), 3)]
-    target = [round(r.uniform(x0 * 0.3, x1 * 0.3), 3), round(r.uniform(0.4, 1.5), 3), round(-D * r.uniform(0.4, 0.7), 3)]
+    target = [round(r.uniform(x0 * 0.3, x1 * 0.3), 3), round(r.uniform(0.4, 1.5), 3),
+              round(-D * r.uniform(0.4, 0.7), 3)]
     return {"camera": {"position": cam, "lookAt": target, "up": [0, 1, 0], "fov": round(r.uniform(35, 60), 2)},
             "materials": mats, "objects": objects, "lights": lights}

@@ -181,7 +181,8 @@ def _inputs_below(d: Path, depth: int) -> List[Path]:
 def discover_inputs(paths: Sequence[str], flag: str = "--in") -> List[Dict[str, Any]]:
     """Render directories (color.exr and its buffers, as `atrous render --out` writes) and frame
     sequences (frame_NNNN/, `atrous render --frames`) given directly, or one level down (a farm
-    render job's output directory), or two (a dataset's: scene_NNNNNN/spp_N/). Returns [{"name", "kind": render|sequence, "path", "frames"}]."""
+    render job's output directory), or two (a dataset's: scene_NNNNNN/spp_N/).
+    Returns [{"name", "kind": render|sequence, "path", "frames"}]."""
     found: List[Dict[str, Any]] = []
     for raw in paths:
         d = Path(raw)
