@@ -321,3 +321,45 @@ TEST(RobustInputs, RimBesideBlackAlbedoIsNotAmplified) {
         EXPECT_LT(e, 0.6 * noisyMse) << denoiseMethodName(m);
     }
 }
+
+TEST(RobustInputs, VisibleLightWithoutEmissionBufferKeepsItsEdge) {
+    // A light of radiance 20 (albedo 0, as Mitsuba writes it) in a noisy wall of 0.3, no emission
+    // buffer, with and without a variance. The light's edge stays sharp: the wall pixels beside
+    // it stay near 0.3 and the light keeps its radiance.
+    const int n = 48;
+    Image truth(n, n, 3), noisy(n, n, 3), variance(n, n, 3), albedo(n, n, 3);
+    std::mt19937 rng(13);
+    std::normal_distribution<float> gauss(0.0f, 1.0f);
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            const bool light = x >= 20 && x < 28 && y >= 10 && y < 38;
+            const float t = light ? 20.0f : 0.3f, var = light ? 0.0f : 0.01f;
+            for (int c = 0; c < 3; ++c) {
+                truth(x, y, c) = t;
+                albedo(x, y, c) = light ? 0.0f : 0.6f;
+                variance(x, y, c) = var;
+                noisy(x, y, c) = t + std::sqrt(var) * gauss(rng);
+            }
+        }
+    for (bool withVariance : {true, false}) {
+        DenoiseInputs in;
+        in.color = &noisy;
+        in.albedo = &albedo;
+        if (withVariance) in.variance = &variance;
+        for (DenoiseMethod m : {DenoiseMethod::Eaw, DenoiseMethod::Sure}) {
+            DenoiseOptions o;
+            o.method = m;
+            const Image out = denoise(in, o);
+            float worstWall = 0, worstLight = 0;
+            for (int y = 12; y < 36; ++y) {
+                for (int x : {18, 19, 28, 29}) worstWall = std::fmax(worstWall, std::fabs(out(x, y, 1) - 0.3f));
+                for (int x = 20; x < 28; ++x) worstLight = std::fmax(worstLight, std::fabs(out(x, y, 1) - 20.0f));
+            }
+            // Measured: wall within 0.004 (EAW), 0.010 (SURE), light within 1e-5; without the
+            // colour-edge rule of DetailEnergy, without a variance, the wall beside the light rose
+            // by 0.69 (to 1.0) and the light lost 0.49.
+            EXPECT_LT(worstWall, 0.1f) << denoiseMethodName(m) << " variance " << withVariance;
+            EXPECT_LT(worstLight, 0.5f) << denoiseMethodName(m) << " variance " << withVariance;
+        }
+    }
+}

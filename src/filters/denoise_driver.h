@@ -159,7 +159,9 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         // clamped with the constant estimate, so that they do not raise it): noise_estimate.h.
         Image demod(w, h, 3, dev), energy(w, h, 3, dev);
         exec.forEachPixel(w, h, DemodulatedCopy{cfg.albedoEpsilon, cfg.albedoFloor, cA.view(), albedo, demod.view()});
-        exec.forEachPixel(w, h, DetailEnergy{demod.view(), energy.view(), normal, depth});
+        DetailEnergy de{demod.view(), energy.view(), normal, depth};
+        for (int c = 0; c < 3; ++c) de.maxDiff2[c] = kNoiseEdgeSigmas2 * kNoiseCapMul * cfg.noiseFloorVar[c];
+        exec.forEachPixel(w, h, de);
         Image rows(w, h, 8, dev);
         exec.forEachPixel(w, h, QuadrantRows{cfg.noiseRadius, energy.view(), rows.view()});
         LocalVariance lv;

@@ -19,6 +19,14 @@ namespace atrous::filters {
 // geometric mean (Mitsuba glass, box filter: 0.0249 -> 0.0115 at 16 spp; Cycles glass at 4 spp
 // alone lost, 0.0248 -> 0.0319).
 constexpr float kNoiseCapMul = 128.0f;
+// DetailEnergy leaves out a tap whose colour differs from p's by more than sqrt(kNoiseEdgeSigmas2
+// · kNoiseCapMul) global standard deviations (68: 6 times the largest local deviation the cap
+// allows): an edge in the colour itself, such as a visible light in a wall of the same normal and
+// depth, whose B3 detail otherwise raised the estimate on both sides and opened the colour stop
+// across the light's edge (RobustInputs.VisibleLightWithoutEmissionBufferKeepsItsEdge). Measured on
+// the corpus (docs/quality.md): 16 spp best/OIDN geomean 1.041 -> 1.020 with 36, 1.024 with 64;
+// 9 lost glass caustics at 4 spp (1.009 -> 1.119), 100 no longer keeps the test's light edge.
+constexpr float kNoiseEdgeSigmas2 = 36.0f;
 
 // var(d_0) = σ² (1 + Σ h² - 2 h(0)) for white noise under the 5×5 B3 kernel (see estimateNoiseSigma).
 constexpr float kDetailVarFactor = float(1.0 + (70.0 / 256.0) * (70.0 / 256.0) - 2.0 * (6 / 16.0) * (6 / 16.0));
@@ -76,16 +84,22 @@ constexpr float kNoiseDepthRel = 0.05f;
 struct DetailEnergy {
     ImageView color, energy;  // color: c_0 demodulated (DemodulatedCopy), energy: out (3 ch)
     ImageView normal, depth;  // sanitised (zeros when absent)
+    // A tap further from p than this (squared, per channel) is across an edge in the colour itself
+    // (a visible light in a wall of the same normal and depth), left out as a geometric edge is.
+    float maxDiff2[3] = {3.0e38f, 3.0e38f, 3.0e38f};
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         const int w = color.width, h = color.height;
         const float nx = normal(x, y, 0), ny = normal(x, y, 1), nz = normal(x, y, 2), zp = depth(x, y, 0);
+        const float cp[3] = {color(x, y, 0), color(x, y, 1), color(x, y, 2)};
         float s[3] = {0, 0, 0}, ws = 0, w2 = 0;
         for (int qy = -2; qy <= 2; ++qy)
             for (int qx = -2; qx <= 2; ++qx) {
                 const int xx = clampIdx(x + qx, w - 1), yy = clampIdx(y + qy, h - 1);
                 const float dn = sq(nx - normal(xx, yy, 0)) + sq(ny - normal(xx, yy, 1)) + sq(nz - normal(xx, yy, 2));
                 const float dz = fabsf(zp - depth(xx, yy, 0));
-                const bool same = (dn <= kNoiseNormalDist2) & (dz <= kNoiseDepthRel * fabsf(zp));
+                const bool near = (sq(color(xx, yy, 0) - cp[0]) <= maxDiff2[0]) & (sq(color(xx, yy, 1) - cp[1]) <= maxDiff2[1]) &
+                                  (sq(color(xx, yy, 2) - cp[2]) <= maxDiff2[2]);
+                const bool same = (dn <= kNoiseNormalDist2) & (dz <= kNoiseDepthRel * fabsf(zp)) & near;
                 const float wt = same ? b3(qx) * b3(qy) : 0.0f;
                 ws += wt;
                 w2 += wt * wt;
