@@ -173,6 +173,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         lv.rows = rows.view();
         lv.albedo = albedo;
         lv.var = vA.view();
+        lv.normal = in.normal.valid() ? normal : ImageView{};
         exec.forEachPixel(w, h, lv);
     }
 
