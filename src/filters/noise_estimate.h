@@ -27,10 +27,13 @@ constexpr float kNoiseCapMul = 128.0f;
 // the corpus (docs/quality.md): 16 spp best/OIDN geomean 1.041 -> 1.020 with 36, 1.024 with 64;
 // 9 lost glass caustics at 4 spp (1.009 -> 1.119), 100 no longer keeps the test's light edge.
 constexpr float kNoiseEdgeSigmas2 = 36.0f;
-// LocalVariance's floor on background pixels (a zero normal), as a fraction of the global estimate.
-// The global estimate is of the image's surfaces; on the corpus it let the filter smooth the sky's
-// gradient toward the horizon (docs/quality.md: 16 spp best/OIDN geomean 1.020 -> 1.009, 4 spp
-// 1.019 -> 1.003; 0.1 and 0.01 equal).
+// The variance of a background pixel (a zero normal), as a fraction of the global estimate, in
+// place of the local estimate. The global estimate is of the image's surfaces, and the local one
+// reads a sky's gradient toward the horizon as noise: with either, the filter smoothed the sky
+// and, on Cycles' sky below the horizon, pulled the horizon's bright rows into the dark ones (the
+// quick corpus's 64^2 Cycles sun-sky scene at 16 spp: 0.0277, worse than its input's 0.0190,
+// -> 0.0123). Measured on the full corpus (docs/quality.md): 16 spp best/OIDN geomean 1.020 ->
+// 1.005, 4 spp 1.019 -> 1.009 (as a floor under the local estimate only: 1.009 and 1.003).
 constexpr float kNoiseBackgroundFloor = 0.01f;
 
 // var(d_0) = σ² (1 + Σ h² - 2 h(0)) for white noise under the 5×5 B3 kernel (see estimateNoiseSigma).
@@ -175,8 +178,8 @@ struct LocalVariance {
     ImageView rows, albedo, var;
     // A pixel whose normal is 0 sees the background (no surface: the sky, an environment map),
     // which renderers look up directly for camera rays, so it is as good as noise-free: its
-    // estimate is floored at kNoiseBackgroundFloor times the global one instead of the whole.
-    // Invalid (no normal buffer): no pixel is background.
+    // variance is kNoiseBackgroundFloor times the global estimate. Invalid (no normal buffer): no
+    // pixel is background.
     ImageView normal;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         const int h = rows.height;
@@ -204,7 +207,8 @@ struct LocalVariance {
         pixelModulationAlbedo(albedo, x, y, eps, floor, m);
         for (int c = 0; c < 3; ++c) {
             const float a = m[c];
-            const float v = minSel(maxSel(q[best][c] / q[best][3], fm * floorVar[c]), capMul * floorVar[c]) * a * a;
+            const float local = bg ? 0.0f : q[best][c] / q[best][3];
+            const float v = minSel(maxSel(local, fm * floorVar[c]), capMul * floorVar[c]) * a * a;
             var(x, y, c) = finite(v) ? v : floorVar[c] * a * a;
         }
     }
