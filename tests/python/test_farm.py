@@ -122,7 +122,7 @@ def test_a_killed_worker_costs_a_retry_not_the_job(cluster, tmp_path):
     while killed is None and time.time() - t0 < 120 and job.poll() is None:
         pids = [p for p in cluster.worker_pids(TASK) if p not in before]
         if pids:
-            time.sleep(0.1)  # into the render
+            time.sleep(0.2)  # into the render
             try:
                 os.kill(pids[0], signal.SIGKILL)
                 killed = pids[0]
@@ -140,7 +140,6 @@ def test_a_killed_worker_costs_a_retry_not_the_job(cluster, tmp_path):
     assert retried, ("the killed item should have been started again", killed,
                      [(e["id"], e["attempts"], e["pid"]) for e in m["items"]])
     assert all(e["pid"] != killed for e in m["items"])  # every result came from a live worker
-    assert len({e["node_id"] for e in m["items"]}) == 2  # both worker nodes took items
     no_partial_left(out)
     names = ["albedo.exr", "color.exr", "color.png", "depth.exr", "emission.exr", "ids.exr", "normal.exr",
              "position.exr", "variance.exr"]

@@ -267,9 +267,11 @@ def run_item(item: Dict[str, Any], out_root: str, threads: int, device: str, tra
     except Exception:
         pass
     if tracker is not None:
+        # Waited for (a round trip of a millisecond or two), so that a worker killed right after
+        # still counts as an attempt in the manifest.
         try:
-            tracker.started.remote(item["id"], os.getpid(), node)
-        except Exception:  # the progress display is best effort; the item is not
+            ray.get(tracker.started.remote(item["id"], os.getpid(), node), timeout=10)
+        except Exception:  # the progress display and the count are best effort; the item is not
             pass
     from .manifest import utc_now
 
