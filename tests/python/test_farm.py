@@ -112,7 +112,7 @@ def test_frames_and_svgf_equal_the_cli(cluster, tmp_path):
 
 def test_a_killed_worker_costs_a_retry_not_the_job(cluster, tmp_path):
     out = tmp_path / "farm"
-    args = ["render", "--scenes", "cornell", "--spp", "256", "--seeds", "1,2,3,4,5,6", "--width", "64", "--height",
+    args = ["render", "--scenes", "cornell", "--spp", "512", "--seeds", "1,2,3,4,5,6", "--width", "64", "--height",
             "64", "--address", cluster.address, "--out", str(out), "--quiet"]
     before = set(cluster.worker_pids(TASK))  # workers of earlier jobs that may still be exiting
     job = subprocess.Popen([sys.executable, "-m", "atrous.farm", *args], env=cluster.env,
@@ -134,7 +134,7 @@ def test_a_killed_worker_costs_a_retry_not_the_job(cluster, tmp_path):
     assert job.returncode == 0, stderr
     m = manifest(out)
     ids = [e["id"] for e in m["items"]]
-    assert sorted(ids) == sorted(f"cornell_spp256_seed{k}" for k in range(1, 7))  # each once
+    assert sorted(ids) == sorted(f"cornell_spp512_seed{k}" for k in range(1, 7))  # each once
     assert all(e["status"] == "done" for e in m["items"])
     retried = [e for e in m["items"] if e["attempts"] >= 2]
     assert retried, ("the killed item should have been started again", killed,
@@ -147,7 +147,7 @@ def test_a_killed_worker_costs_a_retry_not_the_job(cluster, tmp_path):
         assert files_of(out / e["id"]) == names
     # The retried item's pixels are the ones a single process renders.
     e = retried[0]
-    want = atrous.render("cornell", width=64, height=64, spp=256, seed=e["params"]["seed"])["color"]
+    want = atrous.render("cornell", width=64, height=64, spp=512, seed=e["params"]["seed"])["color"]
     np.testing.assert_array_equal(atrous.read_image(out / e["id"] / "color.exr"), want)
 
 
