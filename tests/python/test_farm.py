@@ -207,6 +207,20 @@ def test_a_bad_scene_file_fails_its_item_only(cluster, tmp_path):
     assert m["broken_spp2"]["attempts"] == 1  # bad input is not retried
     assert len(files_of(out / "cornell_spp2")) == 9
     no_partial_left(out)
+    # In an evaluation the broken scene's reference fails, and with it that scene's items only.
+    ev = tmp_path / "eval"
+    r = farm(["evaluate", "--scenes", f"cornell,{bad}", "--spp", "2", "--methods", "noisy,eaw", "--width", "16",
+              "--height", "16", "--ref-spp", "16", "--runs", "1", "--address", cluster.address, "--out", str(ev),
+              "--quiet"], env=cluster.env)
+    assert r.returncode == 2, r.stderr
+    m = {e["id"]: e for e in manifest(ev)["items"]}
+    assert [k for k, e in m.items() if e["status"] == "done"] == ["references/cornell", "cornell/spp2/noisy",
+                                                                   "cornell/spp2/eaw"]
+    assert str(bad) in m["references/broken"]["error"]
+    assert m["broken/spp2/eaw"]["error"].startswith("needs references/broken, which failed: ")
+    res = json.loads((ev / "results.json").read_text())
+    assert [(x["scene"], x["method"]) for x in res["results"]] == [("cornell", "noisy"), ("cornell", "eaw")]
+    assert sorted(f["id"] for f in res["failed"]) == ["broken/spp2/eaw", "broken/spp2/noisy", "references/broken"]
 
 
 def test_evaluate_sweep_dataset_and_denoise_jobs(cluster, tmp_path):

@@ -281,9 +281,11 @@ def run_item(item: Dict[str, Any], out_root: str, threads: int, device: str, tra
                            "started_utc": utc_now()}
     failed_dep = next((d for d in deps if isinstance(d, dict) and d.get("status") != "done"), None)
     try:
-        if failed_dep is not None:
-            raise RuntimeError(f"needs {failed_dep.get('id')}, which failed: {failed_dep.get('error')}")
-        res["result"] = RUNNERS[item["kind"]](item, Path(out_root), threads, device)
+        if failed_dep is not None:  # failed as its dependency did (bad input there is bad input here)
+            res.update(status="failed", error=f"needs {failed_dep.get('id')}, which failed: {failed_dep.get('error')}",
+                       error_kind=failed_dep.get("error_kind") or "runtime")
+        else:
+            res["result"] = RUNNERS[item["kind"]](item, Path(out_root), threads, device)
     except ValueError as e:  # bad input: the library's InputError, a missing buffer
         res.update(status="failed", error=str(e), error_kind="input")
     except (RuntimeError, OSError) as e:
