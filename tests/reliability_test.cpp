@@ -380,14 +380,14 @@ TEST(Reliability, TinyFilterParametersAreRejected) {
         set(o);
         return errorOf([&] { denoise(in, o); });
     };
-    EXPECT_NE(with([](DenoiseOptions& o) { o.eaw.sigmaNormal = 1e-20f; }).find("sigma-normal must be 0 (off) or >= 1e-6"), std::string::npos);
-    EXPECT_NE(with([](DenoiseOptions& o) { o.eaw.sigmaPosition = 1e-20f; }).find("sigma-position"), std::string::npos);
-    EXPECT_NE(with([](DenoiseOptions& o) { o.eaw.sigmaDepth = 1e-20f; }).find("sigma-depth"), std::string::npos);
-    EXPECT_NE(with([](DenoiseOptions& o) { o.albedoEpsilon = 1e-20f; }).find("albedo-epsilon must be >= 1e-6"), std::string::npos);
+    EXPECT_NE(with([](DenoiseOptions& o) { o.eaw.sigmaNormal = 1e-20f; }).find("sigma_normal must be 0 (off) or >= 1e-6"), std::string::npos);
+    EXPECT_NE(with([](DenoiseOptions& o) { o.eaw.sigmaPosition = 1e-20f; }).find("sigma_position"), std::string::npos);
+    EXPECT_NE(with([](DenoiseOptions& o) { o.eaw.sigmaDepth = 1e-20f; }).find("sigma_depth"), std::string::npos);
+    EXPECT_NE(with([](DenoiseOptions& o) { o.albedoEpsilon = 1e-20f; }).find("albedo_epsilon must be a finite number >= 1e-6"), std::string::npos);
     EXPECT_EQ(with([](DenoiseOptions& o) { o.eaw.sigmaNormal = 1e-6f; o.albedoEpsilon = 1e-6f; }), "");
     SvgfParams p;
     p.sigmaZ = 1e-20f;
-    EXPECT_NE(errorOf([&] { SvgfDenoiser d(p); }).find("sigmaZ"), std::string::npos);
+    EXPECT_NE(errorOf([&] { SvgfDenoiser d(p); }).find("sigma_z"), std::string::npos);
 }
 
 // 6. A variance of 3e38 or a colour of 3e38 made the output NaN: beyond 1e30 / 1e15 they are errors.

@@ -280,11 +280,11 @@ TEST(ViewPipeline, EverySlotMethodRunsAndSvgfTakesTheFramesOwnSamples) {
 TEST(ViewPipeline, RejectedParametersLandInTheSlotAndTheInputIsShown) {
     ViewPipeline pl(cornell(), kW, kH, Device::Cpu, 1);
     PipelineSettings s = settings(Method::Eaw);
-    s.eaw.levels = 0;  // 1..10
+    s.denoise.eaw.levels = 0;  // 1..10
     ASSERT_NO_THROW(pl.step(s));
     EXPECT_FALSE(pl.slot(0).error.empty());
     EXPECT_EQ(maxAbsDiff(pl.slot(0).image, pl.color()), 0.0f);
-    s.eaw.levels = 3;
+    s.denoise.eaw.levels = 3;
     pl.step(s);
     EXPECT_TRUE(pl.slot(0).error.empty()) << pl.slot(0).error;
 
@@ -312,13 +312,13 @@ TEST(ViewPipeline, DebugBuffersOnlyWhenAsked) {
     for (size_t i = 0; i < pl.detail().size(); ++i) e += std::fabs(pl.detail().data()[i]);
     EXPECT_GT(e / double(pl.detail().size()), 1e-4);  // d_0 = c_0 - c_1 holds the finest noise
     const Image& f = pl.sureFractions();
-    ASSERT_EQ(f.channels(), s.eaw.levels);
+    ASSERT_EQ(f.channels(), s.denoise.eaw.levels);
     for (size_t i = 0; i < f.size(); ++i) {
         ASSERT_GE(f.data()[i], 0.0f);
         ASSERT_LE(f.data()[i], 1.0f);
     }
 
-    s.detailLevel = s.eaw.levels;  // past the last level: nothing
+    s.detailLevel = s.denoise.eaw.levels;  // past the last level: nothing
     s.sureFractions = false;
     pl.step(s);
     EXPECT_TRUE(pl.detail().empty());

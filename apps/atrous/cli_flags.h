@@ -1,6 +1,7 @@
-// The library's InputErrors name the value ("unknown device 'gpu'") or the parameter ("levels must
-// be in 1..10"), since Python shares them; the CLI puts the flag in front so the user knows which
-// one to fix. Library messages that already start with a flag ("--device cuda: ...") stay as they are.
+// The library's InputErrors name the value ("unknown device 'gpu'") or the parameter (ParamError:
+// the field "sigma_normal"), since Python shares them; the CLI puts the flag in front so the user
+// knows which one to fix: withFlag for a value it parsed, the parameter tables (params.h) for a
+// field. Library messages that already start with a flag ("--device cuda: ...") stay as they are.
 #pragma once
 #include <CLI/CLI.hpp>
 
@@ -8,6 +9,7 @@
 
 #include "atrous/device.h"
 #include "atrous/error.h"
+#include "atrous/params.h"
 
 namespace atrous::cli {
 
@@ -40,22 +42,62 @@ inline std::string givenValue(const CLI::App& cmd, const std::string& flag) {
     return v;
 }
 
-// Rewrites "<prefix><name> <rule>" into "--<flag>: <rule> (got <value>)", mapping the library's
-// parameter name to its flag with flagOf(name) ("" = unknown: the message stays as it is).
-template <class FlagOf>
-[[noreturn]] void rethrowParameterError(const InputError& e, const std::string& prefix, const CLI::App& cmd,
-                                        FlagOf&& flagOf) {
-    const std::string msg = e.what();
-    if (msg.rfind(prefix, 0) == 0) {
-        const std::string rest = msg.substr(prefix.size());
-        const size_t space = rest.find(' ');
-        const std::string flag = flagOf(rest.substr(0, space));
-        if (!flag.empty() && space != std::string::npos) {
-            const std::string got = givenValue(cmd, flag);
-            throw InputError(flag + ": " + rest.substr(space + 1) + (got.empty() ? "" : " (got " + got + ")"));
-        }
+// A ParamError as the user typed it: "--svgf-alpha: must be in (0, 1] (got 2)". The table maps
+// the error's field to its flag (params.h); the message is not read.
+template <class S>
+[[noreturn]] void rethrowAsFlag(const ParamError& e, const ParamTable<S>& t, const CLI::App& cmd) {
+    const ParamField<S>* f = t.find(e.field());
+    if (!f) throw e;
+    const std::string flag = t.flag(*f), got = givenValue(cmd, flag);
+    throw InputError(flag + ": " + e.rule() + (got.empty() ? "" : " (got " + got + ")"));
+}
+
+// validateParams with the flags' names in the message.
+template <class S>
+void checkParamFlags(const S& s, const ParamTable<S>& t, const CLI::App& cmd) {
+    try {
+        validateParams(s, t);
+    } catch (const ParamError& e) {
+        rethrowAsFlag(e, t, cmd);
     }
-    throw e;
+}
+
+// One flag per row of the table, writing into `s` (which must outlive the parse), in the help
+// group group(field); the defaults shown are the struct's. A negated Bool is a --no-<name> switch,
+// a Choice or FloatList takes its text (setParamFromText). Ranges are checked after the parse
+// (checkParamFlags), when every flag is known.
+template <class S, class GroupOf>
+void addParamOptions(CLI::App& cmd, S& s, const ParamTable<S>& t, GroupOf&& group) {
+    for (const ParamField<S>& f : t) {
+        const std::string flag = t.flag(f);
+        const ParamRef r = f.at(s);
+        CLI::Option* opt = nullptr;
+        if (bool* const* b = std::get_if<bool*>(&r)) {
+            bool* p = *b;
+            opt = f.negated ? cmd.add_flag_callback(flag, [p] { *p = false; }, std::string("turn off: ") + f.doc)
+                            : cmd.add_flag(flag, *p, f.doc);
+        } else if (int* const* i = std::get_if<int*>(&r)) {
+            opt = cmd.add_option(flag, **i, f.doc)->capture_default_str();
+        } else if (float* const* x = std::get_if<float*>(&r)) {
+            opt = cmd.add_option(flag, **x, f.doc)->capture_default_str();
+        } else {
+            const ParamField<S>* field = &f;
+            const ParamTable<S>* table = &t;
+            S* target = &s;
+            opt = cmd.add_option_function<std::string>(
+                       flag,
+                       [field, table, target, flag](const std::string& v) {
+                           try {
+                               setParamFromText(*target, *table, *field, v);
+                           } catch (const ParamError& e) {
+                               throw InputError(flag + ": " + e.rule() + " (got " + v + ")");
+                           }
+                       },
+                       f.doc)
+                      ->default_str(paramText(r, f.choices));
+        }
+        opt->group(group(f));
+    }
 }
 
 }  // namespace atrous::cli

@@ -4,7 +4,6 @@
 #include <iterator>
 #include <filesystem>
 #include <memory>
-#include <sstream>
 #include <string>
 
 #include "atrous/denoise.h"
@@ -29,27 +28,10 @@ struct DenoiseArgs {
     bool ldr = false, srgb = false;    // LDR input: output clamped to [0, 1]; --srgb: sRGB-encoded
     std::string oidnFilter = "RT", oidnQuality;  // oidnDenoise's -f, -q (accepted; see addOidnFlags)
     bool oidnCleanAux = false;
-    std::string method = "sure", device = "auto", sureMode = "discrete", sureCandidates;
-    bool normalStepScale = false, noIds = false, noCorrelated = false, noFirefly = false, noDemodulate = false;
-    DenoiseOptions opt;
+    std::string method = "sure", device = "auto";
+    DenoiseOptions opt;  // the filter parameters' flags write here (params.h's table)
     SvgfParams svgf;
 };
-
-std::vector<float> parseFloatList(const std::string& s, const char* flag) {
-    std::vector<float> v;
-    std::stringstream ss(s);
-    std::string item;
-    while (std::getline(ss, item, ',')) {
-        try {
-            size_t used = 0;
-            v.push_back(std::stof(item, &used));
-            if (used != item.size()) throw std::invalid_argument(item);
-        } catch (const std::exception&) {
-            throw InputError(std::string(flag) + ": '" + item + "' is not a number");
-        }
-    }
-    return v;
-}
 
 // Option groups: the flags of one method are ignored by the others (a note says which).
 const char* const kGroupEawSure = "EAW and SURE (--method eaw|sure)";
@@ -71,46 +53,6 @@ void noteIgnoredFlags(const CLI::App& cmd, const std::string& method, bool seque
     if (!ignored.empty()) std::fprintf(stderr, "denoise: note: ignored with --method %s: %s\n", method.c_str(), ignored.c_str());
     if (!ignoredSeq.empty())
         std::fprintf(stderr, "denoise: note: ignored with --sequence (frames bring their own buffers): %s\n", ignoredSeq.c_str());
-}
-
-// validateDenoiseOptions says "parameter out of range: levels must be in 1..10"; the parameter
-// names there are the flag names.
-void validateDenoiseFlags(const DenoiseOptions& o, const CLI::App& cmd) {
-    try {
-        validateDenoiseOptions(o);
-    } catch (const InputError& e) {
-        rethrowParameterError(e, "parameter out of range: ", cmd, [](const std::string& name) { return "--" + name; });
-    }
-}
-
-// validateSvgfParams says "SVGF parameter alpha must be in (0, 1]" with the SvgfParams field name.
-void validateSvgfFlags(const SvgfParams& p, const CLI::App& cmd) {
-    static const char* const kFlags[][2] = {
-        {"sigmaL", "--svgf-sigma-l"},
-        {"sigmaN", "--svgf-sigma-n"},
-        {"sigmaZ", "--svgf-sigma-z"},
-        {"alpha", "--svgf-alpha"},
-        {"momentsAlpha", "--svgf-moments-alpha"},
-        {"historyCap", "--svgf-history-cap"},
-        {"historyClip", "--svgf-history-clip"},
-        {"levels", "--svgf-levels"},
-        {"feedbackTap", "--svgf-feedback-tap"},
-        {"spatialVarianceFrames", "--svgf-spatial-variance-frames"},
-        {"reprojectDepthTolerance", "--svgf-depth-tolerance"},
-        {"reprojectNormalCos", "--svgf-normal-cos"},
-        {"taaAlpha", "--taa-alpha"},
-        {"emissionAlpha", "--svgf-emission-alpha"},
-        {"emissionMotionAlpha", "--svgf-emission-motion-alpha"},
-    };
-    try {
-        validateSvgfParams(p);
-    } catch (const InputError& e) {
-        rethrowParameterError(e, "SVGF parameter ", cmd, [](const std::string& name) -> std::string {
-            for (const auto& f : kFlags)
-                if (name == f[0]) return f[1];
-            return "";
-        });
-    }
 }
 
 // --out FILE: its directory must exist and be a directory (checked before any work).
@@ -169,20 +111,8 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     if (a.method == "svgf" && !sequence)
         throw InputError("--method svgf denoises animated sequences: give --sequence DIR (and an output directory)");
     o.method = a.method == "svgf" ? DenoiseMethod::Sure : parseDenoiseMethod(a.method);
-    if (a.sureMode == "discrete")
-        o.sure.mode = SureMode::Discrete;
-    else if (a.sureMode == "james-stein")
-        o.sure.mode = SureMode::JamesStein;
-    else
-        throw InputError("--sure-mode: unknown mode '" + a.sureMode + "' (expected discrete or james-stein)");
-    if (!a.sureCandidates.empty()) o.sure.candidates = parseFloatList(a.sureCandidates, "--sure-candidates");
-    o.eaw.normalStepScale = a.normalStepScale;
-    o.eaw.useIds = !a.noIds;
-    o.sure.correlatedVariance = !a.noCorrelated;
-    o.firefly.enabled = !a.noFirefly;
-    o.demodulate = !a.noDemodulate;
-    validateDenoiseFlags(o, cmd);
-    if (a.method == "svgf") validateSvgfFlags(a.svgf, cmd);
+    checkParamFlags(o, denoiseParams(), cmd);
+    if (a.method == "svgf") checkParamFlags(a.svgf, svgfParams(), cmd);
     o.device = parseDeviceFlag(a.device);
     noteIgnoredFlags(cmd, a.method, sequence);
     if (sequence) {
@@ -299,46 +229,10 @@ void addDenoiseCommand(CLI::App& app) {
     cmd->add_option("-q,--quality", a->oidnQuality, "oidnDenoise's quality (accepted, no effect: use --method)")->group(kGroupOidn);
     cmd->add_flag("--clean_aux", a->oidnCleanAux, "oidnDenoise's noise-free-features flag (accepted: atrous's "
                   "features are edge stops, never filtered)")->group(kGroupOidn);
-    EawParams& e = a->opt.eaw;
-    cmd->add_option("--levels", e.levels, "A-trous levels (1..10)")->capture_default_str()->group(kGroupEawSure);
-    cmd->add_option("--sigma-color", e.sigmaColor, "Raw sigma_c (0 = automatic from the variance)")->capture_default_str()->group(kGroupEawSure);
-    cmd->add_option("--color-scale", e.colorScale, "k_c of the automatic sigma_c")->capture_default_str()->group(kGroupEawSure);
-    cmd->add_option("--color-level-factor", e.colorLevelFactor, "sigma_c,i = sigma_c * factor^i")->capture_default_str()->group(kGroupEawSure);
-    cmd->add_option("--sigma-normal", e.sigmaNormal, "sigma_n (0 = no normal stop)")->capture_default_str()->group(kGroupEawSure);
-    cmd->add_flag("--normal-step-scale", a->normalStepScale, "Divide the normal distance by step^2 (paper GLSL)")->group(kGroupEawSure);
-    cmd->add_option("--sigma-position", e.sigmaPosition, "Raw sigma_x (0 = automatic from the pixel footprint)")
-        ->capture_default_str()->group(kGroupEawSure);
-    cmd->add_option("--position-scale", e.positionScale, "k_x of the automatic sigma_x")->capture_default_str()->group(kGroupEawSure);
-    cmd->add_option("--sigma-depth", e.sigmaDepth, "sigma_z on relative depth (0 = off)")->capture_default_str()->group(kGroupEawSure);
-    cmd->add_flag("--no-ids", a->noIds, "Ignore the ids buffer")->group(kGroupEawSure);
-    cmd->add_option("--emission-levels", e.emissionLevels,
-                    "Levels of the edge-avoiding filter of the emission buffer (0 = add emission back as is)")
-        ->capture_default_str()->group(kGroupEawSure);
-    cmd->add_option("--emission-scale", e.emissionScale, "k of the emission filter's sigma^2 = k * 2 min(V_p, V_q)")
-        ->capture_default_str()->group(kGroupEawSure);
-    cmd->add_option("--sure-mode", a->sureMode, "discrete | james-stein")->capture_default_str()->group(kGroupSure);
-    cmd->add_option("--sure-candidates", a->sureCandidates, "Comma-separated fractions (default 0,0.2,0.4,0.6,0.8,1)")->group(kGroupSure);
-    cmd->add_option("--sure-window", a->opt.sure.windowRadius, "SURE window radius r ((2r+1)^2 window)")
-        ->capture_default_str()->group(kGroupSure);
-    cmd->add_option("--sure-first-level", a->opt.sure.firstLevel,
-                    "SURE keeps no detail of levels below this one (0 = the paper's form)")
-        ->capture_default_str()->group(kGroupSure);
-    cmd->add_flag("--no-correlated-variance", a->noCorrelated, "Plain independence propagation of the variance")->group(kGroupSure);
-    cmd->add_flag("--no-firefly", a->noFirefly, "Disable firefly suppression")->group(kGroupEawSure);
-    cmd->add_option("--firefly-k", a->opt.firefly.k, "Firefly bound: k local standard deviations")->capture_default_str()->group(kGroupEawSure);
-    cmd->add_flag("--safety-net", a->opt.safety.enabled,
-                  "Where SURE estimates the output worse than the input, move it back toward the input "
-                  "(for a trusted variance buffer; docs/algorithms.md)")->group(kGroupEawSure);
-    cmd->add_option("--safety-window", a->opt.safety.windowRadius, "Radius of the safety net's SURE window")
-        ->capture_default_str()->group(kGroupEawSure);
-    cmd->add_option("--safety-trigger", a->opt.safety.trigger,
-                    "The safety net acts where the residual's energy exceeds this many times the input's variance")
-        ->capture_default_str()->group(kGroupEawSure);
-    cmd->add_flag("--no-demodulate", a->noDemodulate, "Do not divide by the albedo")->group(kGroupEawSure);
-    cmd->add_option("--albedo-epsilon", a->opt.albedoEpsilon, "Smallest albedo divided by")->capture_default_str()->group(kGroupEawSure);
-    cmd->add_option("--albedo-floor", a->opt.albedoFloor,
-                    "Demodulation fades out where the largest albedo channel is below this (black albedo on glass, "
-                    "mirrors, lights; 0 = off)")->capture_default_str()->group(kGroupEawSure);
+    // One flag per parameter (params.h): --levels, --sigma-normal, --no-firefly, --sure-window, ...
+    addParamOptions(*cmd, a->opt, denoiseParams(), [](const ParamField<DenoiseOptions>& f) {
+        return std::string(f.group) == "sure" ? kGroupSure : kGroupEawSure;
+    });
     addSvgfOptions(*cmd, a->svgf);
     // CLI11 reads an empty value ("--sigma-depth ''") as 0 without a word (found by tests/fuzz):
     // every option that takes a value refuses an empty one.

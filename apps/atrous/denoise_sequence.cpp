@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "atrous/error.h"
+#include "cli_flags.h"
 #include "core/timer.h"
 #include "io/image_io.h"
 #include "io/sequence.h"
@@ -76,35 +77,7 @@ void writeAnimatedPreview(const std::string& outDir, int firstIndex, bool quiet,
 }  // namespace
 
 void addSvgfOptions(CLI::App& cmd, SvgfParams& p) {
-    const char* g = "SVGF (--method svgf)";
-    cmd.add_option("--svgf-sigma-l", p.sigmaL, "luminance edge stop σ_l, in standard deviations")->capture_default_str()->group(g);
-    cmd.add_option("--svgf-sigma-n", p.sigmaN, "normal edge stop exponent σ_n")->capture_default_str()->group(g);
-    cmd.add_option("--svgf-sigma-z", p.sigmaZ, "depth edge stop σ_z, relative to the depth gradient")->capture_default_str()->group(g);
-    cmd.add_option("--svgf-alpha", p.alpha, "minimum temporal blend factor of the colour, (0, 1]")->capture_default_str()->group(g);
-    cmd.add_option("--svgf-moments-alpha", p.momentsAlpha, "minimum temporal blend factor of the moments, (0, 1]")
-        ->capture_default_str()->group(g);
-    cmd.add_option("--svgf-history-cap", p.historyCap, "maximum history length in frames")->capture_default_str()->group(g);
-    cmd.add_option("--svgf-history-clip", p.historyClip,
-                   "clip the reprojected history into mean +- this many std of the current 3x3 samples (0 = off)")
-        ->capture_default_str()->group(g);
-    cmd.add_option("--svgf-levels", p.levels, "à-trous levels (0 = temporal accumulation only)")->capture_default_str()->group(g);
-    cmd.add_option("--svgf-feedback-tap", p.feedbackTap, "level whose output becomes the colour history (-1 = unfiltered)")
-        ->capture_default_str()->group(g);
-    cmd.add_option("--svgf-spatial-variance-frames", p.spatialVarianceFrames,
-                   "history length below which the variance is estimated spatially (7x7)")
-        ->capture_default_str()->group(g);
-    cmd.add_option("--svgf-depth-tolerance", p.reprojectDepthTolerance, "reprojection depth test τ_z")
-        ->capture_default_str()->group(g);
-    cmd.add_option("--svgf-normal-cos", p.reprojectNormalCos, "reprojection: minimum cosine between normals")
-        ->capture_default_str()->group(g);
-    cmd.add_flag("--taa", p.taa, "temporal anti-aliasing after SVGF (off by default)")->group(g);
-    cmd.add_option("--taa-alpha", p.taaAlpha, "TAA blend weight of the current frame, (0, 1]")->capture_default_str()->group(g);
-    cmd.add_option("--svgf-emission-alpha", p.emissionAlpha,
-                   "minimum temporal blend factor of the emission (3x3-clamped history; 1 = raw emission), (0, 1]")
-        ->capture_default_str()->group(g);
-    cmd.add_option("--svgf-emission-motion-alpha", p.emissionMotionAlpha,
-                   "emission blend factor at least this times the motion across a light's edge, pixels per frame (0 = off), >= 0")
-        ->capture_default_str()->group(g);
+    addParamOptions(cmd, p, svgfParams(), [](const ParamField<SvgfParams>&) { return "SVGF (--method svgf)"; });
 }
 
 std::string findOnPath(const std::string& name) {

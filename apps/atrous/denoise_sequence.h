@@ -31,11 +31,10 @@ struct SequenceDenoiseArgs {
 // Throws InputError for bad input (the CLI turns it into exit code 2). Returns 0.
 int runSequenceDenoise(const SequenceDenoiseArgs& args);
 
-// Registers one flag per SvgfParams field on `cmd` (--svgf-sigma-l, --svgf-sigma-n, --svgf-sigma-z,
-// --svgf-alpha, --svgf-moments-alpha, --svgf-history-cap, --svgf-levels, --svgf-feedback-tap,
-// --svgf-spatial-variance-frames, --svgf-depth-tolerance, --svgf-normal-cos, --taa, --taa-alpha),
-// writing into `params`; the defaults shown are the struct's. Ranges are checked later by
-// validateSvgfParams (InputError naming the field).
+// Registers one flag per row of svgfParams() (params.h) on `cmd`: --svgf-<name> (--svgf-sigma-l,
+// --svgf-alpha, ...; --svgf-depth-tolerance, --svgf-normal-cos, --taa and --taa-alpha keep their
+// spellings), writing into `params`; the defaults shown are the struct's. Ranges are checked later
+// (checkParamFlags, or validateSvgfParams: a ParamError naming the field).
 void addSvgfOptions(CLI::App& cmd, SvgfParams& params);
 
 // Full path of an executable named `name` on PATH, or "" when there is none.

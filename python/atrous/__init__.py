@@ -27,6 +27,7 @@ output is always finite.
 from __future__ import annotations
 
 import os
+import textwrap
 from typing import Any, Dict, Iterator, Optional, Union
 
 import numpy as np
@@ -43,6 +44,8 @@ __all__ = [
     "Svgf",
     "builtin_scenes",
     "cuda_available",
+    "denoise_params",
+    "svgf_params",
     "METHODS",
 ]
 
@@ -54,6 +57,24 @@ METHODS = ("eaw", "sure")
 def builtin_scenes() -> list:
     """Names of the built-in scenes accepted by :func:`render`."""
     return list(_core.builtin_scenes())
+
+
+def denoise_params() -> list:
+    """The keywords of :func:`denoise`, one dict per parameter, from the library's own table
+    (include/atrous/params.h, which the CLI's flags and the viewer's controls come from too):
+    name, kind ("int", "float", "bool", "choice", "float_list"), default (the C++ struct's), min,
+    max (the allowed range of a number, or of a list's elements; None for the others), min_open
+    (True when min itself is excluded), zero (what
+    0 means when it is allowed outside [min, max], e.g. "off"), rule (the range as the error
+    message says it), choices, doc, group (the C++ struct: eaw, sure, firefly, safety, or "" for
+    DenoiseOptions' own fields), flag (the CLI's) and aliases (other accepted keywords: a negated
+    switch's CLI name, no_firefly=True is firefly=False)."""
+    return [dict(r) for r in _core.denoise_params()]
+
+
+def svgf_params() -> list:
+    """The keywords of :class:`Svgf`, in the form of :func:`denoise_params`."""
+    return [dict(r) for r in _core.svgf_params()]
 
 
 def cuda_available() -> bool:
@@ -160,12 +181,10 @@ def denoise(
     method: "eaw" or "sure". device: "auto" (the arrays' device: CUDA arrays on the GPU, numpy on
     the CPU), "cpu" or "cuda" (numpy inputs are then copied to the GPU and back).
 
-    params: the filter parameters, named as the CLI flags with '_' for '-': levels, sigma_color,
-    color_scale, color_level_factor, sigma_normal, normal_step_scale, sigma_position,
-    position_scale, sigma_depth, use_ids, sure_mode ("discrete" | "james-stein"), sure_candidates,
-    sure_window, sure_first_level, correlated_variance, emission_levels, emission_scale, firefly, firefly_k, demodulate, albedo_epsilon,
-    albedo_floor, safety_net, safety_window, safety_trigger
-    (docs/denoising.md gives their meaning and defaults).
+    params: the filter parameters, the rows of :func:`denoise_params` (the CLI's flags with '_'
+    for '-'; docs/denoising.md gives their meaning and defaults):
+
+{params}
 
     Returns the denoised H x W x 3 float32 image as the same kind of array as `color`.
     """
@@ -305,9 +324,9 @@ def write_image(path: PathLike, image: Any) -> None:
 class Svgf:
     """Spatiotemporal variance-guided filtering of a stream of 1-spp frames (keeps history).
 
-    params: sigma_l, sigma_n, sigma_z, alpha, moments_alpha, history_cap, levels, feedback_tap,
-    spatial_variance_frames, reproject_depth_tolerance, reproject_normal_cos, taa, taa_alpha,
-    emission_alpha, emission_motion_alpha.
+    params: the rows of :func:`svgf_params` (docs/svgf.md gives their meaning):
+
+{params}
     """
 
     def __init__(self, device: str = "auto", **params: Any) -> None:
@@ -331,3 +350,19 @@ class Svgf:
     @property
     def device(self) -> str:
         return self._impl.device
+
+
+def _list_params(rows) -> str:
+    out = []
+    for r in rows:
+        extra = " (" + " | ".join(r["choices"]) + ")" if r["choices"] else ""
+        out.append(r["name"] + extra + "".join(", " + a for a in r["aliases"]))
+    return textwrap.fill(", ".join(out) + ".", width=96, initial_indent="    ", subsequent_indent="    ",
+                         break_on_hyphens=False)
+
+
+# The docstrings list the keywords from the library's table, so they cannot fall behind it.
+if denoise.__doc__:
+    denoise.__doc__ = denoise.__doc__.replace("{params}", _list_params(denoise_params()))
+if Svgf.__doc__:
+    Svgf.__doc__ = Svgf.__doc__.replace("{params}", _list_params(svgf_params()))

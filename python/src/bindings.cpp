@@ -18,6 +18,7 @@
 #include "atrous/error.h"
 #include "atrous/interop.h"
 #include "atrous/metrics.h"
+#include "atrous/params.h"
 #include "atrous/render.h"
 #include "atrous/svgf.h"
 #include "io/image_io.h"
@@ -101,45 +102,81 @@ T as(const nb::handle& v, const std::string& key) {
     }
 }
 
-// The Python keyword names of every denoise parameter (the CLI's flag names with '_' for '-').
-void applyDenoiseParam(DenoiseOptions& o, const std::string& k, const nb::handle& v) {
-    EawParams& e = o.eaw;
-    if (k == "levels") e.levels = as<int>(v, k);
-    else if (k == "sigma_color") e.sigmaColor = as<float>(v, k);
-    else if (k == "color_scale") e.colorScale = as<float>(v, k);
-    else if (k == "color_level_factor") e.colorLevelFactor = as<float>(v, k);
-    else if (k == "sigma_normal") e.sigmaNormal = as<float>(v, k);
-    else if (k == "normal_step_scale") e.normalStepScale = as<bool>(v, k);
-    else if (k == "sigma_position") e.sigmaPosition = as<float>(v, k);
-    else if (k == "position_scale") e.positionScale = as<float>(v, k);
-    else if (k == "sigma_depth") e.sigmaDepth = as<float>(v, k);
-    else if (k == "use_ids") e.useIds = as<bool>(v, k);
-    else if (k == "sure_mode") {
-        std::string m = as<std::string>(v, k);
-        if (m == "discrete") o.sure.mode = SureMode::Discrete;
-        else if (m == "james-stein" || m == "james_stein") o.sure.mode = SureMode::JamesStein;
-        else throw InputError("parameter 'sure_mode' must be 'discrete' or 'james-stein', got '" + m + "'");
-    } else if (k == "sure_candidates") o.sure.candidates = as<std::vector<float>>(v, k);
-    else if (k == "sure_window") o.sure.windowRadius = as<int>(v, k);
-    else if (k == "sure_first_level") o.sure.firstLevel = as<int>(v, k);
-    else if (k == "emission_levels") o.eaw.emissionLevels = as<int>(v, k);
-    else if (k == "emission_scale") o.eaw.emissionScale = as<float>(v, k);
-    else if (k == "correlated_variance") o.sure.correlatedVariance = as<bool>(v, k);
-    else if (k == "firefly") o.firefly.enabled = as<bool>(v, k);
-    else if (k == "firefly_k") o.firefly.k = as<float>(v, k);
-    else if (k == "demodulate") o.demodulate = as<bool>(v, k);
-    else if (k == "safety_net") o.safety.enabled = as<bool>(v, k);
-    else if (k == "safety_window") o.safety.windowRadius = as<int>(v, k);
-    else if (k == "safety_trigger") o.safety.trigger = as<float>(v, k);
-    // The CLI's negative switches, accepted under their flag names too: no_firefly=True is
-    // firefly=False, and so on.
-    else if (k == "no_firefly") o.firefly.enabled = !as<bool>(v, k);
-    else if (k == "no_ids") e.useIds = !as<bool>(v, k);
-    else if (k == "no_demodulate") o.demodulate = !as<bool>(v, k);
-    else if (k == "no_correlated_variance") o.sure.correlatedVariance = !as<bool>(v, k);
-    else if (k == "albedo_epsilon") o.albedoEpsilon = as<float>(v, k);
-    else if (k == "albedo_floor") o.albedoFloor = as<float>(v, k);
-    else throw InputError("unknown denoise parameter '" + k + "'");
+// A negated switch's CLI name as a keyword: --no-firefly -> no_firefly.
+template <class S>
+std::string pyAlias(const ParamTable<S>& t, const ParamField<S>& f) {
+    std::string k = t.flag(f).substr(2);
+    for (char& c : k)
+        if (c == '-') c = '_';
+    return k;
+}
+
+// A keyword of the table (params.h): its row's name, or for a negated switch the CLI's negative
+// name too (no_firefly=True is firefly=False). The value is converted to the field's kind.
+template <class S>
+void applyParam(S& s, const ParamTable<S>& t, const std::string& k, const nb::handle& v, const char* what) {
+    const ParamField<S>* f = t.find(k);
+    bool negate = false;
+    if (!f)
+        for (const ParamField<S>& g : t)
+            if (g.negated && k == pyAlias(t, g)) f = &g, negate = true;
+    if (!f) throw InputError("unknown " + std::string(what) + " parameter '" + k + "'");
+    const ParamRef r = f->at(s);
+    if (int* const* i = std::get_if<int*>(&r)) **i = as<int>(v, k);
+    else if (float* const* x = std::get_if<float*>(&r)) **x = as<float>(v, k);
+    else if (bool* const* b = std::get_if<bool*>(&r)) **b = as<bool>(v, k) != negate;
+    else if (std::get_if<SureMode*>(&r)) setParamFromText(s, t, *f, as<std::string>(v, k));
+    else *std::get<std::vector<float>*>(r) = as<std::vector<float>>(v, k);
+}
+
+// A field's value as a Python object (a choice as its name).
+template <class S>
+nb::object paramValue(const ParamField<S>& f, S& s) {
+    const ParamRef r = f.at(s);
+    if (int* const* i = std::get_if<int*>(&r)) return nb::cast(**i);
+    if (float* const* x = std::get_if<float*>(&r)) return nb::cast(double(**x));
+    if (bool* const* b = std::get_if<bool*>(&r)) return nb::cast(**b);
+    if (std::get_if<SureMode*>(&r)) return nb::cast(paramText(r, f.choices));
+    return nb::cast(*std::get<std::vector<float>*>(r));
+}
+
+// What a set of keywords makes of the struct: {name: value} for every row (atrous' tests).
+template <class S>
+nb::dict resolveParams(const ParamTable<S>& t, nb::dict params, const char* what) {
+    S s{};
+    for (auto [k, v] : params) applyParam(s, t, nb::cast<std::string>(k), v, what);
+    nb::dict d;
+    for (const ParamField<S>& f : t) d[f.name] = paramValue(f, s);
+    return d;
+}
+
+// The table for Python (atrous.denoise_params(), atrous.svgf_params()): one dict per row.
+template <class S>
+nb::list paramRows(const ParamTable<S>& t) {
+    static const char* const kKinds[] = {"int", "float", "bool", "choice", "float_list"};
+    S defaults{};
+    nb::list rows;
+    for (const ParamField<S>& f : t) {
+        nb::dict d;
+        d["name"] = f.name;
+        d["kind"] = kKinds[int(f.kind())];
+        d["default"] = paramValue(f, defaults);
+        const bool numeric = f.kind() == ParamKind::Int || f.kind() == ParamKind::Float || f.kind() == ParamKind::FloatList;
+        d["min"] = numeric ? nb::cast(f.range.lo) : nb::none();
+        d["max"] = numeric ? nb::cast(f.range.hi) : nb::none();
+        d["min_open"] = numeric && f.range.loOpen;  // (min, max]
+        d["zero"] = f.range.zero && numeric ? nb::cast(std::string(f.range.zero)) : nb::none();
+        d["rule"] = numeric ? nb::cast(f.range.rule(f.kind() != ParamKind::Int)) : nb::none();
+        nb::list choices;
+        for (int i = 0; f.choices && f.choices[i]; ++i) choices.append(f.choices[i]);
+        d["choices"] = choices;
+        d["doc"] = f.doc;
+        d["group"] = f.group;
+        d["flag"] = t.flag(f);
+        d["aliases"] = f.negated ? nb::cast(std::vector<std::string>{pyAlias(t, f)}) : nb::cast(std::vector<std::string>{});
+        rows.append(d);
+    }
+    return rows;
 }
 
 nb::object pyDenoise(const Array& color, nb::handle albedo, nb::handle normal, nb::handle position, nb::handle depth,
@@ -159,7 +196,7 @@ nb::object pyDenoise(const Array& color, nb::handle albedo, nb::handle normal, n
     DenoiseOptions o;
     o.method = parseDenoiseMethod(method);
     o.device = c.device();
-    for (auto [k, v] : params) applyDenoiseParam(o, nb::cast<std::string>(k), v);
+    for (auto [k, v] : params) applyParam(o, denoiseParams(), nb::cast<std::string>(k), v, "denoise");
     Image out;
     {
         nb::gil_scoped_release release;
@@ -169,31 +206,11 @@ nb::object pyDenoise(const Array& color, nb::handle albedo, nb::handle normal, n
     return fromImage(std::move(out));
 }
 
-void applySvgfParam(SvgfParams& p, const std::string& k, const nb::handle& v) {
-    if (k == "sigma_l") p.sigmaL = as<float>(v, k);
-    else if (k == "sigma_n") p.sigmaN = as<float>(v, k);
-    else if (k == "sigma_z") p.sigmaZ = as<float>(v, k);
-    else if (k == "alpha") p.alpha = as<float>(v, k);
-    else if (k == "moments_alpha") p.momentsAlpha = as<float>(v, k);
-    else if (k == "history_cap") p.historyCap = as<int>(v, k);
-    else if (k == "levels") p.levels = as<int>(v, k);
-    else if (k == "feedback_tap") p.feedbackTap = as<int>(v, k);
-    else if (k == "spatial_variance_frames") p.spatialVarianceFrames = as<int>(v, k);
-    else if (k == "reproject_depth_tolerance") p.reprojectDepthTolerance = as<float>(v, k);
-    else if (k == "reproject_normal_cos") p.reprojectNormalCos = as<float>(v, k);
-    else if (k == "taa") p.taa = as<bool>(v, k);
-    else if (k == "taa_alpha") p.taaAlpha = as<float>(v, k);
-    else if (k == "emission_alpha") p.emissionAlpha = as<float>(v, k);
-    else if (k == "emission_motion_alpha") p.emissionMotionAlpha = as<float>(v, k);
-    else if (k == "history_clip") p.historyClip = as<float>(v, k);
-    else throw InputError("unknown SVGF parameter '" + k + "'");
-}
-
 class PySvgf {
 public:
     PySvgf(const std::string& device, nb::dict params) {
         SvgfParams p;
-        for (auto [k, v] : params) applySvgfParam(p, nb::cast<std::string>(k), v);
+        for (auto [k, v] : params) applyParam(p, svgfParams(), nb::cast<std::string>(k), v, "SVGF");
         mDenoiser = std::make_unique<SvgfDenoiser>(p, parseDevice(device));
     }
     nb::object denoiseFrame(const Array& color, nb::handle albedo, nb::handle normal, nb::handle depth, nb::handle ids,
@@ -324,8 +341,9 @@ void pyWriteImage(const std::string& path, const Array& image) {
     io::writeImage(path, img);
 }
 
-// The library's messages name the CLI's flags ("--width: -1 is out of range"); in Python the same
-// setting is a keyword argument, so "--max-depth" is shown as "max_depth". Only a "--" at the start
+// The render settings' messages name the CLI's flags ("--width: -1 is out of range"); in Python
+// the same setting is a keyword argument, so "--max-depth" is shown as "max_depth" (the filter
+// parameters' messages name the field already: ParamError). Only a "--" at the start
 // of a word followed by a lower-case flag name is rewritten (file paths keep theirs).
 std::string pythonMessage(const std::string& msg) {
     std::string out;
@@ -367,6 +385,10 @@ NB_MODULE(_core, m) {
     m.def("metrics", &pyMetrics, nb::arg("image"), nb::arg("reference"));
     m.def("read_image", &pyReadImage, nb::arg("path"));
     m.def("write_image", &pyWriteImage, nb::arg("path"), nb::arg("image"));
+    m.def("denoise_params", [] { return paramRows(denoiseParams()); });
+    m.def("svgf_params", [] { return paramRows(svgfParams()); });
+    m.def("resolve_denoise_params", [](nb::dict p) { return resolveParams(denoiseParams(), p, "denoise"); });
+    m.def("resolve_svgf_params", [](nb::dict p) { return resolveParams(svgfParams(), p, "SVGF"); });
     m.def("builtin_scenes", [] { return builtinSceneNames(); });
     m.def("cuda_available", &cudaAvailable);
     m.def("cuda_compiled", &cudaCompiled);

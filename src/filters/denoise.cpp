@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "atrous/error.h"
+#include "atrous/params.h"
 #include "core/parallel.h"
 #include "core/timer.h"
 #include "filters/denoise_driver.h"
@@ -27,44 +28,10 @@ DenoiseMethod parseDenoiseMethod(const std::string& name) {
 
 const char* denoiseMethodName(DenoiseMethod m) { return m == DenoiseMethod::Eaw ? "eaw" : "sure"; }
 
-static void requireRange(bool ok, const std::string& what) {
-    if (!ok) throw InputError("parameter out of range: " + what);
-}
+// The ranges are params.h's table (one row per field); the library's own limits must agree.
+static_assert(filters::kMaxLevels == 10 && filters::kMaxSureCandidates == 8, "update params.h's ranges");
 
-// Smallest non-zero σ, scale or ε: their inverse squares (1e12) stay finite; at 1e-20 the whole
-// output was NaN (docs/reliability.md).
-constexpr float kMinFilterParameter = 1e-6f;
-static bool offOrAtLeastMin(float v) { return std::isfinite(v) && (v == 0.0f || v >= kMinFilterParameter); }
-static bool atLeastMin(float v) { return std::isfinite(v) && v >= kMinFilterParameter; }
-// Scale factors (k_c, k_x, the emission filter's k) up to 1e6: at 1e30 σ² overflowed (tests/fuzz).
-static bool scaleFactor(float v) { return atLeastMin(v) && v <= 1e6f; }
-
-void validateDenoiseOptions(const DenoiseOptions& o) {
-    const EawParams& e = o.eaw;
-    requireRange(e.levels >= 1 && e.levels <= filters::kMaxLevels, "levels must be in 1..10");
-    requireRange(offOrAtLeastMin(e.sigmaColor), "sigma-color must be 0 (automatic) or >= 1e-6");
-    requireRange(scaleFactor(e.colorScale), "color-scale must be in [1e-6, 1e6]");
-    requireRange(std::isfinite(e.colorLevelFactor) && e.colorLevelFactor > 0 && e.colorLevelFactor <= 1,
-                 "color-level-factor must be in (0, 1]");
-    requireRange(offOrAtLeastMin(e.sigmaNormal), "sigma-normal must be 0 (off) or >= 1e-6");
-    requireRange(offOrAtLeastMin(e.sigmaPosition), "sigma-position must be 0 (automatic) or >= 1e-6");
-    requireRange(scaleFactor(e.positionScale), "position-scale must be in [1e-6, 1e6]");
-    requireRange(offOrAtLeastMin(e.sigmaDepth), "sigma-depth must be 0 (off) or >= 1e-6");
-    const SureParams& s = o.sure;
-    requireRange(s.windowRadius >= 1 && s.windowRadius <= 10, "sure-window must be in 1..10");
-    requireRange(s.firstLevel >= 0 && s.firstLevel <= 16, "sure-first-level must be in 0..16");
-    requireRange(o.eaw.emissionLevels >= 0 && o.eaw.emissionLevels <= 10, "emission-levels must be in 0..10");
-    requireRange(scaleFactor(o.eaw.emissionScale), "emission-scale must be in [1e-6, 1e6]");
-    requireRange(!s.candidates.empty() && int(s.candidates.size()) <= filters::kMaxSureCandidates,
-                 "sure-candidates must list 1..8 values");
-    for (float c : s.candidates) requireRange(std::isfinite(c) && c >= 0 && c <= 1, "sure-candidates must be in [0, 1]");
-    requireRange(atLeastMin(o.firefly.k), "firefly-k must be >= 1e-6");
-    requireRange(o.safety.windowRadius >= 1 && o.safety.windowRadius <= 10, "safety-window must be in 1..10");
-    requireRange(std::isfinite(o.safety.trigger) && o.safety.trigger >= 0 && o.safety.trigger <= 1e6f,
-                 "safety-trigger must be in [0, 1e6]");
-    requireRange(atLeastMin(o.albedoEpsilon), "albedo-epsilon must be >= 1e-6");
-    requireRange(std::isfinite(o.albedoFloor) && o.albedoFloor >= 0 && o.albedoFloor <= 1, "albedo-floor must be in [0, 1]");
-}
+void validateDenoiseOptions(const DenoiseOptions& o) { validateParams(o, denoiseParams()); }
 
 namespace filters {
 

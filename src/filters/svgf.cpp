@@ -2,51 +2,17 @@
 // shared driver (the CUDA one is in src/cuda/cuda_svgf.cu).
 #include "atrous/svgf.h"
 
-#include <cmath>
 #include <string>
 
 #include "atrous/error.h"
+#include "atrous/params.h"
 #include "core/parallel.h"
 #include "filters/svgf_pipeline.h"
 
 namespace atrous {
 
-namespace {
-
-void requireRange(bool ok, const char* field, const std::string& rule) {
-    if (!ok) throw InputError(std::string("SVGF parameter ") + field + " " + rule);
-}
-
-// At least 1e-6: σ's inverse squares stay finite (at 1e-20 the whole output was NaN).
-bool finitePositive(float v) { return std::isfinite(v) && v >= 1e-6f; }
-
-}  // namespace
-
-void validateSvgfParams(const SvgfParams& p) {
-    requireRange(finitePositive(p.sigmaL), "sigmaL", "must be a finite number >= 1e-6");
-    requireRange(std::isfinite(p.sigmaN) && p.sigmaN >= 0.0f, "sigmaN", "must be a finite number >= 0");
-    requireRange(finitePositive(p.sigmaZ), "sigmaZ", "must be a finite number >= 1e-6");
-    requireRange(p.alpha > 0.0f && p.alpha <= 1.0f, "alpha", "must be in (0, 1]");
-    requireRange(p.momentsAlpha > 0.0f && p.momentsAlpha <= 1.0f, "momentsAlpha", "must be in (0, 1]");
-    requireRange(p.historyCap >= 1 && p.historyCap <= 1 << 20, "historyCap", "must be in [1, 1048576]");
-    requireRange(p.levels >= 0 && p.levels <= 10, "levels", "must be in [0, 10]");
-    // levels 0 (temporal accumulation only) works with the default tap 0: there is no filtered
-    // level to feed back, so the history is the accumulation (as with -1).
-    requireRange(p.feedbackTap >= -1 && (p.feedbackTap < p.levels || (p.levels == 0 && p.feedbackTap == 0)),
-                 "feedbackTap",
-                 "must be in [-1, levels - 1] (-1 = unfiltered accumulation; got " + std::to_string(p.feedbackTap) +
-                     " with levels " + std::to_string(p.levels) + ")");
-    requireRange(p.spatialVarianceFrames >= 1 && p.spatialVarianceFrames <= 1 << 20, "spatialVarianceFrames",
-                 "must be in [1, 1048576]");
-    requireRange(std::isfinite(p.reprojectDepthTolerance) && p.reprojectDepthTolerance >= 0.0f,
-                 "reprojectDepthTolerance", "must be a finite number >= 0");
-    requireRange(p.reprojectNormalCos >= -1.0f && p.reprojectNormalCos <= 1.0f, "reprojectNormalCos", "must be in [-1, 1]");
-    requireRange(p.taaAlpha > 0.0f && p.taaAlpha <= 1.0f, "taaAlpha", "must be in (0, 1]");
-    requireRange(std::isfinite(p.historyClip) && p.historyClip >= 0.0f, "historyClip", "must be a finite number >= 0 (0 = off)");
-    requireRange(p.emissionAlpha > 0.0f && p.emissionAlpha <= 1.0f, "emissionAlpha", "must be in (0, 1]");
-    requireRange(std::isfinite(p.emissionMotionAlpha) && p.emissionMotionAlpha >= 0.0f, "emissionMotionAlpha",
-                 "must be a finite number >= 0");
-}
+// The ranges are params.h's table (one row per field).
+void validateSvgfParams(const SvgfParams& p) { validateParams(p, svgfParams()); }
 
 namespace svgf {
 

@@ -4,12 +4,14 @@
 #include <imgui.h>
 
 #include <algorithm>
+#include <cfloat>
+#include <cmath>
 #include <cstdint>
-#include <sstream>
+#include <initializer_list>
 #include <string>
-#include <vector>
 
 #include "atrous/device.h"
+#include "atrous/params.h"
 
 namespace atrous::view {
 namespace {
@@ -100,7 +102,7 @@ void methodSection(ViewerState& st, const ViewPipeline& pl) {
     ImGui::Combo("buffer", &v, kViewNames, kViewCount);
     st.view = BufferView(v);
     if (st.view == BufferView::Detail || st.view == BufferView::SureFractions)
-        ImGui::SliderInt("level i", &st.level, 0, std::max(0, ps.eaw.levels - 1));
+        ImGui::SliderInt("level i", &st.level, 0, std::max(0, ps.denoise.eaw.levels - 1));
     if (!st.viewNote.empty()) ImGui::TextWrapped("%s", st.viewNote.c_str());
     for (int i = 0; i < 2; ++i)
         if (!pl.slot(i).error.empty())
@@ -108,79 +110,62 @@ void methodSection(ViewerState& st, const ViewPipeline& pl) {
                                pl.slot(i).error.c_str());
 }
 
-void eawSection(PipelineSettings& ps) {
-    if (ImGui::CollapsingHeader("EAW (also SURE's cascade)",
-                                ImGuiTreeNodeFlags_DefaultOpen)) {
-        EawParams& e = ps.eaw;
-        ImGui::SliderInt("levels", &e.levels, 1, 10);
-        ImGui::DragFloat("sigma color (0=auto)", &e.sigmaColor, 0.01f, 0.0f, 100.0f);
-        ImGui::DragFloat("color scale k_c", &e.colorScale, 0.02f, 0.01f, 20.0f);
-        ImGui::SliderFloat("color level factor", &e.colorLevelFactor, 0.05f, 1.0f);
-        ImGui::DragFloat("sigma normal (0=off)", &e.sigmaNormal, 0.01f, 0.0f, 10.0f);
-        ImGui::Checkbox("normal / step^2", &e.normalStepScale);
-        ImGui::DragFloat("sigma position (0=auto)", &e.sigmaPosition, 0.01f, 0.0f, 100.0f);
-        ImGui::DragFloat("position scale k_x", &e.positionScale, 0.02f, 0.01f, 20.0f);
-        ImGui::DragFloat("sigma depth (0=off)", &e.sigmaDepth, 0.005f, 0.0f, 10.0f);
-        ImGui::Checkbox("id edge stop", &e.useIds);
-    }
-}
-
-void sureSection(ViewerState& st) {
-    PipelineSettings& ps = st.ps;
-    if (ImGui::CollapsingHeader("SURE")) {
-        int mode = int(ps.sure.mode);
-        const char* modes[] = {"discrete", "james-stein"};
-        ImGui::Combo("mode", &mode, modes, 2);
-        ps.sure.mode = SureMode(mode);
-        if (ImGui::InputText("candidates", st.candidatesText, sizeof(st.candidatesText))) {
-            std::vector<float> c;
-            std::stringstream ss(st.candidatesText);
-            std::string item;
-            bool ok = true;
-            while (std::getline(ss, item, ',')) {
-                try {
-                    c.push_back(std::stof(item));
-                } catch (...) {
-                    ok = false;
-                }
-            }
-            if (ok && !c.empty())
-                ps.sure.candidates = c;  // range errors surface as the slot's error
+// One control per row of a parameter table (params.h), labelled with the row's name, its doc
+// line as the tooltip, limited to its range. Out-of-range values the drags can still reach (the
+// open end of (0, 1]) and cross-field rules surface as the slot's error.
+template <class S>
+void paramControl(S& s, const ParamTable<S>& t, const ParamField<S>& f, ViewerState& st) {
+    const ParamRef r = f.at(s);
+    const auto finite = [](double v, float inf) { return std::isinf(v) ? inf : float(v); };
+    if (int* const* i = std::get_if<int*>(&r)) {
+        const int lo = int(f.range.lo), hi = int(f.range.hi);
+        if (hi - lo <= 64)
+            ImGui::SliderInt(f.name, *i, lo, hi);
+        else
+            ImGui::DragInt(f.name, *i, 0.2f, lo, hi);
+    } else if (float* const* x = std::get_if<float*>(&r)) {
+        static const S defaults{};
+        const float d = *std::get<float*>(f.at(const_cast<S&>(defaults)));
+        const float speed = std::max(std::fabs(d), 0.01f) * 0.01f;
+        ImGui::DragFloat(f.name, *x, speed, f.range.zero ? 0.0f : finite(f.range.lo, -FLT_MAX), finite(f.range.hi, FLT_MAX),
+                         "%.4g");
+    } else if (bool* const* b = std::get_if<bool*>(&r)) {
+        ImGui::Checkbox(f.name, *b);
+    } else if (SureMode* const* m = std::get_if<SureMode*>(&r)) {
+        int n = 0, v = int(**m);
+        while (f.choices[n]) ++n;
+        if (ImGui::Combo(f.name, &v, f.choices, n)) **m = SureMode(v);
+    } else if (ImGui::InputText(f.name, st.candidatesText, sizeof(st.candidatesText))) {
+        try {
+            setParamFromText(s, t, f, st.candidatesText);
+        } catch (const ParamError&) {
+            // half-typed: keep the last list that parsed
         }
-        ImGui::SliderInt("window radius", &ps.sure.windowRadius, 1, 10);
-        ImGui::Checkbox("correlated variance", &ps.sure.correlatedVariance);
     }
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", f.doc);
 }
 
-void fireflySection(PipelineSettings& ps) {
-    if (ImGui::CollapsingHeader("Firefly / demodulation")) {
-        ImGui::Checkbox("firefly suppression", &ps.firefly.enabled);
-        ImGui::DragFloat("firefly k", &ps.firefly.k, 0.05f, 0.1f, 50.0f);
-        ImGui::Checkbox("demodulate albedo", &ps.demodulate);
-        ImGui::DragFloat("albedo epsilon", &ps.albedoEpsilon, 1e-4f, 1e-6f, 1.0f, "%.5f");
-    }
+// The rows of `groups` (a row's group is one of them) under a collapsing header.
+template <class S>
+void paramSection(const char* header, S& s, const ParamTable<S>& t, std::initializer_list<const char*> groups,
+                  ViewerState& st, ImGuiTreeNodeFlags flags = 0) {
+    if (!ImGui::CollapsingHeader(header, flags)) return;
+    ImGui::PushID(header);  // "levels" is a row of both tables
+    for (const ParamField<S>& f : t)
+        for (const char* g : groups)
+            if (std::string(f.group) == g) paramControl(s, t, f, st);
+    ImGui::PopID();
 }
 
-void svgfSection(PipelineSettings& ps) {
-    if (ImGui::CollapsingHeader("SVGF")) {
-        SvgfParams& p = ps.svgf;
-        ImGui::DragFloat("sigma_l", &p.sigmaL, 0.05f, 0.0f, 100.0f);
-        ImGui::DragFloat("sigma_n", &p.sigmaN, 1.0f, 0.0f, 1024.0f);
-        ImGui::DragFloat("sigma_z", &p.sigmaZ, 0.02f, 0.0f, 100.0f);
-        ImGui::SliderFloat("alpha", &p.alpha, 0.01f, 1.0f);
-        ImGui::SliderFloat("moments alpha", &p.momentsAlpha, 0.01f, 1.0f);
-        ImGui::SliderInt("history cap", &p.historyCap, 1, 256);
-        ImGui::SliderInt("svgf levels", &p.levels, 0, 10);
-        ImGui::SliderInt("feedback tap", &p.feedbackTap, -1, std::max(-1, p.levels - 1));
-        ImGui::SliderInt("spatial variance frames", &p.spatialVarianceFrames, 1, 32);
-        ImGui::DragFloat("reproject depth tol", &p.reprojectDepthTolerance, 0.05f, 0.0f,
-                         100.0f);
-        ImGui::SliderFloat("reproject normal cos", &p.reprojectNormalCos, -1.0f, 1.0f);
-        ImGui::Checkbox("TAA", &p.taa);
-        ImGui::SliderFloat("TAA alpha", &p.taaAlpha, 0.01f, 1.0f);
+void filterSections(ViewerState& st) {
+    PipelineSettings& ps = st.ps;
+    paramSection("EAW (also SURE's cascade)", ps.denoise, denoiseParams(), {"eaw"}, st, ImGuiTreeNodeFlags_DefaultOpen);
+    paramSection("SURE", ps.denoise, denoiseParams(), {"sure"}, st);
+    paramSection("Firefly / demodulation / safety net", ps.denoise, denoiseParams(), {"firefly", "", "safety"}, st);
+    paramSection("SVGF", ps.svgf, svgfParams(), {""}, st);
+    if (ImGui::CollapsingHeader("SVGF camera motion")) {
         ImGui::Checkbox("motion vectors on camera move", &ps.svgfMotionVectors);
-        ImGui::TextDisabled(ps.svgfMotionVectors ? "(history reprojected)"
-                                                 : "(history reset on move)");
+        ImGui::TextDisabled(ps.svgfMotionVectors ? "(history reprojected)" : "(history reset on move)");
     }
 }
 
@@ -224,10 +209,7 @@ PanelActions drawPanel(ViewerState& st, CameraInput& input, ViewPipeline& pl, co
     renderSection(st, input, pl, a);
     ImGui::Separator();
     methodSection(st, pl);
-    eawSection(st.ps);
-    sureSection(st);
-    fireflySection(st.ps);
-    svgfSection(st.ps);
+    filterSections(st);
     ImGui::Separator();
     if (ImGui::Button("save snapshot (F12 / P)")) a.snapshot = true;
     ImGui::TextDisabled("to %s/snap_NNNN/", info.outDir.c_str());

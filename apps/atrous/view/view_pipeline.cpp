@@ -12,6 +12,7 @@
 #include <initializer_list>
 
 #include "atrous/error.h"
+#include "atrous/params.h"
 #include "core/timer.h"
 #include "filters/denoise_internal.h"
 #include "io/image_io.h"
@@ -45,17 +46,6 @@ Method parseMethod(const std::string& name) {
 }
 
 namespace {
-
-bool sameSvgfParams(const SvgfParams& a, const SvgfParams& b) {
-    return a.sigmaL == b.sigmaL && a.sigmaN == b.sigmaN && a.sigmaZ == b.sigmaZ &&
-           a.alpha == b.alpha && a.momentsAlpha == b.momentsAlpha && a.historyCap == b.historyCap &&
-           a.levels == b.levels && a.feedbackTap == b.feedbackTap &&
-           a.spatialVarianceFrames == b.spatialVarianceFrames &&
-           a.reprojectDepthTolerance == b.reprojectDepthTolerance &&
-           a.reprojectNormalCos == b.reprojectNormalCos && a.taa == b.taa &&
-           a.taaAlpha == b.taaAlpha && a.emissionAlpha == b.emissionAlpha &&
-           a.emissionMotionAlpha == b.emissionMotionAlpha && a.historyClip == b.historyClip;
-}
 
 constexpr float kPi = 3.14159265358979f;
 
@@ -299,14 +289,10 @@ DenoiseInputs ViewPipeline::accumulatedInputs() const {
 }
 
 DenoiseOptions ViewPipeline::denoiseOptions(Method m, const PipelineSettings& s) const {
-    DenoiseOptions o;
+    DenoiseOptions o = s.denoise;
     o.method = m == Method::Sure ? DenoiseMethod::Sure : DenoiseMethod::Eaw;
     o.device = mDevice;
-    o.eaw = s.eaw;
-    o.sure = s.sure;
-    o.firefly = s.firefly;
-    o.demodulate = s.demodulate;
-    o.albedoEpsilon = s.albedoEpsilon;
+    o.report = nullptr;
     return o;
 }
 
@@ -367,7 +353,7 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
     }
     if (m == Method::Svgf) {
         try {
-            if (!mSvgf[i] || !sameSvgfParams(mSvgfParams[i], s.svgf)) {
+            if (!mSvgf[i] || !sameParams(mSvgfParams[i], s.svgf, svgfParams())) {
                 mSvgf[i] = std::make_unique<SvgfDenoiser>(s.svgf, mDevice);  // validates
                 mSvgfParams[i] = s.svgf;
                 mSvgf[i]->setReport(&mSvgfReport[i]);
@@ -409,7 +395,7 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
             // The public denoise() has no debug outputs; the internal CPU entry fills s_i(p).
             filters::PreparedInputs prep = filters::prepareInputs(in, o, rep);
             filters::DriverDebug dbg;
-            dbg.sureS = Image(mWidth, mHeight, s.eaw.levels);
+            dbg.sureS = Image(mWidth, mHeight, s.denoise.eaw.levels);
             r.image = filters::denoiseCpu(in, o, prep, rep, &dbg);
             mSureS = std::move(dbg.sureS);
         } else if (mDevice == Device::Cuda) {
@@ -481,7 +467,7 @@ void ViewPipeline::step(const PipelineSettings& s) {
 
     mDetail = Image();
     mDetailLevelShown = -1;
-    if (s.detailLevel >= 0 && s.detailLevel < s.eaw.levels) {
+    if (s.detailLevel >= 0 && s.detailLevel < s.denoise.eaw.levels) {
         // The driver does not expose d_i; EAW's cascade is prefix-consistent (level i's weights do
         // not depend on the total), so d_i = c_i - c_{i+1} = EAW(i levels) - EAW(i + 1 levels),
         // both remodulated by the albedo. c_0 is taken as the colour before firefly suppression.

@@ -39,12 +39,9 @@ struct PipelineSettings {
     Method methodA = Method::Eaw;
     Method methodB = Method::None;
     bool split = false;  // compute slot B too (split-screen comparison)
-    // Shared by EAW and SURE (SURE runs on the EAW cascade).
-    EawParams eaw;
-    SureParams sure;
-    FireflyParams firefly;
-    bool demodulate = true;
-    float albedoEpsilon = 1e-3f;
+    // EAW's and SURE's parameters (SURE runs on the EAW cascade); the slot sets method, device
+    // and report. The panel's controls are their tables' rows (params.h).
+    DenoiseOptions denoise;
     SvgfParams svgf;
     // SVGF on camera motion: true = feed reprojection motion vectors computed from the depth buffer
     // and the previous camera (history survives the move); false = reset the history instead.
