@@ -20,7 +20,7 @@ namespace atrous::filters {
 
 constexpr int kMaxLevels = 10;
 // Exponent added per unit squared id difference: ids are integers, so a differing id gives a
-// weight of exactly 0 (expNeg returns 0 below -80).
+// weight of exactly 0 (fastExp returns 0 below -80).
 constexpr float kIdPenalty = 1e4f;
 
 struct DriverInputs {
@@ -216,6 +216,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         choice.count = int(cfg.sure.candidates.size());
         for (int k = 0; k < choice.count && k < kMaxSureCandidates; ++k) choice.candidates[k] = cfg.sure.candidates[k];
     }
+    Image rS(w, h, 1, dev);  // each level's 1/σ_c² factors (EawLevel::rS)
     Image* cur = &cA;
     Image* nxt = &cB;
     Image* vcur = &vA;
@@ -241,6 +242,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
             f.detail = detail.view();
         }
         f.S = S.view();
+        f.rS = rS.view();
         f.normal = normal;
         f.position = position;
         f.invX = invX.view();

@@ -1,8 +1,9 @@
-// One level of the edge-avoiding à-trous cascade (Dammertz et al. 2010, docs/denoising.md) as a
-// per-pixel functor shared by the CPU and CUDA backends, plus the tap-weight math that the CPU
-// fast path (src/cpu/eaw_cpu.cpp) reuses so both compute the same thing.
+// The edge-avoiding à-trous edge stop (Dammertz et al. 2010, docs/algorithms-eaw-sure.md) as a
+// policy of the shared à-trous level (filters/atrous_level.h): the functor both backends launch
+// and the CPU row engine (src/cpu/atrous_rows.h) run the same EawStop::tap.
 #pragma once
 #include "atrous/image.h"
+#include "filters/atrous_level.h"
 #include "filters/filter_math.h"
 
 namespace atrous {
@@ -54,7 +55,7 @@ ATROUS_INLINE float eawPositionTapScale(const EawLevelParams& P, int qx, int qy)
 }
 
 // Buffers of one level. Every feature view is present (zero-filled when the user gave none, so
-// its term vanishes); channel counts: c/var/normal/position 3, S/invX/invZ/depth 1, ids 2,
+// its term vanishes); channel counts: c/var/normal/position 3, S/rS/invX/invZ/depth 1, ids 2,
 // detail 2 (D = Σ_ch d_i², V = Σ_ch v_i).
 struct EawLevel {
     EawLevelParams p;
@@ -62,90 +63,142 @@ struct EawLevel {
     ImageView vIn, vOut;     // var(c_i) -> var(c_{i+1}) (propagate only)
     ImageView detail;        // D, V of d_i = c_i - c_{i+1} (propagate only)
     ImageView S;             // colour scale per pixel
+    ImageView rS;            // scratch: runEawLevel writes eawColorRecip(S) of this level here
+                             // (allocated by it when invalid)
     ImageView normal, position, invX, depth, invZ, ids;
+};
 
-    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        const int w = cIn.width, h = cIn.height;
-        const float cr = cIn(x, y, 0), cg = cIn(x, y, 1), cb = cIn(x, y, 2);
-        const float rp = eawColorRecip(p, S(x, y, 0));
-        const float nx = normal(x, y, 0), ny = normal(x, y, 1), nz = normal(x, y, 2);
-        const float px = position(x, y, 0), py = position(x, y, 1), pz = position(x, y, 2);
-        const float ixp = invX(x, y, 0), zp = depth(x, y, 0), izp = invZ(x, y, 0);
-        const float m0 = ids(x, y, 0), m1 = ids(x, y, 1);
-        float ws = 0, ar = 0, ag = 0, ab = 0, vr = 0, vg = 0, vb = 0;
-        for (int qy = -2; qy <= 2; ++qy) {
-            // Taps outside the image are dropped (weight 0) rather than clamped: clamping would
-            // count a border pixel several times and break the variance propagation.
-            const int yq = y + qy * p.step;
-            if (yq < 0 || yq >= h) continue;
-            const float hy = b3(qy);
-            for (int qx = -2; qx <= 2; ++qx) {
-                const int xq = x + qx * p.step;
-                if (xq < 0 || xq >= w) continue;
-                const float qr = cIn(xq, yq, 0), qg = cIn(xq, yq, 1), qb = cIn(xq, yq, 2);
-                const float dc2 = sq(cr - qr) + sq(cg - qg) + sq(cb - qb);
-                const float dn2 = sq(nx - normal(xq, yq, 0)) + sq(ny - normal(xq, yq, 1)) + sq(nz - normal(xq, yq, 2));
-                const float dx2 =
-                    sq(px - position(xq, yq, 0)) + sq(py - position(xq, yq, 1)) + sq(pz - position(xq, yq, 2));
-                const float dz = (zp - depth(xq, yq, 0)) * izp;
-                const float did2 = sq(m0 - ids(xq, yq, 0)) + sq(m1 - ids(xq, yq, 1));
-                const float e = eawExponent(p, dc2, rp, eawColorRecip(p, S(xq, yq, 0)), dn2, dx2, ixp,
-                                            eawPositionTapScale(p, qx, qy), dz, did2);
-                const float wt = hy * b3(qx) * expNeg(-e);
-                ws += wt;
-                ar += wt * qr;
-                ag += wt * qg;
-                ab += wt * qb;
-                if (p.propagate) {
-                    const float w2 = wt * wt;
-                    vr += w2 * vIn(xq, yq, 0);
-                    vg += w2 * vIn(xq, yq, 1);
-                    vb += w2 * vIn(xq, yq, 2);
-                }
-            }
+// r = eawColorRecip(S) per pixel: the taps read the pair's 1/σ_c² as max(r(p), r(q)).
+struct EawColorRecip {
+    EawLevelParams p;
+    ImageView S, r;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const { r(x, y, 0) = eawColorRecip(p, S(x, y, 0)); }
+};
+
+// The EAW edge-stop policy of the à-trous level (filters/atrous_level.h): colour, normal,
+// position, depth and id terms summed into one exponent per tap, w = h exp(-e). With kPropagate
+// it is SURE's: the variance is propagated with squared weights and the detail maps are written.
+// kDepth/kIds = false compile the depth/id terms and their loads out (the CPU row engine picks
+// them when those stops are off; the terms are 0 either way).
+template <bool kPropagate, bool kDepth = true, bool kIds = true>
+struct EawStop {
+    EawLevel f;
+
+    static constexpr int kSums = kPropagate ? 7 : 4;  // Σw, Σwc (3), Σw² var (3)
+    static constexpr bool kCentreTap = false;
+    static constexpr bool kRowPartialSums = true;
+    static constexpr bool kScalarTaps = false;
+
+    struct Row {
+        const float *r, *g, *b, *rS, *nx, *ny, *nz, *px, *py, *pz, *ix, *z, *iz, *m0, *m1, *vr, *vg, *vb;
+    };
+    struct Centre {
+        float r, g, b, rp, nx, ny, nz, px, py, pz, ix, z, iz, m0, m1;
+    };
+    struct TapRow {
+        float pt[5];  // eawPositionTapScale of the row's taps
+    };
+
+    ATROUS_HOST_DEVICE int width() const { return f.cIn.width; }
+    ATROUS_HOST_DEVICE int height() const { return f.cIn.height; }
+    ATROUS_HOST_DEVICE int step() const { return f.p.step; }
+
+    ATROUS_HOST_DEVICE Row row(int y) const {
+        const size_t o = size_t(y) * size_t(f.cIn.width);
+        Row R;
+        R.r = f.cIn.channel(0) + o, R.g = f.cIn.channel(1) + o, R.b = f.cIn.channel(2) + o;
+        R.rS = f.rS.channel(0) + o;
+        R.nx = f.normal.channel(0) + o, R.ny = f.normal.channel(1) + o, R.nz = f.normal.channel(2) + o;
+        R.px = f.position.channel(0) + o, R.py = f.position.channel(1) + o, R.pz = f.position.channel(2) + o;
+        R.ix = f.invX.channel(0) + o, R.z = f.depth.channel(0) + o, R.iz = f.invZ.channel(0) + o;
+        R.m0 = f.ids.channel(0) + o, R.m1 = f.ids.channel(1) + o;
+        R.vr = R.vg = R.vb = nullptr;
+        if (kPropagate) R.vr = f.vIn.channel(0) + o, R.vg = f.vIn.channel(1) + o, R.vb = f.vIn.channel(2) + o;
+        return R;
+    }
+    ATROUS_FORCE_INLINE ATROUS_HOST_DEVICE Centre centre(const Row& R, int x) const {
+        Centre c;
+        c.r = R.r[x], c.g = R.g[x], c.b = R.b[x], c.rp = R.rS[x];
+        c.nx = R.nx[x], c.ny = R.ny[x], c.nz = R.nz[x];
+        c.px = R.px[x], c.py = R.py[x], c.pz = R.pz[x];
+        c.ix = R.ix[x], c.z = kDepth ? R.z[x] : 0.0f, c.iz = kDepth ? R.iz[x] : 0.0f;
+        c.m0 = kIds ? R.m0[x] : 0.0f, c.m1 = kIds ? R.m1[x] : 0.0f;
+        return c;
+    }
+    ATROUS_HOST_DEVICE TapRow tapRow(int qy) const {
+        TapRow T;
+        for (int qx = -2; qx <= 2; ++qx) T.pt[qx + 2] = eawPositionTapScale(f.p, qx, qy);
+        return T;
+    }
+    template <int QX, bool kCentre>
+    ATROUS_FORCE_INLINE ATROUS_HOST_DEVICE void tap(const Row& R, const Centre& c, AtrousSums<kSums>& a, ptrdiff_t q,
+                                                    float hxy, const TapRow& T) const {
+        const float r = R.r[q], g = R.g[q], b = R.b[q];
+        const float dc2 = sq(c.r - r) + sq(c.g - g) + sq(c.b - b);
+        const float dn2 = sq(c.nx - R.nx[q]) + sq(c.ny - R.ny[q]) + sq(c.nz - R.nz[q]);
+        const float dx2 = sq(c.px - R.px[q]) + sq(c.py - R.py[q]) + sq(c.pz - R.pz[q]);
+        const float dz = kDepth ? (c.z - R.z[q]) * c.iz : 0.0f;
+        const float did2 = kIds ? sq(c.m0 - R.m0[q]) + sq(c.m1 - R.m1[q]) : 0.0f;
+        const float e = eawExponent(f.p, dc2, c.rp, R.rS[q], dn2, dx2, c.ix, T.pt[QX + 2], dz, did2);
+        const float wt = hxy * fastExp(-e);
+        a.s[0] += wt;
+        a.s[1] += wt * r;
+        a.s[2] += wt * g;
+        a.s[3] += wt * b;
+        if constexpr (kPropagate) {
+            const float w2 = wt * wt;
+            a.s[4] += w2 * R.vr[q];
+            a.s[5] += w2 * R.vg[q];
+            a.s[6] += w2 * R.vb[q];
         }
-        finish(x, y, ws, ar, ag, ab, vr, vg, vb);
     }
 
-    // Normalisation and the SURE detail maps; shared with the CPU fast path. ws >= h(0) > 0
-    // because the centre tap always has weight h(0)·exp(0).
-    ATROUS_HOST_DEVICE void finish(int x, int y, float ws, float ar, float ag, float ab, float vr, float vg,
-                                   float vb) const {
-        const float inv = 1.0f / ws;
-        const float nr = ar * inv, ng = ag * inv, nb = ab * inv;
-        cOut(x, y, 0) = nr;
-        cOut(x, y, 1) = ng;
-        cOut(x, y, 2) = nb;
-        if (p.propagate) {
+    // Normalisation and the SURE detail maps. Σw >= h(0) > 0 because the centre tap always has
+    // weight h(0)·exp(0).
+    ATROUS_FORCE_INLINE ATROUS_HOST_DEVICE void finish(const Row&, int x, int y, const AtrousSums<kSums>& a) const {
+        const float inv = 1.0f / a.s[0];
+        const float nr = a.s[1] * inv, ng = a.s[2] * inv, nb = a.s[3] * inv;
+        f.cOut(x, y, 0) = nr;
+        f.cOut(x, y, 1) = ng;
+        f.cOut(x, y, 2) = nb;
+        if constexpr (kPropagate) {
             // var(c_{i+1}) = Σ a_q² var(c_i(q)), a_q = h w / k (independence assumption).
             const float inv2 = inv * inv;
-            const float v1r = vr * inv2, v1g = vg * inv2, v1b = vb * inv2;
-            vOut(x, y, 0) = v1r;
-            vOut(x, y, 1) = v1g;
-            vOut(x, y, 2) = v1b;
+            const float v1r = a.s[4] * inv2, v1g = a.s[5] * inv2, v1b = a.s[6] * inv2;
+            f.vOut(x, y, 0) = v1r;
+            f.vOut(x, y, 1) = v1g;
+            f.vOut(x, y, 2) = v1b;
             // v_i = var(c_i) + var(c_{i+1}) - 2 a_p var(c_i), a_p = h(0)/k, times α_i.
             const float ap2 = 2.0f * 0.140625f * inv;
-            const float v0r = vIn(x, y, 0), v0g = vIn(x, y, 1), v0b = vIn(x, y, 2);
+            const float v0r = f.vIn(x, y, 0), v0g = f.vIn(x, y, 1), v0b = f.vIn(x, y, 2);
             const float vd = (v0r + v1r - ap2 * v0r) + (v0g + v1g - ap2 * v0g) + (v0b + v1b - ap2 * v0b);
-            const float dr = cIn(x, y, 0) - nr, dg = cIn(x, y, 1) - ng, db = cIn(x, y, 2) - nb;
-            detail(x, y, 0) = dr * dr + dg * dg + db * db;
-            detail(x, y, 1) = maxSel(vd, 0.0f) * p.detailVarScale;
+            const float dr = f.cIn(x, y, 0) - nr, dg = f.cIn(x, y, 1) - ng, db = f.cIn(x, y, 2) - nb;
+            f.detail(x, y, 0) = dr * dr + dg * dg + db * db;
+            f.detail(x, y, 1) = maxSel(vd, 0.0f) * f.p.detailVarScale;
         }
     }
 };
+// SURE's level is EAW's with the variance propagated and the detail maps written.
+using SureStop = EawStop<true>;
 
-// Runs one level on `exec`. The generic version launches the functor; the CpuExec overload
-// (src/cpu/eaw_cpu.cpp) runs a row-vectorised interior with the same math.
+// Runs one level on `exec` (f.p.propagate picks EAW or SURE's policy): the rS plane, then the
+// functor. The CpuExec overload (src/cpu/eaw_cpu.cpp) runs both through vectorised row loops
+// (the row engine, src/cpu/atrous_rows.h).
 template <class Exec>
-void runEawLevel(const Exec& exec, const EawLevel& f) {
-    exec.forEachPixel(f.cIn.width, f.cIn.height, f);
+void runEawLevel(const Exec& exec, const EawLevel& level) {
+    Image store;
+    EawLevel f = level;
+    f.rS = levelPlane(exec, f.rS, f.cIn.width, f.cIn.height, store);
+    if (f.p.propagate)
+        runAtrousLevelFunctor(exec, EawColorRecip{f.p, f.S, f.rS}, SureStop{f});
+    else
+        runAtrousLevelFunctor(exec, EawColorRecip{f.p, f.S, f.rS}, EawStop<false>{f});
+    if (!store.empty()) exec.synchronize();  // before `store` dies
 }
 void runEawLevel(const CpuExec& exec, const EawLevel& f);
 
-// The CPU fast path is on by default; tests switch it off to compare with the generic functor.
-bool& eawCpuFastPath();
-// The fast path's AVX-512 row loops: on where the CPU has AVX-512 (F/VL/BW/DQ); tests switch it
-// off to run the AVX2 loops too. Setting it on a CPU without AVX-512 is not allowed.
-bool& eawCpuAvx512();
+// Old names of the row engine's switches (filters/atrous_level.h), shared with SVGF.
+inline bool& eawCpuFastPath() { return atrousCpuFastPath(); }
+inline bool& eawCpuAvx512() { return atrousCpuAvx512(); }
 
 }  // namespace atrous::filters

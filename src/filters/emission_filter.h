@@ -58,7 +58,7 @@ struct EmissionLevel {
                 const float s2 = sigmaMul * minSel(vp, vq);
                 // d2 == 0 gives weight 1 whatever σ is (also σ = 0); otherwise σ = 0 gives 0.
                 const float e = d2 > 0.0f ? (s2 > 0.0f ? d2 / s2 : 1e30f) : 0.0f;
-                const float wt = b3(qx) * b3(qy) * expNeg(-e);
+                const float wt = b3(qx) * b3(qy) * fastExp(-e);
                 ws += wt;
                 ar += wt * r;
                 ag += wt * g;

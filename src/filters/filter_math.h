@@ -1,77 +1,13 @@
-// Small math shared by the filter functors on host and device.
+// Small math shared by the filter functors on host and device: the albedo (de)modulation terms.
+// The B3 taps, the exponential, the luminance and the selects are in filters/atrous_math.h.
 #pragma once
 #include <cmath>
-#include <cstring>
 
 #include "atrous/image.h"
 #include "atrous/platform.h"
-
-// Host-only forced inlining for the shared per-pixel math called from the CPU row loops: a call
-// left in the x loop stops it vectorising.
-#if defined(__GNUC__) && !defined(__CUDACC__)
-#define ATROUS_FORCE_INLINE __attribute__((always_inline))
-#else
-#define ATROUS_FORCE_INLINE
-#endif
+#include "filters/atrous_math.h"
 
 namespace atrous::filters {
-
-// B3 spline taps [1, 4, 6, 4, 1] / 16, indexed by q + 2.
-ATROUS_INLINE float b3(int q) {
-    return q == 0 ? 0.375f : ((q == 1 || q == -1) ? 0.25f : 0.0625f);
-}
-
-// exp(x) for x <= 0. On the host a branch-free 2^t polynomial (relative error below 3e-7 on
-// [-87, 0]) so the per-row loops vectorise with AVX2 (libm's expf does not without -ffast-math);
-// on the GPU the hardware __expf. Arguments below -80 (and -inf, never NaN) give exactly 0: a
-// weight of e^-80 is irrelevant, and values that small would make denormal products (w·h, w²)
-// that cost ~100 cycles each on x86.
-ATROUS_INLINE float expNeg(float x) {
-#if ATROUS_ON_DEVICE
-    return x < -80.0f ? 0.0f : __expf(x);
-#else
-    // Written with masks rather than `cond ? a : b` on the result: GCC turns the latter into a
-    // branch inside the unrolled tap loops and then refuses to vectorise them.
-    const int keep = -int(x >= -80.0f);  // all ones, or 0 below -80 (and for -inf, NaN)
-    // Clamp |x| to 80 in the integer domain (a float compare-select here also becomes a branch).
-    int ax;
-    std::memcpy(&ax, &x, sizeof(float));
-    ax &= 0x7fffffff;
-    ax = ax < 0x42A00000 ? ax : 0x42A00000;  // 0x42A00000 = 80.0f
-    float a;
-    std::memcpy(&a, &ax, sizeof(float));
-    x = -a;  // x <= 0 is the domain, so x = -|x|
-    float t = x * 1.44269504088896341f;  // t <= 0
-    // Nearest integer by truncating t - 0.5 toward zero (t <= 0): plain conversions vectorise,
-    // floorf and fmaxf do not under strict IEEE flags.
-    const int ti = int(t - 0.5f);
-    const float fi = float(ti);
-    float f = t - fi;  // (-0.5, 0.5]
-    // 2^f = exp(f ln2): Taylor to degree 6, remainder < 1.2e-7 relative on [-0.5, 0.5).
-    float p = 1.540353039e-4f;
-    p = p * f + 1.333355815e-3f;
-    p = p * f + 9.618129108e-3f;
-    p = p * f + 5.550410866e-2f;
-    p = p * f + 2.402265070e-1f;
-    p = p * f + 6.931471806e-1f;
-    p = p * f + 1.0f;
-    int e = ti + 127;
-    int bits = (e << 23) & keep;  // scale = 2^ti, or exactly 0
-    float scale;
-    std::memcpy(&scale, &bits, sizeof(float));
-    return p * scale;
-#endif
-}
-
-ATROUS_INLINE float lum(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; }
-ATROUS_INLINE bool finite(float v) { return v - v == 0.0f; }
-ATROUS_INLINE int clampIdx(int v, int hi) { return v < 0 ? 0 : (v > hi ? hi : v); }
-ATROUS_INLINE float sq(float v) { return v * v; }
-// max/min as selects: libm's fmaxf/fminf are calls on the host (strict IEEE flags), which stop the
-// per-row loops from vectorising. Same result as fmaxf(a, b)/fminf(a, b) whenever a is not NaN
-// (a NaN a gives b, as fmaxf does).
-ATROUS_INLINE float maxSel(float a, float b) { return a > b ? a : b; }
-ATROUS_INLINE float minSel(float a, float b) { return a < b ? a : b; }
 
 // The albedo that demodulation divides by and remodulation multiplies by (docs/algorithms.md,
 // "Albedo demodulation"), per channel: max(a_c, eps) on surfaces with an albedo, blended toward 1

@@ -5,7 +5,7 @@
 
 #include "atrous/image.h"
 #include "core/math.h"
-#include "filters/filter_math.h"  // ATROUS_FORCE_INLINE
+#include "filters/filter_math.h"  // modulationAlbedo; atrous_math.h: b3, fastExp, lum, selectF
 
 namespace atrous::svgf {
 
@@ -58,25 +58,9 @@ ATROUS_INLINE float dotFma(Vec3 a, Vec3 b) { return fmaf(a.z, b.z, fmaf(a.y, b.y
 
 ATROUS_INLINE bool hasNormal(Vec3 n) { return dotFma(n, n) > 0.25f; }
 
-// c ? a : b for the edge-stopping math. On the host a bit mask: GCC turns a plain `?:` (or
-// fmaxf/floorf) into a branch inside the CPU row loops and then refuses to vectorise them
-// (src/cpu/svgf_atrous_cpu.cpp); the result is the same value either way. Arguments are
-// evaluated unconditionally, so both must be safe to compute (an Inf or NaN in the unused one is
-// harmless).
-ATROUS_FORCE_INLINE ATROUS_INLINE float selectF(bool c, float a, float b) {
-#if ATROUS_ON_DEVICE
-    return c ? a : b;
-#else
-    int ai, bi;
-    memcpy(&ai, &a, sizeof(float));
-    memcpy(&bi, &b, sizeof(float));
-    const int m = -int(c);  // all ones or 0
-    const int ri = (ai & m) | (bi & ~m);
-    float r;
-    memcpy(&r, &ri, sizeof(float));
-    return r;
-#endif
-}
+// The shared selects and exponential (filters/atrous_math.h), by their SVGF names.
+using filters::fastExp;
+using filters::selectF;
 
 // Smallest normal float: fastLog's argument is clamped here (its exponent trick needs a normal
 // number); log(1.2e-38) = -87.3, so σ_n log d already gives a weight of 0 for any σ_n >= 1.
@@ -145,38 +129,6 @@ ATROUS_FORCE_INLINE ATROUS_INLINE float depthLogWeightSel(float zp, float zq, fl
     const bool bp = isBackground(zp), bq = isBackground(zq);
     const float lw = -fabsf(zp - zq) / depthLogWeightDenom(zp, gx, gy, dx, dy, sigmaZ);
     return selectF(bp | bq, selectF(bp == bq, 0.0f, -1e30f), lw);
-}
-
-// e^x for the edge-stopping weights, to ~2e-7 relative error (plus 1.6e-8·|x log2 e| from the
-// rounding of the constant log2 e), 0 at or below -87 (and for NaN). Plain arithmetic instead of
-// expf: several times faster on the CPU, identical on host and device so the two backends agree to
-// float rounding, and branch-free (selects, no floorf) so the CPU row loops vectorise.
-ATROUS_FORCE_INLINE ATROUS_INLINE float fastExp(float x) {
-    const bool keep = x > -87.0f;  // false for NaN
-    x = selectF(keep, x, -87.0f);
-    x = selectF(x < 88.0f, x, 88.0f);
-    // t = x log2(e) in [-125.6, 127]; k = nearest integer to t: truncation of a positive number is
-    // floor, hence the offset 128 (rounding can give k one too large right below a half-integer;
-    // f is then 2^-16 beyond -0.5, where the series is just as accurate). f = t - k with the
-    // exact product (one rounding), so the result does not lose ulp(t) ~ 1e-5 at |t| ~ 100.
-    const int k = int(fmaf(x, 1.44269504f, 128.5f)) - 128;
-    const float f = fmaf(x, 1.44269504f, -float(k));  // in [-0.5, 0.5]
-    // 2^f by its Taylor series in f ln 2 to degree 6 (remainder < 1.3e-7 on [-0.5, 0.5]).
-    float p = fmaf(f, 0.000154035304f, 0.00133335581f);
-    p = fmaf(f, p, 0.00961812911f);
-    p = fmaf(f, p, 0.0555041087f);
-    p = fmaf(f, p, 0.240226507f);
-    p = fmaf(f, p, 0.693147181f);
-    p = fmaf(f, p, 1.0f);
-    const int bits = (k + 127) << 23;  // 2^k, k in [-125, 127]
-    float scale;
-    memcpy(&scale, &bits, sizeof(float));
-    return selectF(keep, p * scale, 0.0f);
-}
-
-// B3-spline taps [1, 4, 6, 4, 1] / 16.
-ATROUS_INLINE float b3Tap(int i) {
-    return i == 0 ? 0.375f : ((i == 1 || i == -1) ? 0.25f : 0.0625f);
 }
 
 }  // namespace atrous::svgf

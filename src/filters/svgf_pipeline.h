@@ -62,6 +62,7 @@ struct SvgfState {
     Image accIllum, accMoments, accLength, variance;
     Image levelIllum[2], levelVariance[2], nextHistIllum;
     Image output, taaOutput, accEmission, accEmissionLength;
+    Image lumStop;  // the à-trous level's luminance stop (Atrous::lumStop)
     const Image* result = nullptr;  // output or taaHistory after the last run
 
     void allocate(int w, int h, Device d) {
@@ -77,7 +78,7 @@ struct SvgfState {
         reprojIllum = make(3), reprojMoments = make(2), reprojLength = make(1);
         accIllum = make(3), accMoments = make(2), accLength = make(1), variance = make(1);
         for (int i = 0; i < 2; ++i) levelIllum[i] = make(3), levelVariance[i] = make(1);
-        nextHistIllum = make(3);
+        nextHistIllum = make(3), lumStop = make(1);
         output = make(3), taaOutput = make(3);
         histEmission = make(3), histEmissionLength = make(1), accEmission = make(3), accEmissionLength = make(1);
         result = nullptr;
@@ -173,6 +174,7 @@ public:
             at.depth = s.depth.view(), at.normal = s.normal.view(), at.depthGrad = s.depthGrad.view();
             at.outIllum = level == mParams.feedbackTap ? s.nextHistIllum.view() : s.levelIllum[level & 1].view();
             at.outVariance = s.levelVariance[level & 1].view();
+            at.lumStop = s.lumStop.view();
             runSvgfAtrous(mExec, at);
             filters::markStage(clock, "level", level);
             inIllum = at.outIllum;
