@@ -103,6 +103,8 @@ struct SafetyNetParams {
 
 struct DenoiseReport;
 
+// The parameters' user-facing names (Python keywords, CLI flags), ranges and doc lines are one
+// table, denoiseParams() in atrous/params.h: a new field needs a row there (tests/params_test.cpp).
 struct DenoiseOptions {
     DenoiseMethod method = DenoiseMethod::Sure;
     Device device = Device::Cpu;
@@ -150,7 +152,8 @@ struct DenoiseReport {
 // InputError for mismatched sizes, missing colour, negative variance or parameters out of range.
 Image denoise(const DenoiseInputs& inputs, const DenoiseOptions& options);
 
-// Throws InputError naming the parameter when one is out of range.
+// Throws ParamError (atrous/params.h: an InputError naming the field, `sigma_normal`) when a
+// parameter is out of range; the ranges are the rows of denoiseParams().
 void validateDenoiseOptions(const DenoiseOptions& options);
 
 DenoiseMethod parseDenoiseMethod(const std::string& name);  // "eaw" | "sure"; InputError otherwise

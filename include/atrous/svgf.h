@@ -10,8 +10,9 @@
 
 namespace atrous {
 
-// Every knob of the filter. One struct feeds the CLI flags, the Python keywords and the kernels;
-// each field changes the output (tests/svgf_test.cpp checks that).
+// Every knob of the filter. Its table, svgfParams() in atrous/params.h (one row per field: name,
+// range, doc), feeds validation, the CLI flags, the Python keywords and the viewer; each field
+// changes the output (tests/svgf_test.cpp checks that).
 struct SvgfParams {
     // À-trous edge stops (paper's σ_l, σ_n, σ_z).
     // luminance: exp(-|l_p - l_q| / (σ_l sqrt(g3x3(var_p)) + ε)). 2 with historyClip 0.5, measured
@@ -59,7 +60,8 @@ struct SvgfParams {
     float emissionMotionAlpha = 4.0f;
 };
 
-// Throws InputError naming the field when a parameter is out of range.
+// Throws ParamError (atrous/params.h: an InputError naming the field, `sigma_l`) when a
+// parameter is out of range.
 void validateSvgfParams(const SvgfParams& p);
 
 // One frame's buffers, each a planar Image of the colour's size on the host or on the denoiser's
