@@ -6,6 +6,11 @@
 //   per level, not one division per tap;
 // - the id term and the depth term are compiled out when they are off (their loads too): the
 //   policy's kDepth/kIds.
+#include <tbb/scalable_allocator.h>
+
+#include <memory>
+
+#include "atrous/error.h"
 #include "core/parallel.h"
 #include "cpu/atrous_rows.h"
 #include "filters/eaw.h"
@@ -39,9 +44,15 @@ void runRows(const EawLevel& f, bool avx512) {
 }  // namespace
 
 void runEawLevel(const CpuExec& exec, const EawLevel& level) {
-    Image store;
     EawLevel f = level;
-    f.rS = levelPlane(exec, f.rS, f.cIn.width, f.cIn.height, store);
+    // The level's r plane, when the caller gave none: from the scalable allocator, whose cache
+    // hands the same block back level after level (not an Image: that would zero-fill it first).
+    std::unique_ptr<float, void (*)(void*)> store(nullptr, scalable_aligned_free);
+    if (!f.rS.valid()) {
+        store.reset(static_cast<float*>(scalable_aligned_malloc(f.S.plane() * sizeof(float), 64)));
+        if (!store) throw RuntimeError("out of host memory for the EAW colour scale plane");
+        f.rS = ImageView{store.get(), f.cIn.width, f.cIn.height, 1};
+    }
     if (!atrousCpuFastPath()) {
         if (f.p.propagate)
             runAtrousLevelFunctor(exec, EawColorRecip{f.p, f.S, f.rS}, SureStop{f});
