@@ -217,8 +217,8 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         for (int k = 0; k < choice.count && k < kMaxSureCandidates; ++k) choice.candidates[k] = cfg.sure.candidates[k];
     }
     // Each level's 1/σ_c² factors (EawLevel::rS). The CPU level takes its plane from the scalable
-    // allocator per level instead: an image held through the cascade made the next call's
-    // sanitise stage pay a fresh buffer's page faults (+15% there at 1080p).
+    // allocator per level instead, as it did before the shared cascade (docs/benchmarks.md, "One
+    // cascade": holding an image through the cascade was a suspect of a slower sanitise stage).
     Image rS = dev == Device::Cpu ? Image() : Image(w, h, 1, dev);
     Image* cur = &cA;
     Image* nxt = &cB;
