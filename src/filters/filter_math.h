@@ -31,7 +31,12 @@ ATROUS_INLINE float modulationTerm(float m, float floor) {
     const float t = floor > 0.0f ? minSel(m / floor, 1.0f) : 1.0f;
     return finite(t) && t > 0.0f ? t * t : 0.0f;
 }
-ATROUS_INLINE float modulationAlbedo(float a, float t, float eps) { return 1.0f + t * (maxSel(a, eps) - 1.0f); }
+// t = 1 (an ordinary surface) gives max(a, eps) exactly, so a' read back as an albedo (floor 0)
+// is a' itself.
+ATROUS_INLINE float modulationAlbedo(float a, float t, float eps) {
+    const float m = maxSel(a, eps);
+    return t >= 1.0f ? m : 1.0f + t * (m - 1.0f);
+}
 ATROUS_INLINE float maxChannel(float a, float b, float c) { return maxSel(maxSel(a, b), c); }
 
 // a'_c of pixel (x, y), c = 0..2, from an albedo view (non-finite values read as 0); an invalid
@@ -49,7 +54,8 @@ ATROUS_INLINE void pixelModulationAlbedo(const ImageView& albedo, int x, int y, 
     // On the rim of a black-albedo surface (a 3x3 neighbour below kBlackAlbedoFraction · floor)
     // the floor is kRimFloorMul times higher.
     float nearBlack = 0.0f;
-    if (floor > 0.0f) {
+    const float mp = maxChannel(v[0], v[1], v[2]);
+    if (floor > 0.0f && mp > 0.0f && mp < kRimFloorMul * floor) {  // elsewhere t is the same either way
         float mn = 1e30f;
         for (int dy = -1; dy <= 1; ++dy)
             for (int dx = -1; dx <= 1; ++dx) {
@@ -59,7 +65,7 @@ ATROUS_INLINE void pixelModulationAlbedo(const ImageView& albedo, int x, int y, 
             }
         nearBlack = mn < kBlackAlbedoFraction * floor ? 1.0f : 0.0f;
     }
-    const float t = modulationTerm(maxChannel(v[0], v[1], v[2]), floor * (1.0f + nearBlack * (kRimFloorMul - 1.0f)));
+    const float t = modulationTerm(mp, floor * (1.0f + nearBlack * (kRimFloorMul - 1.0f)));
     for (int c = 0; c < 3; ++c) a[c] = modulationAlbedo(v[c], t, eps);
 }
 
