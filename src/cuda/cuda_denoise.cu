@@ -110,18 +110,19 @@ struct FillVariance {
 
 }  // namespace
 
-float medianFinite(const CudaExec&, const ImageView& v) {
+float medianFinite(const CudaExec&, const ImageView& v, float none) {
     float* d = v.data;
     const size_t plane = v.plane();
     size_t n = 0;
     try {
-        // +Inf and NaN (neither below +Inf) sort after every finite value.
+        // The median the host takes with nth_element at n / 2: sort; +Inf and NaN (neither below
+        // +Inf) go after every finite value.
         n = size_t(thrust::count_if(thrust::cuda::par, d, d + plane, IsFiniteDetail{}));
         if (n) thrust::sort(thrust::cuda::par, d, d + plane);
     } catch (const std::exception& e) {
-        throw RuntimeError(std::string("CUDA safety-net median failed: ") + e.what());
+        throw RuntimeError(std::string("CUDA median failed: ") + e.what());
     }
-    if (!n) return 1.0f;
+    if (!n) return none;
     float mid = 0.0f;
     ATROUS_CUDA_CHECK(cudaMemcpy(&mid, d + n / 2, sizeof(float), cudaMemcpyDeviceToHost));
     return mid;
@@ -129,39 +130,10 @@ float medianFinite(const CudaExec&, const ImageView& v) {
 
 void estimateNoiseSigmaCuda(const Image& color, const Image* albedo, float eps, float floor, float sigma[3]) {
     if (color.device() != Device::Cuda) throw RuntimeError("estimateNoiseSigmaCuda: the colour is not on the GPU");
-    const int w = color.width(), h = color.height();
-    const size_t plane = color.plane();
-    Image detail(w, h, 3, Device::Cuda), albedoHolder, demod;
-    const CudaExec exec;
-    if (albedo) {
-        if (albedo->device() != Device::Cuda) albedoHolder = albedo->to(Device::Cuda);
-        demod = Image(w, h, 3, Device::Cuda);
-        exec.forEachPixel(w, h, DemodulatedCopy{eps, floor, color.view(),
-                                                albedoHolder.empty() ? albedo->view() : albedoHolder.view(), demod.view()});
-    }
-    exec.forEachPixel(w, h, MadDetail{albedo ? demod.view() : color.view(), detail.view()});
-    exec.synchronize();
-    // As estimateNoiseSigma: var(d_0) = σ² (1 + Σh² − 2 h(0)) for white noise.
-    const double sumH2 = (70.0 / 256.0) * (70.0 / 256.0), h0 = (6 / 16.0) * (6 / 16.0);
-    const double detailVar = 1.0 + sumH2 - 2.0 * h0;
-    for (int c = 0; c < 3; ++c) {
-        float* d = detail.data() + size_t(c) * plane;
-        size_t n = 0;
-        try {
-            n = size_t(thrust::count_if(thrust::cuda::par, d, d + plane, IsFiniteDetail{}));
-            // The median the host takes with nth_element at n / 2: sort, skipped pixels (+Inf) last.
-            if (n) thrust::sort(thrust::cuda::par, d, d + plane);
-        } catch (const std::exception& e) {
-            throw RuntimeError(std::string("CUDA noise estimate failed: ") + e.what());
-        }
-        if (!n) {
-            sigma[c] = 0;
-            continue;
-        }
-        float mid = 0.0f;
-        ATROUS_CUDA_CHECK(cudaMemcpy(&mid, d + n / 2, sizeof(float), cudaMemcpyDeviceToHost));
-        sigma[c] = float(double(mid) / 0.6745 / std::sqrt(detailVar));
-    }
+    Image albedoHolder;
+    if (albedo && albedo->device() != Device::Cuda) albedoHolder = albedo->to(Device::Cuda);
+    const ImageView a = !albedo ? ImageView{} : (albedoHolder.empty() ? albedo->view() : albedoHolder.view());
+    globalNoiseSigma(CudaExec{}, color.view(), a, eps, floor, sigma);
 }
 
 Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const PreparedInputs& prep, DenoiseReport& rep) {

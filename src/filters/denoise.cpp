@@ -40,36 +40,15 @@ namespace filters {
 // σ = σ_d / sqrt(0.7900...). Per channel, over finite pixels; of the demodulated colour when an
 // albedo is given.
 void estimateNoiseSigma(const Image& color, const Image* albedo, float eps, float floor, float sigma[3]) {
-    const int w = color.width(), h = color.height();
-    Image detail(w, h, 3, Device::Cpu), demod;
-    const CpuExec exec;
-    if (albedo) {
-        demod = Image(w, h, 3, Device::Cpu);
-        exec.forEachPixel(w, h, DemodulatedCopy{eps, floor, color.view(), albedo->view(), demod.view()});
-    }
-    exec.forEachPixel(w, h, MadDetail{albedo ? demod.view() : color.view(), detail.view()});
-    for (int c = 0; c < 3; ++c) {
-        std::vector<float> d;
-        d.reserve(detail.plane());
-        const float* p = detail.data() + size_t(c) * detail.plane();
-        for (size_t i = 0; i < detail.plane(); ++i)
-            if (p[i] < INFINITY) d.push_back(p[i]);
-        if (d.empty()) {
-            sigma[c] = 0;
-            continue;
-        }
-        auto mid = d.begin() + d.size() / 2;
-        std::nth_element(d.begin(), mid, d.end());
-        sigma[c] = float(double(*mid) / 0.6745 / std::sqrt(double(kDetailVarFactor)));
-    }
+    globalNoiseSigma(CpuExec{}, color.view(), albedo ? albedo->view() : ImageView{}, eps, floor, sigma);
 }
 
-float medianFinite(const CpuExec&, const ImageView& v) {
+float medianFinite(const CpuExec&, const ImageView& v, float none) {
     float* d = v.data;
     const size_t n = size_t(v.width) * size_t(v.height);
     float* end = std::partition(d, d + n, [](float a) { return a < INFINITY && a == a; });
     const size_t m = size_t(end - d);
-    if (!m) return 1.0f;
+    if (!m) return none;
     std::nth_element(d, d + m / 2, end);
     return d[m / 2];
 }

@@ -299,7 +299,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         if (!cfg.varianceGiven) {
             Image ratio(w, h, 1, dev);
             exec.forEachPixel(w, h, SafetyRatio{sp.radius, boxH.view(), ratio.view()});
-            kappa = std::fmax(1.0f, medianFinite(exec, ratio.view()));
+            kappa = std::fmax(1.0f, medianFinite(exec, ratio.view(), 1.0f));
         }
         exec.forEachPixel(w, h, SafetyBlend{sp, kappa, cfg.safety.trigger, boxH.view(), safetyIn.view(), cur->view(), detailSum, ImageView{}});
         detailSum = ImageView{};

@@ -8,10 +8,24 @@
 // isolated firefly fills one, so it is left to the firefly pass. Floored at the global estimate
 // (the local one only raises it where the noise is higher) and capped at kNoiseCapMul times it. Shared by CPU and CUDA (the driver runs it on its executor).
 #pragma once
+#include <cmath>
+
 #include "atrous/image.h"
 #include "filters/filter_math.h"
 
+namespace atrous {
+struct CpuExec;
+struct CudaExec;
+}
+
 namespace atrous::filters {
+
+// The median of the finite values of a 1-channel image (`none` when it has none; +Inf and NaN
+// are skipped), reordering the image: the global noise estimate's per-channel median of the B3
+// details and the safety net's calibration. CPU: nth_element (src/filters/denoise.cpp); CUDA: a
+// device sort (src/cuda/cuda_denoise.cu).
+float medianFinite(const CpuExec& exec, const ImageView& v, float none);
+float medianFinite(const CudaExec& exec, const ImageView& v, float none);
 
 // The local estimate is capped at this many times the global one. A visible light's edge or a
 // sun's rim reads as noise thousands of times the image's, and the colour stop then opened across
@@ -82,6 +96,26 @@ struct DemodulatedCopy {
         for (int c = 0; c < 3; ++c) out(x, y, c) = albedo.valid() ? color(x, y, c) / m[c] : color(x, y, c);
     }
 };
+
+// Donoho's global estimate on `exec`, per channel: σ_c = median |d_0,c| / 0.6745 /
+// sqrt(kDetailVarFactor) over the pixels whose 5×5 window is finite (0 when none is), of `color`
+// divided by a' when `albedo` is valid. estimateNoiseSigma (CPU) and estimateNoiseSigmaCuda.
+template <class Exec>
+void globalNoiseSigma(const Exec& exec, const ImageView& color, const ImageView& albedo, float eps, float floor,
+                      float sigma[3]) {
+    const int w = color.width, h = color.height;
+    Image detail(w, h, 3, exec.device()), demod;
+    if (albedo.valid()) {
+        demod = Image(w, h, 3, exec.device());
+        exec.forEachPixel(w, h, DemodulatedCopy{eps, floor, color, albedo, demod.view()});
+    }
+    exec.forEachPixel(w, h, MadDetail{albedo.valid() ? demod.view() : color, detail.view()});
+    exec.synchronize();
+    for (int c = 0; c < 3; ++c) {
+        const float mid = medianFinite(exec, ImageView{detail.view().channel(c), w, h, 1}, 0.0f);
+        sigma[c] = float(double(mid) / 0.6745 / std::sqrt(double(kDetailVarFactor)));
+    }
+}
 
 // e_c(p) = d_0,c(p)² / kDetailVarFactor: an unbiased per-pixel estimate of σ_c² on white noise.
 // The B3 taps across a geometric edge (normals further apart than kNoiseNormalDist, or depths

@@ -11,11 +11,6 @@
 #include "filters/filter_math.h"
 #include "filters/sure.h"
 
-namespace atrous {
-struct CpuExec;
-struct CudaExec;
-}
-
 namespace atrous::filters {
 
 // The input's summed variance, kept before the cascade (SURE's propagation overwrites the
@@ -44,17 +39,6 @@ struct SafetyDetail {
     }
 };
 
-ATROUS_INLINE void safetyWindowSums(const ImageView& boxH, int radius, int x, int y, float& sumD,
-                             float& sumV) {
-    sumD = 0;
-    sumV = 0;
-    for (int dy = -radius; dy <= radius; ++dy) {
-        const int yy = clampIdx(y + dy, boxH.height - 1);
-        sumD += boxH(x, yy, 0);
-        sumV += boxH(x, yy, 1);
-    }
-}
-
 // ΣD / ΣV of p's window (+Inf where ΣV = 0): its median over the image is the calibration κ of an
 // estimated variance (the driver, step 6).
 struct SafetyRatio {
@@ -62,7 +46,7 @@ struct SafetyRatio {
     ImageView boxH, ratio;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         float sumD, sumV;
-        safetyWindowSums(boxH, radius, x, y, sumD, sumV);
+        sureWindowSums(boxH, radius, x, y, sumD, sumV);
         ratio(x, y, 0) = sumV > 0.0f ? sumD / sumV : INFINITY;
     }
 };
@@ -77,7 +61,7 @@ struct SafetyBlend {
     ImageView sOut;  // optional: the chosen s (1 channel)
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         float sumD, sumV;
-        safetyWindowSums(boxH, p.radius, x, y, sumD, sumV);
+        sureWindowSums(boxH, p.radius, x, y, sumD, sumV);
         const float s = sumD > trigger * varScale * sumV ? sureChoose(p, sumD, varScale * sumV) : 0.0f;
         for (int c = 0; c < 3; ++c) {
             float f = cN(x, y, c);
@@ -87,10 +71,5 @@ struct SafetyBlend {
         if (sOut.valid()) sOut(x, y, 0) = s;
     }
 };
-
-// The median of the finite values of a 1-channel image (1 when there are none); the image is
-// reordered. CPU: nth_element (src/filters/denoise.cpp); CUDA: a device sort (cuda_denoise.cu).
-float medianFinite(const CpuExec& exec, const ImageView& v);
-float medianFinite(const CudaExec& exec, const ImageView& v);
 
 }  // namespace atrous::filters

@@ -57,18 +57,26 @@ struct SureBoxH {
     }
 };
 
+// Vertical sums over rows y - r..y + r (clamped) of the horizontal sums (SureBoxH): ΣD and ΣV
+// of p's window. Shared by SureChoose and the safety net (safety_net.h).
+ATROUS_INLINE void sureWindowSums(const ImageView& boxH, int radius, int x, int y, float& sumD, float& sumV) {
+    sumD = 0;
+    sumV = 0;
+    for (int dy = -radius; dy <= radius; ++dy) {
+        const int yy = clampIdx(y + dy, boxH.height - 1);
+        sumD += boxH(x, yy, 0);
+        sumV += boxH(x, yy, 1);
+    }
+}
+
 // Vertical window sums, the choice of s_i(p), and acc += s_i(p) · d_i(p), d_i = c_i - c_{i+1}.
 struct SureChoose {
     SureChoiceParams p;
     ImageView boxH, cI, cNext, acc;
     ImageView sOut;  // optional: the chosen s_i (1 channel), for tests and debugging
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        float sumD = 0, sumV = 0;
-        for (int dy = -p.radius; dy <= p.radius; ++dy) {
-            const int yy = clampIdx(y + dy, boxH.height - 1);
-            sumD += boxH(x, yy, 0);
-            sumV += boxH(x, yy, 1);
-        }
+        float sumD, sumV;
+        sureWindowSums(boxH, p.radius, x, y, sumD, sumV);
         const float s = sureChoose(p, sumD, sumV);
         for (int c = 0; c < 3; ++c) acc(x, y, c) += s * (cI(x, y, c) - cNext(x, y, c));
         if (sOut.valid()) sOut(x, y, 0) = s;
