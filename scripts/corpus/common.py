@@ -2,6 +2,7 @@
 
 Modes (sizes, sample counts, seeds) live here so both renderers use the same ones.
 """
+import argparse
 import json
 import os
 import time
@@ -61,3 +62,34 @@ def done(path):
 
 def log(*a):
     print(time.strftime("%H:%M:%S"), *a, flush=True)
+
+
+def parse_render_args(renderer, quick, stills):
+    """The command line both renderers take: (args, mode dict, output root, still names to render).
+
+    --scenes keeps only names of `stills` (the sequence's name is checked by the caller)."""
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--mode", choices=list(MODES), default="quick")
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--scenes", default="")
+    a = ap.parse_args()
+    names = quick if a.mode == "quick" else list(stills)
+    if a.scenes:
+        names = [n for n in a.scenes.split(",") if n in stills]
+    return a, MODES[a.mode], Path(a.out) / renderer, names
+
+
+def still_jobs(mode):
+    """(spp, seed, file stem) of a still's renders: the noisy ones, then the reference."""
+    jobs = [(spp, SEED_NOISY[spp], f"spp{spp:04d}") for spp in mode["spp"]]
+    jobs.append((mode["ref_spp"], SEED_REF, f"ref{mode['ref_spp']:04d}"))
+    return jobs
+
+
+def merged_render_seconds(man_path, times):
+    """The manifest's render_seconds: what an earlier run recorded, updated with this run's `times`."""
+    old = {}
+    if Path(man_path).exists():
+        old = json.loads(Path(man_path).read_text()).get("render_seconds", {})
+    old.update({k: round(v, 2) for k, v in times.items()})
+    return old

@@ -7,7 +7,6 @@ Layout written, as a Blender user has it: one OPEN_EXR_MULTILAYER file per rende
 with the passes Combined, Denoising Data, Normal, Position, Z, Emission, Object Index, Material
 Index and Vector. Cycles on the CPU, denoiser off, adaptive sampling off, fixed seeds.
 """
-import argparse
 import math
 import sys
 import time
@@ -16,9 +15,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import (MODES, SEED_NOISY, SEED_REF, SEED_SEQ, SEED_SEQ_REF, done, exr_channels,  # noqa: E402
+from common import (SEED_SEQ, SEED_SEQ_REF, done, exr_channels, merged_render_seconds,  # noqa: E402
                     exr_read_all,
-                    log, write_manifest)
+                    log, parse_render_args, still_jobs, write_manifest)
 
 import bpy  # noqa: E402
 from mathutils import Vector  # noqa: E402
@@ -457,26 +456,15 @@ def vector_check(path, sc, frame_prev):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--mode", choices=list(MODES), default="quick")
-    ap.add_argument("--out", required=True)
-    ap.add_argument("--scenes", default="")
-    a = ap.parse_args()
-    mode = MODES[a.mode]
-    root = Path(a.out) / "cycles"
-    names = QUICK if a.mode == "quick" else list(STILLS)
-    if a.scenes:
-        names = [n for n in a.scenes.split(",") if n in STILLS]
+    a, mode, root, names = parse_render_args("cycles", QUICK, STILLS)
     res = mode["res"]
     version = bpy.app.version_string
     for name in names:
         d = root / name
         d.mkdir(parents=True, exist_ok=True)
-        jobs = [(spp, SEED_NOISY[spp], f"spp{spp:04d}") for spp in mode["spp"]]
-        jobs.append((mode["ref_spp"], SEED_REF, f"ref{mode['ref_spp']:04d}"))
         files, times = {}, {}
         what = bg = settings = None
-        for spp, seed, stem in jobs:
+        for spp, seed, stem in still_jobs(mode):
             _obj_index[0] = 0
             sc = reset()
             what, bg = STILLS[name](sc)
@@ -494,15 +482,10 @@ def main():
         bpy.context.view_layer.update()  # matrix_world is stale until the depsgraph is evaluated
         fwd = cam.matrix_world.to_3x3() @ Vector((0, 0, -1))
         man_path = d / "manifest.json"
-        old = {}
-        if man_path.exists():
-            import json
-            old = json.loads(man_path.read_text()).get("render_seconds", {})
-        old.update({k: round(v, 2) for k, v in times.items()})
         write_manifest(man_path, {
             "scene": name, "renderer": "blender-cycles", "version": version, "description": what,
             "resolution": [res, res], "layout": "blender-multilayer-exr", "files": files,
-            "reference": f"ref{mode['ref_spp']:04d}", "settings": settings, "render_seconds": old,
+            "reference": f"ref{mode['ref_spp']:04d}", "settings": settings, "render_seconds": merged_render_seconds(man_path, times),
             "conventions": CONVENTIONS, "background": bg,
             "depth_check": check_depth(d / f"ref{mode['ref_spp']:04d}.exr", list(cam.location), list(fwd)),
             "camera": {"location": list(cam.location), "forward": list(fwd), "lens_mm": cam.data.lens,

@@ -11,7 +11,6 @@ Mitsuba user has them:
 Sequences: aov layout per frame plus <frame>_motion.exr computed here from pos.* and the previous
 frame's camera (Mitsuba has no motion AOV).
 """
-import argparse
 import math
 import os
 import sys
@@ -21,8 +20,8 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import (MODES, SEED_NOISY, SEED_REF, SEED_SEQ, SEED_SEQ_REF, done, exr_channels,  # noqa: E402
-                    log, write_manifest)
+from common import (SEED_SEQ, SEED_SEQ_REF, done, exr_channels, merged_render_seconds,  # noqa: E402
+                    log, parse_render_args, still_jobs, write_manifest)
 
 import mitsuba as mi  # noqa: E402
 
@@ -347,27 +346,16 @@ def write_motion(path, motion):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--mode", choices=list(MODES), default="quick")
-    ap.add_argument("--out", required=True)
-    ap.add_argument("--scenes", default="")
-    a = ap.parse_args()
-    mode = MODES[a.mode]
-    root = Path(a.out) / "mitsuba"
-    names = QUICK if a.mode == "quick" else list(STILLS)
-    if a.scenes:
-        names = [n for n in a.scenes.split(",") if n in STILLS]
+    a, mode, root, names = parse_render_args("mitsuba", QUICK, STILLS)
     res = mode["res"]
     for name in names:
         fn, layout, rfilter = STILLS[name]
         objects, cam, what, bg = fn()
         d = root / name
         d.mkdir(parents=True, exist_ok=True)
-        jobs = [(spp, SEED_NOISY[spp], f"spp{spp:04d}") for spp in mode["spp"]]
-        jobs.append((mode["ref_spp"], SEED_REF, f"ref{mode['ref_spp']:04d}"))
         times = {}
         files = {}
-        for spp, seed, stem in jobs:
+        for spp, seed, stem in still_jobs(mode):
             if layout == "aov":
                 target = d / f"{stem}.exr"
                 if not done(target):
@@ -384,17 +372,12 @@ def main():
                 files[stem] = {"spp": spp, "seed": seed, "folder": stem,
                                "files": {p.name: exr_channels(p) for p in sorted(folder.glob("*.exr"))}}
         man_path = d / "manifest.json"
-        old = {}
-        if man_path.exists():
-            import json
-            old = json.loads(man_path.read_text()).get("render_seconds", {})
-        old.update({k: round(v, 2) for k, v in times.items()})
         write_manifest(man_path, {
             "scene": name, "renderer": "mitsuba", "version": mi.__version__, "variant": VARIANT,
             "description": what, "resolution": [res, res], "pixel_filter": rfilter,
             "integrator": f"aov(path max_depth={MAX_DEPTH})" if layout == "aov" else f"path max_depth={MAX_DEPTH} + aov",
             "aovs": AOVS, "layout": layout, "files": files, "reference": f"ref{mode['ref_spp']:04d}",
-            "render_seconds": old, "conventions": CONVENTIONS, "background": bg, "camera": cam,
+            "render_seconds": merged_render_seconds(man_path, times), "conventions": CONVENTIONS, "background": bg, "camera": cam,
         })
 
     # ------------------------------------------------ sequence
