@@ -1,4 +1,6 @@
-// The switches of the CPU row engine (src/cpu/atrous_rows.h), one pair for every policy.
+// The switches of the CPU row engine (src/cpu/atrous_rows.h), one pair for every policy. The
+// AVX-512 switch starts as "the ISA in use is AVX-512" (src/cpu/cpu_isa.h); cpu::setActiveIsa
+// sets it too.
 #include "cpu/cpu_simd.h"
 #include "filters/atrous_level.h"
 
@@ -10,7 +12,7 @@ bool& atrousCpuFastPath() {
 }
 
 bool& atrousCpuAvx512() {
-    static bool enabled = cpuHasAvx512();
+    static bool enabled = cpu::activeIsaOrBaseline() == cpu::Isa::Avx512;
     return enabled;
 }
 

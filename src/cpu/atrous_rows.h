@@ -8,48 +8,21 @@
 // read through the centre row's plane pointers plus one row offset (one index per tap rather than
 // a second set of row pointers, which the x loop had to reload from the stack).
 //
-// The same row loops are compiled twice, for AVX2 (the build's baseline, x86-64-v3) and for
-// AVX-512, chosen at run time (parallelForIsa): EAW's tap loop needs ~30 live vectors (16 ymm
+// The same row loops are compiled three times, for baseline x86-64 (SSE2, what the library is
+// compiled for), AVX2 (x86-64-v3) and AVX-512, chosen at run time (parallelForIsa, cpu_isa.h):
+// EAW's tap loop needs ~30 live vectors (16 ymm
 // registers spilled to the stack on every tap) and 16 lanes halve the instruction count where the
 // core has 512-bit units (measured 27% less CPU time for the level loop on an AMD EPYC).
 //
 // Plain floats and small structs only in the loop bodies; everything they call is force-inlined.
 #pragma once
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <cstddef>
 #include <vector>
 
-#include "cpu/cpu_simd.h"
+#include "cpu/isa_dispatch.h"
 #include "filters/atrous_level.h"
 
 namespace atrous::cpu {
-
-// ISA dispatch, written once: body(i0, i1) (a force-inlined operator()) compiled for AVX2 and for
-// AVX-512, run over [begin, end) in TBB blocks of `grain`.
-template <class Body, class Index>
-void isaRangeAvx2(const Body& body, Index i0, Index i1) {
-    body(i0, i1);
-}
-#if ATROUS_CPU_AVX512
-template <class Body, class Index>
-ATROUS_TARGET_AVX512 void isaRangeAvx512(const Body& body, Index i0, Index i1) {
-    body(i0, i1);
-}
-#endif
-
-template <class Index, class Body>
-void parallelForIsa(bool avx512, Index begin, Index end, Index grain, const Body& body) {
-    void (*fn)(const Body&, Index, Index) = &isaRangeAvx2<Body, Index>;
-#if ATROUS_CPU_AVX512
-    if (avx512) fn = &isaRangeAvx512<Body, Index>;
-#else
-    (void)avx512;
-#endif
-    tbb::parallel_for(tbb::blocked_range<Index>(begin, end, grain),
-                      [&](const tbb::blocked_range<Index>& r) { fn(body, r.begin(), r.end()); });
-}
 
 // The pixel's running sums to and from the row buffers (acc[k][x]), fully unrolled.
 template <int K, bool kFromZero>
@@ -161,8 +134,13 @@ struct AtrousRows {
 
 // One level of `stop` on the CPU's cores.
 template <class Stop>
+void runAtrousRows(const Stop& stop, Isa isa) {
+    parallelForIsa(isa, 0, stop.height(), 8, AtrousRows<Stop>{stop});
+}
+// With the row engine's switch (filters::atrousCpuAvx512()).
+template <class Stop>
 void runAtrousRows(const Stop& stop, bool avx512) {
-    parallelForIsa(avx512, 0, stop.height(), 8, AtrousRows<Stop>{stop});
+    runAtrousRows(stop, isaFromAvx512Switch(avx512));
 }
 
 }  // namespace atrous::cpu

@@ -10,13 +10,12 @@
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC optimize("no-trapping-math")
 #endif
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <atomic>
 #include <vector>
 
 #include "core/parallel.h"
+#include "cpu/isa_dispatch.h"
 #include "filters/prepass.h"
 
 namespace atrous::filters {
@@ -27,11 +26,11 @@ void runFireflyClamp(const CpuExec& exec, const FireflyClamp& f) {
         exec.forEachPixel(w, h, f);
         return;
     }
-    tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& r) {
+    cpu::parallelForIsa(cpu::activeIsa(), 0, h, 8, [&](int r0, int r1) {
         const FireflyClamp g = f;  // a local copy: its views cannot alias the stores
         std::vector<float> rowsL(size_t(3) * w), rowsV(size_t(3) * w);
         std::vector<float> scratch(w);  // flag row when no flag view was given
-        for (int y = r.begin(); y < r.end(); ++y) {
+        for (int y = r0; y < r1; ++y) {
             for (int k = 0; k < 3; ++k) {
                 const int yy = clampIdx(y + k - 1, h - 1);
                 const size_t o = size_t(yy) * w;
@@ -74,9 +73,9 @@ namespace atrous::filters {
 
 void runSanitizeColor(const CpuExec&, const SanitizeColor& f) {
     const int w = f.colorIn.width, h = f.colorIn.height;
-    tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& r) {
+    cpu::parallelForIsa(cpu::activeIsa(), 0, h, 8, [&](int r0, int r1) {
         const SanitizeColor g = f;
-        for (int y = r.begin(); y < r.end(); ++y)
+        for (int y = r0; y < r1; ++y)
             for (int c = 0; c < 3; ++c)
                 for (int k = 0; k < 2; ++k) {
                     const ImageView& in = k == 0 ? g.colorIn : g.varIn;
@@ -101,10 +100,10 @@ ImageView sanitizedFeature(const CpuExec& exec, ImageView in, int width, int hei
     if (in.valid()) {
         // sanitizeFeature(a) == a exactly where a is finite and |a| <= kFeatureClamp.
         std::atomic<bool> clean{true};
-        tbb::parallel_for(tbb::blocked_range<int>(0, height, 16), [&](const tbb::blocked_range<int>& r) {
+        cpu::parallelForIsa(cpu::activeIsa(), 0, height, 16, [&](int r0, int r1) {
             for (int c = 0; c < channels && clean.load(std::memory_order_relaxed); ++c) {
                 int bad = 0;
-                for (int y = r.begin(); y < r.end(); ++y) {
+                for (int y = r0; y < r1; ++y) {
                     const float* ATROUS_RESTRICT a = in.channel(c) + size_t(y) * width;
 #pragma omp simd reduction(| : bad)
                     for (int x = 0; x < width; ++x) bad |= (a[x] >= -kFeatureClamp) & (a[x] <= kFeatureClamp) ? 0 : 1;
@@ -121,9 +120,9 @@ ImageView sanitizedFeature(const CpuExec& exec, ImageView in, int width, int hei
     if (in.valid()) {
         // The functor's copy as plain row loops (the functor through forEachPixel stayed scalar).
         const ImageView out = storage.view();
-        tbb::parallel_for(tbb::blocked_range<int>(0, height, 16), [&](const tbb::blocked_range<int>& r) {
+        cpu::parallelForIsa(cpu::activeIsa(), 0, height, 16, [&](int r0, int r1) {
             for (int c = 0; c < channels; ++c)
-                for (int y = r.begin(); y < r.end(); ++y) {
+                for (int y = r0; y < r1; ++y) {
                     const float* ATROUS_RESTRICT a = in.channel(c) + size_t(y) * width;
                     float* ATROUS_RESTRICT o = out.channel(c) + size_t(y) * width;
 #pragma omp simd
@@ -141,10 +140,10 @@ void runColorScale(const CpuExec& exec, const ColorScale& f) {
         exec.forEachPixel(w, h, f);
         return;
     }
-    tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& r) {
+    cpu::parallelForIsa(cpu::activeIsa(), 0, h, 8, [&](int r0, int r1) {
         const ColorScale g = f;  // a local copy: its views cannot alias the stores
         std::vector<float> rows(size_t(3) * w);
-        for (int y = r.begin(); y < r.end(); ++y) {
+        for (int y = r0; y < r1; ++y) {
             // Channel-summed variance of rows y-1, y, y+1 (clamped as in the functor).
             for (int k = 0; k < 3; ++k) {
                 const size_t o = size_t(clampIdx(y + k - 1, h - 1)) * w;
@@ -176,9 +175,9 @@ void runFootprint(const CpuExec& exec, const Footprint& f) {
         exec.forEachPixel(w, h, f);
         return;
     }
-    tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& r) {
+    cpu::parallelForIsa(cpu::activeIsa(), 0, h, 8, [&](int r0, int r1) {
         const Footprint g = f;  // a local copy: its views cannot alias the stores
-        for (int y = r.begin(); y < r.end(); ++y) {
+        for (int y = r0; y < r1; ++y) {
             const size_t o = size_t(y) * w;
             // Rows above and below; at the top/bottom border the functor's neighbour is the pixel
             // itself (kFootprintBorder): the row pointer then stays valid and the select drops it.

@@ -9,12 +9,11 @@
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC optimize("no-trapping-math")
 #endif
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <vector>
 
 #include "core/parallel.h"
+#include "cpu/isa_dispatch.h"
 #include "filters/sure.h"
 
 namespace atrous::filters {
@@ -25,9 +24,9 @@ void runSureBoxH(const CpuExec& exec, const SureBoxH& f) {
         exec.forEachPixel(w, h, f);
         return;
     }
-    tbb::parallel_for(tbb::blocked_range<int>(0, h, 16), [&](const tbb::blocked_range<int>& range) {
+    cpu::parallelForIsa(cpu::activeIsa(), 0, h, 16, [&](int range0, int range1) {
         const SureBoxH g = f;
-        for (int y = range.begin(); y < range.end(); ++y) {
+        for (int y = range0; y < range1; ++y) {
             const size_t o = size_t(y) * w;
             const float* ATROUS_RESTRICT d = g.in.channel(0) + o;
             const float* ATROUS_RESTRICT v = g.in.channel(1) + o;
@@ -92,11 +91,11 @@ void chooseRows(const SureChoose& f, int y0, int y1) {
 
 void runSureChoose(const CpuExec&, const SureChoose& f) {
     const int h = f.boxH.height;
-    tbb::parallel_for(tbb::blocked_range<int>(0, h, 16), [&](const tbb::blocked_range<int>& range) {
+    cpu::parallelForIsa(cpu::activeIsa(), 0, h, 16, [&](int range0, int range1) {
         if (f.p.jamesStein)
-            chooseRows<1>(f, range.begin(), range.end());
+            chooseRows<1>(f, range0, range1);
         else
-            chooseRows<0>(f, range.begin(), range.end());
+            chooseRows<0>(f, range0, range1);
     });
 }
 
