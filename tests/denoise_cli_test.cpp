@@ -201,7 +201,7 @@ TEST(DenoiseCli, ErrorsNameTheFlag) {
     SyntheticScene s = makeScene(16, 16, 0.3f, 26);
     writeScene(s, in);
     const std::string o = " --out " + (out / "d.exr");
-    expectBadInput("denoise --in " + in.str() + " --device gpu" + o, "--device: unknown device 'gpu'", out);
+    expectBadInput("denoise --in " + in.str() + " --device gpu" + o, "--device: must be cpu, cuda or auto (got 'gpu')", out);
     expectBadInput("denoise --in " + in.str() + " --levels 11" + o, "--levels: must be in 1..10 (got 11)", out);
     expectBadInput("denoise --in " + in.str() + " --sure-window 12" + o, "--sure-window: must be in 1..10 (got 12)", out);
     expectBadInput("denoise --in " + in.str() + " --method foo" + o, "--method: unknown denoise method 'foo'", out);

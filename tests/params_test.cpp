@@ -56,6 +56,7 @@ TEST(ParamTables, EveryStructFieldHasARow) {
     EXPECT_EQ(rowsOf(d, "") + 7, fieldCount<DenoiseOptions>());
     EXPECT_EQ(d.count, rowsOf(d, "eaw") + rowsOf(d, "sure") + rowsOf(d, "firefly") + rowsOf(d, "safety") + rowsOf(d, ""));
     EXPECT_EQ(svgfParams().count, fieldCount<SvgfParams>());
+    EXPECT_EQ(renderParams().count + 1, fieldCount<RenderSettings>());  // samplesDone is no parameter
 }
 
 template <class S>
@@ -75,6 +76,7 @@ void expectDistinctRows(const ParamTable<S>& t) {
 TEST(ParamTables, RowsAreDistinctFields) {
     expectDistinctRows(denoiseParams());
     expectDistinctRows(svgfParams());
+    expectDistinctRows(renderParams());
 }
 
 // ---- values to try per row -------------------------------------------------------------------
@@ -92,6 +94,7 @@ std::string otherValidText(const ParamField<S>& f, const S& defaults) {
                 **i = *std::get<int*>(f.at(const_cast<S&>(defaults)));
             }
     }
+    if (uint32_t* const* u = std::get_if<uint32_t*>(&r)) return std::to_string(**u + 1);
     if (float* const* x = std::get_if<float*>(&r))
         for (double v : {double(**x) * 2, double(**x) * 0.5, 0.75, 0.5, f.range.lo, f.range.hi})
             if (float(v) != **x && f.range.allows(v, true)) return formatParamNumber(v);
@@ -102,6 +105,7 @@ std::string otherValidText(const ParamField<S>& f, const S& defaults) {
 // A value outside the row's range, or "" when every value of its type is allowed.
 template <class S>
 std::string outOfRangeText(const ParamField<S>& f) {
+    if (f.kind() == ParamKind::UInt) return "";  // 0..2^32-1: CLI11 refuses the rest itself
     const bool isFloat = f.kind() != ParamKind::Int;
     for (double v : {f.range.lo - 1, f.range.hi + 1, f.range.lo * 0.5, -1.0, 1e30})
         if (std::isfinite(v) && !f.range.allows(v, isFloat))
@@ -113,6 +117,7 @@ template <class S>
 void setFromNumber(S& s, const ParamField<S>& f, const std::string& v) {
     const ParamRef r = f.at(s);
     if (int* const* i = std::get_if<int*>(&r)) **i = std::stoi(v);
+    if (uint32_t* const* u = std::get_if<uint32_t*>(&r)) **u = uint32_t(std::stoul(v));
     if (float* const* x = std::get_if<float*>(&r)) **x = std::stof(v);
 }
 
@@ -131,6 +136,7 @@ template <class S>
 void cliRoundTrip(const ParamTable<S>& t) {
     const S defaults{};
     for (const ParamField<S>& f : t) {
+        if (t.flag(f).empty()) continue;  // no CLI flag (RenderSettings::firstSample)
         S got{};
         CLI::App app;
         cli::addParamOptions(app, got, t, [](const ParamField<S>&) { return "params"; });
@@ -167,6 +173,7 @@ void cliRoundTrip(const ParamTable<S>& t) {
 TEST(ParamTables, EveryRowHasACliFlagThatSetsItsField) {
     cliRoundTrip(denoiseParams());
     cliRoundTrip(svgfParams());
+    cliRoundTrip(renderParams());
 }
 
 TEST(ParamTables, NegatedSwitchesKeepTheirFlags) {
@@ -182,7 +189,7 @@ TEST(ParamTables, NegatedSwitchesKeepTheirFlags) {
 // Out of range: the library's error names the field (ParamError::field, and in the message);
 // the CLI's names the flag and what was typed.
 template <class S>
-void outOfRange(const ParamTable<S>& t, void (*validate)(const S&)) {
+void outOfRange(const ParamTable<S>& t, void (*validate)(const S&), int minTried = 10) {
     int tried = 0;
     for (const ParamField<S>& f : t) {
         const ParamKind k = f.kind();
@@ -211,12 +218,57 @@ void outOfRange(const ParamTable<S>& t, void (*validate)(const S&)) {
             EXPECT_NE(std::string(e.what()).find("(got " + bad + ")"), std::string::npos) << e.what();
         }
     }
-    EXPECT_GE(tried, 10);
+    EXPECT_GE(tried, minTried);
 }
 
 TEST(ParamTables, OutOfRangeValuesNameTheFieldOrTheFlag) {
     outOfRange(denoiseParams(), &validateDenoiseOptions);
     outOfRange(svgfParams(), &validateSvgfParams);
+    outOfRange(renderParams(), &validateRenderSettings, 5);  // width, height, spp, max_depth, threads
+}
+
+// Library errors outside a command's own tables (the render settings, the device) reach main.cpp
+// as ParamError; cli::flagMessage names the flag from the field, never from the message.
+TEST(ParamTables, LibraryErrorsMapToFlagsByField) {
+    RenderSettings s;
+    s.maxDepth = -1;
+    try {
+        validateRenderSettings(s);
+        ADD_FAILURE();
+    } catch (const ParamError& e) {
+        EXPECT_EQ(e.set(), "render");
+        EXPECT_EQ(e.field(), "max_depth");
+        EXPECT_STREQ(e.what(), "parameter max_depth must be in 0..1024 (got -1)");
+        EXPECT_EQ(cli::flagMessage(e), "--max-depth: must be in 0..1024 (got -1)");
+    }
+    s = RenderSettings{};
+    s.spp = 0;
+    try {
+        validateRenderSettings(s);
+        ADD_FAILURE();
+    } catch (const ParamError& e) {
+        EXPECT_EQ(cli::flagMessage(e), "--spp: must be at least 1 (got 0)");
+    }
+    try {
+        (void)parseDevice("gpu");
+        ADD_FAILURE();
+    } catch (const ParamError& e) {
+        EXPECT_EQ(e.set(), "device");
+        EXPECT_EQ(e.field(), "device");
+        EXPECT_EQ(cli::flagMessage(e), "--device: must be cpu, cuda or auto (got 'gpu')");
+    }
+    if (!cudaAvailable()) {
+        try {
+            (void)parseDevice("cuda");
+            ADD_FAILURE();
+        } catch (const ParamError& e) {
+            EXPECT_EQ(e.field(), "device");
+            EXPECT_EQ(cli::flagMessage(e).rfind("--device: cannot be cuda: ", 0), 0u) << cli::flagMessage(e);
+        }
+    }
+    // A field without a flag keeps the library's message.
+    const ParamError noFlag("render", "first_sample", "must be in 0..1");
+    EXPECT_STREQ(cli::flagMessage(noFlag).c_str(), noFlag.what());
 }
 
 TEST(ParamTables, CrossFieldRulesAndTextValues) {

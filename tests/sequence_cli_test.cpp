@@ -43,6 +43,42 @@ TEST(SequenceCli, SvgfEawAndSureDenoiseEveryFrame) {
     }
 }
 
+bool sameImages(const atrous::Image& a, const atrous::Image& b) {
+    return a.width() == b.width() && a.height() == b.height() && a.channels() == b.channels() &&
+           std::equal(a.data(), a.data() + a.size(), b.data());
+}
+
+// Per-frame EAW/SURE of a sequence uses every buffer of each frame, emission included, through the
+// same input assembly as `denoise --in FRAME_DIR` (io::BufferRefs). Same buffers, deterministic
+// CPU filters: equal bit for bit. A frame without its emission.exr denoises differently, so the
+// equality shows the emission was read.
+TEST(SequenceCli, PerFrameMethodsEqualDenoiseOfEachFrame) {
+    TempDir dir;
+    const std::string seq = renderSequence(dir);
+    for (const char* method : {"eaw", "sure"}) {
+        const std::string out = dir / (std::string("seq_") + method);
+        auto r = runCli(std::string("denoise --method ") + method + " --device cpu --sequence " + seq + " --out " + out);
+        ASSERT_EQ(r.exitCode, 0) << r.output;
+        for (int f = 0; f < 3; ++f) {
+            const std::string frame = seq + "/frame_000" + std::to_string(f);
+            ASSERT_TRUE(fs::exists(frame + "/emission.exr")) << frame;
+            const std::string one = dir / "one.exr";
+            r = runCli(std::string("denoise --method ") + method + " --device cpu --in " + frame + " --out " + one);
+            ASSERT_EQ(r.exitCode, 0) << r.output;
+            const atrous::Image fromSequence = atrous::io::readImage(out + "/frame_000" + std::to_string(f) + ".exr");
+            EXPECT_TRUE(sameImages(fromSequence, atrous::io::readImage(one))) << method << " frame " << f;
+            const std::string bare = dir / "bare";
+            fs::remove_all(bare);
+            fs::create_directories(bare);
+            for (const auto& e : fs::directory_iterator(frame))
+                if (e.path().filename() != "emission.exr") fs::copy_file(e.path(), fs::path(bare) / e.path().filename());
+            r = runCli(std::string("denoise --method ") + method + " --device cpu --in " + bare + " --out " + one);
+            ASSERT_EQ(r.exitCode, 0) << r.output;
+            EXPECT_FALSE(sameImages(fromSequence, atrous::io::readImage(one))) << method << " frame " << f;
+        }
+    }
+}
+
 TEST(SequenceCli, BadSequencesExitTwoAndWriteNothing) {
     TempDir dir;
     const std::string seq = renderSequence(dir);

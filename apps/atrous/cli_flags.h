@@ -1,7 +1,7 @@
-// The library's InputErrors name the value ("unknown device 'gpu'") or the parameter (ParamError:
-// the field "sigma_normal"), since Python shares them; the CLI puts the flag in front so the user
-// knows which one to fix: withFlag for a value it parsed, the parameter tables (params.h) for a
-// field. Library messages that already start with a flag ("--device cuda: ...") stay as they are.
+// The library's InputErrors name the value ("unknown denoise method 'x'") or the parameter
+// (ParamError: the field "sigma_normal", "max_depth", "device"), since Python shares them; the CLI
+// puts the flag in front so the user knows which one to fix: withFlag for a value it parsed, the
+// parameter tables (params.h) for a field. No message is read to find its flag.
 #pragma once
 #include <CLI/CLI.hpp>
 
@@ -13,11 +13,9 @@
 
 namespace atrous::cli {
 
-// "flag: message", unless the message already names a flag.
+// "flag: message".
 [[noreturn]] inline void rethrowWithFlag(const std::string& flag, const InputError& e) {
-    const std::string msg = e.what();
-    if (msg.rfind("--", 0) == 0) throw e;
-    throw InputError(flag + ": " + msg);
+    throw InputError(flag + ": " + e.what());
 }
 
 template <class F>
@@ -29,9 +27,10 @@ auto withFlag(const std::string& flag, F&& f) -> decltype(f()) {
     }
 }
 
-inline Device parseDeviceFlag(const std::string& name) {
-    return withFlag("--device", [&] { return parseDevice(name); });
-}
+// CLI11 reads an empty value ("--max-depth ''") as 0 without a word (found by tests/fuzz).
+inline const CLI::Validator kNonEmptyNumber(
+    [](std::string& v) { return v.empty() ? std::string("an empty value is not a number") : std::string(); }, "",
+    "non-empty");
 
 // What the user typed for `flag` on `cmd`, or "" when it was not given.
 inline std::string givenValue(const CLI::App& cmd, const std::string& flag) {
@@ -52,6 +51,27 @@ template <class S>
     throw InputError(flag + ": " + e.rule() + (got.empty() ? "" : " (got " + got + ")"));
 }
 
+// The flag of a library ParamError's field: the denoise, SVGF and render tables' rows, --device for
+// parseDevice's; "" when the field has none (RenderSettings::firstSample).
+inline std::string flagOf(const ParamError& e) {
+    auto in = [&](const auto& t) -> std::string {
+        const auto* f = t.find(e.field());
+        return f ? t.flag(*f) : std::string();
+    };
+    if (e.set() == "device") return "--device";
+    if (e.set() == "render") return in(renderParams());
+    if (e.set() == "svgf") return in(svgfParams());
+    if (e.set() == "denoise") return in(denoiseParams());
+    return "";
+}
+
+// "--max-depth: must be in 0..1024 (got -1)" (the library's message when the field has no flag).
+inline std::string flagMessage(const ParamError& e) {
+    const std::string flag = flagOf(e);
+    if (flag.empty()) return e.what();
+    return flag + ": " + e.rule() + (e.got().empty() ? "" : " (got " + e.got() + ")");
+}
+
 // validateParams with the flags' names in the message.
 template <class S>
 void checkParamFlags(const S& s, const ParamTable<S>& t, const CLI::App& cmd) {
@@ -62,14 +82,17 @@ void checkParamFlags(const S& s, const ParamTable<S>& t, const CLI::App& cmd) {
     }
 }
 
-// One flag per row of the table, writing into `s` (which must outlive the parse), in the help
-// group group(field); the defaults shown are the struct's. A negated Bool is a --no-<name> switch,
-// a Choice or FloatList takes its text (setParamFromText). Ranges are checked after the parse
-// (checkParamFlags), when every flag is known.
+// One flag per row of the table (rows without a flag, and those `keep` refuses, left out),
+// writing into `s` (which must outlive the parse), in the help group group(field); the defaults
+// shown are the struct's. A negated Bool is a --no-<name> switch, a Choice or FloatList takes its
+// text (setParamFromText). Ranges are checked after the parse (checkParamFlags), when every flag is
+// known.
 template <class S, class GroupOf>
-void addParamOptions(CLI::App& cmd, S& s, const ParamTable<S>& t, GroupOf&& group) {
+void addParamOptions(CLI::App& cmd, S& s, const ParamTable<S>& t, GroupOf&& group,
+                     bool (*keep)(const ParamField<S>&) = nullptr) {
     for (const ParamField<S>& f : t) {
         const std::string flag = t.flag(f);
+        if (flag.empty() || (keep && !keep(f))) continue;
         const ParamRef r = f.at(s);
         CLI::Option* opt = nullptr;
         if (bool* const* b = std::get_if<bool*>(&r)) {
@@ -77,9 +100,11 @@ void addParamOptions(CLI::App& cmd, S& s, const ParamTable<S>& t, GroupOf&& grou
             opt = f.negated ? cmd.add_flag_callback(flag, [p] { *p = false; }, std::string("turn off: ") + f.doc)
                             : cmd.add_flag(flag, *p, f.doc);
         } else if (int* const* i = std::get_if<int*>(&r)) {
-            opt = cmd.add_option(flag, **i, f.doc)->capture_default_str();
+            opt = cmd.add_option(flag, **i, f.doc)->check(kNonEmptyNumber)->capture_default_str();
+        } else if (uint32_t* const* u = std::get_if<uint32_t*>(&r)) {
+            opt = cmd.add_option(flag, **u, f.doc)->check(kNonEmptyNumber)->capture_default_str();
         } else if (float* const* x = std::get_if<float*>(&r)) {
-            opt = cmd.add_option(flag, **x, f.doc)->capture_default_str();
+            opt = cmd.add_option(flag, **x, f.doc)->check(kNonEmptyNumber)->capture_default_str();
         } else {
             const ParamField<S>* field = &f;
             const ParamTable<S>* table = &t;

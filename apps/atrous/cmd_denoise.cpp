@@ -113,7 +113,7 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     o.method = a.method == "svgf" ? DenoiseMethod::Sure : parseDenoiseMethod(a.method);
     checkParamFlags(o, denoiseParams(), cmd);
     if (a.method == "svgf") checkParamFlags(a.svgf, svgfParams(), cmd);
-    o.device = parseDeviceFlag(a.device);
+    o.device = parseDevice(a.device);
     noteIgnoredFlags(cmd, a.method, sequence);
     if (sequence) {
         if (!a.inDir.empty() || !a.color.empty())

@@ -10,6 +10,7 @@
 
 #include "atrous/denoise.h"
 #include "atrous/error.h"
+#include "atrous/params.h"
 #include "atrous/render.h"
 #include "cli_flags.h"
 #include "commands.h"
@@ -21,10 +22,6 @@
 
 namespace atrous::cli {
 namespace {
-
-// CLI11 reads an empty value ("--max-depth ''") as 0 without a word (found by tests/fuzz).
-const CLI::Validator kNonEmptyNumber(
-    [](std::string& v) { return v.empty() ? std::string("an empty value is not a number") : std::string(); }, "", "non-empty");
 
 struct RenderArgs {
     std::string scene;
@@ -149,7 +146,7 @@ std::vector<DenoiseMethod> parseMethods(const std::string& list) {
 
 void run(const RenderArgs& a) {
     // InputError for cuda without a GPU or CUDA build. Animations render on the CPU (auto picks it).
-    const Device device = parseDeviceFlag(a.framesGiven && a.device == "auto" ? "cpu" : a.device);
+    const Device device = parseDevice(a.framesGiven && a.device == "auto" ? "cpu" : a.device);
     if (a.framesGiven) {
         if (device == Device::Cuda) throw InputError("--frames: animation renders on the CPU only so far (use --device cpu)");
         return runFrames(a);
@@ -219,12 +216,10 @@ void addRenderCommand(CLI::App& app) {
                     "Output directory (created if missing). With --frames, OUT/frame_NNNN/ is replaced whole, and "
                     "frame_NNNN/ directories of an earlier run with NNNN >= --frames are removed (one note on stderr)")
         ->required();
-    cmd->add_option("--width", args->settings.width, "Image width in pixels")->check(kNonEmptyNumber)->capture_default_str();
-    cmd->add_option("--height", args->settings.height, "Image height in pixels")->check(kNonEmptyNumber)->capture_default_str();
-    cmd->add_option("--spp", args->settings.spp, "Samples per pixel")->check(kNonEmptyNumber)->capture_default_str();
-    cmd->add_option("--seed", args->settings.seed, "Random seed (same seed, same image)")->check(kNonEmptyNumber)->capture_default_str();
-    cmd->add_option("--max-depth", args->settings.maxDepth, "Maximum bounces (1 = direct light only)")->check(kNonEmptyNumber)->capture_default_str();
-    cmd->add_option("--threads", args->settings.threads, "Worker threads (0 = all cores)")->check(kNonEmptyNumber)->capture_default_str();
+    // --width, --height, --spp, --seed, --max-depth, --threads, --no-light-sampling: the render
+    // parameter table (atrous/params.h); out-of-range values are the library's ParamError, which
+    // main.cpp shows with the row's flag.
+    addParamOptions(*cmd, args->settings, renderParams(), [](const ParamField<RenderSettings>&) { return "Render settings"; });
     cmd->add_option("--device", args->device, "cpu, cuda or auto (cuda when a GPU is present; the GPU path tracer runs over a BVH built by Embree)")
         ->capture_default_str();
     cmd->add_option("--denoise", args->denoise, "Also denoise with these methods (comma list: eaw,sure)");

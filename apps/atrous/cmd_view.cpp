@@ -5,6 +5,8 @@
 #include "atrous/error.h"
 #include "commands.h"
 #if defined(ATROUS_HAVE_VIEWER)
+#include "atrous/params.h"
+#include "cli_flags.h"
 #include "view/viewer.h"
 #endif
 
@@ -20,12 +22,14 @@ void addViewCommand(CLI::App& app) {
     cmd->add_option("--scene", o.scene, "Built-in scene name or JSON scene file")
         ->capture_default_str();
     cmd->add_option("--device", o.device, "cpu | cuda | auto")->capture_default_str();
-    cmd->add_option("--width", o.width, "Image width in pixels")->capture_default_str();
-    cmd->add_option("--height", o.height, "Image height in pixels")->capture_default_str();
-    cmd->add_option("--spp", o.spp, "Samples per pixel per frame")->capture_default_str();
-    cmd->add_option("--max-depth", o.maxDepth, "Path bounces")->capture_default_str();
-    cmd->add_option("--seed", o.seed, "Render seed (frame k takes sample indices k*spp.. of each pixel, so frames add fresh samples)")
-        ->capture_default_str();
+    // --width, --height, --spp (per frame), --max-depth, --seed from the render parameter table
+    // (frame k takes sample indices k*spp.. of each pixel, so frames add fresh samples); the
+    // viewer's renderer uses all its threads and light sampling.
+    addParamOptions(*cmd, o.render, renderParams(), [](const ParamField<RenderSettings>&) { return "Render settings"; },
+                    +[](const ParamField<RenderSettings>& f) {
+                        const std::string n = f.name;
+                        return n != "threads" && n != "light_sampling";
+                    });
     cmd->add_option("--method", o.method, "Denoiser of the main view: none | eaw | sure | svgf")
         ->capture_default_str();
     cmd->add_option("--compare", o.compare, "Split screen: the method shown on the right half");

@@ -14,6 +14,7 @@
 #include "atrous/error.h"
 #include "cli_flags.h"
 #include "core/timer.h"
+#include "io/buffer_set.h"
 #include "io/image_io.h"
 #include "io/sequence.h"
 #include "sequence_checks.h"
@@ -206,7 +207,6 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
     StagedOutput staged(args.outDir);
     const std::string stage = staged.stage();
 
-    auto img = [](const Image& i) { return i.empty() ? nullptr : &i; };
     int firstIndex = -1;
     bool idsTrusted = true, warnedSign = false, notedMotion = false;
     io::SequenceFrame prev;
@@ -238,28 +238,13 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
         }
         Timer timer;
         Image out;
-        if (svgf) {
-            SvgfFrame in;
-            in.color = &f.color;
-            in.albedo = img(f.albedo);
-            in.normal = img(f.normal);
-            in.depth = img(f.depth);
-            in.ids = idsTrusted ? img(f.ids) : nullptr;
-            in.motion = img(f.motion);
-            in.emission = img(f.emission);
-            out = svgfDenoiser->denoiseFrame(in);
-        } else {
-            DenoiseInputs in;
-            in.color = &f.color;
-            in.variance = img(f.variance);
-            in.albedo = img(f.albedo);
-            in.normal = img(f.normal);
-            in.position = img(f.position);
-            in.depth = img(f.depth);
-            in.ids = idsTrusted ? img(f.ids) : nullptr;
-            in.emission = img(f.emission);
-            out = denoise(in, options);
-        }
+        // Every buffer the frame has (emission included), through the one input assembly.
+        io::BufferRefs refs = io::refsOf(f);
+        if (!idsTrusted) refs.set(io::Buffer::ObjectId, nullptr);
+        if (svgf)
+            out = svgfDenoiser->denoiseFrame(io::svgfFrame(refs));
+        else
+            out = denoise(io::denoiseInputs(refs), options);
         double ms = timer.ms();
         io::writeImage((fs::path(stage) / (name + ".exr")).string(), out);
         io::writePng((fs::path(stage) / (name + ".png")).string(), out, args.exposure);

@@ -6,6 +6,8 @@
 #include <string>
 
 #include "atrous/error.h"
+#include "atrous/params.h"
+#include "cli_flags.h"
 #include "commands.h"
 
 namespace {
@@ -42,12 +44,13 @@ int main(int argc, char** argv) {
         // Bad flags are bad input: one line, exit code 2.
         std::fprintf(stderr, "atrous: error: %s (see --help)\n", oneLine(e.what()).c_str());
         return 2;
+    } catch (const atrous::ParamError& e) {
+        // A library setting out of range (--device, --width, ...): the error names the field and
+        // the parameter tables its flag (cli_flags.h); the message is not read.
+        std::fprintf(stderr, "atrous: error: %s\n", oneLine(atrous::cli::flagMessage(e)).c_str());
+        return 2;
     } catch (const atrous::InputError& e) {
-        // parseDevice's message names the value only; every subcommand feeds it from --device
-        // (render and denoise add the flag themselves: apps/atrous/cli_flags.h).
-        const std::string msg = oneLine(e.what());
-        const char* flag = msg.rfind("unknown device '", 0) == 0 ? "--device: " : "";
-        std::fprintf(stderr, "atrous: error: %s%s\n", flag, msg.c_str());
+        std::fprintf(stderr, "atrous: error: %s\n", oneLine(e.what()).c_str());
         return 2;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "atrous: error: %s\n", oneLine(e.what()).c_str());

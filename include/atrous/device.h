@@ -12,8 +12,9 @@ bool cudaAvailable();
 bool cudaCompiled();
 // "cpu" / "cuda".
 const char* deviceToString(Device d);
-// Parses "cpu", "cuda" or "auto" (auto: cuda when available, else cpu). Throws InputError on any
-// other word, or when "cuda" is asked for and cudaAvailable() is false.
+// Parses "cpu", "cuda" or "auto" (auto: cuda when available, else cpu). Throws ParamError
+// (atrous/params.h, field "device") on any other word, or when "cuda" is asked for and
+// cudaAvailable() is false.
 Device parseDevice(const std::string& name);
 // Human-readable name of the hardware behind `d`: the CPU model with its thread count, or the
 // GPU's name. Used in benchmark JSON.

@@ -8,9 +8,12 @@
 //   denoiseParams(): DenoiseOptions' scalars with its EawParams, SureParams, FireflyParams and
 //                    SafetyNetParams (each row says which in `group`); CLI flag --<name>
 //   svgfParams():    SvgfParams; CLI flag --svgf-<name> (a few keep older spellings, `flag`)
+//   renderParams():  RenderSettings (but its progress counter); CLI flag --<name> of `atrous render`
+//                    and `atrous view`
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <iterator>
@@ -21,6 +24,8 @@
 
 #include "atrous/denoise.h"
 #include "atrous/error.h"
+#include "atrous/image.h"
+#include "atrous/render.h"
 #include "atrous/svgf.h"
 
 namespace atrous {
@@ -33,18 +38,19 @@ public:
     ParamError(const std::string& set, const std::string& field, const std::string& rule, const std::string& got = "")
         : InputError(std::string(set == "svgf" ? "SVGF parameter " : "parameter ") + field + " " + rule +
                      (got.empty() ? "" : " (got " + got + ")")),
-          mSet(set), mField(field), mRule(rule) {}
-    const std::string& set() const { return mSet; }      // the table: "denoise" or "svgf"
+          mSet(set), mField(field), mRule(rule), mGot(got) {}
+    const std::string& set() const { return mSet; }      // the table: "denoise", "svgf", "render" or "device"
     const std::string& field() const { return mField; }  // the row's name, e.g. "sigma_normal"
     const std::string& rule() const { return mRule; }    // e.g. "must be in 1..10"
+    const std::string& got() const { return mGot; }      // the value as given ("" when not shown)
 
 private:
-    std::string mSet, mField, mRule;
+    std::string mSet, mField, mRule, mGot;
 };
 
 // Where a field lives; its alternative is the field's kind.
-using ParamRef = std::variant<int*, float*, bool*, SureMode*, std::vector<float>*>;
-enum class ParamKind { Int, Float, Bool, Choice, FloatList };  // ParamRef's alternatives, in order
+using ParamRef = std::variant<int*, float*, bool*, SureMode*, std::vector<float>*, uint32_t*>;
+enum class ParamKind { Int, Float, Bool, Choice, FloatList, UInt };  // ParamRef's alternatives, in order
 
 // The values a number may take (a FloatList's elements, for a list): finite, in [lo, hi] or
 // (lo, hi]; `zero` also allows 0 and says what it means ("off", "automatic").
@@ -78,7 +84,7 @@ struct ParamField {
     ParamRange range;    // Int, Float and FloatList elements; unused for Bool and Choice
     const char* doc;     // one line: the CLI's help, Python's and the viewer's tooltip
     const char* group = "";         // the nested struct ("eaw", "sure", ...), "" for S's own fields
-    const char* flag = nullptr;     // the CLI flag without "--" when it is not the table's rule
+    const char* flag = nullptr;     // the CLI flag without "--" when it is not the table's rule; "" = none
     bool negated = false;           // Bool: the CLI flag (--no-<name>) clears it; Python accepts no_<name> too
     const char* const* choices = nullptr;      // Choice: the names of the enum's values, in order, null-ended
     std::string (*check)(const S&) = nullptr;  // a rule that involves other fields: "" or what is wrong
@@ -90,7 +96,7 @@ struct ParamField {
 
 template <class S>
 struct ParamTable {
-    const char* set;         // "denoise" | "svgf" (ParamError::set)
+    const char* set;         // "denoise" | "svgf" | "render" (ParamError::set)
     const char* flagPrefix;  // CLI flag = "--" + flagPrefix + name with '-' for '_'
     const ParamField<S>* first;
     size_t count;
@@ -101,7 +107,7 @@ struct ParamTable {
             if (name == f.name) return &f;
         return nullptr;
     }
-    std::string flag(const ParamField<S>& f) const;  // "--sigma-normal", "--no-firefly", "--svgf-alpha"
+    std::string flag(const ParamField<S>& f) const;  // "--sigma-normal", "--no-firefly", "--svgf-alpha"; "" = none
 };
 
 namespace params_detail {
@@ -125,6 +131,7 @@ std::string checkCandidates(const DenoiseOptions& o);
 
 using D = DenoiseOptions;
 using P = SvgfParams;
+using R = RenderSettings;
 // clang-format off
 inline const ParamField<D> kDenoise[] = {
     {"levels", &at2<&D::eaw, &EawParams::levels>, paramIn(1, 10), "a-trous levels (5 reach +-62 pixels)", "eaw"},
@@ -200,6 +207,21 @@ inline const ParamField<P> kSvgf[] = {
     {"emission_motion_alpha", &at<&P::emissionMotionAlpha>, paramAtLeast(0),
      "emission blend factor at least this times the motion across a light's edge, pixels per frame (0 = off)"},
 };
+
+// threads: a ceiling, since tbb::task_arena aborts in its destructor from 65537 threads on
+// (docs/reliability.md).
+inline const ParamField<R> kRender[] = {
+    {"width", &at<&R::width>, paramIn(1, kMaxImageDim), "image width in pixels"},
+    {"height", &at<&R::height>, paramIn(1, kMaxImageDim), "image height in pixels"},
+    {"spp", &at<&R::spp>, paramAtLeast(1), "samples per pixel"},
+    {"seed", &at<&R::seed>, paramIn(0, 4294967295.0), "random seed (same seed, same image, whatever the thread count)"},
+    {"first_sample", &at<&R::firstSample>, paramIn(0, 4294967295.0),
+     "global index of the first sample (progressive accumulation: frame * spp)", "", ""},
+    {"max_depth", &at<&R::maxDepth>, paramIn(0, 1024), "maximum bounces (0 = emitted light only, 1 = direct light)"},
+    {"threads", &at<&R::threads>, paramIn(0, 4096), "worker threads (0 = all cores)"},
+    {"light_sampling", &at<&R::lightSampling>, {},
+     "next-event estimation with multiple importance sampling (else BSDF sampling only)", "", nullptr, true},
+};
 // clang-format on
 }  // namespace params_detail
 
@@ -209,6 +231,10 @@ inline const ParamTable<DenoiseOptions>& denoiseParams() {
 }
 inline const ParamTable<SvgfParams>& svgfParams() {
     static const ParamTable<SvgfParams> t{"svgf", "svgf-", params_detail::kSvgf, std::size(params_detail::kSvgf)};
+    return t;
+}
+inline const ParamTable<RenderSettings>& renderParams() {
+    static const ParamTable<RenderSettings> t{"render", "", params_detail::kRender, std::size(params_detail::kRender)};
     return t;
 }
 
@@ -236,17 +262,19 @@ inline std::string formatParamNumber(double v) {
 }
 
 inline std::string ParamRange::rule(bool isFloat) const {
-    const std::string l = formatParamNumber(lo), h = formatParamNumber(hi);
     const bool open = std::isinf(hi);
+    // Integer bounds in full (4294967295, not 4.2949673e9).
+    auto text = [&](double v) { return isFloat || std::isinf(v) ? formatParamNumber(v) : std::to_string((long long)v); };
+    const std::string l = text(lo), h = text(hi);
     if (zero) return std::string("must be 0 (") + zero + ") or " + (open ? ">= " + l : "in [" + l + ", " + h + "]");
-    if (!isFloat) return "must be in " + l + ".." + h;
+    if (!isFloat) return open ? "must be at least " + l : "must be in " + l + ".." + h;
     if (open) return "must be a finite number " + std::string(loOpen ? "> " : ">= ") + l;
     return "must be in " + std::string(loOpen ? "(" : "[") + l + ", " + h + "]";
 }
 
 template <class S>
 std::string ParamTable<S>::flag(const ParamField<S>& f) const {
-    if (f.flag) return std::string("--") + f.flag;
+    if (f.flag) return *f.flag ? std::string("--") + f.flag : std::string();
     std::string s = std::string("--") + flagPrefix + (f.negated ? "no-" : "") + f.name;
     for (char& c : s)
         if (c == '_') c = '-';
@@ -258,6 +286,7 @@ inline std::string paramText(const ParamRef& r, const char* const* choices = nul
     struct V {
         const char* const* choices;
         std::string operator()(int* p) const { return std::to_string(*p); }
+        std::string operator()(uint32_t* p) const { return std::to_string(*p); }
         std::string operator()(float* p) const { return formatParamNumber(*p); }
         std::string operator()(bool* p) const { return *p ? "true" : "false"; }
         std::string operator()(SureMode* p) const { return choices ? choices[int(*p)] : std::to_string(int(*p)); }
@@ -314,6 +343,8 @@ void validateParams(const S& s, const ParamTable<S>& t) {
         const ParamRef r = f.at(m);
         if (const int* const* i = std::get_if<int*>(&r); i && !f.range.allows(**i, false))
             throw ParamError(t.set, f.name, f.range.rule(false), std::to_string(**i));
+        if (const uint32_t* const* u = std::get_if<uint32_t*>(&r); u && !f.range.allows(**u, false))
+            throw ParamError(t.set, f.name, f.range.rule(false), std::to_string(**u));
         if (const float* const* x = std::get_if<float*>(&r); x && !f.range.allows(**x, true))
             throw ParamError(t.set, f.name, f.range.rule(true), formatParamNumber(**x));
         if (f.check)

@@ -17,6 +17,7 @@ namespace pt {
 struct SceneData;  // flat, GPU-friendly scene arrays (src/render/scene_data.h)
 }
 
+// Each field has a row in renderParams() (atrous/params.h): its name, range and doc line.
 struct RenderSettings {
     int width = 512;
     int height = 512;
@@ -67,20 +68,9 @@ enum class CameraPath { Auto, Static, Orbit, Dolly, Keyframes };
 // "auto", "static", "orbit", "dolly", "keyframes"; InputError naming --camera-path otherwise.
 CameraPath parseCameraPath(const std::string& name);
 
-// The denoiser's view of a render: every buffer it uses (variance, features, ids, emission).
-inline DenoiseInputs denoiseInputsOf(const RenderBuffers& b) {
-    auto opt = [](const Image& img) { return img.empty() ? nullptr : &img; };
-    DenoiseInputs in;
-    in.color = &b.color;
-    in.variance = opt(b.variance);
-    in.albedo = opt(b.albedo);
-    in.normal = opt(b.normal);
-    in.position = opt(b.position);
-    in.depth = opt(b.depth);
-    in.ids = opt(b.ids);
-    in.emission = opt(b.emission);
-    return in;
-}
+// The denoiser's view of a render: every buffer it uses (variance, features, ids, emission); the
+// library's one input assembly (src/io/buffer_set.h), which the CLI, viewer and Python share.
+DenoiseInputs denoiseInputsOf(const RenderBuffers& b);
 
 // Depth written for pixels that see no surface (a finite stand-in for +inf).
 constexpr float kBackgroundDepth = 1e30f;
@@ -125,8 +115,9 @@ private:
 
 const std::vector<std::string>& builtinSceneNames();
 
-// Throws InputError naming the flag (--spp, --width, ...) for settings out of range: spp <= 0,
-// width or height <= 0 or > kMaxImageDim, maxDepth outside 0..1024, threads < 0.
+// Throws ParamError (atrous/params.h: an InputError naming the field, `max_depth`) for settings
+// outside their ranges in renderParams(): spp <= 0, width or height <= 0 or > kMaxImageDim,
+// maxDepth outside 0..1024, threads outside 0..4096.
 void validateRenderSettings(const RenderSettings& settings);
 
 // Renders `scene` on the CPU (validates the settings first). motion stays empty; emission is filled.

@@ -46,6 +46,7 @@ __all__ = [
     "cuda_available",
     "denoise_params",
     "svgf_params",
+    "render_params",
     "METHODS",
 ]
 
@@ -75,6 +76,22 @@ def denoise_params() -> list:
 def svgf_params() -> list:
     """The keywords of :class:`Svgf`, in the form of :func:`denoise_params`."""
     return [dict(r) for r in _core.svgf_params()]
+
+
+def render_params() -> list:
+    """The keywords of :func:`render` and :func:`render_sequence` (the C++ RenderSettings), in the
+    form of :func:`denoise_params` (kind "uint" for the seed and the first sample index)."""
+    return [dict(r) for r in _core.render_params()]
+
+
+def _render_settings(settings: Dict[str, Any]) -> Dict[str, Any]:
+    # Integers must be integers (a float width is a mistake, not a request to truncate); the
+    # library checks the names and ranges (ValueError naming the keyword).
+    kinds = {r["name"]: r["kind"] for r in _core.render_params()}
+    for name, v in settings.items():
+        if kinds.get(name) in ("int", "uint") and (not isinstance(v, (int, np.integer)) or isinstance(v, bool)):
+            raise ValueError(f"{name} must be an integer, got {v!r}")
+    return {k: (int(v) if isinstance(v, np.integer) else v) for k, v in settings.items()}
 
 
 def cuda_available() -> bool:
@@ -223,44 +240,27 @@ def _denoise_numpy_on_gpu(c, bufs, method, params):  # pragma: no cover - needs 
     return cupy.asnumpy(cupy.from_dlpack(out))
 
 
-def render(
-    scene: str,
-    *,
-    width: int = 512,
-    height: int = 512,
-    spp: int = 16,
-    seed: int = 1,
-    max_depth: int = 8,
-    threads: int = 0,
-) -> Dict[str, np.ndarray]:
+def render(scene: str, **settings: Any) -> Dict[str, np.ndarray]:
     """Path-traces `scene` (a built-in name or a JSON scene file) on the CPU.
+
+    settings: the rows of :func:`render_params` (the CLI's ``atrous render`` flags with '_' for
+    '-'; defaults 512 x 512, 16 spp, seed 1, max_depth 8, all threads):
+
+{params}
 
     Returns a dict of H x W x 3 float32 arrays: color, variance (of the mean), albedo, normal,
     position, depth, ids, emission (docs/rendering.md). Same seed, same pixels, whatever the
     thread count.
     """
-    for name, v in (("width", width), ("height", height), ("spp", spp)):
-        if not isinstance(v, (int, np.integer)) or isinstance(v, bool):
-            raise ValueError(f"{name} must be an integer, got {v!r}")
-    return dict(_core.render(str(scene), int(width), int(height), int(spp), int(seed), int(max_depth),
-                             int(threads)))
+    return dict(_core.render(str(scene), _render_settings(settings)))
 
 
-def render_sequence(
-    scene: str,
-    frames: int,
-    *,
-    width: int = 512,
-    height: int = 512,
-    spp: int = 1,
-    seed: int = 1,
-    camera_path: str = "auto",
-    max_depth: int = 8,
-    threads: int = 0,
-) -> Iterator[Dict[str, Any]]:
+def render_sequence(scene: str, frames: int, *, camera_path: str = "auto", spp: int = 1,
+                    **settings: Any) -> Iterator[Dict[str, Any]]:
     """Renders the animation of `scene` frame by frame, as `atrous render --frames` does.
 
-    A generator: each item is the dict of :func:`render` plus ``motion`` (H x W x 3, R = dx,
+    settings: those of :func:`render` (spp defaults to 1 here). A generator: each item is the dict
+    of :func:`render` plus ``motion`` (H x W x 3, R = dx,
     G = dy in pixels, previous - current; frame 0 has none) and ``time`` (t in [0, 1]). Frame f is
     at t = f / (frames - 1), with seed ``seed + f`` (so its samples are fresh), exactly the frames
     the CLI writes. camera_path: "auto" (the scene's keyframes, else static), "static", "orbit",
@@ -271,14 +271,13 @@ def render_sequence(
             out = s.denoise_frame(b["color"], albedo=b["albedo"], normal=b["normal"], depth=b["depth"],
                                   ids=b["ids"], motion=b["motion"], emission=b["emission"])
     """
-    for name, v in (("frames", frames), ("width", width), ("height", height), ("spp", spp)):
-        if not isinstance(v, (int, np.integer)) or isinstance(v, bool):
-            raise ValueError(f"{name} must be an integer, got {v!r}")
+    if not isinstance(frames, (int, np.integer)) or isinstance(frames, bool):
+        raise ValueError(f"frames must be an integer, got {frames!r}")
     if int(frames) < 1:
         raise ValueError(f"frames must be at least 1, got {frames}")
+    rs = _render_settings(dict(settings, spp=spp))
     for f in range(int(frames)):
-        yield dict(_core.render_frame(str(scene), f, int(frames), str(camera_path), int(width), int(height),
-                                      int(spp), int(seed), int(max_depth), int(threads)))
+        yield dict(_core.render_frame(str(scene), f, int(frames), str(camera_path), rs))
 
 
 def metrics(image: Any, reference: Any) -> Dict[str, float]:
@@ -366,3 +365,5 @@ if denoise.__doc__:
     denoise.__doc__ = denoise.__doc__.replace("{params}", _list_params(denoise_params()))
 if Svgf.__doc__:
     Svgf.__doc__ = Svgf.__doc__.replace("{params}", _list_params(svgf_params()))
+if render.__doc__:
+    render.__doc__ = render.__doc__.replace("{params}", _list_params(render_params()))

@@ -8,6 +8,7 @@
 #include <nanobind/stl/vector.h>
 #include <nanobind/stl/unordered_map.h>
 
+#include <initializer_list>
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -21,6 +22,7 @@
 #include "atrous/params.h"
 #include "atrous/render.h"
 #include "atrous/svgf.h"
+#include "io/buffer_set.h"
 #include "io/image_io.h"
 
 namespace nb = nanobind;
@@ -75,21 +77,36 @@ nb::object fromImage(Image&& img) {
     return arr.cast();
 }
 
+// The arrays of one denoise call as images, put into the library's one input assembly
+// (io::BufferRefs -> denoiseInputs / svgfFrame), as the CLI and the viewer do.
 struct Buffers {
     std::vector<std::unique_ptr<Image>> owned;
-    // `anyChannels`: keep the array's own channel count (motion vectors have 2).
-    const Image* add(const nb::handle& obj, const char* what, const Image& color, bool anyChannels = false) {
-        if (obj.is_none()) return nullptr;
-        Array a = nb::cast<Array>(obj);
-        const int channels = anyChannels && a.ndim() == 3 ? int(a.shape(2)) : 3;
-        owned.push_back(std::make_unique<Image>(toImage(a, what, channels)));
+    const Image& color;
+    io::BufferRefs refs;
+    explicit Buffers(const Image& c) : color(c) { refs.set(io::Buffer::Color, &c); }
+    struct Arg {
+        nb::handle obj;
+        io::Buffer buffer;
+        const char* what;  // the keyword
+    };
+    Buffers& add(std::initializer_list<Arg> args) {
+        for (const Arg& a : args) add(a);
+        return *this;
+    }
+    void add(const Arg& arg) {
+        if (arg.obj.is_none()) return;
+        Array a = nb::cast<Array>(arg.obj);
+        // Motion vectors keep the array's own channel count (2).
+        const int channels = arg.buffer == io::Buffer::Motion && a.ndim() == 3 ? int(a.shape(2)) : 3;
+        owned.push_back(std::make_unique<Image>(toImage(a, arg.what, channels)));
         const Image& img = *owned.back();
         if (!img.view().sameSize(color.view()))
-            throw InputError(std::string(what) + ": size " + std::to_string(img.width()) + "x" + std::to_string(img.height()) +
-                             " differs from the color's " + std::to_string(color.width()) + "x" + std::to_string(color.height()));
+            throw InputError(std::string(arg.what) + ": size " + std::to_string(img.width()) + "x" +
+                             std::to_string(img.height()) + " differs from the color's " + std::to_string(color.width()) +
+                             "x" + std::to_string(color.height()));
         if (img.device() != color.device())
-            throw InputError(std::string(what) + ": lives on a different device than color");
-        return &img;
+            throw InputError(std::string(arg.what) + ": lives on a different device than color");
+        refs.set(arg.buffer, &img);
     }
 };
 
@@ -123,7 +140,11 @@ void applyParam(S& s, const ParamTable<S>& t, const std::string& k, const nb::ha
     if (!f) throw InputError("unknown " + std::string(what) + " parameter '" + k + "'");
     const ParamRef r = f->at(s);
     if (int* const* i = std::get_if<int*>(&r)) **i = as<int>(v, k);
-    else if (float* const* x = std::get_if<float*>(&r)) **x = as<float>(v, k);
+    else if (uint32_t* const* u = std::get_if<uint32_t*>(&r)) {
+        const long long x = as<long long>(v, k);  // range-checked here: a cast would wrap
+        if (x < 0 || x > 4294967295LL) throw ParamError(t.set, f->name, f->range.rule(false), std::to_string(x));
+        **u = uint32_t(x);
+    } else if (float* const* x = std::get_if<float*>(&r)) **x = as<float>(v, k);
     else if (bool* const* b = std::get_if<bool*>(&r)) **b = as<bool>(v, k) != negate;
     else if (std::get_if<SureMode*>(&r)) setParamFromText(s, t, *f, as<std::string>(v, k));
     else *std::get<std::vector<float>*>(r) = as<std::vector<float>>(v, k);
@@ -134,6 +155,7 @@ template <class S>
 nb::object paramValue(const ParamField<S>& f, S& s) {
     const ParamRef r = f.at(s);
     if (int* const* i = std::get_if<int*>(&r)) return nb::cast(**i);
+    if (uint32_t* const* u = std::get_if<uint32_t*>(&r)) return nb::cast(**u);
     if (float* const* x = std::get_if<float*>(&r)) return nb::cast(double(**x));
     if (bool* const* b = std::get_if<bool*>(&r)) return nb::cast(**b);
     if (std::get_if<SureMode*>(&r)) return nb::cast(paramText(r, f.choices));
@@ -153,7 +175,7 @@ nb::dict resolveParams(const ParamTable<S>& t, nb::dict params, const char* what
 // The table for Python (atrous.denoise_params(), atrous.svgf_params()): one dict per row.
 template <class S>
 nb::list paramRows(const ParamTable<S>& t) {
-    static const char* const kKinds[] = {"int", "float", "bool", "choice", "float_list"};
+    static const char* const kKinds[] = {"int", "float", "bool", "choice", "float_list", "uint"};
     S defaults{};
     nb::list rows;
     for (const ParamField<S>& f : t) {
@@ -161,12 +183,13 @@ nb::list paramRows(const ParamTable<S>& t) {
         d["name"] = f.name;
         d["kind"] = kKinds[int(f.kind())];
         d["default"] = paramValue(f, defaults);
-        const bool numeric = f.kind() == ParamKind::Int || f.kind() == ParamKind::Float || f.kind() == ParamKind::FloatList;
+        const bool numeric = f.kind() != ParamKind::Bool && f.kind() != ParamKind::Choice;
         d["min"] = numeric ? nb::cast(f.range.lo) : nb::none();
         d["max"] = numeric ? nb::cast(f.range.hi) : nb::none();
         d["min_open"] = numeric && f.range.loOpen;  // (min, max]
         d["zero"] = f.range.zero && numeric ? nb::cast(std::string(f.range.zero)) : nb::none();
-        d["rule"] = numeric ? nb::cast(f.range.rule(f.kind() != ParamKind::Int)) : nb::none();
+        const bool isFloat = f.kind() == ParamKind::Float || f.kind() == ParamKind::FloatList;
+        d["rule"] = numeric ? nb::cast(f.range.rule(isFloat)) : nb::none();
         nb::list choices;
         for (int i = 0; f.choices && f.choices[i]; ++i) choices.append(f.choices[i]);
         d["choices"] = choices;
@@ -182,17 +205,13 @@ nb::list paramRows(const ParamTable<S>& t) {
 nb::object pyDenoise(const Array& color, nb::handle albedo, nb::handle normal, nb::handle position, nb::handle depth,
                      nb::handle variance, nb::handle ids, nb::handle emission, const std::string& method,
                      nb::dict params) {
+    using B = io::Buffer;
     Image c = toImage(color, "color");
-    Buffers b;
-    DenoiseInputs in;
-    in.color = &c;
-    in.albedo = b.add(albedo, "albedo", c);
-    in.normal = b.add(normal, "normal", c);
-    in.position = b.add(position, "position", c);
-    in.depth = b.add(depth, "depth", c);
-    in.variance = b.add(variance, "variance", c);
-    in.ids = b.add(ids, "ids", c);
-    in.emission = b.add(emission, "emission", c);
+    Buffers b(c);
+    b.add({{albedo, B::Albedo, "albedo"}, {normal, B::Normal, "normal"}, {position, B::Position, "position"},
+           {depth, B::Depth, "depth"}, {variance, B::Variance, "variance"}, {ids, B::ObjectId, "ids"},
+           {emission, B::Emission, "emission"}});
+    const DenoiseInputs in = io::denoiseInputs(b.refs);
     DenoiseOptions o;
     o.method = parseDenoiseMethod(method);
     o.device = c.device();
@@ -215,16 +234,12 @@ public:
     }
     nb::object denoiseFrame(const Array& color, nb::handle albedo, nb::handle normal, nb::handle depth, nb::handle ids,
                             nb::handle motion, nb::handle emission) {
+        using B = io::Buffer;
         Image c = toImage(color, "color");
-        Buffers b;
-        SvgfFrame f;
-        f.color = &c;
-        f.albedo = b.add(albedo, "albedo", c);
-        f.normal = b.add(normal, "normal", c);
-        f.depth = b.add(depth, "depth", c);
-        f.ids = b.add(ids, "ids", c);
-        f.motion = b.add(motion, "motion", c, true);
-        f.emission = b.add(emission, "emission", c);
+        Buffers b(c);
+        b.add({{albedo, B::Albedo, "albedo"}, {normal, B::Normal, "normal"}, {depth, B::Depth, "depth"},
+               {ids, B::ObjectId, "ids"}, {motion, B::Motion, "motion"}, {emission, B::Emission, "emission"}});
+        const SvgfFrame f = io::svgfFrame(b.refs);
         Image out;
         {
             nb::gil_scoped_release release;
@@ -243,14 +258,10 @@ private:
     std::unique_ptr<SvgfDenoiser> mDenoiser;
 };
 
-RenderSettings renderSettings(int width, int height, int spp, uint32_t seed, int maxDepth, int threads) {
+// Python's keywords are the render table's rows (params.h); the library validates the ranges.
+RenderSettings renderSettings(nb::dict params) {
     RenderSettings rs;
-    rs.width = width;
-    rs.height = height;
-    rs.spp = spp;
-    rs.seed = seed;
-    rs.maxDepth = maxDepth;
-    rs.threads = threads;
+    for (auto [k, v] : params) applyParam(rs, renderParams(), nb::cast<std::string>(k), v, "render");
     return rs;
 }
 
@@ -269,9 +280,10 @@ nb::dict buffersDict(RenderBuffers&& b) {
     return d;
 }
 
-nb::dict pyRender(const std::string& scene, int width, int height, int spp, uint32_t seed, int maxDepth, int threads) {
+nb::dict pyRender(const std::string& scene, nb::dict params) {
+    const RenderSettings rs = renderSettings(params);
+    validateRenderSettings(rs);
     Scene s = Scene::loadByNameOrFile(scene);
-    const RenderSettings rs = renderSettings(width, height, spp, seed, maxDepth, threads);
     RenderBuffers b;
     {
         nb::gil_scoped_release release;
@@ -282,14 +294,15 @@ nb::dict pyRender(const std::string& scene, int width, int height, int spp, uint
 
 // Frame `frame` of `frames` of an animated scene (atrous.render_sequence): the CLI's `render
 // --frames` rule for times (frameTime) and seeds (seed + frame), motion against the previous frame.
-nb::dict pyRenderFrame(const std::string& scene, int frame, int frames, const std::string& cameraPath, int width,
-                       int height, int spp, uint32_t seed, int maxDepth, int threads) {
+nb::dict pyRenderFrame(const std::string& scene, int frame, int frames, const std::string& cameraPath, nb::dict params) {
     if (frames < 1) throw InputError("frames: must be at least 1 (got " + std::to_string(frames) + ")");
     if (frame < 0 || frame >= frames)
         throw InputError("frame " + std::to_string(frame) + " is outside 0.." + std::to_string(frames - 1));
     Scene s = Scene::loadByNameOrFile(scene);
     const CameraPath path = parseCameraPath(cameraPath);
-    const RenderSettings rs = renderSettings(width, height, spp, seed + uint32_t(frame), maxDepth, threads);
+    RenderSettings rs = renderSettings(params);
+    validateRenderSettings(rs);
+    rs.seed += uint32_t(frame);
     const float t = frameTime(frame, frames);
     const float tPrev = frame > 0 ? frameTime(frame - 1, frames) : t;
     RenderBuffers b;
@@ -341,10 +354,11 @@ void pyWriteImage(const std::string& path, const Array& image) {
     io::writeImage(path, img);
 }
 
-// The render settings' messages name the CLI's flags ("--width: -1 is out of range"); in Python
-// the same setting is a keyword argument, so "--max-depth" is shown as "max_depth" (the filter
-// parameters' messages name the field already: ParamError). Only a "--" at the start
-// of a word followed by a lower-case flag name is rewritten (file paths keep theirs).
+// Parameters arrive as ParamError, which names the field (`max_depth`, `device`) as Python's
+// keyword. A few library messages still name a CLI flag ("--camera-path: ...", "--device cuda:
+// ..." from the CUDA stubs in src/render and src/filters); in Python the same setting is a keyword
+// argument, so "--camera-path" is shown as "camera_path". Only a "--" at the start of a word
+// followed by a lower-case flag name is rewritten (file paths keep theirs).
 std::string pythonMessage(const std::string& msg) {
     std::string out;
     out.reserve(msg.size());
@@ -378,15 +392,15 @@ NB_MODULE(_core, m) {
     m.def("denoise", &pyDenoise, nb::arg("color"), nb::arg("albedo").none(), nb::arg("normal").none(),
           nb::arg("position").none(), nb::arg("depth").none(), nb::arg("variance").none(), nb::arg("ids").none(),
           nb::arg("emission").none(), nb::arg("method"), nb::arg("params"));
-    m.def("render", &pyRender, nb::arg("scene"), nb::arg("width"), nb::arg("height"), nb::arg("spp"), nb::arg("seed"),
-          nb::arg("max_depth"), nb::arg("threads"));
+    m.def("render", &pyRender, nb::arg("scene"), nb::arg("params"));
     m.def("render_frame", &pyRenderFrame, nb::arg("scene"), nb::arg("frame"), nb::arg("frames"), nb::arg("camera_path"),
-          nb::arg("width"), nb::arg("height"), nb::arg("spp"), nb::arg("seed"), nb::arg("max_depth"), nb::arg("threads"));
+          nb::arg("params"));
     m.def("metrics", &pyMetrics, nb::arg("image"), nb::arg("reference"));
     m.def("read_image", &pyReadImage, nb::arg("path"));
     m.def("write_image", &pyWriteImage, nb::arg("path"), nb::arg("image"));
     m.def("denoise_params", [] { return paramRows(denoiseParams()); });
     m.def("svgf_params", [] { return paramRows(svgfParams()); });
+    m.def("render_params", [] { return paramRows(renderParams()); });
     m.def("resolve_denoise_params", [](nb::dict p) { return resolveParams(denoiseParams(), p, "denoise"); });
     m.def("resolve_svgf_params", [](nb::dict p) { return resolveParams(svgfParams(), p, "SVGF"); });
     m.def("builtin_scenes", [] { return builtinSceneNames(); });

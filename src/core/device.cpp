@@ -7,6 +7,7 @@
 #include <tbb/info.h>
 
 #include "atrous/error.h"
+#include "atrous/params.h"
 #include "core/memory.h"
 
 namespace atrous {
@@ -19,12 +20,13 @@ Device parseDevice(const std::string& name) {
     if (name == "cpu") return Device::Cpu;
     if (name == "auto") return cudaAvailable() ? Device::Cuda : Device::Cpu;
     if (name == "cuda") {
+        // ParamError naming the field `device`: the CLI shows its flag, Python its keyword.
         if (!cudaCompiled())
-            throw InputError("--device cuda: this build of atrous has no CUDA backend (nvcc was not found at build time)");
-        if (!detail::cudaDevicePresent()) throw InputError("--device cuda: no CUDA-capable GPU is available");
+            throw ParamError("device", "device", "cannot be cuda: this build of atrous has no CUDA backend (nvcc was not found at build time)");
+        if (!detail::cudaDevicePresent()) throw ParamError("device", "device", "cannot be cuda: no CUDA-capable GPU is available");
         return Device::Cuda;
     }
-    throw InputError("unknown device '" + name + "' (expected cpu, cuda or auto)");
+    throw ParamError("device", "device", "must be cpu, cuda or auto", "'" + name + "'");
 }
 
 static std::string cpuModel() {

@@ -29,17 +29,52 @@ Image composeIds(const Image* object, const Image* material, int w, int h) {
 
 }  // namespace
 
-DenoiseInputs BufferSet::inputs() const {
+DenoiseInputs BufferSet::inputs() const { return denoiseInputs(refsOf(*this)); }
+
+BufferRefs refsOf(const BufferSet& set) {
+    BufferRefs r;
+    for (int b = 0; b < kBufferCount; ++b) r.set(Buffer(b), &set.image[b]);
+    return r;
+}
+
+namespace {
+// RenderBuffers and SequenceFrame name their images alike.
+template <class B>
+BufferRefs refsOfNamed(const B& b) {
+    BufferRefs r;
+    r.set(Buffer::Color, &b.color).set(Buffer::Variance, &b.variance).set(Buffer::Albedo, &b.albedo);
+    r.set(Buffer::Normal, &b.normal).set(Buffer::Position, &b.position).set(Buffer::Depth, &b.depth);
+    r.set(Buffer::ObjectId, &b.ids).set(Buffer::Emission, &b.emission).set(Buffer::Motion, &b.motion);
+    return r;
+}
+}  // namespace
+
+BufferRefs refsOf(const RenderBuffers& b) { return refsOfNamed(b); }
+BufferRefs refsOf(const SequenceFrame& f) { return refsOfNamed(f); }
+
+DenoiseInputs denoiseInputs(const BufferRefs& r) {
     DenoiseInputs in;
-    in.color = get(Buffer::Color);
-    in.variance = get(Buffer::Variance);
-    in.albedo = get(Buffer::Albedo);
-    in.normal = get(Buffer::Normal);
-    in.position = get(Buffer::Position);
-    in.depth = get(Buffer::Depth);
-    in.ids = get(Buffer::ObjectId);
-    in.emission = get(Buffer::Emission);
+    in.color = r.get(Buffer::Color);
+    in.variance = r.get(Buffer::Variance);
+    in.albedo = r.get(Buffer::Albedo);
+    in.normal = r.get(Buffer::Normal);
+    in.position = r.get(Buffer::Position);
+    in.depth = r.get(Buffer::Depth);
+    in.ids = r.get(Buffer::ObjectId);
+    in.emission = r.get(Buffer::Emission);
     return in;
+}
+
+SvgfFrame svgfFrame(const BufferRefs& r) {
+    SvgfFrame f;
+    f.color = r.get(Buffer::Color);
+    f.albedo = r.get(Buffer::Albedo);
+    f.normal = r.get(Buffer::Normal);
+    f.depth = r.get(Buffer::Depth);
+    f.ids = r.get(Buffer::ObjectId);
+    f.motion = r.get(Buffer::Motion);
+    f.emission = r.get(Buffer::Emission);
+    return f;
 }
 
 Image readBufferFile(const std::string& path, Buffer b, const std::vector<PassRequest>& passes,
@@ -131,3 +166,7 @@ BufferSet loadBuffers(const BufferFiles& f) {
 }
 
 }  // namespace atrous::io
+
+namespace atrous {
+DenoiseInputs denoiseInputsOf(const RenderBuffers& b) { return io::denoiseInputs(io::refsOf(b)); }
+}  // namespace atrous

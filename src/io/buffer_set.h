@@ -8,8 +8,11 @@
 
 #include "atrous/denoise.h"
 #include "atrous/image.h"
+#include "atrous/render.h"
+#include "atrous/svgf.h"
 #include "io/exr_layers.h"
 #include "io/pass_map.h"
+#include "io/sequence.h"
 
 namespace atrous::io {
 
@@ -29,8 +32,31 @@ struct BufferSet {
     std::shared_ptr<ExrInfo> layered;  // the layered file given as `in`, if any
     std::vector<std::string> notes;    // conventions applied, passes not found, ...
     const Image* get(Buffer b) const { return image[int(b)].empty() ? nullptr : &image[int(b)]; }
-    DenoiseInputs inputs() const;  // colour and features (motion is not a denoise input)
+    DenoiseInputs inputs() const;  // denoiseInputs(refsOf(*this))
 };
+
+// One set of buffers by buffer, not owned (nullptr = absent; ids in the object_id slot, as in
+// BufferSet). Every entry point (render --denoise, denoise, denoise --sequence, the viewer,
+// Python) puts what it holds here and takes each denoiser's inputs from denoiseInputs() /
+// svgfFrame(): the one place where buffers become a denoiser's inputs, so a new buffer reaches
+// all of them at once.
+struct BufferRefs {
+    const Image* at[kBufferCount] = {};
+    const Image* get(Buffer b) const { return at[int(b)]; }
+    // An empty image counts as absent.
+    BufferRefs& set(Buffer b, const Image* img) {
+        at[int(b)] = img && !img->empty() ? img : nullptr;
+        return *this;
+    }
+};
+BufferRefs refsOf(const BufferSet& set);
+BufferRefs refsOf(const RenderBuffers& b);  // motion too, when the render made one
+BufferRefs refsOf(const SequenceFrame& f);  // all but the reference
+
+// EAW/SURE read colour, variance, albedo, normal, position, depth, ids and emission; SVGF colour,
+// albedo, normal, depth, ids, motion and emission (its variance is its own, from the history).
+DenoiseInputs denoiseInputs(const BufferRefs& r);
+SvgfFrame svgfFrame(const BufferRefs& r);
 
 // Reads every buffer that `files` names or that `files.in` holds. Throws InputError naming the
 // file (and part) for a missing colour, an unreadable file, an ambiguous or empty pass mapping, or

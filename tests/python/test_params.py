@@ -109,3 +109,43 @@ def test_docstrings_list_every_keyword():
     for row in atrous.svgf_params():
         assert row["name"] in doc
     assert "{params}" not in atrous.denoise.__doc__
+
+
+# ---- the render table (RenderSettings): Python's keywords and errors come from it ----------------
+
+def test_render_params_are_the_tables_rows():
+    rows = {r["name"]: r for r in atrous.render_params()}
+    assert set(rows) == {"width", "height", "spp", "seed", "first_sample", "max_depth", "threads",
+                         "light_sampling"}
+    assert rows["width"]["default"] == 512 and rows["max_depth"]["default"] == 8
+    assert rows["seed"]["kind"] == "uint" and rows["light_sampling"]["aliases"] == ["no_light_sampling"]
+    assert rows["max_depth"]["flag"] == "--max-depth" and rows["first_sample"]["flag"] == ""
+    for name in rows:
+        assert name in atrous.render.__doc__, name
+
+
+def test_render_errors_name_the_keyword():
+    for kw, msg in (({"width": 0}, "parameter width must be in 1..16384 (got 0)"),
+                    ({"max_depth": -3}, "parameter max_depth must be in 0..1024 (got -3)"),
+                    ({"threads": 100000}, "parameter threads must be in 0..4096 (got 100000)"),
+                    ({"seed": -1}, "parameter seed must be in 0..4294967295 (got -1)")):
+        with pytest.raises(ValueError) as e:
+            atrous.render("cornell", **dict(dict(width=8, height=8, spp=1), **kw))
+        assert str(e.value) == msg
+    with pytest.raises(ValueError, match="unknown render parameter 'bounces'"):
+        atrous.render("cornell", width=8, height=8, spp=1, bounces=2)
+    with pytest.raises(ValueError, match="width must be an integer"):
+        atrous.render("cornell", width=8.0, height=8, spp=1)
+
+
+def test_render_keywords_reach_the_renderer():
+    base = atrous.render("cornell", width=16, height=16, spp=2, seed=3)
+    again = atrous.render("cornell", width=16, height=16, spp=2, seed=3, threads=1)
+    assert np.array_equal(base["color"], again["color"])  # same seed, any thread count
+    assert not np.array_equal(base["color"], atrous.render("cornell", width=16, height=16, spp=2, seed=4)["color"])
+    direct = atrous.render("cornell", width=16, height=16, spp=2, seed=3, max_depth=1)
+    assert not np.array_equal(base["color"], direct["color"])
+    bsdf = atrous.render("cornell", width=16, height=16, spp=2, seed=3, no_light_sampling=True)
+    assert not np.array_equal(base["color"], bsdf["color"])
+    seq = next(atrous.render_sequence("cornell-moving", 2, width=8, height=8, seed=5))
+    assert seq["color"].shape == (8, 8, 3) and "motion" not in seq or seq["motion"].shape[:2] == (8, 8)

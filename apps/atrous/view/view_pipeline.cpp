@@ -15,6 +15,7 @@
 #include "atrous/params.h"
 #include "core/timer.h"
 #include "filters/denoise_internal.h"
+#include "io/buffer_set.h"
 #include "io/image_io.h"
 #include "render/accumulate.h"
 #include "render/bvh_render.h"
@@ -101,7 +102,7 @@ ViewPipeline::ViewPipeline(const Scene& scene, int width, int height, Device dev
     RenderSettings check;
     check.width = width;
     check.height = height;
-    validateRenderSettings(check);  // --width / --height in the message
+    validateRenderSettings(check);  // ParamError naming width / height
     const pt::SceneData& data = scene.data();
     mSceneCamera = mCamera = mPrevCamera = data.camera;
     mBvh = std::make_unique<BvhData>(pt::buildSceneBvh(data));
@@ -272,20 +273,16 @@ void ViewPipeline::computeEmission() {
 }
 
 DenoiseInputs ViewPipeline::accumulatedInputs() const {
-    DenoiseInputs in;
-    in.color = &mColor;
+    io::BufferRefs r;
+    r.set(io::Buffer::Color, &mColor).set(io::Buffer::Albedo, &mAlbedo).set(io::Buffer::Normal, &mNormal);
+    r.set(io::Buffer::Position, &mPosition).set(io::Buffer::Depth, &mDepth).set(io::Buffer::ObjectId, &mIds);
     // At one sample per pixel there is no variance estimate: the filter then estimates the noise
     // from the image (Donoho's MAD) rather than seeing zero noise everywhere.
-    in.variance = mVarianceValid ? &mVariance : nullptr;
-    in.albedo = &mAlbedo;
-    in.normal = &mNormal;
-    in.position = &mPosition;
-    in.depth = &mDepth;
-    in.ids = &mIds;
+    if (mVarianceValid) r.set(io::Buffer::Variance, &mVariance);
     // Emission: the filters work on colour - emission and add back its edge-filtered mean, so a
     // visible light neither bleeds into the ceiling nor keeps its coverage noise (docs/denoising.md).
-    in.emission = mEmissionValid ? &mEmissionMean : nullptr;
-    return in;
+    if (mEmissionValid) r.set(io::Buffer::Emission, &mEmissionMean);
+    return io::denoiseInputs(r);
 }
 
 DenoiseOptions ViewPipeline::denoiseOptions(Method m, const PipelineSettings& s) const {
@@ -363,14 +360,9 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
             // running mean. On CUDA all of them are device images, which the SVGF pipeline reads
             // in place (svgf_pipeline.h copies only inputs that are not on its device).
             const RenderBuffers& fr = frame();
-            SvgfFrame f;
-            f.color = &fr.color;
-            f.albedo = &fr.albedo;
-            f.normal = &fr.normal;
-            f.depth = &fr.depth;
-            f.ids = &fr.ids;
-            f.motion = &mMotion;
-            f.emission = &mEmission;
+            io::BufferRefs refs = io::refsOf(fr);
+            refs.set(io::Buffer::Motion, &mMotion).set(io::Buffer::Emission, &mEmission);
+            const SvgfFrame f = io::svgfFrame(refs);
             Timer t;
             if (onDevice)
                 r.deviceImage = mSvgf[i]->denoiseFrameOnDevice(f).clone();  // valid until next frame

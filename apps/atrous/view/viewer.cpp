@@ -42,8 +42,8 @@ ViewerState checkOptions(const ViewerOptions& opt) {
     ps.methodA = parseMethod(opt.method);
     ps.split = !opt.compare.empty();
     if (ps.split) ps.methodB = parseMethod(opt.compare);
-    ps.sppPerFrame = opt.spp;
-    ps.maxDepth = opt.maxDepth;
+    ps.sppPerFrame = opt.render.spp;
+    ps.maxDepth = opt.render.maxDepth;
     ps.accumulate = !opt.noAccumulate;
     st.view = parseBufferView(opt.bufferView);
     if (opt.frames < 0) throw InputError("--frames: must be 0 (interactive) or more");
@@ -59,14 +59,7 @@ ViewerState checkOptions(const ViewerOptions& opt) {
         io::ensureWritableDirectory(opt.dumpDir);
     }
     if (!(opt.exposure > 0.0f)) throw InputError("--exposure: must be > 0");
-    {
-        RenderSettings rs;
-        rs.width = opt.width;
-        rs.height = opt.height;
-        rs.spp = opt.spp;
-        rs.maxDepth = opt.maxDepth;
-        validateRenderSettings(rs);  // names --width/--height/--spp/--max-depth
-    }
+    validateRenderSettings(opt.render);  // ParamError naming the field; main.cpp shows its flag
     st.exposure = opt.exposure;
     st.uiVisible = !opt.hideUi;
     return st;
@@ -115,14 +108,14 @@ void runViewer(const ViewerOptions& opt) {
     const bool headless = opt.frames > 0;
 
     GlfwSession session;
-    const int winW = opt.hideUi ? opt.width : opt.width + int(kPanelWidth);
-    const int winH = opt.hideUi ? opt.height : std::max(opt.height, 720);
+    const int winW = opt.hideUi ? opt.render.width : opt.render.width + int(kPanelWidth);
+    const int winH = opt.hideUi ? opt.render.height : std::max(opt.render.height, 720);
     openWindow(session, winW, winH, "atrous view: " + scene.name(), headless);
     GLFWwindow* win = session.window;
     const ImGuiIO& io = ImGui::GetIO();
 
-    ViewPipeline pl(scene, opt.width, opt.height, device, opt.seed);
-    const int w = opt.width, h = opt.height;
+    ViewPipeline pl(scene, opt.render.width, opt.render.height, device, opt.render.seed);
+    const int w = opt.render.width, h = opt.render.height;
     FrameDisplay display(session, device, w, h);
 
     CameraInput input;

@@ -4,15 +4,20 @@
 #include <cstdint>
 #include <string>
 
+#include "atrous/render.h"
+
 namespace atrous::view {
 
 struct ViewerOptions {
     std::string scene = "cornell";
     std::string device = "cpu";
-    int width = 512, height = 512;  // rendered image size
-    int spp = 1;                    // samples per pixel per frame
-    int maxDepth = 8;
-    uint32_t seed = 1;
+    // Image size, samples per pixel per frame, bounces and seed (flags from the render parameter
+    // table, atrous/params.h); one sample per pixel per frame by default.
+    RenderSettings render = [] {
+        RenderSettings r;
+        r.spp = 1;
+        return r;
+    }();
     std::string method = "eaw";  // slot A: none | eaw | sure | svgf
     std::string compare;         // slot B for the split screen (empty: no split)
     bool noAccumulate = false;
