@@ -9,6 +9,7 @@
 #include "atrous/denoise.h"
 #include "atrous/error.h"
 #include "denoise_test_util.h"
+#include "param_effect_util.h"
 #include "filters/eaw.h"
 #include "filters/filter_math.h"
 
@@ -164,13 +165,7 @@ TEST(Eaw, EveryParameterChangesTheOutput) {
     // Ids off in the base: in this scene they change exactly where normals and depth do, and a
     // weight of 0 from the ids would hide those terms.
     base.eaw.useIds = false;
-    const Image ref = denoise(s.inputs(), base);
-    auto changed = [&](const char* name, auto mutate) {
-        DenoiseOptions o = base;
-        mutate(o);
-        Image out = denoise(s.inputs(), o);
-        EXPECT_GT(maxAbsDiff(out, ref), 1e-4) << name << " did not change the output";
-    };
+    const auto changed = outputChangeCheck(s, base);
     changed("levels", [](DenoiseOptions& o) { o.eaw.levels = 3; });
     changed("sigmaColor", [](DenoiseOptions& o) { o.eaw.sigmaColor = 0.05f; });
     changed("colorScale", [](DenoiseOptions& o) { o.eaw.colorScale = 3.0f; });

@@ -174,11 +174,46 @@ TEST(NoiseEstimate, DenoiseWithoutVarianceSmoothsACaustic) {
 
 namespace {
 
+// An n x n truth with its noisy colour and the per-channel variance of that noise (and an albedo
+// pass where the wall has one), as denoise inputs.
+struct NoisyWall {
+    Image truth, noisy, variance, albedo;
+    bool hasAlbedo;
+    NoisyWall(int n, bool withAlbedo)
+        : truth(n, n, 3), noisy(n, n, 3), variance(n, n, 3), albedo(n, n, 3), hasAlbedo(withAlbedo) {}
+    DenoiseInputs inputs(bool withVariance = true) const {
+        DenoiseInputs in;
+        in.color = &noisy;
+        if (hasAlbedo) in.albedo = &albedo;
+        if (withVariance) in.variance = &variance;
+        return in;
+    }
+    // Sets every channel of pixel (x, y) from f(x, y) = {truth, albedo, variance}, with the noisy
+    // colour truth + sqrt(variance)·z, z standard normal (one draw per channel, in row order).
+    struct Pixel {
+        float truth, albedo, var;
+    };
+    template <class F>
+    void fill(unsigned seed, F f) {
+        std::mt19937 rng(seed);
+        std::normal_distribution<float> gauss(0.0f, 1.0f);
+        for (int y = 0; y < truth.height(); ++y)
+            for (int x = 0; x < truth.width(); ++x) {
+                const Pixel p = f(x, y);
+                for (int c = 0; c < 3; ++c) {
+                    truth(x, y, c) = p.truth;
+                    albedo(x, y, c) = p.albedo;
+                    variance(x, y, c) = p.var;
+                    noisy(x, y, c) = p.truth + std::sqrt(p.var) * gauss(rng);
+                }
+            }
+    }
+};
+
 // A flat, lit wall with a one-pixel checker albedo of 0.9 / `dark`, colour = albedo · (1 + n),
 // n white noise of standard deviation 0.2 (the truth is the albedo itself).
-struct CheckerWall {
-    Image truth, noisy, variance, albedo;
-    CheckerWall(int n, float dark, unsigned seed) : truth(n, n, 3), noisy(n, n, 3), variance(n, n, 3), albedo(n, n, 3) {
+struct CheckerWall : NoisyWall {
+    CheckerWall(int n, float dark, unsigned seed) : NoisyWall(n, true) {
         std::mt19937 rng(seed);
         std::normal_distribution<float> gauss(0.0f, 0.2f);
         for (int y = 0; y < n; ++y)
@@ -192,12 +227,21 @@ struct CheckerWall {
                 }
             }
     }
-    DenoiseInputs inputs(bool withVariance) const {
-        DenoiseInputs in;
-        in.color = &noisy;
-        in.albedo = &albedo;
-        if (withVariance) in.variance = &variance;
-        return in;
+};
+
+// Stripes of period 2 pixels (0.5 / 1.5) under white noise of standard deviation 0.05, with the
+// variance given: a filter with a colour stop opened wide (σ_c = 100) removes the stripes.
+struct Stripes : NoisyWall {
+    Stripes(int n, float amplitude, unsigned seed) : NoisyWall(n, false) {
+        std::mt19937 rng(seed);
+        std::normal_distribution<float> gauss(0.0f, 0.05f);
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x)
+                for (int c = 0; c < 3; ++c) {
+                    truth(x, y, c) = 1.0f + (x % 2 ? amplitude : -amplitude);
+                    noisy(x, y, c) = truth(x, y, c) + gauss(rng);
+                    variance(x, y, c) = 0.05f * 0.05f;
+                }
     }
 };
 
@@ -225,33 +269,6 @@ TEST(RobustInputs, DarkTextureIsDemodulatedWhole) {
         }
     }
 }
-
-namespace {
-
-// Stripes of period 2 pixels (0.5 / 1.5) under white noise of standard deviation 0.05, with the
-// variance given: a filter with a colour stop opened wide (σ_c = 100) removes the stripes.
-struct Stripes {
-    Image truth, noisy, variance;
-    Stripes(int n, float amplitude, unsigned seed) : truth(n, n, 3), noisy(n, n, 3), variance(n, n, 3) {
-        std::mt19937 rng(seed);
-        std::normal_distribution<float> gauss(0.0f, 0.05f);
-        for (int y = 0; y < n; ++y)
-            for (int x = 0; x < n; ++x)
-                for (int c = 0; c < 3; ++c) {
-                    truth(x, y, c) = 1.0f + (x % 2 ? amplitude : -amplitude);
-                    noisy(x, y, c) = truth(x, y, c) + gauss(rng);
-                    variance(x, y, c) = 0.05f * 0.05f;
-                }
-    }
-    DenoiseInputs inputs() const {
-        DenoiseInputs in;
-        in.color = &noisy;
-        in.variance = &variance;
-        return in;
-    }
-};
-
-}  // namespace
 
 TEST(SafetyNet, FallsBackWhereTheFilterRemovedSignal) {
     const Stripes s(48, 0.5f, 9);
@@ -290,32 +307,18 @@ TEST(RobustInputs, RimBesideBlackAlbedoIsNotAmplified) {
     // columns beside it are rim pixels 10% covered by the wall: albedo 0.07, colour mostly the
     // reflection. Dividing them by 0.07 (the floor 0.05 alone) made them 26 in the filters' units
     // and spread them along the rim; the rim rule raises the floor to 0.1 beside black albedo.
-    const int n = 48;
-    Image truth(n, n, 3), noisy(n, n, 3), variance(n, n, 3), albedo(n, n, 3);
-    std::mt19937 rng(12);
-    std::normal_distribution<float> gauss(0.0f, 1.0f);
-    for (int y = 0; y < n; ++y)
-        for (int x = 0; x < n; ++x) {
-            const bool mirror = x >= 16 && x < 32, rim = x == 15 || x == 32;
-            const float a = mirror ? 0.0f : (rim ? 0.07f : 0.7f);
-            const float t = mirror ? 2.0f : (rim ? 0.1f * 0.35f + 0.9f * 2.0f : 0.35f);
-            const float var = 0.05f * t;
-            for (int c = 0; c < 3; ++c) {
-                truth(x, y, c) = t;
-                albedo(x, y, c) = a;
-                variance(x, y, c) = var;
-                noisy(x, y, c) = t + std::sqrt(var) * gauss(rng);
-            }
-        }
-    DenoiseInputs in;
-    in.color = &noisy;
-    in.variance = &variance;
-    in.albedo = &albedo;
-    const double noisyMse = mse(noisy, truth);
+    NoisyWall s(48, true);
+    s.fill(12, [](int x, int) {
+        const bool mirror = x >= 16 && x < 32, rim = x == 15 || x == 32;
+        const float a = mirror ? 0.0f : (rim ? 0.07f : 0.7f);
+        const float t = mirror ? 2.0f : (rim ? 0.1f * 0.35f + 0.9f * 2.0f : 0.35f);
+        return NoisyWall::Pixel{t, a, 0.05f * t};
+    });
+    const double noisyMse = mse(s.noisy, s.truth);
     for (DenoiseMethod m : {DenoiseMethod::Eaw, DenoiseMethod::Sure}) {
         DenoiseOptions o;
         o.method = m;
-        const double e = mse(denoise(in, o), truth);
+        const double e = mse(denoise(s.inputs(), o), s.truth);
         // Measured: noisy 0.048; with the rule 0.022 (EAW), 0.018 (SURE); with kRimFloorMul = 1
         // 0.045 and 0.044 (no better than the input). Bound: 0.6x the input.
         EXPECT_LT(e, 0.6 * noisyMse) << denoiseMethodName(m);
@@ -326,26 +329,13 @@ TEST(RobustInputs, VisibleLightWithoutEmissionBufferKeepsItsEdge) {
     // A light of radiance 20 (albedo 0, as Mitsuba writes it) in a noisy wall of 0.3, no emission
     // buffer, with and without a variance. The light's edge stays sharp: the wall pixels beside
     // it stay near 0.3 and the light keeps its radiance.
-    const int n = 48;
-    Image truth(n, n, 3), noisy(n, n, 3), variance(n, n, 3), albedo(n, n, 3);
-    std::mt19937 rng(13);
-    std::normal_distribution<float> gauss(0.0f, 1.0f);
-    for (int y = 0; y < n; ++y)
-        for (int x = 0; x < n; ++x) {
-            const bool light = x >= 20 && x < 28 && y >= 10 && y < 38;
-            const float t = light ? 20.0f : 0.3f, var = light ? 0.0f : 0.01f;
-            for (int c = 0; c < 3; ++c) {
-                truth(x, y, c) = t;
-                albedo(x, y, c) = light ? 0.0f : 0.6f;
-                variance(x, y, c) = var;
-                noisy(x, y, c) = t + std::sqrt(var) * gauss(rng);
-            }
-        }
+    NoisyWall s(48, true);
+    s.fill(13, [](int x, int y) {
+        const bool light = x >= 20 && x < 28 && y >= 10 && y < 38;
+        return light ? NoisyWall::Pixel{20.0f, 0.0f, 0.0f} : NoisyWall::Pixel{0.3f, 0.6f, 0.01f};
+    });
     for (bool withVariance : {true, false}) {
-        DenoiseInputs in;
-        in.color = &noisy;
-        in.albedo = &albedo;
-        if (withVariance) in.variance = &variance;
+        const DenoiseInputs in = s.inputs(withVariance);
         for (DenoiseMethod m : {DenoiseMethod::Eaw, DenoiseMethod::Sure}) {
             DenoiseOptions o;
             o.method = m;

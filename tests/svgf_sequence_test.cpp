@@ -48,6 +48,20 @@ void writeSequence(const std::string& dir, const SceneOptions& o, int count, int
     }
 }
 
+// Writes `count` frames of a w x h scene (noise σ `noise`) to dir/seq; returns the quiet arguments
+// that denoise it into dir/out.
+cli::SequenceDenoiseArgs sequenceArgs(const test::TempDir& dir, int w, int h, float noise, int count) {
+    SceneOptions o;
+    o.width = w, o.height = h;
+    o.noiseSigma = noise;
+    writeSequence(dir / "seq", o, count);
+    cli::SequenceDenoiseArgs args;
+    args.sequenceDir = dir / "seq";
+    args.outDir = dir / "out";
+    args.quiet = true;
+    return args;
+}
+
 std::string errorOf(const std::function<void()>& f) {
     try {
         f();
@@ -133,14 +147,10 @@ TEST(SvgfSequence, GapsMissingBuffersAndSizeMismatchesAreNamed) {
 
 TEST(SvgfSequence, DenoiseCommandWritesEveryFrameAndBeatsTheInput) {
     test::TempDir dir;
+    cli::SequenceDenoiseArgs args = sequenceArgs(dir, 48, 32, 0.2f, 4);
     SceneOptions o;
     o.width = 48, o.height = 32;
     o.noiseSigma = 0.2f;
-    writeSequence(dir / "seq", o, 4);
-    cli::SequenceDenoiseArgs args;
-    args.sequenceDir = dir / "seq";
-    args.outDir = dir / "out";
-    args.quiet = true;
     EXPECT_EQ(cli::runSequenceDenoise(args), 0);
     for (int t = 0; t < 4; ++t) {
         std::string name = io::sequenceFrameName(t);
@@ -186,15 +196,8 @@ TEST(SvgfSequence, EveryParamHasAFlag) {
 
 TEST(SvgfSequence, PerFrameEawAlsoRuns) {
     test::TempDir dir;
-    SceneOptions o;
-    o.width = 32, o.height = 24;
-    o.noiseSigma = 0.2f;
-    writeSequence(dir / "seq", o, 2);
-    cli::SequenceDenoiseArgs args;
+    cli::SequenceDenoiseArgs args = sequenceArgs(dir, 32, 24, 0.2f, 2);
     args.method = "eaw";
-    args.sequenceDir = dir / "seq";
-    args.outDir = dir / "out";
-    args.quiet = true;
     args.preview = false;
     EXPECT_EQ(cli::runSequenceDenoise(args), 0);
     EXPECT_TRUE(std::filesystem::exists(dir / "out/frame_0001.exr"));
@@ -202,14 +205,8 @@ TEST(SvgfSequence, PerFrameEawAlsoRuns) {
 
 TEST(SvgfSequence, BadSequencesWriteNothing) {
     test::TempDir dir;
-    SceneOptions o;
-    o.width = 16, o.height = 12;
-    writeSequence(dir / "seq", o, 3);
+    cli::SequenceDenoiseArgs args = sequenceArgs(dir, 16, 12, SceneOptions{}.noiseSigma, 3);
     std::filesystem::remove(dir / "seq/frame_0002/albedo.exr");
-    cli::SequenceDenoiseArgs args;
-    args.sequenceDir = dir / "seq";
-    args.outDir = dir / "out";
-    args.quiet = true;
     std::string msg = errorOf([&] { cli::runSequenceDenoise(args); });
     EXPECT_NE(msg.find("frame_0002/albedo.exr"), std::string::npos) << msg;
     EXPECT_FALSE(std::filesystem::exists(dir / "out"));
