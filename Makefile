@@ -62,3 +62,23 @@ sanitize: setup
 
 clean:
 	rm -rf $(BUILD) $(BUILD).configure.log out
+
+# The learned filter (docs/learned.md): its training venv (.venv-train), the dataset (out/train/data,
+# resumable) and the training run (out/train/run, resumable), which regenerates
+# src/filters/learned_weights_default.cpp. `train-smoke`: a few scenes and steps (minutes).
+TRAIN_BUILD ?= build-learn
+.PHONY: train train-smoke
+train:
+	@./scripts/train/setup.sh
+	@cmake -S . -B $(TRAIN_BUILD) -DCMAKE_BUILD_TYPE=Release -DATROUS_ENABLE_CUDA=OFF > /dev/null
+	@cmake --build $(TRAIN_BUILD) -j $(JOBS) --target atrous
+	@.venv-train/bin/python scripts/train/dataset.py --atrous $(TRAIN_BUILD)/atrous --scenes 160 --test-scenes 16
+	@.venv-train/bin/python scripts/train/train.py --steps 3000 --minutes 60 --export
+
+train-smoke:
+	@./scripts/train/setup.sh
+	@cmake -S . -B $(TRAIN_BUILD) -DCMAKE_BUILD_TYPE=Release -DATROUS_ENABLE_CUDA=OFF > /dev/null
+	@cmake --build $(TRAIN_BUILD) -j $(JOBS) --target atrous
+	@.venv-train/bin/python scripts/train/dataset.py --atrous $(TRAIN_BUILD)/atrous --out out/train-smoke --scenes 3 --test-scenes 1 --size 64
+	@.venv-train/bin/python scripts/train/train.py --data out/train-smoke/data --out out/train-smoke/run --steps 100
+	@.venv-train/bin/python -m pytest -q tests/python/test_learn.py
