@@ -178,7 +178,7 @@ Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const Prepar
     std::unique_ptr<StageClock> clock = o.report ? makeStageClock(Device::Cuda) : nullptr;
     dout.clock = clock.get();
     Timer t;
-    DriverConfig cfg = makeConfig(o);
+    DriverConfig cfg{o};
     cfg.varianceGiven = in.variance != nullptr;
     setNoiseEstimate(cfg, rep);
     if (clock) clock->start();

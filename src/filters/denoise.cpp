@@ -157,19 +157,6 @@ void setNoiseEstimate(DriverConfig& cfg, const DenoiseReport& rep) {
     for (int c = 0; c < 3; ++c) cfg.noiseFloorVar[c] = kNoiseFloorFraction * rep.noiseSigma[c] * rep.noiseSigma[c];
 }
 
-DriverConfig makeConfig(const DenoiseOptions& o) {
-    DriverConfig cfg;
-    cfg.method = o.method;
-    cfg.eaw = o.eaw;
-    cfg.sure = o.sure;
-    cfg.firefly = o.firefly;
-    cfg.safety = o.safety;
-    cfg.demodulate = o.demodulate;
-    cfg.albedoEpsilon = o.albedoEpsilon;
-    cfg.albedoFloor = o.albedoFloor;
-    return cfg;
-}
-
 static ImageView viewOf(const Image* img) { return img ? img->view() : ImageView{}; }
 
 static double meanLuminance(const Image& img) {
@@ -207,7 +194,7 @@ Image denoiseCpu(const DenoiseInputs& in, const DenoiseOptions& o, const Prepare
     std::unique_ptr<StageClock> clock = makeStageClock(Device::Cpu);
     dout.clock = clock.get();
     Timer t;
-    DriverConfig cfg = makeConfig(o);
+    DriverConfig cfg{o};
     cfg.varianceGiven = in.variance != nullptr;
     setNoiseEstimate(cfg, rep);
     clock->start();

@@ -36,15 +36,10 @@ struct DriverOutputs {
     StageClock* clock = nullptr;  // optional: started by the caller, marked after each stage
 };
 
+// The caller's options held whole (as SvgfPipeline holds its SvgfParams), plus what the driver
+// derives from the inputs: whether a variance was given, and the local noise estimate.
 struct DriverConfig {
-    DenoiseMethod method = DenoiseMethod::Sure;
-    EawParams eaw;
-    SureParams sure;
-    FireflyParams firefly;
-    SafetyNetParams safety;
-    bool demodulate = true;
-    float albedoEpsilon = 1e-3f;
-    float albedoFloor = 0.0f;
+    DenoiseOptions opts;
     bool varianceGiven = true;  // false: the variance is a constant estimate
     // Without a variance: the local estimate (noise_estimate.h) over quadrants of this radius
     // (0 = keep the constant), floored at noiseFloorVar (the global estimate times a fraction) and
@@ -94,14 +89,15 @@ template <class Exec>
 void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cfg, const DriverOutputs& out) {
     const int w = in.color.width, h = in.color.height;
     const Device dev = exec.device();
-    const bool sure = cfg.method == DenoiseMethod::Sure;
-    const int levels = cfg.eaw.levels;
+    const DenoiseOptions& o = cfg.opts;
+    const bool sure = o.method == DenoiseMethod::Sure;
+    const int levels = o.eaw.levels;
 
     // 1. Non-finite samples and features.
     Image c0(w, h, 3, dev), v0(w, h, 3, dev);
     runSanitizeColor(exec, SanitizeColor{in.color, in.variance, c0.view(), v0.view()});
     // The albedo the demodulation divides by, sanitised once (the noise estimate reads it too).
-    ImageView albedo = cfg.demodulate ? in.albedo : ImageView{};
+    ImageView albedo = o.demodulate ? in.albedo : ImageView{};
     Image albedoStore;
     if (albedo.valid()) albedo = sanitizedFeature(exec, albedo, w, h, 3, albedoStore);
     if (!cfg.varianceGiven && cfg.noiseRadius > 0 && albedo.valid()) {
@@ -109,8 +105,8 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         // the albedo (noise_estimate.h). Without an albedo the constant given is that already.
         GlobalVariance gv;
         for (int c = 0; c < 3; ++c) gv.floorVar[c] = cfg.noiseFloorVar[c];
-        gv.eps = cfg.albedoEpsilon;
-        gv.floor = cfg.albedoFloor;
+        gv.eps = o.albedoEpsilon;
+        gv.floor = o.albedoFloor;
         gv.albedo = albedo;
         gv.var = v0.view();
         exec.forEachPixel(w, h, gv);
@@ -124,10 +120,10 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         emission = sanitizedFeature(exec, in.emission, w, h, 3, emissionStore);
         exec.forEachPixel(w, h, SubtractEmission{emission, c0.view()});
         // The emission added back is filtered along emitter edges (filters/emission_filter.h).
-        if (cfg.eaw.emissionLevels > 0) {
+        if (o.eaw.emissionLevels > 0) {
             emissionA = Image(w, h, 3, dev);
             emissionB = Image(w, h, 3, dev);
-            emission = runEmissionFilter(exec, cfg.eaw.emissionLevels, cfg.eaw.emissionScale, v0.view(), emission,
+            emission = runEmissionFilter(exec, o.eaw.emissionLevels, o.eaw.emissionScale, v0.view(), emission,
                                          emissionA.view(), emissionB.view());
         }
     }
@@ -141,10 +137,10 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     // c0/v0 are dead after this step: without the firefly pass they become cA/vA (no copy), with
     // it they are reused below as the cascade's second buffers (fewer image-sized temporaries).
     Image cA, vA;
-    if (cfg.firefly.enabled) {
+    if (o.firefly.enabled) {
         cA = Image(w, h, 3, dev);
         vA = Image(w, h, 3, dev);
-        runFireflyClamp(exec, FireflyClamp{cfg.firefly.k, cfg.varianceGiven ? 1 : 0, c0.view(), v0.view(), cA.view(),
+        runFireflyClamp(exec, FireflyClamp{o.firefly.k, cfg.varianceGiven ? 1 : 0, c0.view(), v0.view(), cA.view(),
                                            vA.view(), out.fireflyFlag});
     } else {
         cA = std::move(c0);
@@ -158,7 +154,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         // The variance from the colour itself (after the emission is taken out and the fireflies
         // clamped with the constant estimate, so that they do not raise it): noise_estimate.h.
         Image demod(w, h, 3, dev), energy(w, h, 3, dev);
-        exec.forEachPixel(w, h, DemodulatedCopy{cfg.albedoEpsilon, cfg.albedoFloor, cA.view(), albedo, demod.view()});
+        exec.forEachPixel(w, h, DemodulatedCopy{o.albedoEpsilon, o.albedoFloor, cA.view(), albedo, demod.view()});
         DetailEnergy de{demod.view(), energy.view(), normal, depth};
         for (int c = 0; c < 3; ++c) de.maxDiff2[c] = kNoiseEdgeSigmas2 * kNoiseCapMul * cfg.noiseFloorVar[c];
         exec.forEachPixel(w, h, de);
@@ -168,8 +164,8 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         lv.radius = cfg.noiseRadius;
         lv.capMul = kNoiseCapMul;
         for (int c = 0; c < 3; ++c) lv.floorVar[c] = cfg.noiseFloorVar[c];
-        lv.eps = cfg.albedoEpsilon;
-        lv.floor = cfg.albedoFloor;
+        lv.eps = o.albedoEpsilon;
+        lv.floor = o.albedoFloor;
         lv.rows = rows.view();
         lv.albedo = albedo;
         lv.var = vA.view();
@@ -179,11 +175,11 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
 
     // 3. Albedo demodulation.
     if (albedo.valid()) {
-        exec.forEachPixel(w, h, Demodulate{cfg.albedoEpsilon, cfg.albedoFloor, albedo, cA.view(), vA.view()});
+        exec.forEachPixel(w, h, Demodulate{o.albedoEpsilon, o.albedoFloor, albedo, cA.view(), vA.view()});
     }
     // The safety net's input y and its summed variance, kept before the cascade overwrites them.
     Image safetyIn, safetyVar;
-    if (cfg.safety.enabled) {
+    if (o.safety.enabled) {
         safetyIn = Image(w, h, 3, dev);
         safetyVar = Image(w, h, 1, dev);
         exec.forEachPixel(w, h, Copy3{cA.view(), safetyIn.view()});
@@ -193,9 +189,9 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
 
     // 4. Per-pixel scales of the automatic σ_c and σ_x.
     Image S(w, h, 1, dev), invX(w, h, 1, dev), invZ(w, h, 1, dev);
-    runColorScale(exec, ColorScale{cfg.eaw.sigmaColor, cfg.eaw.colorScale * cfg.eaw.colorScale, vA.view(), S.view()});
-    runFootprint(exec, Footprint{in.position.valid() ? 1 : 0, cfg.eaw.sigmaPosition,
-                                 cfg.eaw.positionScale * cfg.eaw.positionScale, position, depth, invX.view(),
+    runColorScale(exec, ColorScale{o.eaw.sigmaColor, o.eaw.colorScale * o.eaw.colorScale, vA.view(), S.view()});
+    runFootprint(exec, Footprint{in.position.valid() ? 1 : 0, o.eaw.sigmaPosition,
+                                 o.eaw.positionScale * o.eaw.positionScale, position, depth, invX.view(),
                                  invZ.view()});
     markStage(out.clock, "sigma scales");
 
@@ -210,11 +206,11 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         detail = Image(w, h, 2, dev);
         boxH = Image(w, h, 2, dev);
         acc = Image(w, h, 3, dev);
-        if (cfg.sure.correlatedVariance) sureDetailVarianceFactors(levels, alpha);
-        choice.radius = cfg.sure.windowRadius;
-        choice.jamesStein = cfg.sure.mode == SureMode::JamesStein ? 1 : 0;
-        choice.count = int(cfg.sure.candidates.size());
-        for (int k = 0; k < choice.count && k < kMaxSureCandidates; ++k) choice.candidates[k] = cfg.sure.candidates[k];
+        if (o.sure.correlatedVariance) sureDetailVarianceFactors(levels, alpha);
+        choice.radius = o.sure.windowRadius;
+        choice.jamesStein = o.sure.mode == SureMode::JamesStein ? 1 : 0;
+        choice.count = int(o.sure.candidates.size());
+        for (int k = 0; k < choice.count && k < kMaxSureCandidates; ++k) choice.candidates[k] = o.sure.candidates[k];
     }
     // Each level's 1/σ_c² factors (EawLevel::rS). The CPU level takes its plane from the scalable
     // allocator per level instead, as it did before the shared cascade (docs/benchmarks.md, "One
@@ -224,15 +220,15 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     Image* nxt = &cB;
     Image* vcur = &vA;
     Image* vnxt = &vB;
-    const float invSigmaN2 = cfg.eaw.sigmaNormal > 0 && in.normal.valid() ? 1.0f / (cfg.eaw.sigmaNormal * cfg.eaw.sigmaNormal) : 0.0f;
+    const float invSigmaN2 = o.eaw.sigmaNormal > 0 && in.normal.valid() ? 1.0f / (o.eaw.sigmaNormal * o.eaw.sigmaNormal) : 0.0f;
     for (int i = 0; i < levels; ++i) {
         EawLevelParams lp;
         lp.step = 1 << i;
-        lp.colorMul = std::pow(cfg.eaw.colorLevelFactor, 2.0f * float(i));
-        lp.invNormal = cfg.eaw.normalStepScale ? invSigmaN2 / float(lp.step * lp.step) : invSigmaN2;
-        lp.autoPosition = cfg.eaw.sigmaPosition > 0 ? 0 : 1;
-        lp.invDepth = cfg.eaw.sigmaDepth > 0 && in.depth.valid() ? 1.0f / (cfg.eaw.sigmaDepth * cfg.eaw.sigmaDepth) : 0.0f;
-        lp.idPenalty = cfg.eaw.useIds && in.ids.valid() ? kIdPenalty : 0.0f;
+        lp.colorMul = std::pow(o.eaw.colorLevelFactor, 2.0f * float(i));
+        lp.invNormal = o.eaw.normalStepScale ? invSigmaN2 / float(lp.step * lp.step) : invSigmaN2;
+        lp.autoPosition = o.eaw.sigmaPosition > 0 ? 0 : 1;
+        lp.invDepth = o.eaw.sigmaDepth > 0 && in.depth.valid() ? 1.0f / (o.eaw.sigmaDepth * o.eaw.sigmaDepth) : 0.0f;
+        lp.idPenalty = o.eaw.useIds && in.ids.valid() ? kIdPenalty : 0.0f;
         lp.propagate = sure ? 1 : 0;
         lp.detailVarScale = alpha[i];
         EawLevel f;
@@ -260,7 +256,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
             // detail noise correlates at ~0.7 after colour-weighted levels (docs/quality.md), so
             // their individual SURE choices keep noise. Adding 0·d_i to acc is a no-op, so such a
             // level runs no window passes unless its s_i map is asked for (it is then all 0).
-            const bool dropped = i < cfg.sure.firstLevel;
+            const bool dropped = i < o.sure.firstLevel;
             if (!dropped || out.sureS.valid()) {
                 runSureBoxH(exec, SureBoxH{choice.radius, detail.view(), boxH.view()});
                 ImageView sOut;
@@ -281,13 +277,13 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
 
     // 6. The safety net: F' = F + s (y - F), s chosen by SURE on the residual (safety_net.h).
     ImageView detailSum = sure ? acc.view() : ImageView{};
-    if (cfg.safety.enabled) {
+    if (o.safety.enabled) {
         if (!sure) {
             detail = Image(w, h, 2, dev);
             boxH = Image(w, h, 2, dev);
         }
         SureChoiceParams sp;
-        sp.radius = cfg.safety.windowRadius;
+        sp.radius = o.safety.windowRadius;
         exec.forEachPixel(w, h, SafetyDetail{safetyIn.view(), cur->view(), detailSum, safetyVar.view(), detail.view()});
         runSureBoxH(exec, SureBoxH{sp.radius, detail.view(), boxH.view()});
         // κ: an estimated variance (no variance buffer) can be off by a factor (spatially
@@ -301,13 +297,13 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
             exec.forEachPixel(w, h, SafetyRatio{sp.radius, boxH.view(), ratio.view()});
             kappa = std::fmax(1.0f, medianFinite(exec, ratio.view(), 1.0f));
         }
-        exec.forEachPixel(w, h, SafetyBlend{sp, kappa, cfg.safety.trigger, boxH.view(), safetyIn.view(), cur->view(), detailSum, ImageView{}});
+        exec.forEachPixel(w, h, SafetyBlend{sp, kappa, o.safety.trigger, boxH.view(), safetyIn.view(), cur->view(), detailSum, ImageView{}});
         detailSum = ImageView{};
         markStage(out.clock, "safety net");
     }
 
     // 7. out = (c_N + Σ s_i d_i) · albedo.
-    exec.forEachPixel(w, h, Recombine{cfg.albedoEpsilon, cfg.albedoFloor, cur->view(), detailSum, albedo,
+    exec.forEachPixel(w, h, Recombine{o.albedoEpsilon, o.albedoFloor, cur->view(), detailSum, albedo,
                                       emission, out.out});
     markStage(out.clock, "remodulate");
     exec.synchronize();

@@ -25,7 +25,6 @@ struct DriverDebug {
 PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, DenoiseReport& rep);
 // The InputError for a negative variance value at planar index `pixel` (of one plane).
 InputError negativeVarianceError(float value, size_t pixel, int width);
-DriverConfig makeConfig(const DenoiseOptions& o);
 // Without a variance buffer: the driver's local noise estimate (noise_estimate.h), floored at
 // kNoiseFloorFraction of the global estimate in `rep`. Nothing when cfg.varianceGiven. Measured
 // on the Mitsuba corpus (docs/quality.md): radius 5 beat 2, 3, 7 and 10; the floor at the
