@@ -427,22 +427,30 @@ def _int_list(text: str, flag: str) -> List[int]:
     return vals
 
 
-def _check_out_dir(out: str) -> None:
-    """--out must be a writable directory or creatable as one; nothing is created here."""
+def out_dir_problem(out) -> Optional[str]:
+    """Why --out cannot be used as the output directory (it must be a writable directory or
+    creatable as one), or None; nothing is created here. Also atrous.farm's check."""
     p = Path(out)
     if p.exists():
         if not p.is_dir():
-            raise UsageError(f"--out '{out}': exists and is not a directory")
+            return f"--out '{out}': exists and is not a directory"
         if not os.access(p, os.W_OK | os.X_OK):
-            raise UsageError(f"--out '{out}': directory is not writable")
-        return
+            return f"--out '{out}': directory is not writable"
+        return None
     parent = p.absolute().parent
     while not parent.exists():
         parent = parent.parent
     if not parent.is_dir():
-        raise UsageError(f"--out '{out}': {parent} is not a directory")
+        return f"--out '{out}': {parent} is not a directory"
     if not os.access(parent, os.W_OK | os.X_OK):
-        raise UsageError(f"--out '{out}': cannot create it ({parent} is not writable)")
+        return f"--out '{out}': cannot create it ({parent} is not writable)"
+    return None
+
+
+def _check_out_dir(out: str) -> None:
+    problem = out_dir_problem(out)
+    if problem:
+        raise UsageError(problem)
 
 
 def _check_sequence(seq_dir: str) -> None:

@@ -129,6 +129,32 @@ def _grid(n: int):
     return rows, cols
 
 
+def _log_axes(ax, title: str, xlabel: str, ylabel: str, xbase: Optional[int] = None) -> None:
+    """Log y (and, with xbase, log x to that base), titles and the plots' grid."""
+    if xbase:
+        ax.set_xscale("log", base=xbase)
+    ax.set_yscale("log")
+    ax.set_title(title)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(True, which="both", alpha=0.3)
+
+
+def _end_panels(fig, axes, n: int, legend_size: int, title: str) -> None:
+    """A per-scene panel figure: blank the unused panels, the legend on the first, the title."""
+    for ax in list(axes.flat)[n:]:
+        ax.axis("off")
+    axes.flat[0].legend(fontsize=legend_size)
+    fig.suptitle(title)
+
+
+def _save(plt, fig, out: Path, made: Dict[str, str], name: str) -> None:
+    fig.tight_layout()
+    fig.savefig(out / f"{name}.png", dpi=100)
+    plt.close(fig)
+    made[name] = f"{name}.png"
+
+
 def write_plots(data: Dict[str, Any], out: Path) -> Dict[str, str]:
     """Writes the PNG plots into `out`; returns {name: file name}."""
     plt = _plt()
@@ -148,21 +174,10 @@ def write_plots(data: Dict[str, Any], out: Path) -> Dict[str, str]:
         floor = data["references"].get(sc, {}).get("floor_relmse")
         if floor:
             ax.axhline(floor, color="k", ls=":", lw=1, label="reference noise")
-        ax.set_xscale("log", base=2)
-        ax.set_yscale("log")
-        ax.set_title(sc)
-        ax.set_xlabel("input spp")
-        ax.set_ylabel("relMSE")
-        ax.grid(True, which="both", alpha=0.3)
-    for ax in list(axes.flat)[len(scenes):]:
-        ax.axis("off")
-    axes.flat[0].legend(fontsize=8)
-    fig.suptitle(f"relMSE vs spp ({data['config']['width']}x{data['config']['height']}, "
-                 f"reference {data['config']['ref_spp']} spp)")
-    fig.tight_layout()
-    fig.savefig(out / "quality_vs_spp.png", dpi=100)
-    plt.close(fig)
-    made["quality_vs_spp"] = "quality_vs_spp.png"
+        _log_axes(ax, sc, "input spp", "relMSE", xbase=2)
+    _end_panels(fig, axes, len(scenes), 8, f"relMSE vs spp ({data['config']['width']}x{data['config']['height']}, "
+                f"reference {data['config']['ref_spp']} spp)")
+    _save(plt, fig, out, made, "quality_vs_spp")
 
     # 2. Equal time: relMSE vs total time (render + denoise) per scene.
     et = data.get("equal_time") or []
@@ -183,21 +198,10 @@ def write_plots(data: Dict[str, Any], out: Path) -> Dict[str, str]:
                 p = sorted((r["total_ms"], r["denoised_relmse"]) for r in et if r["scene"] == sc and r["method"] == m)
                 if p:
                     ax.plot(*zip(*p), "s-", color=COLORS.get(m), label=f"{m} (render + denoise)")
-            ax.set_xscale("log")
-            ax.set_yscale("log")
-            ax.xaxis.set_minor_formatter(_null_formatter())
-            ax.set_title(sc)
-            ax.set_xlabel("render + denoise time (ms)")
-            ax.set_ylabel("relMSE")
-            ax.grid(True, which="both", alpha=0.3)
-        for ax in list(axes.flat)[len(scenes):]:
-            ax.axis("off")
-        axes.flat[0].legend(fontsize=7)
-        fig.suptitle("Equal time: relMSE vs time spent")
-        fig.tight_layout()
-        fig.savefig(out / "equal_time.png", dpi=100)
-        plt.close(fig)
-        made["equal_time"] = "equal_time.png"
+            _log_axes(ax, sc, "render + denoise time (ms)", "relMSE", xbase=10)
+            ax.xaxis.set_minor_formatter(_null_formatter())  # after the scale, which resets it
+        _end_panels(fig, axes, len(scenes), 7, "Equal time: relMSE vs time spent")
+        _save(plt, fig, out, made, "equal_time")
 
     # 3. Runtime vs resolution.
     rt = data.get("runtime_vs_resolution") or []
@@ -206,17 +210,10 @@ def write_plots(data: Dict[str, Any], out: Path) -> Dict[str, str]:
         for m in list(dict.fromkeys(r["method"] for r in rt)):
             p = sorted((r["megapixels"], r["ms"]) for r in rt if r["method"] == m)
             ax.plot(*zip(*p), "o--" if m.startswith("render") else "o-", color=COLORS.get(m), label=m)
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel("megapixels")
-        ax.set_ylabel("ms (median)")
-        ax.set_title(f"Denoise time vs resolution ({data['environment'].get('cpu_count')} CPU threads)")
-        ax.grid(True, which="both", alpha=0.3)
+        _log_axes(ax, f"Denoise time vs resolution ({data['environment'].get('cpu_count')} CPU threads)",
+                  "megapixels", "ms (median)", xbase=10)
         ax.legend(fontsize=8)
-        fig.tight_layout()
-        fig.savefig(out / "runtime_vs_resolution.png", dpi=100)
-        plt.close(fig)
-        made["runtime_vs_resolution"] = "runtime_vs_resolution.png"
+        _save(plt, fig, out, made, "runtime_vs_resolution")
 
     # 4. Quality per millisecond: relMSE reduction vs denoise time, one point per scene x spp.
     by = {(r["scene"], r["spp"], r["method"]): r for r in rows}
@@ -231,18 +228,13 @@ def write_plots(data: Dict[str, Any], out: Path) -> Dict[str, str]:
             any_pt = True
             ax.scatter(*zip(*p), color=COLORS.get(m), label=m, alpha=0.8)
     if any_pt:
-        ax.set_xscale("log")
-        ax.set_yscale("log")
         ax.axhline(1.0, color="k", lw=0.8)
-        ax.set_xlabel("denoise time (ms, median)")
-        ax.set_ylabel("relMSE reduction over noisy (x)")
-        ax.set_title("Quality per millisecond (one point per scene x spp)")
-        ax.grid(True, which="both", alpha=0.3)
+        _log_axes(ax, "Quality per millisecond (one point per scene x spp)", "denoise time (ms, median)",
+                  "relMSE reduction over noisy (x)", xbase=10)
         ax.legend(fontsize=8)
-        fig.tight_layout()
-        fig.savefig(out / "quality_per_ms.png", dpi=100)
-        made["quality_per_ms"] = "quality_per_ms.png"
-    plt.close(fig)
+        _save(plt, fig, out, made, "quality_per_ms")
+    else:
+        plt.close(fig)
 
     # 5. Sequence: per-frame relMSE.
     seq = data.get("sequence")
@@ -252,16 +244,9 @@ def write_plots(data: Dict[str, Any], out: Path) -> Dict[str, str]:
             ys = [f["relmse"].get(m) for f in seq["frames"]]
             if any(y is not None for y in ys):
                 ax.plot(range(len(ys)), ys, "o-", ms=3, color=COLORS.get(m), label=m)
-        ax.set_yscale("log")
-        ax.set_xlabel("frame")
-        ax.set_ylabel("relMSE")
-        ax.set_title("Sequence: relMSE per frame")
-        ax.grid(True, which="both", alpha=0.3)
+        _log_axes(ax, "Sequence: relMSE per frame", "frame", "relMSE")
         ax.legend(fontsize=8)
-        fig.tight_layout()
-        fig.savefig(out / "sequence.png", dpi=100)
-        plt.close(fig)
-        made["sequence"] = "sequence.png"
+        _save(plt, fig, out, made, "sequence")
     return made
 
 

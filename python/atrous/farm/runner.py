@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional
 
+from ..eval import out_dir_problem
 from .items import FarmInputError, Item
 from .manifest import Manifest, load, utc_now
 from .progress import Progress, summary_table
@@ -51,18 +52,10 @@ class JobResult:
 
 
 def check_out_dir(out: Path) -> None:
-    """OUT must be a writable directory or creatable as one."""
-    if out.exists():
-        if not out.is_dir():
-            raise FarmInputError(f"--out '{out}': exists and is not a directory")
-        if not os.access(out, os.W_OK | os.X_OK):
-            raise FarmInputError(f"--out '{out}': directory is not writable")
-        return
-    parent = out.absolute().parent
-    while not parent.exists():
-        parent = parent.parent
-    if not parent.is_dir() or not os.access(parent, os.W_OK | os.X_OK):
-        raise FarmInputError(f"--out '{out}': cannot create it ({parent} is not a writable directory)")
+    """OUT must be a writable directory or creatable as one (the same rule as atrous-eval's --out)."""
+    problem = out_dir_problem(out)
+    if problem:
+        raise FarmInputError(problem)
 
 
 def connect(address: str, num_cpus: Optional[int] = None) -> bool:
