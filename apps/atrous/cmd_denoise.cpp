@@ -118,14 +118,7 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     if (sequence) {
         if (!a.inDir.empty() || !a.color.empty())
             throw InputError("--sequence DIR denoises the frames of DIR: drop --in/--color");
-        SequenceDenoiseArgs s;
-        s.method = a.method;
-        s.sequenceDir = a.sequence;
-        s.outDir = a.out;
-        s.device = o.device;
-        s.svgf = a.svgf;
-        s.frameOptions = o;
-        runSequenceDenoise(s);
+        runSequenceDenoise(SequenceDenoiseArgs{a.method, a.sequence, a.out, o.device, a.svgf, o});
         return;
     }
     const std::string ext = io::extensionOf(a.out);

@@ -49,14 +49,11 @@ uint32_t referenceSeed(uint32_t seed) { return seed + 0x9E3779B9u; }
 void writeBuffers(const std::string& dir, const RenderBuffers& b, bool withVariance = true) {
     namespace fs = std::filesystem;
     auto path = [&](const std::string& name) { return (fs::path(dir) / name).string(); };
-    io::writeImage(path("color.exr"), b.color);
-    if (withVariance) io::writeImage(path("variance.exr"), b.variance);
-    io::writeImage(path("albedo.exr"), b.albedo);
-    io::writeImage(path("normal.exr"), b.normal);
-    io::writeImage(path("position.exr"), b.position);
-    io::writeImage(path("depth.exr"), b.depth);
-    io::writeImage(path("ids.exr"), b.ids);
-    if (!b.emission.empty()) io::writeImage(path("emission.exr"), b.emission);
+    for (const RenderBufferField& f : kRenderBufferFields) {  // NAME.exr for every buffer it has
+        const Image& img = b.*f.image;
+        if (!img.empty() && (withVariance || f.image != &RenderBuffers::variance))
+            io::writeImage(path(std::string(f.name) + ".exr"), img);
+    }
 }
 
 // `atrous render --frames F`: DIR/frame_NNNN/ per frame (time t = f / max(F - 1, 1)) with the
@@ -112,8 +109,7 @@ void runFrames(const RenderArgs& a) {
         fs::remove_all(stage, ec);
         io::ensureWritableDirectory(stage);
         try {
-            writeBuffers(stage, b, /*withVariance=*/s.spp > 1);
-            io::writeImage((fs::path(stage) / "motion.exr").string(), b.motion);
+            writeBuffers(stage, b, /*withVariance=*/s.spp > 1);  // motion.exr too
             if (!reference.empty()) io::writeImage((fs::path(stage) / "reference.exr").string(), reference);
             io::writePng((fs::path(stage) / "color.png").string(), b.color);
         } catch (...) {

@@ -57,6 +57,18 @@ struct RenderBuffers {
     Image motion, emission;
 };
 
+// RenderBuffers' images by name, in declaration order: the file NAME.exr the CLI writes, the key
+// of Python's dict. Code that handles every buffer walks this list.
+struct RenderBufferField {
+    const char* name;
+    Image RenderBuffers::*image;
+};
+inline constexpr RenderBufferField kRenderBufferFields[] = {
+    {"color", &RenderBuffers::color},   {"variance", &RenderBuffers::variance}, {"albedo", &RenderBuffers::albedo},
+    {"normal", &RenderBuffers::normal}, {"position", &RenderBuffers::position}, {"depth", &RenderBuffers::depth},
+    {"ids", &RenderBuffers::ids},       {"motion", &RenderBuffers::motion},     {"emission", &RenderBuffers::emission},
+};
+
 // Camera paths of animations (docs/scenes.md, "Animation"). Time t in [0, 1] spans the sequence.
 //   Static     the scene's camera at every t
 //   Orbit      turns about the vertical axis through the camera's target, -10..+10 degrees

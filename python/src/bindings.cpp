@@ -268,15 +268,8 @@ RenderSettings renderSettings(nb::dict params) {
 // The render's buffers as a dict of H x W x 3 arrays (motion only when the render made one).
 nb::dict buffersDict(RenderBuffers&& b) {
     nb::dict d;
-    d["color"] = fromImage(std::move(b.color));
-    d["variance"] = fromImage(std::move(b.variance));
-    d["albedo"] = fromImage(std::move(b.albedo));
-    d["normal"] = fromImage(std::move(b.normal));
-    d["position"] = fromImage(std::move(b.position));
-    d["depth"] = fromImage(std::move(b.depth));
-    d["ids"] = fromImage(std::move(b.ids));
-    d["emission"] = fromImage(std::move(b.emission));
-    if (!b.motion.empty()) d["motion"] = fromImage(std::move(b.motion));
+    for (const RenderBufferField& f : kRenderBufferFields)
+        if (!(b.*f.image).empty()) d[f.name] = fromImage(std::move(b.*f.image));
     return d;
 }
 

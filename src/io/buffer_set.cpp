@@ -65,16 +65,10 @@ DenoiseInputs denoiseInputs(const BufferRefs& r) {
     return in;
 }
 
+// The same buffers as denoiseInputs() gives, plus motion (SvgfFrame's order).
 SvgfFrame svgfFrame(const BufferRefs& r) {
-    SvgfFrame f;
-    f.color = r.get(Buffer::Color);
-    f.albedo = r.get(Buffer::Albedo);
-    f.normal = r.get(Buffer::Normal);
-    f.depth = r.get(Buffer::Depth);
-    f.ids = r.get(Buffer::ObjectId);
-    f.motion = r.get(Buffer::Motion);
-    f.emission = r.get(Buffer::Emission);
-    return f;
+    const DenoiseInputs in = denoiseInputs(r);
+    return SvgfFrame{in.color, in.albedo, in.normal, in.depth, in.ids, r.get(Buffer::Motion), in.emission};
 }
 
 Image readBufferFile(const std::string& path, Buffer b, const std::vector<PassRequest>& passes,

@@ -57,14 +57,8 @@ namespace detail {
 
 inline RenderBuffers allocateRenderBuffers(int w, int h, Device device) {
     RenderBuffers b;
-    b.color = Image(w, h, 3, device);
-    b.variance = Image(w, h, 3, device);
-    b.albedo = Image(w, h, 3, device);
-    b.normal = Image(w, h, 3, device);
-    b.position = Image(w, h, 3, device);
-    b.depth = Image(w, h, 3, device);
-    b.ids = Image(w, h, 3, device);
-    b.emission = Image(w, h, 3, device);  // motion stays empty: still images only
+    for (const RenderBufferField& f : kRenderBufferFields)
+        if (f.image != &RenderBuffers::motion) b.*f.image = Image(w, h, 3, device);  // motion: still images have none
     return b;
 }
 

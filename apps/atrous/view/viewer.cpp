@@ -158,13 +158,7 @@ void runViewer(const ViewerOptions& opt) {
 
         // ---- display image: every frame (exposure and the view can change while paused) ----
         Timer dispTimer;
-        DisplaySettings ds;
-        ds.view = st.view;
-        ds.split = ps.split;
-        ds.splitPos = st.splitPos;
-        ds.exposure = st.exposure;
-        ds.level = st.level;
-        st.viewNote = display.update(pl, ds);
+        st.viewNote = display.update(pl, DisplaySettings{st.view, ps.split, st.splitPos, st.exposure, st.level});
         const double displayTime = dispTimer.ms();
 
         // ---- UI ----
