@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cfloat>
+#include <climits>
 #include <cmath>
 #include <cstdint>
 #include <initializer_list>
@@ -70,11 +71,54 @@ void statusSection(const ViewPipeline& pl, const StageHistory& history, const Pa
         stageTable(history);
 }
 
+// One control per row of a parameter table (params.h), labelled with the row's name, its doc
+// line as the tooltip, limited to its range. Out-of-range values the drags can still reach (the
+// open end of (0, 1]) and cross-field rules surface as the slot's error.
+template <class S>
+void paramControl(S& s, const ParamTable<S>& t, const ParamField<S>& f, ViewerState& st) {
+    const ParamRef r = f.at(s);
+    const auto finite = [](double v, float inf) { return std::isinf(v) ? inf : float(v); };
+    if (int* const* i = std::get_if<int*>(&r)) {
+        const int lo = int(f.range.lo), hi = std::isinf(f.range.hi) ? INT_MAX : int(f.range.hi);
+        if (hi - lo <= 64)
+            ImGui::SliderInt(f.name, *i, lo, hi);
+        else
+            ImGui::DragInt(f.name, *i, 0.2f, lo, hi);
+    } else if (float* const* x = std::get_if<float*>(&r)) {
+        static const S defaults{};
+        const float d = *std::get<float*>(f.at(const_cast<S&>(defaults)));
+        const float speed = std::max(std::fabs(d), 0.01f) * 0.01f;
+        ImGui::DragFloat(f.name, *x, speed, f.range.zero ? 0.0f : finite(f.range.lo, -FLT_MAX), finite(f.range.hi, FLT_MAX),
+                         "%.4g");
+    } else if (bool* const* b = std::get_if<bool*>(&r)) {
+        ImGui::Checkbox(f.name, *b);
+    } else if (SureMode* const* m = std::get_if<SureMode*>(&r)) {
+        int n = 0, v = int(**m);
+        while (f.choices[n]) ++n;
+        if (ImGui::Combo(f.name, &v, f.choices, n)) **m = SureMode(v);
+    } else if (ImGui::InputText(f.name, st.candidatesText, sizeof(st.candidatesText))) {
+        try {
+            setParamFromText(s, t, f, st.candidatesText);
+        } catch (const ParamError&) {
+            // half-typed: keep the last list that parsed
+        }
+    }
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", f.doc);
+}
+
 // Samples, depth, accumulation, pause, exposure, camera.
 void renderSection(ViewerState& st, CameraInput& input, ViewPipeline& pl, PanelActions& a) {
     PipelineSettings& ps = st.ps;
-    if (ImGui::SliderInt("spp / frame", &ps.sppPerFrame, 1, 64)) pl.resetAccumulation();
-    if (ImGui::SliderInt("max depth", &ps.maxDepth, 0, 32)) pl.resetAccumulation();
+    // spp (per frame) and max_depth: the render table's rows (name, doc line, range).
+    RenderSettings rs;
+    rs.spp = ps.sppPerFrame;
+    rs.maxDepth = ps.maxDepth;
+    for (const char* name : {"spp", "max_depth"}) paramControl(rs, renderParams(), *renderParams().find(name), st);
+    if (rs.spp != ps.sppPerFrame || rs.maxDepth != ps.maxDepth) {
+        ps.sppPerFrame = rs.spp;
+        ps.maxDepth = rs.maxDepth;
+        pl.resetAccumulation();
+    }
     if (ImGui::Checkbox("accumulate", &ps.accumulate)) pl.resetAccumulation();
     ImGui::SameLine();
     ImGui::Checkbox("pause", &st.paused);
@@ -108,41 +152,6 @@ void methodSection(ViewerState& st, const ViewPipeline& pl) {
         if (!pl.slot(i).error.empty())
             ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s: %s", i ? "B" : "A",
                                pl.slot(i).error.c_str());
-}
-
-// One control per row of a parameter table (params.h), labelled with the row's name, its doc
-// line as the tooltip, limited to its range. Out-of-range values the drags can still reach (the
-// open end of (0, 1]) and cross-field rules surface as the slot's error.
-template <class S>
-void paramControl(S& s, const ParamTable<S>& t, const ParamField<S>& f, ViewerState& st) {
-    const ParamRef r = f.at(s);
-    const auto finite = [](double v, float inf) { return std::isinf(v) ? inf : float(v); };
-    if (int* const* i = std::get_if<int*>(&r)) {
-        const int lo = int(f.range.lo), hi = int(f.range.hi);
-        if (hi - lo <= 64)
-            ImGui::SliderInt(f.name, *i, lo, hi);
-        else
-            ImGui::DragInt(f.name, *i, 0.2f, lo, hi);
-    } else if (float* const* x = std::get_if<float*>(&r)) {
-        static const S defaults{};
-        const float d = *std::get<float*>(f.at(const_cast<S&>(defaults)));
-        const float speed = std::max(std::fabs(d), 0.01f) * 0.01f;
-        ImGui::DragFloat(f.name, *x, speed, f.range.zero ? 0.0f : finite(f.range.lo, -FLT_MAX), finite(f.range.hi, FLT_MAX),
-                         "%.4g");
-    } else if (bool* const* b = std::get_if<bool*>(&r)) {
-        ImGui::Checkbox(f.name, *b);
-    } else if (SureMode* const* m = std::get_if<SureMode*>(&r)) {
-        int n = 0, v = int(**m);
-        while (f.choices[n]) ++n;
-        if (ImGui::Combo(f.name, &v, f.choices, n)) **m = SureMode(v);
-    } else if (ImGui::InputText(f.name, st.candidatesText, sizeof(st.candidatesText))) {
-        try {
-            setParamFromText(s, t, f, st.candidatesText);
-        } catch (const ParamError&) {
-            // half-typed: keep the last list that parsed
-        }
-    }
-    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", f.doc);
 }
 
 // The rows of `groups` (a row's group is one of them) under a collapsing header.
