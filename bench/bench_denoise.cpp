@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "atrous/denoise.h"
+#include "../tests/denoise_test_util.h"  // inputsOf
 #include "bench_cli.h"
 #include "core/timer.h"
 
@@ -61,17 +62,7 @@ struct Buffers {
                 position(x, y, 2) = z;
             }
     }
-    DenoiseInputs inputs() const {
-        DenoiseInputs in;
-        in.color = &color;
-        in.variance = &variance;
-        in.albedo = &albedo;
-        in.normal = &normal;
-        in.position = &position;
-        in.depth = &depth;
-        in.ids = &ids;
-        return in;
-    }
+    DenoiseInputs inputs() const { return test::inputsOf(color, variance, albedo, normal, position, depth, ids); }
 };
 
 }  // namespace

@@ -9,19 +9,23 @@
 
 namespace atrous::test {
 
+// DenoiseInputs over seven buffers the caller keeps alive (emission unset). Also bench_denoise's.
+inline DenoiseInputs inputsOf(const Image& color, const Image& variance, const Image& albedo, const Image& normal,
+                              const Image& position, const Image& depth, const Image& ids) {
+    DenoiseInputs in;
+    in.color = &color;
+    in.variance = &variance;
+    in.albedo = &albedo;
+    in.normal = &normal;
+    in.position = &position;
+    in.depth = &depth;
+    in.ids = &ids;
+    return in;
+}
+
 struct SyntheticScene {
     Image truth, noisy, variance, albedo, normal, position, depth, ids;
-    DenoiseInputs inputs() const {
-        DenoiseInputs in;
-        in.color = &noisy;
-        in.variance = &variance;
-        in.albedo = &albedo;
-        in.normal = &normal;
-        in.position = &position;
-        in.depth = &depth;
-        in.ids = &ids;
-        return in;
-    }
+    DenoiseInputs inputs() const { return inputsOf(noisy, variance, albedo, normal, position, depth, ids); }
 };
 
 // Region 0: back wall at z = 5 (normal +z), 1: a box face at z = 3, 2: a disk at z = 2 (normal

@@ -16,13 +16,7 @@
 using namespace atrous;
 using atrous::test::TempDir;
 
-static Image ramp(int w, int h) {
-    Image img(w, h, 3);
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x)
-            for (int c = 0; c < 3; ++c) img(x, y, c) = 0.1f * x + 10.0f * y + 100.0f * c + 0.125f;
-    return img;
-}
+static Image ramp(int w, int h) { return test::rampImage(w, h, 0.1f, 10.0f, 100.0f); }
 
 static void expectSame(const Image& a, const Image& b) {
     ASSERT_EQ(a.width(), b.width());

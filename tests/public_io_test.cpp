@@ -12,13 +12,7 @@
 using namespace atrous;
 using atrous::test::TempDir;
 
-static Image ramp(int w, int h) {
-    Image img(w, h, 3);
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x)
-            for (int c = 0; c < 3; ++c) img(x, y, c) = 0.25f * x - 3.0f * y + 1000.0f * c + 0.125f;
-    return img;
-}
+static Image ramp(int w, int h) { return test::rampImage(w, h, 0.25f, -3.0f, 1000.0f); }
 
 TEST(PublicIo, ExrAndPfmRoundTripsAreExact) {
     // Both formats store 32-bit floats, so the values come back bit for bit (no tolerance).

@@ -15,14 +15,21 @@
 
 using namespace atrous;
 
-TEST(StageTimes, EawReportListsEveryStageInOrder) {
-    const test::SyntheticScene scene = test::makeScene(48, 40, 0.3f, 7);
+// The stage report of one still denoise (default options but the method and level count) of a
+// 48 x 40 synthetic scene.
+static DenoiseReport stillReport(DenoiseMethod method, int levels, unsigned seed) {
+    const test::SyntheticScene scene = test::makeScene(48, 40, 0.3f, seed);
     DenoiseOptions o;
-    o.method = DenoiseMethod::Eaw;
-    o.eaw.levels = 3;
+    o.method = method;
+    o.eaw.levels = levels;
     DenoiseReport rep;
     o.report = &rep;
     denoise(scene.inputs(), o);
+    return rep;
+}
+
+TEST(StageTimes, EawReportListsEveryStageInOrder) {
+    const DenoiseReport rep = stillReport(DenoiseMethod::Eaw, 3, 7);
     const std::vector<std::string> expected = {"sanitize", "fireflies",  "demodulate", "sigma scales", "level 0",
                                                "level 1",  "level 2", "remodulate"};
     EXPECT_EQ(test::stageNames(rep.stages), expected);
@@ -33,13 +40,7 @@ TEST(StageTimes, EawReportListsEveryStageInOrder) {
 }
 
 TEST(StageTimes, SureReportHasTheChoiceAfterEachLevel) {
-    const test::SyntheticScene scene = test::makeScene(48, 40, 0.3f, 8);
-    DenoiseOptions o;
-    o.method = DenoiseMethod::Sure;
-    o.eaw.levels = 2;
-    DenoiseReport rep;
-    o.report = &rep;
-    denoise(scene.inputs(), o);
+    const DenoiseReport rep = stillReport(DenoiseMethod::Sure, 2, 8);
     const std::vector<std::string> expected = {"sanitize", "fireflies", "demodulate", "sigma scales", "level 0",
                                                "sure 0",   "level 1",   "sure 1",     "remodulate"};
     EXPECT_EQ(test::stageNames(rep.stages), expected);

@@ -10,7 +10,19 @@
 #include <random>
 #include <string>
 
+#include "atrous/image.h"
+
 namespace atrous::test {
+
+// A 3-channel affine ramp, img(x, y, c) = dx·x + dy·y + dc·c + 0.125 (the I/O round-trip tests'
+// image: distinct values per pixel and channel for distinct steps).
+inline Image rampImage(int w, int h, float dx, float dy, float dc) {
+    Image img(w, h, 3);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c) img(x, y, c) = dx * x + dy * y + dc * c + 0.125f;
+    return img;
+}
 
 // A fresh directory under the system temp dir, removed when the object dies.
 class TempDir {
