@@ -1,8 +1,9 @@
 // The CPU instruction set the hot loops run with, chosen once per process. The library is
 // compiled for baseline x86-64 (SSE2), so it runs on every x86-64 CPU; the loops that pay for it
 // are compiled three times (cpu_simd.h: baseline, AVX2+FMA = x86-64-v3, AVX-512) and the dispatch
-// (parallelForIsa, src/cpu/atrous_rows.h, which CpuExec's loops also go through) picks one of
-// them from activeIsa(). activeIsa() is the best this CPU has (CPUID), or what the environment
+// (parallelForIsa, src/cpu/isa_dispatch.h) picks one of
+// them from activeIsa() (the functors CpuExec runs are compiled for the baseline only:
+// src/core/parallel.h says why). activeIsa() is the best this CPU has (CPUID), or what the environment
 // variable ATROUS_CPU_ISA=baseline|avx2|avx512 asks for; asking for an unknown name or an ISA the
 // CPU lacks is an InputError (one line) at the first CPU loop, never an illegal instruction.
 #pragma once

@@ -1,7 +1,7 @@
 // The one place the CPU loops pick their instruction set (src/cpu/cpu_isa.h): parallelForIsa
 // runs a body compiled for baseline x86-64, AVX2 (x86-64-v3) or AVX-512 on TBB threads. The row
-// engine (atrous_rows.h), the CPU stages of src/cpu and CpuExec's loops (src/core/parallel.h) all
-// come through here, so no stage writes its own dispatch.
+// engine (atrous_rows.h) and the row loops of src/cpu come through here, so no stage writes its
+// own dispatch.
 #pragma once
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -12,7 +12,7 @@ namespace atrous::cpu {
 
 // ISA dispatch, written once: body(i0, i1) (a force-inlined or flattened operator()) compiled
 // for baseline x86-64, AVX2 (x86-64-v3) and AVX-512, run over [begin, end) in TBB blocks of
-// `grain` with the loops of `isa`. CpuExec's loops (src/core/parallel.h) come here too.
+// `grain` with the loops of `isa`.
 template <class Body, class Index>
 ATROUS_TARGET_BASELINE void isaRangeBaseline(const Body& body, Index i0, Index i1) {
     body(i0, i1);
