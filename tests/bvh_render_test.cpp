@@ -13,18 +13,12 @@
 #include "atrous/error.h"
 #include "atrous/render.h"
 #include "render/bvh_render.h"
+#include "render_test_util.h"
 
 namespace atrous {
 namespace {
 
-RenderSettings small(int w, int h, int spp) {
-    RenderSettings s;
-    s.width = w;
-    s.height = h;
-    s.spp = spp;
-    s.seed = 3;
-    return s;
-}
+RenderSettings small(int w, int h, int spp) { return test::smallRender(w, h, spp, 3); }
 
 struct Diff {
     double meanA = 0, meanB = 0;  // image means (all channels)

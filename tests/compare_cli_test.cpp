@@ -25,6 +25,11 @@ Image ramp(int w, int h) {
     return img;
 }
 
+// `atrous compare [--json] --ref REF IMG` on files in `dir`.
+CliResult compare(const TempDir& dir, const std::string& ref, const std::string& img, bool json = false) {
+    return runCli(std::string("compare ") + (json ? "--json " : "") + "--ref " + (dir / ref) + " " + (dir / img));
+}
+
 }  // namespace
 
 TEST(CompareCli, ReportsNonFinitePixels) {
@@ -35,18 +40,18 @@ TEST(CompareCli, ReportsNonFinitePixels) {
     bad(9, 9, 1) = -INFINITY;
     io::writeImage(dir / "ref.exr", ref);
     io::writeImage(dir / "bad.exr", bad);
-    CliResult text = runCli("compare --ref " + (dir / "ref.exr") + " " + (dir / "bad.exr"));
+    CliResult text = compare(dir, "ref.exr", "bad.exr");
     ASSERT_EQ(text.exitCode, 0) << text.output;
     EXPECT_NE(text.output.find("bad.exr has 2 non-finite"), std::string::npos) << text.output;
-    CliResult json = runCli("compare --json --ref " + (dir / "ref.exr") + " " + (dir / "bad.exr"));
+    CliResult json = compare(dir, "ref.exr", "bad.exr", true);
     ASSERT_EQ(json.exitCode, 0) << json.output;
     EXPECT_NE(json.output.find("\"non_finite_pixels\": 2"), std::string::npos) << json.output;
     EXPECT_NE(json.output.find("\"reference_non_finite_pixels\": 0"), std::string::npos) << json.output;
     // A clean image gets no note.
-    CliResult clean = runCli("compare --ref " + (dir / "ref.exr") + " " + (dir / "ref.exr"));
+    CliResult clean = compare(dir, "ref.exr", "ref.exr");
     EXPECT_EQ(clean.output.find("non-finite"), std::string::npos) << clean.output;
     // A broken reference is named.
-    CliResult badRef = runCli("compare --ref " + (dir / "bad.exr") + " " + (dir / "ref.exr"));
+    CliResult badRef = compare(dir, "bad.exr", "ref.exr");
     EXPECT_NE(badRef.output.find("reference " + (dir / "bad.exr") + " has 2 non-finite"), std::string::npos)
         << badRef.output;
 }
@@ -56,9 +61,9 @@ TEST(CompareCli, NotesThatAPngIsNotHdr) {
     Image ref = ramp(8, 8);
     io::writeImage(dir / "ref.exr", ref);
     io::writeImage(dir / "ref.png", ref);
-    CliResult r = runCli("compare --ref " + (dir / "ref.exr") + " " + (dir / "ref.png"));
+    CliResult r = compare(dir, "ref.exr", "ref.png");
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_NE(r.output.find("ref.png is an 8-bit PNG"), std::string::npos) << r.output;
-    CliResult exr = runCli("compare --ref " + (dir / "ref.exr") + " " + (dir / "ref.exr"));
+    CliResult exr = compare(dir, "ref.exr", "ref.exr");
     EXPECT_EQ(exr.output.find("8-bit"), std::string::npos) << exr.output;
 }

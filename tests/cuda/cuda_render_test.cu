@@ -15,19 +15,13 @@
 #include "atrous/device.h"
 #include "atrous/render.h"
 #include "render/bvh_render.h"
+#include "../render_test_util.h"
 #include "render/scene_data.h"
 
 namespace atrous {
 namespace {
 
-RenderSettings small(int w, int h, int spp) {
-    RenderSettings s;
-    s.width = w;
-    s.height = h;
-    s.spp = spp;
-    s.seed = 5;
-    return s;
-}
+RenderSettings small(int w, int h, int spp) { return test::smallRender(w, h, spp, 5); }
 
 }  // namespace
 
