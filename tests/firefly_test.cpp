@@ -28,6 +28,21 @@ struct Flat {
         in.variance = &var;
         return in;
     }
+    // A bright pixel: `value` in R, G, B with a variance of the mean of sd² per channel.
+    void spike(int x, int y, float value, float sd) {
+        for (int c = 0; c < 3; ++c) {
+            color(x, y, c) = value;
+            var(x, y, c) = sd * sd;
+        }
+    }
+    // The report of a denoise with the default options.
+    DenoiseReport defaultReport() const {
+        DenoiseReport rep;
+        DenoiseOptions o;
+        o.report = &rep;
+        denoise(inputs(), o);
+        return rep;
+    }
 };
 
 }  // namespace
@@ -36,10 +51,7 @@ TEST(Firefly, ClampsAnOutlierAndLeavesNoiseAlone) {
     Flat f(64, 64, 1);
     // One firefly: one huge sample among n raises the mean by E and reports a variance of the
     // mean of about E² (what the renderer's variance buffer holds for it).
-    for (int c = 0; c < 3; ++c) {
-        f.color(30, 20, c) = 500.0f;
-        f.var(30, 20, c) = 500.0f * 500.0f;
-    }
+    f.spike(30, 20, 500.0f, 500.0f);
     DenoiseReport rep;
     DenoiseOptions o;
     o.method = DenoiseMethod::Eaw;
@@ -63,10 +75,7 @@ TEST(Firefly, ClampsAnOutlierAndLeavesNoiseAlone) {
 
 TEST(Firefly, ParametersChangeTheOutput) {
     Flat f(48, 48, 2);
-    for (int c = 0; c < 3; ++c) {
-        f.color(10, 10, c) = 50.0f;
-        f.var(10, 10, c) = 50.0f * 50.0f;
-    }
+    f.spike(10, 10, 50.0f, 50.0f);
     DenoiseOptions base;
     const Image ref = denoise(f.inputs(), base);
     DenoiseOptions off = base;
@@ -81,16 +90,9 @@ TEST(Firefly, TwoPixelClusterIsClamped) {
     // The brightest neighbour is left out of the local statistics, so a firefly next to another
     // one does not vouch for it.
     Flat f(32, 32, 3);
-    for (int c = 0; c < 3; ++c) {
-        f.color(10, 10, c) = 200.0f;
-        f.color(11, 10, c) = 150.0f;
-        f.var(10, 10, c) = 200.0f * 200.0f;
-        f.var(11, 10, c) = 150.0f * 150.0f;
-    }
-    DenoiseReport rep;
-    DenoiseOptions o;
-    o.report = &rep;
-    denoise(f.inputs(), o);
+    f.spike(10, 10, 200.0f, 200.0f);
+    f.spike(11, 10, 150.0f, 150.0f);
+    const DenoiseReport rep = f.defaultReport();
     EXPECT_NEAR(rep.meanLuminanceAfterFirefly, 0.5, 0.01);
 }
 
@@ -98,14 +100,8 @@ TEST(Firefly, BrightPixelWithLowOwnVarianceIsSignal) {
     // The sun seen directly: very bright, but its own standard deviation (here 10% of its excess)
     // says most samples agree, so it is kept (docs/denoising.md, "Fireflies": only implausible pixels).
     Flat f(32, 32, 5);
-    for (int c = 0; c < 3; ++c) {
-        f.color(16, 16, c) = 1000.0f;
-        f.var(16, 16, c) = 100.0f * 100.0f;
-    }
-    DenoiseReport rep;
-    DenoiseOptions o;
-    o.report = &rep;
-    denoise(f.inputs(), o);
+    f.spike(16, 16, 1000.0f, 100.0f);
+    const DenoiseReport rep = f.defaultReport();
     EXPECT_EQ(rep.firefliesClamped, 0);
     EXPECT_NEAR(rep.meanLuminanceAfterFirefly, rep.meanLuminanceIn, 1e-6);
 }
