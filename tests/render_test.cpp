@@ -17,19 +17,13 @@
 #include "render/lights.h"
 #include "render/sampling.h"
 #include "render/scene_data.h"
+#include "render_test_util.h"
 #include "test_util.h"
 
 namespace atrous {
 namespace {
 
-RenderSettings small(int w, int h, int spp, uint32_t seed = 1) {
-    RenderSettings s;
-    s.width = w;
-    s.height = h;
-    s.spp = spp;
-    s.seed = seed;
-    return s;
-}
+RenderSettings small(int w, int h, int spp, uint32_t seed = 1) { return test::smallRender(w, h, spp, seed); }
 
 // A diffuse sphere of albedo 0.5 seen from z = 5 under a uniform environment of radiance 1, given
 // either as a constant or as an EXR map (which goes through the 2D importance-sampling tables).

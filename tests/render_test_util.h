@@ -1,4 +1,4 @@
-// Render settings of the small renders the render tests run (tests/bvh_render_test.cpp,
+// Render settings of the small renders the render tests run (tests/render_test.cpp, bvh_render_test.cpp,
 // tests/cuda/cuda_render_test.cu): size and sample count, one fixed seed, the rest the defaults.
 #pragma once
 #include <cstdint>
