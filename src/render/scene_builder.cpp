@@ -7,6 +7,22 @@
 
 namespace atrous::pt {
 
+namespace {
+
+// cdf[0..n] of n non-negative weights f with sum `sum`: the running sums over the sum (uniform
+// steps when the sum is 0), cdf[0] = 0 and cdf[n] = 1 exactly. The env map's rows and marginal.
+void fillCdf(float* cdf, const double* f, int n, double sum) {
+    double run = 0.0;
+    cdf[0] = 0.0f;
+    for (int i = 0; i < n; ++i) {
+        run += f[i];
+        cdf[i + 1] = sum > 0.0 ? float(run / sum) : float(i + 1) / float(n);
+    }
+    cdf[n] = 1.0f;
+}
+
+}  // namespace
+
 std::shared_ptr<SceneData> SceneBuilder::finalize() {
     // Bounding sphere of geometry and camera (ray offsets, environment light power).
     Vec3 lo(1e30f), hi(-1e30f);
@@ -60,25 +76,13 @@ std::shared_ptr<SceneData> SceneBuilder::finalize() {
                 f[x] = std::max(0.0, double(luminance(Vec3(p[0], p[plane], p[2 * plane])))) * sinTheta;
                 acc += f[x];
             }
-            double run = 0.0;
-            cdf[0] = 0.0f;
-            for (int x = 0; x < w; ++x) {
-                run += f[x];
-                cdf[x + 1] = acc > 0.0 ? float(run / acc) : float(x + 1) / float(w);
-            }
-            cdf[w] = 1.0f;
+            fillCdf(cdf, f.data(), w, acc);
             rowInt[y] = acc / w;
             d.envDist[size_t(d.env.condInt) + y] = float(acc / w);
             total += acc / w;
         }
         float* marg = d.envDist.data() + d.env.margCdf;
-        double run = 0.0;
-        marg[0] = 0.0f;
-        for (int y = 0; y < h; ++y) {
-            run += rowInt[y];
-            marg[y + 1] = total > 0.0 ? float(run / total) : float(y + 1) / float(h);
-        }
-        marg[h] = 1.0f;
+        fillCdf(marg, rowInt.data(), h, total);
         d.env.margInt = float(total / h);
         // Average radiance over the sphere (sin-weighted mean of the map's luminance) for the power.
         double avg = 0.0, wsum = 0.0;
