@@ -14,6 +14,22 @@ namespace atrous {
 namespace pt {
 namespace {
 
+// A diffuse checker between albedo and albedo2, `scale` checks per unit of uv.
+Material checkerDiffuse(Vec3 albedo, Vec3 albedo2, float scale) {
+    Material m = diffuse(albedo);
+    m.checker = 1;
+    m.albedo2 = albedo2;
+    m.checkerScale = scale;
+    return m;
+}
+
+Material mirrorOf(Vec3 albedo) {
+    Material m;
+    m.type = MaterialType::Mirror;
+    m.albedo = albedo;
+    return m;
+}
+
 // The Cornell box (Cornell University Program of Computer Graphics measurements, in metres /100
 // of the original millimetre-ish units), camera as in the original photograph.
 void addCornellRoom(SceneBuilder& b, bool areaLight, Vec3 lightRadiance, int floorMaterial = -1) {
@@ -79,18 +95,13 @@ std::shared_ptr<SceneData> buildCornellPoint() {
 
 std::shared_ptr<SceneData> buildCornellSpheres() {
     SceneBuilder b("cornell-spheres");
-    Material checker = diffuse(Vec3(0.75f, 0.74f, 0.72f));
-    checker.checker = 1;
-    checker.albedo2 = Vec3(0.12f, 0.12f, 0.14f);
-    checker.checkerScale = 8.0f;
+    const Material checker = checkerDiffuse(Vec3(0.75f, 0.74f, 0.72f), Vec3(0.12f, 0.12f, 0.14f), 8.0f);
     addCornellRoom(b, true, kCornellLight);
     int floorMat = b.addMaterial("checker", checker);
     // The floor quad is the room's first mesh (two triangles): give it the checker material.
     b.d.triMaterial[0] = floorMat;
     b.d.triMaterial[1] = floorMat;
-    Material mirror;
-    mirror.type = MaterialType::Mirror;
-    mirror.albedo = Vec3(0.95f);
+    const Material mirror = mirrorOf(Vec3(0.95f));
     Material glass;
     glass.type = MaterialType::Dielectric;
     glass.albedo = Vec3(1.0f);
@@ -102,15 +113,9 @@ std::shared_ptr<SceneData> buildCornellSpheres() {
 
 std::shared_ptr<SceneData> buildSphereEnv() {
     SceneBuilder b("sphere-env");
-    Material checker = diffuse(Vec3(0.7f, 0.7f, 0.68f));
-    checker.checker = 1;
-    checker.albedo2 = Vec3(0.18f, 0.2f, 0.22f);
-    checker.checkerScale = 60.0f;  // 2 m checks on the 120 m ground
-    int floorMat = b.addMaterial("checker", checker);
-    Material mirror;
-    mirror.type = MaterialType::Mirror;
-    mirror.albedo = Vec3(0.95f);
-    int mirrorMat = b.addMaterial("mirror", mirror);
+    // 2 m checks on the 120 m ground.
+    int floorMat = b.addMaterial("checker", checkerDiffuse(Vec3(0.7f, 0.7f, 0.68f), Vec3(0.18f, 0.2f, 0.22f), 60.0f));
+    int mirrorMat = b.addMaterial("mirror", mirrorOf(Vec3(0.95f)));
     int red = b.addMaterial("red", diffuse(Vec3(0.7f, 0.12f, 0.08f)));
     Material gold;
     gold.type = MaterialType::Conductor;
