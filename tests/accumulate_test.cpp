@@ -12,6 +12,7 @@
 
 #include "atrous/render.h"
 #include "render/integrator.h"
+#include "motion_test_util.h"
 
 namespace atrous {
 namespace {
@@ -234,14 +235,7 @@ TEST(MotionFromDepth, ReprojectsTheRebuiltHitIntoThePreviousCamera) {
             // The last row is background: it moves like a direction.
             depth.data()[i] = y == h - 1 ? kBackgroundDepth : dot(points[i] - cur.position, cur.forward);
         }
-    MotionFromDepth m;
-    m.p.current = cur;
-    m.p.previous = prev;
-    m.p.moved = 1;
-    m.p.hitDepth = 0.1f * kBackgroundDepth;
-    m.p.offscreen = pt::kMotionOffscreen;
-    m.depth = depth.view();
-    m.motion = motion.view();
+    MotionFromDepth m = test::motionFromDepth(cur, prev, depth, motion);
     runMotionFromDepth(Device::Cpu, m);
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {

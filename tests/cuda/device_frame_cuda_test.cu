@@ -14,6 +14,7 @@
 #include "render/accumulate.h"
 #include "render/bvh_render.h"
 #include "render/integrator.h"
+#include "../motion_test_util.h"
 #include "../denoise_test_util.h"
 
 using namespace atrous;
@@ -92,14 +93,9 @@ TEST(DeviceFrameCuda, MotionMatchesTheCpuFunctor) {
     for (size_t i = 0; i < depth.size(); ++i) depth.data()[i] = i % 7 == 0 ? kBackgroundDepth : 2.0f + float(i % 13);
     const Image depthGpu = depth.to(Device::Cuda);
     Image mCpu(w, h, 3), mGpu(w, h, 3, Device::Cuda);
-    MotionFromDepth m;
-    m.p.current = pt::makeLookAtCamera(Vec3(0.2f, 0.1f, 5.0f), Vec3(0, 0, 0), Vec3(0, 1, 0), 45.0f);
-    m.p.previous = pt::makeLookAtCamera(Vec3(-0.3f, 0.0f, 5.2f), Vec3(0, 0, 0), Vec3(0, 1, 0), 45.0f);
-    m.p.moved = 1;
-    m.p.hitDepth = 0.1f * kBackgroundDepth;
-    m.p.offscreen = pt::kMotionOffscreen;
-    m.depth = depth.view();
-    m.motion = mCpu.view();
+    MotionFromDepth m =
+        motionFromDepth(pt::makeLookAtCamera(Vec3(0.2f, 0.1f, 5.0f), Vec3(0, 0, 0), Vec3(0, 1, 0), 45.0f),
+                        pt::makeLookAtCamera(Vec3(-0.3f, 0.0f, 5.2f), Vec3(0, 0, 0), Vec3(0, 1, 0), 45.0f), depth, mCpu);
     runMotionFromDepth(Device::Cpu, m);
     m.depth = depthGpu.view();
     m.motion = mGpu.view();
