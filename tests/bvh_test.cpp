@@ -39,24 +39,17 @@ public:
         rtcSetSceneBuildQuality(mScene, RTC_BUILD_QUALITY_HIGH);
         if (s.triangleCount()) {
             RTCGeometry g = rtcNewGeometry(mDevice, RTC_GEOMETRY_TYPE_TRIANGLE);
-            void* vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-                                               s.positions.size() / 3);
-            std::memcpy(vb, s.positions.data(), s.positions.size() * sizeof(float));
-            void* ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t),
-                                               s.triangleCount());
-            std::memcpy(ib, s.indices.data(), s.indices.size() * sizeof(uint32_t));
-            rtcCommitGeometry(g);
-            rtcAttachGeometryByID(mScene, g, 0);
-            rtcReleaseGeometry(g);
+            copyBuffer(g, RTC_BUFFER_TYPE_VERTEX, RTC_FORMAT_FLOAT3, 3 * sizeof(float), s.positions.size() / 3,
+                       s.positions.data(), s.positions.size() * sizeof(float));
+            copyBuffer(g, RTC_BUFFER_TYPE_INDEX, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), s.triangleCount(),
+                       s.indices.data(), s.indices.size() * sizeof(uint32_t));
+            attach(g, 0);
         }
         if (s.sphereCount()) {
             RTCGeometry g = rtcNewGeometry(mDevice, RTC_GEOMETRY_TYPE_SPHERE_POINT);
-            void* vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float),
-                                               s.sphereCount());
-            std::memcpy(vb, s.spheres.data(), s.spheres.size() * sizeof(float));
-            rtcCommitGeometry(g);
-            rtcAttachGeometryByID(mScene, g, 1);
-            rtcReleaseGeometry(g);
+            copyBuffer(g, RTC_BUFFER_TYPE_VERTEX, RTC_FORMAT_FLOAT4, 4 * sizeof(float), s.sphereCount(),
+                       s.spheres.data(), s.spheres.size() * sizeof(float));
+            attach(g, 1);
         }
         rtcCommitScene(mScene);
     }
@@ -104,6 +97,18 @@ public:
     }
 
 private:
+    // A new buffer of `count` items of `stride` bytes in slot 0 of g, filled with `bytes` from src.
+    static void copyBuffer(RTCGeometry g, RTCBufferType type, RTCFormat format, size_t stride, size_t count,
+                           const void* src, size_t bytes) {
+        void* dst = rtcSetNewGeometryBuffer(g, type, 0, format, stride, count);
+        std::memcpy(dst, src, bytes);
+    }
+    void attach(RTCGeometry g, unsigned id) {
+        rtcCommitGeometry(g);
+        rtcAttachGeometryByID(mScene, g, id);
+        rtcReleaseGeometry(g);
+    }
+
     uint32_t mTriangles;
     RTCDevice mDevice = nullptr;
     RTCScene mScene = nullptr;
