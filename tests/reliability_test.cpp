@@ -160,37 +160,47 @@ TEST(Reliability, ObjAndMtlValuesFollowTheSceneRules) {
         });
     };
     const std::string useMtl = "mtllib m.mtl\nusemtl a\n";
-    std::string msg = load(useMtl + quad + "f 1/1 2/2 3/3 4/4\n", "newmtl a\nKd 0.5 0.5 0.5\nKe 1e39 1 1\n");
-    EXPECT_NE(msg.find("m.mtl: line 3: Ke value \"1e39\" is not a finite number"), std::string::npos) << msg;
-    msg = load(useMtl + quad + "f 1/1 2/2 3/3 4/4\n", "newmtl a\nKd nan 0.5 0.5\n");
-    EXPECT_NE(msg.find("m.mtl: line 2: Kd value \"nan\" is not a finite number"), std::string::npos) << msg;
-    msg = load(useMtl + quad + "f 1/1 2/2 3/3 4/4\n", "newmtl a\nKd 0.5 0.5 0.5\nKe 1e9 1 1\n");
-    EXPECT_NE(msg.find("material \"a\""), std::string::npos) << msg;
-    EXPECT_NE(msg.find("m.mtl): Ke must be in [0, 1e8] (got 1e+09)"), std::string::npos) << msg;
-    msg = load(useMtl + quad + "f 1 2 3 4\n", "newmtl a\nKe -10 0 0\n");
-    EXPECT_NE(msg.find("Ke must be in [0, 1e8] (got -10)"), std::string::npos) << msg;
-    msg = load(useMtl + quad + "f 1 2 3 4\n", "newmtl a\nKd 2 0.5 0.5\n");
-    EXPECT_NE(msg.find("Kd must be in [0, 1]"), std::string::npos) << msg;
-    msg = load(useMtl + quad + "f 1 2 3 4\n", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd .\n");
-    EXPECT_NE(msg.find("is a directory"), std::string::npos) << msg;
-    EXPECT_NE(msg.find("map_Kd of material \"a\" in"), std::string::npos) << msg;
-    EXPECT_NE(msg.find("m.mtl"), std::string::npos) << msg;
-    msg = load("v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 1e39 1e39\nf 1/1 2/1 3/1\n", "");
-    EXPECT_NE(msg.find("m.obj: line 4: \"1e39\" is not a finite number"), std::string::npos) << msg;
-    msg = load("v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 1e7 0\nf 1/1 2/1 3/1\n", "");
-    EXPECT_NE(msg.find("m.obj: texture coordinate (vt) 1 must be finite and within +-1e6"), std::string::npos) << msg;
-    msg = load("v 0 0 0\nv nan 1 0\nv 1 1 0\nf 1 2 3\n", "");
-    EXPECT_NE(msg.find("m.obj: line 2: \"nan\" is not a finite number"), std::string::npos) << msg;
-    msg = load("v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nf 1/1 2/1 3/9\n", "");
-    EXPECT_NE(msg.find("line 5: face index \"3/9\" refers to a missing texture coordinate"), std::string::npos) << msg;
-    msg = load("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 999 3\n", "");  // tinyobjloader dropped the face
-    EXPECT_NE(msg.find("face index \"999\" refers to a missing vertex (the file has 3)"), std::string::npos) << msg;
-    msg = load("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 -99 3\n", "");
-    EXPECT_NE(msg.find("face index \"-99\" refers to a missing vertex"), std::string::npos) << msg;
-    msg = load("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 99999999999999999999\n", "");
-    EXPECT_NE(msg.find("m.obj: line 4: face index \"99999999999999999999\" is out of range"), std::string::npos) << msg;
+    // Each case: the OBJ, the MTL ("" for none) and what the error message must contain.
+    struct Case {
+        std::string obj, mtl;
+        std::vector<std::string> needles;
+    };
+    const std::vector<Case> cases = {
+        {useMtl + quad + "f 1/1 2/2 3/3 4/4\n", "newmtl a\nKd 0.5 0.5 0.5\nKe 1e39 1 1\n",
+         {"m.mtl: line 3: Ke value \"1e39\" is not a finite number"}},
+        {useMtl + quad + "f 1/1 2/2 3/3 4/4\n", "newmtl a\nKd nan 0.5 0.5\n",
+         {"m.mtl: line 2: Kd value \"nan\" is not a finite number"}},
+        {useMtl + quad + "f 1/1 2/2 3/3 4/4\n", "newmtl a\nKd 0.5 0.5 0.5\nKe 1e9 1 1\n",
+         {"material \"a\"", "m.mtl): Ke must be in [0, 1e8] (got 1e+09)"}},
+        {useMtl + quad + "f 1 2 3 4\n", "newmtl a\nKe -10 0 0\n",
+         {"Ke must be in [0, 1e8] (got -10)"}},
+        {useMtl + quad + "f 1 2 3 4\n", "newmtl a\nKd 2 0.5 0.5\n",
+         {"Kd must be in [0, 1]"}},
+        {useMtl + quad + "f 1 2 3 4\n", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd .\n",
+         {"is a directory", "map_Kd of material \"a\" in", "m.mtl"}},
+        {"v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 1e39 1e39\nf 1/1 2/1 3/1\n", "",
+         {"m.obj: line 4: \"1e39\" is not a finite number"}},
+        {"v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 1e7 0\nf 1/1 2/1 3/1\n", "",
+         {"m.obj: texture coordinate (vt) 1 must be finite and within +-1e6"}},
+        {"v 0 0 0\nv nan 1 0\nv 1 1 0\nf 1 2 3\n", "",
+         {"m.obj: line 2: \"nan\" is not a finite number"}},
+        {"v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nf 1/1 2/1 3/9\n", "",
+         {"line 5: face index \"3/9\" refers to a missing texture coordinate"}},
+        // (tinyobjloader dropped this face)
+        {"v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 999 3\n", "",
+         {"face index \"999\" refers to a missing vertex (the file has 3)"}},
+        {"v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 -99 3\n", "",
+         {"face index \"-99\" refers to a missing vertex"}},
+        {"v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 99999999999999999999\n", "",
+         {"m.obj: line 4: face index \"99999999999999999999\" is out of range"}},
+    };
+    for (const Case& c : cases) {
+        const std::string msg = load(c.obj, c.mtl);
+        for (const std::string& needle : c.needles)
+            EXPECT_NE(msg.find(needle), std::string::npos) << needle << "\n" << msg;
+    }
     fs::remove(dir / "m.mtl");
-    msg = load("mtllib missing.mtl\n" + quad + "f 1 2 3 4\n", "");
+    const std::string msg = load("mtllib missing.mtl\n" + quad + "f 1 2 3 4\n", "");
     EXPECT_NE(msg.find("m.obj: mtllib missing.mtl: material file not found"), std::string::npos) << msg;
     // Valid values still load.
     EXPECT_EQ(load(useMtl + quad + "f 1/1 2/2 3/3 4/4\n", "newmtl a\nKd 0.5 0.5 0.5\nKe 10 10 10\n"), "");
