@@ -373,3 +373,37 @@ TEST(SvgfParamsTest, EveryFieldChangesTheOutput) {
         EXPECT_GT(maxAbsDiff(out, *c.reference), 1e-3f) << c.name << " did not change the output";
     }
 }
+
+TEST(SvgfModulation, IsTheStillFiltersAlbedoWithSvgfsFloorAndNoRimRule) {
+    // SVGF's divisor is filters::pixelModulationAlbedo<false> (one function for both): per pixel
+    // it must equal SVGF's own rule as it was written before the merge, exactly (same operations):
+    // non-finite channel -> 1, t = min(m / 0.1, 1)^2, a' = 1 + t (max(a, 1e-3) - 1), a' = max(a,
+    // 1e-3) where t = 1. And no rim rule: a black neighbour changes nothing (the still filters'
+    // rule raises their floor there).
+    const float vals[] = {0.0f, 1e-4f, 1e-3f, 0.02f, 0.05f, 0.0999f, 0.1f, 0.15f, 0.5f, 1.0f, 3.0f, NAN, INFINITY};
+    Image img(3, 3, 3);
+    for (float r : vals)
+        for (float g : vals)
+            for (float b : {0.0f, 0.07f, 0.9f, NAN}) {
+                img.fill(0.0f);  // black neighbours
+                img(1, 1, 0) = r, img(1, 1, 1) = g, img(1, 1, 2) = b;
+                const Vec3 got = svgf::modulationAlbedo(img.view(), 1, 1);
+                const float a[3] = {std::isfinite(r) ? r : 1.0f, std::isfinite(g) ? g : 1.0f, std::isfinite(b) ? b : 1.0f};
+                const float m = std::max(std::max(a[0], a[1]), a[2]);
+                const float t = std::min(m / 0.1f, 1.0f) * std::min(m / 0.1f, 1.0f);
+                float want[3];
+                for (int c = 0; c < 3; ++c) {
+                    const float ac = std::max(a[c], 1e-3f);
+                    want[c] = t >= 1.0f ? ac : 1.0f + t * (ac - 1.0f);
+                }
+                EXPECT_EQ(got.x, want[0]) << r << " " << g << " " << b;
+                EXPECT_EQ(got.y, want[1]) << r << " " << g << " " << b;
+                EXPECT_EQ(got.z, want[2]) << r << " " << g << " " << b;
+            }
+    // The still filters' rule does act on this pixel (so the test above would see it).
+    img.fill(0.0f);
+    for (int c = 0; c < 3; ++c) img(1, 1, c) = 0.15f;
+    float still[3];
+    filters::pixelModulationAlbedo(img.view(), 1, 1, 1e-3f, 0.1f, still);
+    EXPECT_NE(still[0], svgf::modulationAlbedo(img.view(), 1, 1).x);
+}

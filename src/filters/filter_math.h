@@ -39,9 +39,14 @@ ATROUS_INLINE float modulationAlbedo(float a, float t, float eps) {
 }
 ATROUS_INLINE float maxChannel(float a, float b, float c) { return maxSel(maxSel(a, b), c); }
 
-// a'_c of pixel (x, y), c = 0..2, from an albedo view (non-finite values read as 0); an invalid
-// view gives 1 (no demodulation). The one place the filters turn an albedo pixel into divisors.
-ATROUS_INLINE void pixelModulationAlbedo(const ImageView& albedo, int x, int y, float eps, float floor, float (&a)[3]) {
+// a'_c of pixel (x, y), c = 0..2, from an albedo view (non-finite channels read as `nonFinite`);
+// an invalid view gives 1 (no demodulation). The one place the filters (EAW, SURE and SVGF) turn
+// an albedo pixel into divisors. kRimRule: the rim rule below (EAW/SURE); SVGF calls it with
+// false and nonFinite = 1 (svgf::modulationAlbedo: its floor 0.1 without the rule, as measured
+// for it so far; docs/svgf.md).
+template <bool kRimRule = true>
+ATROUS_INLINE void pixelModulationAlbedo(const ImageView& albedo, int x, int y, float eps, float floor, float (&a)[3],
+                                         float nonFinite = 0.0f) {
     if (!albedo.valid()) {
         a[0] = a[1] = a[2] = 1.0f;
         return;
@@ -49,13 +54,13 @@ ATROUS_INLINE void pixelModulationAlbedo(const ImageView& albedo, int x, int y, 
     float v[3];
     for (int c = 0; c < 3; ++c) {
         const float u = albedo(x, y, c);
-        v[c] = finite(u) ? u : 0.0f;
+        v[c] = finite(u) ? u : nonFinite;
     }
     // On the rim of a black-albedo surface (a 3x3 neighbour below kBlackAlbedoFraction · floor)
     // the floor is kRimFloorMul times higher.
     float nearBlack = 0.0f;
     const float mp = maxChannel(v[0], v[1], v[2]);
-    if (floor > 0.0f && mp > 0.0f && mp < kRimFloorMul * floor) {  // elsewhere t is the same either way
+    if (kRimRule && floor > 0.0f && mp > 0.0f && mp < kRimFloorMul * floor) {  // elsewhere t is the same either way
         float mn = 1e30f;
         for (int dy = -1; dy <= 1; ++dy)
             for (int dx = -1; dx <= 1; ++dx) {

@@ -32,15 +32,13 @@ ATROUS_INLINE void writeVec3(const ImageView& v, int x, int y, Vec3 c) {
     v(x, y, 2) = c.z;
 }
 
-// Albedo used for (de)modulation: missing -> 1, non-finite -> 1, else max(a, kMinAlbedo).
-// Blended toward 1 where the albedo is near black, as EAW/SURE do (filters::modulationAlbedo).
+// Albedo used for (de)modulation: missing -> 1, non-finite channel -> 1, else max(a, kMinAlbedo),
+// blended toward 1 where the albedo is near black: filters::pixelModulationAlbedo, the still
+// filters' own, with SVGF's floor (kDefaultAlbedoFloor) and without their rim rule.
 ATROUS_INLINE Vec3 modulationAlbedo(const ImageView& albedo, int x, int y) {
-    if (!albedo.valid()) return Vec3(1.0f);
-    Vec3 a = readVec3(albedo, x, y);
-    a = Vec3(finiteOr(a.x, 1.0f), finiteOr(a.y, 1.0f), finiteOr(a.z, 1.0f));
-    const float t = filters::modulationTerm(filters::maxChannel(a.x, a.y, a.z), filters::kDefaultAlbedoFloor);
-    return Vec3(filters::modulationAlbedo(a.x, t, kMinAlbedo), filters::modulationAlbedo(a.y, t, kMinAlbedo),
-                filters::modulationAlbedo(a.z, t, kMinAlbedo));
+    float a[3];
+    filters::pixelModulationAlbedo<false>(albedo, x, y, kMinAlbedo, filters::kDefaultAlbedoFloor, a, 1.0f);
+    return Vec3(a[0], a[1], a[2]);
 }
 
 // Emission to subtract/add back: missing or non-finite -> 0.
