@@ -23,6 +23,14 @@ inline DenoiseInputs inputsOf(const Image& color, const Image& variance, const I
     return in;
 }
 
+// DenoiseInputs of a colour and its variance only (no feature buffers).
+inline DenoiseInputs inputsOf(const Image& color, const Image& variance) {
+    DenoiseInputs in;
+    in.color = &color;
+    in.variance = &variance;
+    return in;
+}
+
 struct SyntheticScene {
     Image truth, noisy, variance, albedo, normal, position, depth, ids;
     DenoiseInputs inputs() const { return inputsOf(noisy, variance, albedo, normal, position, depth, ids); }

@@ -22,12 +22,7 @@ struct Flat {
         for (size_t i = 0; i < color.size(); ++i) color.data()[i] = 0.5f + g(rng);
         var.fill(0.05f * 0.05f);
     }
-    DenoiseInputs inputs() const {
-        DenoiseInputs in;
-        in.color = &color;
-        in.variance = &var;
-        return in;
-    }
+    DenoiseInputs inputs() const { return inputsOf(color, var); }
     // A bright pixel: `value` in R, G, B with a variance of the mean of sd² per channel.
     void spike(int x, int y, float value, float sd) {
         for (int c = 0; c < 3; ++c) {

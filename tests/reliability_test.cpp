@@ -23,6 +23,7 @@
 #include "atrous/render.h"
 #include "atrous/svgf.h"
 #include "io/image_io.h"
+#include "denoise_test_util.h"
 #include "test_util.h"
 
 using namespace atrous;
@@ -404,9 +405,7 @@ TEST(Reliability, TinyFilterParametersAreRejected) {
 TEST(Reliability, ColourAndVarianceBeyondTheirRangeAreRejected) {
     Image color(16, 16, 3), var(16, 16, 3);
     for (size_t i = 0; i < color.plane() * 3; ++i) color.data()[i] = 0.5f, var.data()[i] = 0.01f;
-    DenoiseInputs in;
-    in.color = &color;
-    in.variance = &var;
+    const DenoiseInputs in = test::inputsOf(color, var);
     for (DenoiseMethod m : {DenoiseMethod::Eaw, DenoiseMethod::Sure}) {
         DenoiseOptions o;
         o.method = m;
