@@ -228,7 +228,7 @@ TEST(Reliability, HugeObjFaceIsRefusedAtOnce) {
 TEST(Reliability, ThreadsHaveACeiling) {
     RenderSettings s = tiny();
     s.threads = 65537;
-    EXPECT_NE(errorOf([&] { validateRenderSettings(s); }).find("--threads: must be in 0..4096"), std::string::npos);
+    EXPECT_NE(errorOf([&] { validateRenderSettings(s); }).find("parameter threads must be in 0..4096"), std::string::npos);
     s.threads = 4096;
     EXPECT_NO_THROW(validateRenderSettings(s));
     TempDir dir;

@@ -51,14 +51,17 @@ template <class S>
     throw InputError(flag + ": " + e.rule() + (got.empty() ? "" : " (got " + got + ")"));
 }
 
-// The flag of a library ParamError's field: the denoise, SVGF and render tables' rows, --device for
-// parseDevice's; "" when the field has none (RenderSettings::firstSample).
+// The flag of a library ParamError's field: the denoise, SVGF and render tables' rows; --device
+// --camera-path and --scene for parseDevice's, parseCameraPath's and Scene::builtin's; "" when the field has none
+// (RenderSettings::firstSample).
 inline std::string flagOf(const ParamError& e) {
     auto in = [&](const auto& t) -> std::string {
         const auto* f = t.find(e.field());
         return f ? t.flag(*f) : std::string();
     };
     if (e.set() == "device") return "--device";
+    if (e.set() == "camera_path") return "--camera-path";
+    if (e.set() == "scene") return "--scene";
     if (e.set() == "render") return in(renderParams());
     if (e.set() == "svgf") return in(svgfParams());
     if (e.set() == "denoise") return in(denoiseParams());

@@ -16,8 +16,14 @@ const char* deviceToString(Device d);
 // (atrous/params.h, field "device") on any other word, or when "cuda" is asked for and
 // cudaAvailable() is false.
 Device parseDevice(const std::string& name);
-// Human-readable name of the hardware behind `d`: the CPU model with its thread count, or the
-// GPU's name. Used in benchmark JSON.
+// Throws parseDevice("cuda")'s ParamError (field "device") unless cudaAvailable(): what every
+// CUDA entry point calls first. noCudaBackend: the same error for a build without the backend
+// (the stubs of CUDA-only entry points).
+void requireCuda();
+[[noreturn]] void noCudaBackend();
+// Human-readable name of the hardware behind `d`: the CPU model with its thread count and the
+// instruction set its row loops run (ATROUS_CPU_ISA, docs/development.md), or the GPU's name.
+// Used in benchmark JSON.
 std::string deviceName(Device d);
 
 }  // namespace atrous

@@ -39,7 +39,7 @@ public:
         : InputError(std::string(set == "svgf" ? "SVGF parameter " : "parameter ") + field + " " + rule +
                      (got.empty() ? "" : " (got " + got + ")")),
           mSet(set), mField(field), mRule(rule), mGot(got) {}
-    const std::string& set() const { return mSet; }      // the table: "denoise", "svgf", "render" or "device"
+    const std::string& set() const { return mSet; }      // "denoise", "svgf", "render" (a table), "device", "camera_path" or "scene"
     const std::string& field() const { return mField; }  // the row's name, e.g. "sigma_normal"
     const std::string& rule() const { return mRule; }    // e.g. "must be in 1..10"
     const std::string& got() const { return mGot; }      // the value as given ("" when not shown)

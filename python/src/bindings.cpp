@@ -347,27 +347,8 @@ void pyWriteImage(const std::string& path, const Array& image) {
     io::writeImage(path, img);
 }
 
-// Parameters arrive as ParamError, which names the field (`max_depth`, `device`) as Python's
-// keyword. A few library messages still name a CLI flag ("--camera-path: ...", "--device cuda:
-// ..." from the CUDA stubs in src/render and src/filters); in Python the same setting is a keyword
-// argument, so "--camera-path" is shown as "camera_path". Only a "--" at the start of a word
-// followed by a lower-case flag name is rewritten (file paths keep theirs).
-std::string pythonMessage(const std::string& msg) {
-    std::string out;
-    out.reserve(msg.size());
-    for (size_t i = 0; i < msg.size();) {
-        const bool wordStart = i == 0 || msg[i - 1] == ' ' || msg[i - 1] == '\'' || msg[i - 1] == '(';
-        if (wordStart && msg.compare(i, 2, "--") == 0 && i + 2 < msg.size() && msg[i + 2] >= 'a' && msg[i + 2] <= 'z') {
-            size_t j = i + 2;
-            while (j < msg.size() && ((msg[j] >= 'a' && msg[j] <= 'z') || (msg[j] >= '0' && msg[j] <= '9') || msg[j] == '-'))
-                out += msg[j] == '-' ? '_' : msg[j], ++j;
-            i = j;
-        } else {
-            out += msg[i++];
-        }
-    }
-    return out;
-}
+// Library errors name the field (`max_depth`, `device`, `camera_path`: ParamError) or the file,
+// never a CLI flag, so Python shows them as they are: the field is the keyword.
 
 }  // namespace
 
@@ -377,9 +358,9 @@ NB_MODULE(_core, m) {
         try {
             std::rethrow_exception(p);
         } catch (const InputError& e) {
-            PyErr_SetString(PyExc_ValueError, pythonMessage(e.what()).c_str());
+            PyErr_SetString(PyExc_ValueError, e.what());
         } catch (const atrous::RuntimeError& e) {
-            PyErr_SetString(PyExc_RuntimeError, pythonMessage(e.what()).c_str());
+            PyErr_SetString(PyExc_RuntimeError, e.what());
         }
     });
     m.def("denoise", &pyDenoise, nb::arg("color"), nb::arg("albedo").none(), nb::arg("normal").none(),

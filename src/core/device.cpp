@@ -9,6 +9,7 @@
 #include "atrous/error.h"
 #include "atrous/params.h"
 #include "core/memory.h"
+#include "cpu/cpu_isa.h"
 
 namespace atrous {
 
@@ -16,14 +17,21 @@ bool cudaAvailable() { return cudaCompiled() && detail::cudaDevicePresent(); }
 
 const char* deviceToString(Device d) { return d == Device::Cuda ? "cuda" : "cpu"; }
 
+void noCudaBackend() {
+    throw ParamError("device", "device", "cannot be cuda: this build of atrous has no CUDA backend (nvcc was not found at build time)");
+}
+
+void requireCuda() {
+    if (!cudaCompiled()) noCudaBackend();
+    if (!detail::cudaDevicePresent()) throw ParamError("device", "device", "cannot be cuda: no CUDA-capable GPU is available");
+}
+
 Device parseDevice(const std::string& name) {
     if (name == "cpu") return Device::Cpu;
     if (name == "auto") return cudaAvailable() ? Device::Cuda : Device::Cpu;
     if (name == "cuda") {
         // ParamError naming the field `device`: the CLI shows its flag, Python its keyword.
-        if (!cudaCompiled())
-            throw ParamError("device", "device", "cannot be cuda: this build of atrous has no CUDA backend (nvcc was not found at build time)");
-        if (!detail::cudaDevicePresent()) throw ParamError("device", "device", "cannot be cuda: no CUDA-capable GPU is available");
+        requireCuda();
         return Device::Cuda;
     }
     throw ParamError("device", "device", "must be cpu, cuda or auto", "'" + name + "'");
@@ -43,7 +51,7 @@ static std::string cpuModel() {
 
 std::string deviceName(Device d) {
     if (d == Device::Cuda) return detail::cudaDeviceName();
-    return cpuModel() + " (" + std::to_string(tbb::info::default_concurrency()) + " threads)";
+    return cpuModel() + " (" + std::to_string(tbb::info::default_concurrency()) + " threads, " + cpu::isaDescription() + ")";
 }
 
 }  // namespace atrous

@@ -69,7 +69,7 @@ struct CudaBvhRenderer::Impl {
 };
 
 CudaBvhRenderer::CudaBvhRenderer(const Scene& scene) {
-    if (!cudaAvailable()) throw InputError("--device cuda: no CUDA device is available");
+    requireCuda();
     mImpl = std::make_unique<Impl>(scene);
 }
 CudaBvhRenderer::~CudaBvhRenderer() = default;

@@ -244,8 +244,7 @@ Image denoise(const DenoiseInputs& given, const DenoiseOptions& options) {
         rep.buffersUsed += ",variance(ignored: all zero, e.g. a 1-spp render; noise estimated)";
     }
     if (options.device == Device::Cuda) {
-        if (!cudaCompiled()) throw InputError("--device cuda: this build of atrous has no CUDA backend");
-        if (!cudaAvailable()) throw InputError("--device cuda: no CUDA-capable GPU is available");
+        requireCuda();
         return filters::denoiseCuda(inputs, options, prep, rep);
     }
     for (const Image* img : {inputs.color, inputs.variance, inputs.albedo, inputs.normal, inputs.position,
@@ -262,10 +261,10 @@ Image denoise(const DenoiseInputs& given, const DenoiseOptions& options) {
 #if !defined(ATROUS_HAVE_CUDA)
 namespace atrous::filters {
 Image denoiseCuda(const DenoiseInputs&, const DenoiseOptions&, const PreparedInputs&, DenoiseReport&) {
-    throw InputError("--device cuda: this build of atrous has no CUDA backend");
+    noCudaBackend();
 }
 void estimateNoiseSigmaCuda(const Image&, const Image*, float, float, float[3]) {
-    throw InputError("--device cuda: this build of atrous has no CUDA backend");
+    noCudaBackend();
 }
 }  // namespace atrous::filters
 #endif

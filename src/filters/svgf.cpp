@@ -48,7 +48,7 @@ std::unique_ptr<SvgfBackend> makeSvgfCpuBackend(const SvgfParams& params) {
 
 #if !defined(ATROUS_HAVE_CUDA)
 std::unique_ptr<SvgfBackend> makeSvgfCudaBackend(const SvgfParams&) {
-    throw InputError("SVGF on cuda: this build of atrous has no CUDA backend (nvcc was not found at build time)");
+    noCudaBackend();
 }
 #endif
 
@@ -57,7 +57,7 @@ std::unique_ptr<SvgfBackend> makeSvgfCudaBackend(const SvgfParams&) {
 SvgfDenoiser::SvgfDenoiser(const SvgfParams& params, Device device) : mParams(params), mDevice(device) {
     validateSvgfParams(params);
     if (device == Device::Cuda) {
-        if (!cudaAvailable()) throw InputError("SVGF on cuda: no CUDA backend or no CUDA-capable GPU is available");
+        requireCuda();
         mImpl = detail::makeSvgfCudaBackend(params);
     } else {
         mImpl = detail::makeSvgfCpuBackend(params);

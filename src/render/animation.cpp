@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "atrous/error.h"
+#include "atrous/params.h"
 #include "render/camera.h"
 
 namespace atrous {
@@ -68,7 +69,7 @@ Camera cameraAtTime(const SceneData& s, CameraPath path, float t) {
     switch (resolve(s, path)) {
         case CameraPath::Keyframes:
             if (s.cameraKeys.empty())
-                throw InputError("--camera-path keyframes: scene \"" + s.name + "\" has no \"camera.keyframes\"");
+                throw ParamError("camera_path", "camera_path", "cannot be keyframes: scene \"" + s.name + "\" has no \"camera.keyframes\"");
             return keyframedCamera(s.cameraKeys, t);
         case CameraPath::Orbit: {
             // A rigid turn of the whole camera frame about the vertical axis through the target,
@@ -160,7 +161,7 @@ CameraPath parseCameraPath(const std::string& name) {
     if (name == "orbit") return CameraPath::Orbit;
     if (name == "dolly") return CameraPath::Dolly;
     if (name == "keyframes") return CameraPath::Keyframes;
-    throw InputError("--camera-path: unknown path \"" + name + "\" (auto, static, orbit, dolly, keyframes)");
+    throw ParamError("camera_path", "camera_path", "must be auto, static, orbit, dolly or keyframes", "'" + name + "'");
 }
 
 bool Scene::hasCameraKeyframes() const { return !data().cameraKeys.empty(); }

@@ -6,6 +6,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "atrous/device.h"
 #include "atrous/error.h"
 
 namespace atrous {
@@ -25,16 +26,16 @@ RenderBuffers renderBvhCpu(const Scene& scene, const RenderSettings& settings) {
 struct CudaBvhRenderer::Impl {};
 
 CudaBvhRenderer::CudaBvhRenderer(const Scene&) {
-    throw InputError("--device cuda: this build of atrous has no CUDA backend");
+    noCudaBackend();
 }
 CudaBvhRenderer::~CudaBvhRenderer() = default;
 CudaBvhRenderer::CudaBvhRenderer(CudaBvhRenderer&&) noexcept = default;
 CudaBvhRenderer& CudaBvhRenderer::operator=(CudaBvhRenderer&&) noexcept = default;
 RenderBuffers CudaBvhRenderer::render(const RenderSettings&, const pt::Camera*) {
-    throw InputError("--device cuda: this build of atrous has no CUDA backend");
+    noCudaBackend();
 }
 const RenderBuffers& CudaBvhRenderer::renderOnDevice(const RenderSettings&, const pt::Camera*) {
-    throw InputError("--device cuda: this build of atrous has no CUDA backend");
+    noCudaBackend();
 }
 
 RenderBuffers renderBvhCuda(const Scene& scene, const RenderSettings& settings) {

@@ -22,7 +22,7 @@ RenderBuffers renderBvhCpu(const Scene& scene, const RenderSettings& settings);
 
 // The CUDA path tracer (src/cuda/cuda_render.cu): scene and BVH uploaded to the GPU, one thread
 // per pixel; buffers come back as host images. Throws InputError when the build has no CUDA
-// backend or no GPU is present (the message names --device cuda).
+// backend or no GPU is present (a ParamError naming the field `device`).
 RenderBuffers renderBvhCuda(const Scene& scene, const RenderSettings& settings);
 
 // The CUDA path tracer for repeated renders of one scene (interactive viewers, sequences): the

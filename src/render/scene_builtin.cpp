@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "atrous/error.h"
+#include "atrous/params.h"
 #include "atrous/render.h"
 #include "render/scene_builder.h"
 #include "render/scene_data.h"
@@ -180,7 +181,7 @@ Scene Scene::builtin(const std::string& name) {
     else {
         std::string list;
         for (const auto& n : builtinSceneNames()) list += (list.empty() ? "" : ", ") + n;
-        throw InputError("--scene: unknown scene \"" + name + "\" (built-in scenes: " + list + "; or a .json file)");
+        throw ParamError("scene", "scene", "must be a built-in scene (" + list + ") or a .json file", "'" + name + "'");
     }
     return s;
 }

@@ -113,7 +113,7 @@ def test_bad_arguments_raise_value_error(bufs):
         atrous.denoise(c, sigma_colour=1.0)
     with pytest.raises(ValueError, match="variance"):
         atrous.denoise(c, variance=-np.ones_like(c))
-    with pytest.raises(ValueError, match="unknown scene"):
+    with pytest.raises(ValueError, match="parameter scene must be a built-in scene"):
         atrous.render("no-such-scene", width=8, height=8, spp=1)
     with pytest.raises(ValueError):
         atrous.render("cornell", width=8, height=8, spp=0)

@@ -134,8 +134,13 @@ def run_frame(item: Dict[str, Any], out: Path, threads: int, device: str) -> Dic
 
     p = item["params"]
     f, frames, seed = p["frame"], p["frames"], p["seed"]
-    args = (p["scene"], f, frames, p["camera_path"], p["width"], p["height"])
-    bufs = dict(_core.render_frame(*args, p["spp"], seed, p["max_depth"], threads))
+    args = (p["scene"], f, frames, p["camera_path"])
+
+    def settings(spp: int, seed: int) -> Dict[str, Any]:  # the render table's keywords
+        return {"width": p["width"], "height": p["height"], "spp": spp, "seed": seed,
+                "max_depth": p["max_depth"], "threads": threads}
+
+    bufs = dict(_core.render_frame(*args, settings(p["spp"], seed)))
     bufs.pop("time", None)
     with staged(out, item["id"]) as stage:
         write_buffers(stage, bufs, with_variance=p["spp"] > 1)
@@ -143,7 +148,7 @@ def run_frame(item: Dict[str, Any], out: Path, threads: int, device: str) -> Dic
             # The CLI renders every frame's reference with one seed, seed + 0x9E3779B9;
             # render_frame adds the frame number to the seed it is given.
             ref_seed = (seed + REFERENCE_SEED_OFFSET - f) % 2 ** 32
-            ref = _core.render_frame(*args, p["reference_spp"], ref_seed, p["max_depth"], threads)["color"]
+            ref = _core.render_frame(*args, settings(p["reference_spp"], ref_seed))["color"]
             atrous.write_image(stage / "reference.exr", ref)
         publish_dir(stage, out / item["outputs"][0])
     return {}
