@@ -196,10 +196,14 @@ TEST(SvgfVariance, SpatialEstimateIsUsedWhileTheHistoryIsShort) {
     // History 1 < 4: the 7x7 spatial estimate, (49 - 1)/49 σ² in expectation on this flat plane
     // (fewer taps at the border); ±6% covers the sampling error of 3072 correlated estimates.
     EXPECT_NEAR(meanVariance(SvgfParams{}) / sigma2, 48.0 / 49.0, 0.06);
-    // Forcing the temporal estimate at history 1 gives μ2 - μ1² = l² - l² = 0.
+    // Forcing the temporal estimate at history 1 gives μ2 - μ1² = l² - l² = 0, up to the rounding
+    // of l²: on the FMA targets (AVX2, AVX-512: src/cpu/isa_dispatch.h) μ2 - μ1·μ1 is contracted
+    // into one fused multiply-add, which leaves l²'s rounding error, at most half an ulp of l²
+    // (l ≈ 1 here: 6e-8; measured mean 1.2e-8). The bound, 1e-5 σ² = 1e-7, is 1e5 times below
+    // the spatial estimate this test tells it from (σ² = 1e-2).
     SvgfParams temporal;
     temporal.spatialVarianceFrames = 1;
-    EXPECT_LT(meanVariance(temporal), 1e-6 * sigma2);
+    EXPECT_LT(meanVariance(temporal), 1e-5 * sigma2);
 }
 
 // ---- bad input ----------------------------------------------------------------------------------

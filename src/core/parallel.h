@@ -7,34 +7,49 @@
 #include <tbb/parallel_for.h>
 
 #include "atrous/device.h"
+#include "cpu/isa_dispatch.h"
 
 namespace atrous {
 
-// Runs f(x, y) for every pixel of a width x height grid on TBB threads. Rows are the unit of
-// work (grain: a few rows), and the inner x loop is a plain loop the compiler can vectorise.
-// Compiled for the build's baseline (x86-64), not ISA-dispatched (src/cpu/isa_dispatch.h): run
-// through parallelForIsa's flattened wrappers, SVGF's μ2 - μ1² (svgf_variance.h) was contracted
-// into an FMA, which keeps the rounding error of l² where svgf_test expects exact cancellation.
-// Dispatched, SVGF's reprojection ran 2.99 -> 2.33 ms at 512² (whole SVGF ~2%); a stage that
-// pays gets a src/cpu row loop that calls parallelForIsa.
+namespace detail {
+
+// Rows [y0, y1) of parallelFor2dCpu / parallelForRowsCpu, the body the ISA wrappers compile.
 template <class F>
-void parallelFor2dCpu(int width, int height, const F& f, int grainRows = 4) {
-    if (width <= 0 || height <= 0) return;
-    tbb::parallel_for(tbb::blocked_range<int>(0, height, grainRows), [&](const tbb::blocked_range<int>& r) {
-        for (int y = r.begin(); y < r.end(); ++y) {
+struct PixelRows {
+    const F& f;
+    int width;
+    void operator()(int y0, int y1) const {
+        for (int y = y0; y < y1; ++y) {
 #pragma omp simd
             for (int x = 0; x < width; ++x) f(x, y);
         }
-    });
+    }
+};
+template <class F>
+struct WholeRows {
+    const F& f;
+    void operator()(int y0, int y1) const {
+        for (int y = y0; y < y1; ++y) f(y);
+    }
+};
+
+}  // namespace detail
+
+// Runs f(x, y) for every pixel of a width x height grid on TBB threads, with the loops of the
+// CPU ISA in use (cpu::parallelForIsa: f is compiled for baseline x86-64, AVX2 and AVX-512). Rows
+// are the unit of work (grain: a few rows), and the inner x loop is a plain loop the compiler can
+// vectorise.
+template <class F>
+void parallelFor2dCpu(int width, int height, const F& f, int grainRows = 4) {
+    if (width <= 0 || height <= 0) return;
+    cpu::parallelForIsa(cpu::activeIsa(), 0, height, grainRows, detail::PixelRows<F>{f, width});
 }
 
 // Runs f(y) for every row; for functors that process a whole row at a time.
 template <class F>
 void parallelForRowsCpu(int height, const F& f, int grainRows = 4) {
     if (height <= 0) return;
-    tbb::parallel_for(tbb::blocked_range<int>(0, height, grainRows), [&](const tbb::blocked_range<int>& r) {
-        for (int y = r.begin(); y < r.end(); ++y) f(y);
-    });
+    cpu::parallelForIsa(cpu::activeIsa(), 0, height, grainRows, detail::WholeRows<F>{f});
 }
 
 struct CpuExec {
