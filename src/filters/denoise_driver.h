@@ -10,6 +10,7 @@
 #include "atrous/image.h"
 #include "filters/eaw.h"
 #include "filters/emission_filter.h"
+#include "filters/modulation.h"
 #include "filters/noise_estimate.h"
 #include "filters/prepass.h"
 #include "filters/safety_net.h"
@@ -38,6 +39,14 @@ struct DriverOutputs {
 
 // The caller's options held whole (as SvgfPipeline holds its SvgfParams), plus what the driver
 // derives from the inputs: whether a variance was given, and the local noise estimate.
+// The still filters' albedo rule (modulation.h): the options' eps and floor, the rim rule on,
+// a non-finite albedo read as 0.
+inline AlbedoRule stillAlbedoRule(const DenoiseOptions& o) {
+    AlbedoRule r;
+    r.eps = o.albedoEpsilon, r.floor = o.albedoFloor;
+    return r;
+}
+
 struct DriverConfig {
     DenoiseOptions opts;
     bool varianceGiven = true;  // false: the variance is a constant estimate
@@ -154,7 +163,10 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         // The variance from the colour itself (after the emission is taken out and the fireflies
         // clamped with the constant estimate, so that they do not raise it): noise_estimate.h.
         Image demod(w, h, 3, dev), energy(w, h, 3, dev);
-        exec.forEachPixel(w, h, DemodulatedCopy{o.albedoEpsilon, o.albedoFloor, cA.view(), albedo, demod.view()});
+        Demodulate d;
+        d.rule = stillAlbedoRule(o);
+        d.albedo = albedo, d.in = cA.view(), d.out = demod.view();
+        exec.forEachPixel(w, h, d);
         DetailEnergy de{demod.view(), energy.view(), normal, depth};
         for (int c = 0; c < 3; ++c) de.maxDiff2[c] = kNoiseEdgeSigmas2 * kNoiseCapMul * cfg.noiseFloorVar[c];
         exec.forEachPixel(w, h, de);
@@ -175,7 +187,12 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
 
     // 3. Albedo demodulation.
     if (albedo.valid()) {
-        exec.forEachPixel(w, h, Demodulate{o.albedoEpsilon, o.albedoFloor, albedo, cA.view(), vA.view()});
+        Demodulate d;
+        d.rule = stillAlbedoRule(o);
+        d.albedo = albedo;
+        d.in = d.out = cA.view();
+        d.var = vA.view();
+        exec.forEachPixel(w, h, d);
     }
     // The safety net's input y and its summed variance, kept before the cascade overwrites them.
     Image safetyIn, safetyVar;
@@ -303,8 +320,10 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     }
 
     // 7. out = (c_N + Σ s_i d_i) · albedo.
-    exec.forEachPixel(w, h, Recombine{o.albedoEpsilon, o.albedoFloor, cur->view(), detailSum, albedo,
-                                      emission, out.out});
+    Remodulate r;
+    r.rule = stillAlbedoRule(o);
+    r.base = cur->view(), r.detail = detailSum, r.albedo = albedo, r.emission = emission, r.out = out.out;
+    exec.forEachPixel(w, h, r);
     markStage(out.clock, "remodulate");
     exec.synchronize();
 }

@@ -12,6 +12,7 @@
 
 #include "atrous/image.h"
 #include "filters/filter_math.h"
+#include "filters/modulation.h"
 
 namespace atrous {
 struct CpuExec;
@@ -54,7 +55,7 @@ constexpr float kNoiseBackgroundFloor = 0.01f;
 constexpr float kDetailVarFactor = float(1.0 + (70.0 / 256.0) * (70.0 / 256.0) - 2.0 * (6 / 16.0) * (6 / 16.0));
 
 // Donoho's finest B3 detail |v − (B3 ∗ v)(p)| per channel of v (the demodulated colour:
-// DemodulatedCopy, so that texture, which the filters never see, does not read as noise), over
+// Demodulate (modulation.h) into a copy, so that texture, which the filters never see, does not read as noise), over
 // clamped borders in double sums: the global estimate's input on the CPU (estimateNoiseSigma) and
 // the GPU (estimateNoiseSigmaCuda) alike. Pixels with a non-finite value in their 5×5 window get
 // +Inf (sorted after every detail).
@@ -86,17 +87,6 @@ struct MadDetail {
     }
 };
 
-// out = c / a' (a' the modulation albedo, filter_math.h; albedo invalid: a copy).
-struct DemodulatedCopy {
-    float eps = 1e-3f, floor = 0.0f;
-    ImageView color, albedo, out;
-    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        float m[3];
-        pixelModulationAlbedo(albedo, x, y, eps, floor, m);
-        for (int c = 0; c < 3; ++c) out(x, y, c) = albedo.valid() ? color(x, y, c) / m[c] : color(x, y, c);
-    }
-};
-
 // Donoho's global estimate on `exec`, per channel: σ_c = median |d_0,c| / 0.6745 /
 // sqrt(kDetailVarFactor) over the pixels whose 5×5 window is finite (0 when none is), of `color`
 // divided by a' when `albedo` is valid. estimateNoiseSigma (CPU) and estimateNoiseSigmaCuda.
@@ -107,7 +97,10 @@ void globalNoiseSigma(const Exec& exec, const ImageView& color, const ImageView&
     Image detail(w, h, 3, exec.device()), demod;
     if (albedo.valid()) {
         demod = Image(w, h, 3, exec.device());
-        exec.forEachPixel(w, h, DemodulatedCopy{eps, floor, color, albedo, demod.view()});
+        Demodulate d;  // c / a', the still filters' rule (modulation.h)
+        d.rule.eps = eps, d.rule.floor = floor;
+        d.albedo = albedo, d.in = color, d.out = demod.view();
+        exec.forEachPixel(w, h, d);
     }
     exec.forEachPixel(w, h, MadDetail{albedo.valid() ? demod.view() : color, detail.view()});
     exec.synchronize();
@@ -124,7 +117,7 @@ void globalNoiseSigma(const Exec& exec, const ImageView& color, const ImageView&
 constexpr float kNoiseNormalDist2 = 0.1f;  // |n_p - n_q|² (about 18 degrees)
 constexpr float kNoiseDepthRel = 0.05f;
 struct DetailEnergy {
-    ImageView color, energy;  // color: c_0 demodulated (DemodulatedCopy), energy: out (3 ch)
+    ImageView color, energy;  // color: c_0 demodulated (Demodulate into a copy), energy: out (3 ch)
     ImageView normal, depth;  // sanitised (zeros when absent)
     // A tap further from p than this (squared, per channel) is across an edge in the colour itself
     // (a visible light in a wall of the same normal and depth), left out as a geometric edge is.

@@ -188,21 +188,6 @@ void runFireflyClamp(const Exec& exec, const FireflyClamp& f) {
 }
 void runFireflyClamp(const CpuExec& exec, const FireflyClamp& f);
 
-// c / a', var / a'² (in place), a' = modulationAlbedo (filter_math.h).
-struct Demodulate {
-    float eps, floor;
-    ImageView albedo, color, var;
-    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        float m[3];
-        pixelModulationAlbedo(albedo, x, y, eps, floor, m);
-        for (int c = 0; c < 3; ++c) {
-            const float ia = 1.0f / m[c];
-            color(x, y, c) *= ia;
-            var(x, y, c) *= ia * ia;
-        }
-    }
-};
-
 // Per-pixel colour scale S of the automatic σ_c: k_c² · (3×3 [1 2 1]² / 16 prefilter of the
 // channel-summed variance, without its largest neighbour, renormalised) — prefiltered because a
 // few-sample variance estimate is itself noisy, and without the largest neighbour so that one
@@ -306,23 +291,6 @@ struct SubtractEmission {
         color(x, y, 0) -= emission(x, y, 0);
         color(x, y, 1) -= emission(x, y, 1);
         color(x, y, 2) -= emission(x, y, 2);
-    }
-};
-
-// out = (c_N + Σ s_i d_i) · a' + emission (a' as in Demodulate; albedo/emission invalid: skipped).
-struct Recombine {
-    float eps, floor;
-    ImageView cN, detailSum, albedo, emission, out;  // detailSum may be invalid (EAW)
-    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        float m[3];
-        pixelModulationAlbedo(albedo, x, y, eps, floor, m);
-        for (int c = 0; c < 3; ++c) {
-            float v = cN(x, y, c);
-            if (detailSum.valid()) v += detailSum(x, y, c);
-            if (albedo.valid()) v *= m[c];
-            if (emission.valid()) v += emission(x, y, c);
-            out(x, y, c) = v;
-        }
     }
 };
 

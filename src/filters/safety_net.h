@@ -52,7 +52,7 @@ struct SafetyRatio {
 };
 
 // Vertical window sums of the horizontal sums (SureBoxH), the choice of s, and
-// cN ← F + s (y - F) in place (detailSum is folded in: Recombine then runs without it).
+// cN ← F + s (y - F) in place (detailSum is folded in: Remodulate then runs without it).
 struct SafetyBlend {
     SureChoiceParams p;
     float varScale;  // κ: ΣV is taken as κ ΣV

@@ -5,7 +5,7 @@
 
 #include "atrous/image.h"
 #include "core/math.h"
-#include "filters/filter_math.h"  // modulationAlbedo; atrous_math.h: b3, fastExp, lum, selectF
+#include "filters/modulation.h"  // AlbedoRule, Demodulate, Remodulate; atrous_math.h: b3, fastExp, lum, selectF
 
 namespace atrous::svgf {
 
@@ -32,12 +32,18 @@ ATROUS_INLINE void writeVec3(const ImageView& v, int x, int y, Vec3 c) {
     v(x, y, 2) = c.z;
 }
 
-// Albedo used for (de)modulation: missing -> 1, non-finite channel -> 1, else max(a, kMinAlbedo),
-// blended toward 1 where the albedo is near black: filters::pixelModulationAlbedo, the still
-// filters' own, with SVGF's floor (kDefaultAlbedoFloor) and without their rim rule.
+// SVGF's albedo rule for the one demodulate/remodulate pair (filters/modulation.h): missing -> 1,
+// non-finite channel -> 1, else max(a, kMinAlbedo), blended toward 1 where the albedo is near
+// black: filters::pixelModulationAlbedo, the still filters' own, with SVGF's floor
+// (kDefaultAlbedoFloor) and without their rim rule. modulationAlbedo: its a' at one pixel.
+ATROUS_INLINE filters::AlbedoRule albedoRule() {
+    filters::AlbedoRule r;
+    r.eps = kMinAlbedo, r.floor = filters::kDefaultAlbedoFloor, r.rim = false, r.nonFinite = 1.0f;
+    return r;
+}
 ATROUS_INLINE Vec3 modulationAlbedo(const ImageView& albedo, int x, int y) {
     float a[3];
-    filters::pixelModulationAlbedo<false>(albedo, x, y, kMinAlbedo, filters::kDefaultAlbedoFloor, a, 1.0f);
+    albedoRule().at(albedo, x, y, a);
     return Vec3(a[0], a[1], a[2]);
 }
 

@@ -12,10 +12,8 @@
 #include "filters/stage_clock.h"
 #include "filters/svgf_accumulate.h"
 #include "filters/svgf_atrous.h"
-#include "filters/svgf_demodulate.h"
 #include "filters/svgf_emission.h"
 #include "filters/svgf_gbuffer.h"
-#include "filters/svgf_remodulate.h"
 #include "filters/svgf_reproject.h"
 #include "filters/svgf_taa.h"
 #include "filters/svgf_variance.h"
@@ -124,7 +122,13 @@ public:
         const ImageView color = views[0], albedo = views[1], normalIn = views[2], depthIn = views[3], idsIn = views[4],
                         motionIn = views[5], emission = views[6];
 
-        mExec.forEachPixel(w, h, Demodulate{color, albedo, emission, s.illum.view(), s.valid.view()});
+        // illumination = (colour - emission) / a', clamped to ±kMaxIllum so that l² stays finite;
+        // a non-finite colour is no sample (valid 0: the history is kept there).
+        filters::Demodulate demod;
+        demod.rule = albedoRule();
+        demod.albedo = albedo, demod.in = color, demod.out = s.illum.view();
+        demod.emission = emission, demod.valid = s.valid.view(), demod.maxAbs = kMaxIllum;
+        mExec.forEachPixel(w, h, demod);
         mExec.forEachPixel(w, h, SanitizeGbuffer{depthIn, normalIn, idsIn, motionIn, s.depth.view(), s.normal.view(),
                                                  s.ids.view(), s.motion.view()});
         mExec.forEachPixel(w, h, DepthGradient{s.depth.view(), s.depthGrad.view()});
@@ -197,7 +201,10 @@ public:
             mExec.forEachPixel(w, h, ae);
             remodEmission = s.accEmission.view();
         }
-        mExec.forEachPixel(w, h, Remodulate{inIllum, albedo, remodEmission, s.output.view()});
+        filters::Remodulate remod;  // colour = illumination × a' + emission, non-finite -> 0
+        remod.rule = albedoRule();
+        remod.base = inIllum, remod.albedo = albedo, remod.emission = remodEmission, remod.out = s.output.view();
+        mExec.forEachPixel(w, h, remod);
         filters::markStage(clock, "remodulate");
         s.result = &s.output;
         if (mParams.taa) {
