@@ -13,7 +13,9 @@
 
 using namespace atrous;
 using filters::Demodulate;
+using filters::DemodulateSample;
 using filters::Remodulate;
+using filters::RemodulateGuarded;
 
 namespace {
 
@@ -84,7 +86,7 @@ TEST(Modulation, NonFiniteColourIsNoSampleAndTheClampHolds) {
     color(0, 0, 1) = kNan;
     color(1, 0, 2) = kInf;
     color(2, 0, 0) = 1e30f;  // finite, beyond the clamp
-    Demodulate d;
+    DemodulateSample d;  // SVGF's
     d.in = color.view(), d.out = out.view(), d.valid = valid.view(), d.maxAbs = svgf::kMaxIllum;
     for (int x = 0; x < 3; ++x) d(x, 0);
     EXPECT_EQ(valid(0, 0, 0), 0.0f);
@@ -100,7 +102,7 @@ TEST(Modulation, RemodulateNeverLetsANonFiniteValueOut) {
     emission.fill(0.5f);
     base(0, 0, 0) = kNan;
     emission(1, 0, 1) = kInf;  // a non-finite emission reads as 0
-    Remodulate r;
+    RemodulateGuarded r;  // SVGF's
     r.base = base.view(), r.emission = emission.view(), r.out = out.view();
     for (int x = 0; x < 2; ++x) r(x, 0);
     EXPECT_EQ(out(0, 0, 0), 0.0f);

@@ -124,7 +124,7 @@ public:
 
         // illumination = (colour - emission) / a', clamped to ±kMaxIllum so that l² stays finite;
         // a non-finite colour is no sample (valid 0: the history is kept there).
-        filters::Demodulate demod;
+        filters::DemodulateSample demod;
         demod.rule = albedoRule();
         demod.albedo = albedo, demod.in = color, demod.out = s.illum.view();
         demod.emission = emission, demod.valid = s.valid.view(), demod.maxAbs = kMaxIllum;
@@ -201,7 +201,7 @@ public:
             mExec.forEachPixel(w, h, ae);
             remodEmission = s.accEmission.view();
         }
-        filters::Remodulate remod;  // colour = illumination × a' + emission, non-finite -> 0
+        filters::RemodulateGuarded remod;  // colour = illumination × a' + emission, non-finite -> 0
         remod.rule = albedoRule();
         remod.base = inIllum, remod.albedo = albedo, remod.emission = remodEmission, remod.out = s.output.view();
         mExec.forEachPixel(w, h, remod);
