@@ -379,7 +379,8 @@ TEST(SvgfParamsTest, EveryFieldChangesTheOutput) {
 }
 
 TEST(SvgfModulation, IsTheStillFiltersAlbedoWithSvgfsFloorAndNoRimRule) {
-    // SVGF's divisor is filters::pixelModulationAlbedo<false> (one function for both): per pixel
+    // SVGF's divisor is filters::pixelModulationAlbedo without the rim rule (svgf::albedoRule();
+    // one function for both): per pixel
     // it must equal SVGF's own rule as it was written before the merge, exactly (same operations):
     // non-finite channel -> 1, t = min(m / 0.1, 1)^2, a' = 1 + t (max(a, 1e-3) - 1), a' = max(a,
     // 1e-3) where t = 1. And no rim rule: a black neighbour changes nothing (the still filters'
@@ -391,7 +392,9 @@ TEST(SvgfModulation, IsTheStillFiltersAlbedoWithSvgfsFloorAndNoRimRule) {
             for (float b : {0.0f, 0.07f, 0.9f, NAN}) {
                 img.fill(0.0f);  // black neighbours
                 img(1, 1, 0) = r, img(1, 1, 1) = g, img(1, 1, 2) = b;
-                const Vec3 got = svgf::modulationAlbedo(img.view(), 1, 1);
+                float a3[3];
+                svgf::albedoRule().at(img.view(), 1, 1, a3);
+                const Vec3 got(a3[0], a3[1], a3[2]);
                 const float a[3] = {std::isfinite(r) ? r : 1.0f, std::isfinite(g) ? g : 1.0f, std::isfinite(b) ? b : 1.0f};
                 const float m = std::max(std::max(a[0], a[1]), a[2]);
                 const float t = std::min(m / 0.1f, 1.0f) * std::min(m / 0.1f, 1.0f);
@@ -409,5 +412,7 @@ TEST(SvgfModulation, IsTheStillFiltersAlbedoWithSvgfsFloorAndNoRimRule) {
     for (int c = 0; c < 3; ++c) img(1, 1, c) = 0.15f;
     float still[3];
     filters::pixelModulationAlbedo(img.view(), 1, 1, 1e-3f, 0.1f, still);
-    EXPECT_NE(still[0], svgf::modulationAlbedo(img.view(), 1, 1).x);
+    float svgfA[3];
+    svgf::albedoRule().at(img.view(), 1, 1, svgfA);
+    EXPECT_NE(still[0], svgfA[0]);
 }

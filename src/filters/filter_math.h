@@ -41,11 +41,9 @@ ATROUS_INLINE float maxChannel(float a, float b, float c) { return maxSel(maxSel
 
 // a'_c of pixel (x, y), c = 0..2, from an albedo view (non-finite channels read as `nonFinite`);
 // an invalid view gives 1 (no demodulation). The one place the filters (EAW, SURE and SVGF) turn
-// an albedo pixel into divisors. kRimRule (or rim = false at run time, AlbedoRule in
-// modulation.h): the rim rule below (EAW/SURE); SVGF calls it with
-// false and nonFinite = 1 (svgf::modulationAlbedo: its floor 0.1 without the rule, as measured
-// for it so far; docs/svgf.md).
-template <bool kRimRule = true>
+// an albedo pixel into divisors. rim: the rim rule below (EAW/SURE); SVGF calls it (through
+// AlbedoRule, modulation.h) with rim = false and nonFinite = 1: its floor 0.1 without the rule,
+// as measured for it so far (docs/svgf.md).
 ATROUS_INLINE void pixelModulationAlbedo(const ImageView& albedo, int x, int y, float eps, float floor, float (&a)[3],
                                          float nonFinite = 0.0f, bool rim = true) {
     if (!albedo.valid()) {
@@ -61,7 +59,7 @@ ATROUS_INLINE void pixelModulationAlbedo(const ImageView& albedo, int x, int y, 
     // the floor is kRimFloorMul times higher.
     float nearBlack = 0.0f;
     const float mp = maxChannel(v[0], v[1], v[2]);
-    if (kRimRule && rim && floor > 0.0f && mp > 0.0f && mp < kRimFloorMul * floor) {  // elsewhere t is the same either way
+    if (rim && floor > 0.0f && mp > 0.0f && mp < kRimFloorMul * floor) {  // elsewhere t is the same either way
         float mn = 1e30f;
         for (int dy = -1; dy <= 1; ++dy)
             for (int dx = -1; dx <= 1; ++dx) {

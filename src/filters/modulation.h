@@ -18,7 +18,7 @@ struct AlbedoRule {
     bool rim = true;
     float nonFinite = 0.0f;
     ATROUS_INLINE void at(const ImageView& albedo, int x, int y, float (&a)[3]) const {
-        pixelModulationAlbedo<true>(albedo, x, y, eps, floor, a, nonFinite, rim);
+        pixelModulationAlbedo(albedo, x, y, eps, floor, a, nonFinite, rim);
     }
 };
 

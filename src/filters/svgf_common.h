@@ -14,7 +14,7 @@ constexpr float kBackgroundDepth = 1e29f;
 constexpr float kBackgroundDepthValue = 1e30f;
 // Motion at least this large (or non-finite) cannot be reprojected: the pixel's history resets.
 constexpr float kMaxMotion = 1e5f;
-// Demodulation divides by modulationAlbedo (max(albedo, kMinAlbedo) on surfaces); remodulation multiplies by the same value so
+// Demodulation divides by albedoRule()'s a' (max(albedo, kMinAlbedo) on surfaces); remodulation multiplies by the same value so
 // the pair is an identity wherever the filter leaves a pixel alone.
 constexpr float kMinAlbedo = 1e-3f;
 // Illumination magnitudes are clamped here so the second moment (l^2) stays finite in float.
@@ -35,16 +35,11 @@ ATROUS_INLINE void writeVec3(const ImageView& v, int x, int y, Vec3 c) {
 // SVGF's albedo rule for the one demodulate/remodulate pair (filters/modulation.h): missing -> 1,
 // non-finite channel -> 1, else max(a, kMinAlbedo), blended toward 1 where the albedo is near
 // black: filters::pixelModulationAlbedo, the still filters' own, with SVGF's floor
-// (kDefaultAlbedoFloor) and without their rim rule. modulationAlbedo: its a' at one pixel.
+// (kDefaultAlbedoFloor) and without their rim rule.
 ATROUS_INLINE filters::AlbedoRule albedoRule() {
     filters::AlbedoRule r;
     r.eps = kMinAlbedo, r.floor = filters::kDefaultAlbedoFloor, r.rim = false, r.nonFinite = 1.0f;
     return r;
-}
-ATROUS_INLINE Vec3 modulationAlbedo(const ImageView& albedo, int x, int y) {
-    float a[3];
-    albedoRule().at(albedo, x, y, a);
-    return Vec3(a[0], a[1], a[2]);
 }
 
 // Emission to subtract/add back: missing or non-finite -> 0.
