@@ -1,10 +1,12 @@
 #!/usr/bin/env python3
-"""Writes tests/learned_fixture.bin: a small input set, a weight file and the JAX forward pass's
-output on them, which tests/learned_test.cpp (C++ inference) and tests/python/test_learn.py (the
-JAX code as it is now) compare with. Layout (little-endian):
-  "ATRF" | u32 width | u32 height | u32 n (weight-file bytes) | the weight file
-  | 6 inputs (color, variance, albedo, normal, depth, emission) and the output, each 3 planes of
-    height x width f32 (atrous's Image layout)."""
+"""Writes tests/learned_fixture.bin (the learned filter v2's parity fixture): synthetic prepared
+planes (what the still driver hands the learned cascade: d, var, albedo, normal, depth), a weight
+file with random non-trivial weights and the JAX d_out on them, which tests/learned_test.cpp (C++
+inference) and tests/python/test_learn.py (the JAX code as it is now) compare with.
+Layout (little-endian):
+  "ATRF" | u32 version (2) | u32 width | u32 height | u32 n (weight-file bytes) | the weight file
+  | planes d(3), var(3), albedo(3), normal(3), depth(1), out_d(3): f32, planar, channel-major
+    (atrous's Image layout: channel c's plane is height x width row-major)."""
 import struct
 import sys
 from pathlib import Path
@@ -16,55 +18,78 @@ import jax  # noqa: E402
 import jax.numpy as jnp  # noqa: E402
 from learn import features, model, weights  # noqa: E402
 
-INPUTS = ("color", "variance", "albedo", "normal", "depth", "emission")
+PLANES = (("d", 3), ("var", 3), ("albedo", 3), ("normal", 3), ("depth", 1))
+VERSION = 2
 
 
-def make_inputs(w: int = 24, h: int = 20, seed: int = 5) -> dict:
+def make_planes(w: int = 24, h: int = 20, seed: int = 5) -> dict:
+    """Prepared planes with an edge (albedo, normal and brightness change at x = w/2), a black-albedo
+    patch, sky depth 1e30 (clamped to 1e4 by the inputs), a bright firefly-ish pixel and noise."""
     rng = np.random.default_rng(seed)
     yy, xx = np.mgrid[0:h, 0:w]
     edge = (xx > w // 2).astype(np.float32)[..., None]
     albedo = np.where(edge > 0, [0.8, 0.3, 0.2], [0.2, 0.6, 0.7]).astype(np.float32) * np.ones((h, w, 1), np.float32)
-    albedo[:4, :5] = 0.0  # a black-albedo patch: the rim rule and floor
-    albedo[4, 2] = 0.07
-    normal = np.where(edge > 0, [0, 1, 0], [1, 0, 0]).astype(np.float32) * np.ones((h, w, 1), np.float32)
-    depth = (2.0 + 0.1 * xx + 0.05 * yy).astype(np.float32)[..., None].repeat(3, 2)
+    albedo[:4, :5] = 0.0  # black albedo: inputs 3-5 read 0 there
+    normal = np.where(edge > 0, [0, 1, 0], [0.6, 0, 0.8]).astype(np.float32) * np.ones((h, w, 1), np.float32)
+    depth = (2.0 + 0.1 * xx + 0.05 * yy).astype(np.float32)[..., None]
     depth[-3:, -4:] = 1e30  # sky
-    color = (albedo * (0.5 + 2 * edge) * rng.gamma(1.5, 1.0, (h, w, 3))).astype(np.float32)
-    color[7, 9] = 40.0  # a firefly
-    color[3, 3] = np.nan  # a non-finite sample
-    variance = (0.1 * color * color + 0.01).astype(np.float32)
-    variance[3, 3] = 0.0
-    emission = np.zeros((h, w, 3), np.float32)
-    emission[-2:, :3] = 5.0
-    color[-2:, :3] += 5.0
-    return {"color": color, "variance": variance, "albedo": albedo, "normal": normal, "depth": depth,
-            "emission": emission}
+    d = ((0.3 + 1.5 * edge) * rng.gamma(2.0, 0.5, (h, w, 3))).astype(np.float32)
+    d[7, 9] = [60.0, 45.0, 30.0]  # a bright, firefly-ish pixel (the driver's clamp leaves some)
+    d[12, 3] = 0.0  # a black pixel: kappa's 0.01
+    var = (0.2 * d * d + 0.005).astype(np.float32)
+    var[:2, -3:] = 0.0  # no variance: input 10 reads log1p(0)
+    return {"d": d, "var": var, "albedo": albedo, "normal": normal, "depth": depth}
 
 
 def fixture_params(seed: int = 7) -> dict:
-    p = model.init_params(seed)
-    rng = np.random.default_rng(seed + 1)
-    return {k: jnp.asarray(np.asarray(v) + rng.normal(0, 0.3, v.shape).astype(np.float32)) for k, v in p.items()}
+    """Random weights of unit-ish scale (every output term active: a, m, b of O(1), blend spread)."""
+    rng = np.random.default_rng(seed)
+    p = {}
+    for name, shape in model.SHAPES:
+        scale = np.sqrt(2.0 / shape[0]) if name.startswith("w") else 0.5
+        p[name] = (rng.standard_normal(shape) * scale).astype(np.float32)
+    p["w3"] *= 0.5
+    return {k: jnp.asarray(v) for k, v in p.items()}
 
 
-def forward_np(params: dict, inputs: dict) -> np.ndarray:
-    x, d, a, e = features.prepare(*(inputs[n] for n in INPUTS))
-    out = model.forward(params, jnp.asarray(x[None]), jnp.asarray(d[None]), jnp.asarray(a[None]), jnp.asarray(e[None]))
+def d_out_np(params: dict, planes: dict, **ablate) -> np.ndarray:
+    x = features.inputs_of(planes)
+    out = model.denoise_d(params, jnp.asarray(x[None]), jnp.asarray(planes["d"][None]), **ablate)
     return np.asarray(out[0])
+
+
+def read(path: Path):
+    """(width, height, weight-file bytes, planes dict incl. out_d) of a fixture file."""
+    data = path.read_bytes()
+    if data[:4] != b"ATRF" or struct.unpack("<I", data[4:8])[0] != VERSION:
+        raise ValueError(f"{path}: not a version-{VERSION} ATRF fixture")
+    w, h, n = struct.unpack("<3I", data[8:20])
+    wb = data[20:20 + n]
+    flat = np.frombuffer(data[20 + n:], "<f4")
+    planes, o = {}, 0
+    for name, c in PLANES + (("out_d", 3),):
+        planes[name] = flat[o:o + c * h * w].reshape(c, h, w).transpose(1, 2, 0).copy()
+        o += c * h * w
+    if o != flat.size:
+        raise ValueError(f"{path}: {flat.size} floats after the weights, expected {o}")
+    return w, h, wb, planes
 
 
 def main() -> int:
     jax.config.update("jax_enable_x64", False)
-    inputs = make_inputs()
+    planes = make_planes()
     params = fixture_params()
     wbytes = weights.to_bytes(params)
-    out = forward_np(params, inputs)
+    out = d_out_np(params, planes)
     h, w = out.shape[:2]
     with open(Path(__file__).resolve().parents[2] / "tests" / "learned_fixture.bin", "wb") as f:
-        f.write(b"ATRF" + struct.pack("<3I", w, h, len(wbytes)) + wbytes)
-        for arr in [inputs[n] for n in INPUTS] + [out]:
+        f.write(b"ATRF" + struct.pack("<4I", VERSION, w, h, len(wbytes)) + wbytes)
+        for arr in [planes[n] for n, _ in PLANES] + [out]:
             f.write(np.ascontiguousarray(arr.transpose(2, 0, 1), "<f4").tobytes())
-    print(f"fixture: {w}x{h}, output mean {np.mean(out):.4f}, min {out.min():.4f}, max {out.max():.4f}")
+    print(f"fixture: {w}x{h}, d_out mean {np.mean(out):.4f}, min {out.min():.4f}, max {out.max():.4f}")
+    for name, kw in (("colour term", {"colour": False}), ("blend", {"blend": False})):
+        diff = np.abs(d_out_np(params, planes, **kw) - out).max() / np.abs(out).max()
+        print(f"  without the {name}: max |change| {diff:.3g} of max |d_out|")
     return 0
 
 

@@ -1,46 +1,62 @@
-"""Per-pixel inputs of the learned filter, in numpy, exactly as src/filters/learned.h computes them
-(docs/learned.md, "Inputs"). No JAX here: the pre-processing is not differentiated."""
+"""The learned filter v2's per-pixel inputs (docs/learned.md, "Inputs"), in numpy, from the still
+driver's prepared planes (atrous.learned_planes: d, var, albedo, normal, depth), exactly as
+src/filters/learned.h computes them. No JAX here: the inputs are not differentiated.
+
+    0-2   log1p(max(d_c, 0))
+    3-5   albedo present ? clamp(albedo_c, 0, 1) : 1
+    6-8   normal present ? normal_c : 0
+    9     log(clamp(depth present ? depth : 1, 1e-3, 1e4))
+    10    log1p(sqrt(max(mean_c var_c, 0)))
+    11-13 3x3 box mean of inputs 0-2 (over the taps inside the image)
+    14    3x3 local std of L = log1p(max(mean_c d_c, 0)): sqrt(max(E[L^2] - E[L]^2, 0)), same taps
+Non-finite plane values read as 0."""
 from __future__ import annotations
 
 import numpy as np
 
-ALBEDO_EPS = 1e-3      # DenoiseOptions::albedoEpsilon
-ALBEDO_FLOOR = 0.05    # DenoiseOptions::albedoFloor
-RIM_FLOOR_MUL = 2.0    # filters/filter_math.h kRimFloorMul
-BLACK_FRACTION = 0.1   # kBlackAlbedoFraction
 DEPTH_MIN, DEPTH_MAX = 1e-3, 1e4
-N_IN = 11
+N_IN = 15
+BOX = slice(11, 15)  # the neighbourhood inputs (the "no box" ablation masks them)
 
 
 def _finite(x: np.ndarray) -> np.ndarray:
-    return np.where(np.isfinite(x), x, 0.0).astype(np.float32)
+    x = np.asarray(x, np.float32)
+    return np.where(np.isfinite(x), x, np.float32(0.0)).astype(np.float32)
 
 
-def modulation_albedo(albedo: np.ndarray, eps: float = ALBEDO_EPS, floor: float = ALBEDO_FLOOR) -> np.ndarray:
-    """a'_c of filter_math.h pixelModulationAlbedo for an H x W x 3 albedo (rim rule included)."""
-    v = _finite(albedo)
-    m = v.max(axis=2)
-    pad = np.pad(m, 1, mode="edge")
-    h, w = m.shape
-    mn = np.min([pad[dy:dy + h, dx:dx + w] for dy in range(3) for dx in range(3)], axis=0)
-    near = ((floor > 0) & (m > 0) & (m < RIM_FLOOR_MUL * floor) & (mn < BLACK_FRACTION * floor)).astype(np.float32)
-    fl = np.float32(floor) * (1.0 + near * np.float32(RIM_FLOOR_MUL - 1.0))
-    t = np.minimum(m / fl, 1.0) if floor > 0 else np.ones_like(m)
-    t = np.where(np.isfinite(t) & (t > 0), t * t, 0.0).astype(np.float32)[..., None]
-    mm = np.maximum(v, np.float32(eps))
-    return np.where(t >= 1.0, mm, 1.0 + t * (mm - 1.0)).astype(np.float32)
+def box3(x: np.ndarray) -> np.ndarray:
+    """3x3 mean of an H x W x C array over the taps inside the image (edges: fewer taps)."""
+    h, w = x.shape[:2]
+    p = np.pad(x, ((1, 1), (1, 1), (0, 0)))
+    ones = np.pad(np.ones((h, w, 1), np.float32), ((1, 1), (1, 1), (0, 0)))
+    s = np.zeros_like(x)
+    n = np.zeros((h, w, 1), np.float32)
+    for dy in range(3):
+        for dx in range(3):
+            s += p[dy:dy + h, dx:dx + w]
+            n += ones[dy:dy + h, dx:dx + w]
+    return (s / n).astype(np.float32)
 
 
-def prepare(color, variance, albedo, normal, depth, emission):
-    """(x, d, a', e): network inputs H x W x N_IN, demodulated colour H x W x 3, a' and the emission
-    (colour = d a' + e). All buffers H x W x 3 float32 (depth: channel 0 is used)."""
-    e = _finite(emission)
-    c = np.maximum(_finite(color) - e, 0.0)
-    a = modulation_albedo(albedo)
-    d = (c / a).astype(np.float32)
-    var = np.maximum(_finite(variance), 0.0) / (a * a)
-    z = np.log(np.clip(_finite(depth[..., 0]), DEPTH_MIN, DEPTH_MAX))
-    sd = np.sqrt(var.mean(axis=2))
-    x = np.concatenate([np.log1p(d), np.clip(_finite(albedo), 0.0, 1.0), _finite(normal),
-                        z[..., None], np.log1p(sd)[..., None]], axis=2).astype(np.float32)
-    return x, d, a, e
+def inputs(d, var, albedo=None, normal=None, depth=None) -> np.ndarray:
+    """The network inputs H x W x N_IN of one image's prepared planes (H x W x 3; depth H x W x 1 or
+    x 3, channel 0 used; albedo/normal/depth None when absent)."""
+    d = _finite(d)
+    h, w = d.shape[:2]
+    ld = np.log1p(np.maximum(d, 0.0))
+    alb = np.clip(_finite(albedo), 0.0, 1.0) if albedo is not None else np.ones((h, w, 3), np.float32)
+    nrm = _finite(normal) if normal is not None else np.zeros((h, w, 3), np.float32)
+    z = _finite(depth)[..., :1] if depth is not None else np.ones((h, w, 1), np.float32)
+    z = np.log(np.clip(z, DEPTH_MIN, DEPTH_MAX))
+    sd = np.log1p(np.sqrt(np.maximum(_finite(var).mean(axis=2, keepdims=True), 0.0)))
+    lum = np.log1p(np.maximum(d.mean(axis=2, keepdims=True), 0.0))
+    m = box3(np.concatenate([ld, lum, lum * lum], axis=2))
+    std = np.sqrt(np.maximum(m[..., 4:5] - m[..., 3:4] ** 2, 0.0))
+    return np.concatenate([ld, alb, nrm, z, sd, m[..., :3], std], axis=2).astype(np.float32)
+
+
+def inputs_of(planes: dict, suffix: str = "") -> np.ndarray:
+    """inputs() of a dict holding d, var and optionally albedo, normal, depth (keys + suffix)."""
+    g = planes.get
+    return inputs(planes["d" + suffix], planes["var" + suffix], g("albedo" + suffix), g("normal" + suffix),
+                  g("depth" + suffix))

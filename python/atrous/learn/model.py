@@ -1,8 +1,16 @@
-"""The learned filter's forward pass in JAX (docs/learned.md): a per-pixel MLP gives a guide feature
-vector f and, per level i, a bandwidth a_i and a centre weight m_i; a 5-level à-trous cascade (B3
-5x5 taps at step 2^i, taps outside the image dropped, as src/filters/atrous_level.h) filters the
-demodulated colour with w = h(q) exp(-a_i(p) |f_p - f_q|^2), the centre tap h(0)^2 (1 + m_i(p)).
-src/filters/learned.h is the same math in C++; tests/learned_test.cpp holds the two equal."""
+"""The learned filter v2's forward pass in JAX (docs/learned.md): a per-pixel MLP 15 -> 24 -> 24 -> 29
+gives a guide feature vector f, per level i a feature bandwidth a_i, a centre weight m_i and a
+colour bandwidth b_i, and 6 blend logits beta; a 5-level à-trous cascade (B3 5x5 taps at step 2^i,
+taps outside the image dropped, as src/filters/atrous_level.h) filters the demodulated colour d:
+
+    kappa_i(p) = 1 / (0.01 + mean_c d_i(p,c)^2)
+    w_i(p,q)   = h(q) exp(-a_i(p) |f_p - f_q|^2 - b_i(p) kappa_i(p) sum_c (d_i(q,c) - d_i(p,c))^2)
+    w_i(p,p)   = h(0)^2 (1 + m_i(p))
+    d_{i+1}(p) = sum_q w_i(p,q) d_i(q) / sum_q w_i(p,q)
+    d_out(p)   = sum_j softmax(beta(p))_j d_j(p)     (j = 0..5)
+
+src/filters/learned.h is the same math in C++; tests/learned_test.cpp holds the two equal on
+tests/learned_fixture.bin. The ablation switches (colour, blend) exist only here."""
 from __future__ import annotations
 
 import jax
@@ -11,16 +19,26 @@ import numpy as np
 
 from .features import N_IN
 
-N_HIDDEN = 16
+N_HIDDEN = 24
 N_FEAT = 8
 N_LEVELS = 5
-N_OUT = N_FEAT + 2 * N_LEVELS
+N_OUT = N_FEAT + 3 * N_LEVELS + (N_LEVELS + 1)
 B3 = (1.0 / 16, 1.0 / 4, 3.0 / 8, 1.0 / 4, 1.0 / 16)
+KAPPA_EPS = 0.01
 SHAPES = (("w1", (N_IN, N_HIDDEN)), ("b1", (N_HIDDEN,)), ("w2", (N_HIDDEN, N_HIDDEN)), ("b2", (N_HIDDEN,)),
           ("w3", (N_HIDDEN, N_OUT)), ("b3", (N_OUT,)))
+# Output slices, in the weight file's order.
+F_ = slice(0, N_FEAT)
+A_ = slice(N_FEAT, N_FEAT + N_LEVELS)
+M_ = slice(N_FEAT + N_LEVELS, N_FEAT + 2 * N_LEVELS)
+BC_ = slice(N_FEAT + 2 * N_LEVELS, N_FEAT + 3 * N_LEVELS)
+BETA_ = slice(N_FEAT + 3 * N_LEVELS, N_OUT)
 
 
 def init_params(seed: int) -> dict:
+    """He-initialised MLP; the last layer small, its biases chosen so training starts near a plain
+    B3 cascade: a_i, m_i about softplus(0) = 0.69, b_i small (softplus(-3) = 0.05), the blend
+    leaning to d_5 (logit +1 against 0)."""
     rng = np.random.default_rng(seed)
     p = {}
     for name, shape in SHAPES:
@@ -28,7 +46,9 @@ def init_params(seed: int) -> dict:
             p[name] = (rng.standard_normal(shape) * np.sqrt(2.0 / shape[0])).astype(np.float32)
         else:
             p[name] = np.zeros(shape, np.float32)
-    p["w3"] *= 0.3
+    p["w3"] *= 0.1
+    p["b3"][BC_] = -3.0
+    p["b3"][BETA_.stop - 1] = 1.0
     return {k: jnp.asarray(v) for k, v in p.items()}
 
 
@@ -38,11 +58,11 @@ def softplus(x):
 
 
 def network(params: dict, x):
-    """x: ... x N_IN -> (f ... x N_FEAT, a ... x N_LEVELS, m ... x N_LEVELS)."""
+    """x: ... x N_IN -> (f ... x N_FEAT, a, m, b ... x N_LEVELS, beta ... x N_LEVELS + 1)."""
     h = jax.nn.relu(x @ params["w1"] + params["b1"])
     h = jax.nn.relu(h @ params["w2"] + params["b2"])
     o = h @ params["w3"] + params["b3"]
-    return o[..., :N_FEAT], softplus(o[..., N_FEAT:N_FEAT + N_LEVELS]), softplus(o[..., N_FEAT + N_LEVELS:])
+    return o[..., F_], softplus(o[..., A_]), softplus(o[..., M_]), softplus(o[..., BC_]), o[..., BETA_]
 
 
 def _shift(arr, dy: int, dx: int, pad: int):
@@ -51,15 +71,18 @@ def _shift(arr, dy: int, dx: int, pad: int):
     return arr[:, pad + dy:pad + dy + h, pad + dx:pad + dx + w]
 
 
-def cascade(d, f, a, m):
-    """d: B x H x W x 3 demodulated colour, f/a/m from network(); returns the filtered d."""
+def cascade(d, f, a, m, b, beta, colour: bool = True, blend: bool = True):
+    """d: B x H x W x 3 demodulated colour, the rest from network(); returns d_out (B x H x W x 3).
+    colour=False drops the colour term (b = 0), blend=False returns d_5 (ablations only)."""
     ones = jnp.ones(d.shape[:3] + (1,), d.dtype)
+    levels = [d]
     for i in range(N_LEVELS):
         s = 1 << i
         P = 2 * s
         padw = ((0, 0), (P, P), (P, P), (0, 0))
         dp, fp, vp = jnp.pad(d, padw), jnp.pad(f, padw), jnp.pad(ones, padw)
         ai, mi = a[..., i:i + 1], m[..., i:i + 1]
+        bk = b[..., i:i + 1] / (KAPPA_EPS + jnp.mean(jnp.square(d), axis=-1, keepdims=True))
         num = jnp.zeros_like(d)
         den = jnp.zeros_like(ones)
         for qy in range(-2, 3):
@@ -71,19 +94,31 @@ def cascade(d, f, a, m):
                 else:
                     fq = _shift(fp, qy * s, qx * s, P)
                     vq = _shift(vp, qy * s, qx * s, P)
-                    w = hxy * vq * jnp.exp(-ai * jnp.sum(jnp.square(f - fq), axis=-1, keepdims=True))
+                    e = ai * jnp.sum(jnp.square(f - fq), axis=-1, keepdims=True)
+                    if colour:
+                        e = e + bk * jnp.sum(jnp.square(dq - d), axis=-1, keepdims=True)
+                    w = hxy * vq * jnp.exp(-e)
                 num = num + w * dq
                 den = den + w
         d = num / den
-    return d
+        levels.append(d)
+    if not blend:
+        return d
+    wts = jax.nn.softmax(beta, axis=-1)
+    return sum(wts[..., j:j + 1] * levels[j] for j in range(N_LEVELS + 1))
 
 
-def forward(params: dict, x, d, alb, e):
-    """The filtered colour: cascade(d) a' + e (B x H x W x 3)."""
-    f, a, m = network(params, x)
-    return cascade(d, f, a, m) * alb + e
+def denoise_d(params: dict, x, d, colour: bool = True, blend: bool = True):
+    """d_out of the network inputs x (B x H x W x N_IN) and the demodulated colour d."""
+    f, a, m, b, beta = network(params, x)
+    return cascade(d, f, a, m, b, beta, colour, blend)
 
 
-def relmse(out, ref):
-    """docs/eval.md's relMSE: mean of (x - r)^2 / (r^2 + 0.01) over pixels and channels."""
-    return jnp.mean(jnp.square(out - ref) / (jnp.square(ref) + 0.01))
+def forward(params: dict, x, d, mod, e, colour: bool = True, blend: bool = True):
+    """The library's output (safety net off): d_out mod + e (B x H x W x 3)."""
+    return denoise_d(params, x, d, colour, blend) * mod + e
+
+
+def relmse(out, ref, eps: float = 0.01):
+    """docs/eval.md's relMSE: mean of (x - r)^2 / (r^2 + eps) over pixels and channels (eps 0.01)."""
+    return jnp.mean(jnp.square(out - ref) / (jnp.square(ref) + eps))

@@ -1,8 +1,8 @@
-"""The learned filter's weight file (docs/learned.md, "Weight file"), read by
+"""The learned filter's weight file, version 2 (docs/learned.md, "Weight file"), read by
 src/filters/learned_weights.cpp: little-endian
-  "ATRL" | u32 version (1) | u32 n_in | u32 n_hidden | u32 n_feat | u32 n_levels | u32 n_floats
+  "ATRL" | u32 version (2) | u32 n_in | u32 n_hidden | u32 n_feat | u32 n_levels | u32 n_floats
   | n_floats f32 (w1 [n_in][n_hidden], b1, w2 [n_hidden][n_hidden], b2, w3 [n_hidden][n_out], b3)
-  | u32 FNV-1a of every byte before it."""
+  | u32 FNV-1a of every byte before it. Version 1 (the first network, 11 -> 16 -> 16 -> 18) is refused."""
 from __future__ import annotations
 
 import struct
@@ -12,7 +12,7 @@ import numpy as np
 from .model import N_FEAT, N_HIDDEN, N_IN, N_LEVELS, SHAPES
 
 MAGIC = b"ATRL"
-VERSION = 1
+VERSION = 2
 
 
 def fnv1a(data: bytes) -> int:
@@ -32,8 +32,13 @@ def from_bytes(data: bytes, name: str = "weights") -> dict:
     if len(data) < 32 or data[:4] != MAGIC:
         raise ValueError(f"{name}: not an atrous learned-filter weight file (no ATRL header)")
     version, n_in, n_hid, n_feat, n_lev, n = struct.unpack("<6I", data[4:28])
-    if version != VERSION or (n_in, n_hid, n_feat, n_lev) != (N_IN, N_HIDDEN, N_FEAT, N_LEVELS):
-        raise ValueError(f"{name}: version {version} / shape {(n_in, n_hid, n_feat, n_lev)} is not this build's")
+    if version == 1:
+        raise ValueError(f"{name}: version 1 (the first network, retired); retrain with make train")
+    if version != VERSION:
+        raise ValueError(f"{name}: version {version}, this build reads version {VERSION}")
+    if (n_in, n_hid, n_feat, n_lev) != (N_IN, N_HIDDEN, N_FEAT, N_LEVELS):
+        raise ValueError(f"{name}: network shape (n_in, n_hidden, n_feat, n_levels) = {(n_in, n_hid, n_feat, n_lev)}, "
+                         f"this build's is {(N_IN, N_HIDDEN, N_FEAT, N_LEVELS)}")
     if len(data) != 28 + 4 * n + 4 or fnv1a(data[:-4]) != struct.unpack("<I", data[-4:])[0]:
         raise ValueError(f"{name}: truncated or corrupt (size or checksum)")
     flat = np.frombuffer(data[28:28 + 4 * n], "<f4")
