@@ -36,6 +36,7 @@ from . import _core
 
 __all__ = [
     "denoise",
+    "learned_planes",
     "render",
     "render_sequence",
     "metrics",
@@ -229,6 +230,34 @@ def denoise(
     out = _core.denoise(c, bufs["albedo"], bufs["normal"], bufs["position"], bufs["depth"],
                         bufs["variance"], bufs["ids"], bufs["emission"], method, dict(params))
     return _wrap_like(out, color)
+
+
+def learned_planes(color: Any, variance: Any = None, albedo: Any = None, normal: Any = None,
+                   depth: Any = None, emission: Any = None, **params: Any) -> Dict[str, np.ndarray]:
+    """The planes the learned filter reads (docs/learned.md), from the library's own preparation:
+    what :func:`denoise` does before any filter (NaN/Inf repair, the emission split and the
+    emission filter, the firefly clamp, the per-pixel noise estimate without a variance, albedo
+    demodulation), on the CPU. For training: the network then sees exactly what it sees in the
+    library.
+
+    The arguments, keywords and errors are those of :func:`denoise` (numpy arrays only). Returns a
+    dict of H x W x C float32 arrays: ``d`` (3: the demodulated, firefly-clamped colour), ``var``
+    (3: its variance, given or estimated, demodulated), ``albedo`` (3: the sanitised albedo the
+    colour was divided by; absent without an albedo or with demodulate=False), ``normal`` (3),
+    ``depth`` (1; both absent when not given), ``mod`` (3: the per-pixel factor the library's
+    output multiplies the filtered ``d`` by; 1 without an albedo) and ``emission`` (3: the
+    filtered emission added after; 0 without one). With the safety net off, the library's output
+    is ``filtered(d) * mod + emission``.
+    """
+    c = _prepare(color, "color", allow_gray=False)
+    bufs = {name: _prepare(val, name)
+            for name, val in (("variance", variance), ("albedo", albedo), ("normal", normal),
+                              ("depth", depth), ("emission", emission))}
+    for name, b in (("color", c), *bufs.items()):
+        if b is not None and _is_cuda(b):
+            raise ValueError(f"{name}: learned_planes takes host (numpy) arrays")
+    return dict(_core.learned_planes(c, bufs["variance"], bufs["albedo"], bufs["normal"], bufs["depth"],
+                                     bufs["emission"], dict(params)))
 
 
 def _denoise_numpy_on_gpu(c, bufs, method, params):  # pragma: no cover - needs a GPU

@@ -22,6 +22,7 @@
 #include "atrous/params.h"
 #include "atrous/render.h"
 #include "atrous/svgf.h"
+#include "filters/denoise_internal.h"
 #include "io/buffer_set.h"
 #include "io/image_io.h"
 
@@ -225,6 +226,33 @@ nb::object pyDenoise(const Array& color, nb::handle albedo, nb::handle normal, n
     return fromImage(std::move(out));
 }
 
+// The learned filter's prepared planes (filters::learnedPlanes): d, var, albedo, normal, depth
+// (the last three only when given), mod and emission, on the host, for training.
+nb::dict pyLearnedPlanes(const Array& color, nb::handle variance, nb::handle albedo, nb::handle normal,
+                         nb::handle depth, nb::handle emission, nb::dict params) {
+    using B = io::Buffer;
+    Image c = toImage(color, "color");
+    if (c.device() != Device::Cpu) throw InputError("learned_planes: color must be a host (numpy) array");
+    Buffers b(c);
+    b.add({{albedo, B::Albedo, "albedo"}, {normal, B::Normal, "normal"}, {depth, B::Depth, "depth"},
+           {variance, B::Variance, "variance"}, {emission, B::Emission, "emission"}});
+    const DenoiseInputs in = io::denoiseInputs(b.refs);
+    DenoiseOptions o;
+    for (auto [k, v] : params) applyParam(o, denoiseParams(), nb::cast<std::string>(k), v, "denoise");
+    filters::PreparedPlanes p;
+    {
+        nb::gil_scoped_release release;
+        p = filters::learnedPlanes(in, o);
+    }
+    nb::dict d;
+    const std::pair<const char*, Image*> planes[] = {{"d", &p.d},           {"var", &p.var},   {"albedo", &p.albedo},
+                                                     {"normal", &p.normal}, {"depth", &p.depth}, {"mod", &p.mod},
+                                                     {"emission", &p.emission}};
+    for (const auto& [name, img] : planes)
+        if (!img->empty()) d[name] = fromImage(std::move(*img));
+    return d;
+}
+
 class PySvgf {
 public:
     PySvgf(const std::string& device, nb::dict params) {
@@ -366,6 +394,8 @@ NB_MODULE(_core, m) {
     m.def("denoise", &pyDenoise, nb::arg("color"), nb::arg("albedo").none(), nb::arg("normal").none(),
           nb::arg("position").none(), nb::arg("depth").none(), nb::arg("variance").none(), nb::arg("ids").none(),
           nb::arg("emission").none(), nb::arg("method"), nb::arg("params"));
+    m.def("learned_planes", &pyLearnedPlanes, nb::arg("color"), nb::arg("variance").none(), nb::arg("albedo").none(),
+          nb::arg("normal").none(), nb::arg("depth").none(), nb::arg("emission").none(), nb::arg("params"));
     m.def("render", &pyRender, nb::arg("scene"), nb::arg("params"));
     m.def("render_frame", &pyRenderFrame, nb::arg("scene"), nb::arg("frame"), nb::arg("frames"), nb::arg("camera_path"),
           nb::arg("params"));

@@ -172,9 +172,7 @@ static double meanLuminance(const Image& img) {
     return n ? s / double(n) : 0.0;
 }
 
-Image denoiseCpu(const DenoiseInputs& in, const DenoiseOptions& o, const PreparedInputs& prep, DenoiseReport& rep,
-                 DriverDebug* debug) {
-    const int w = in.color->width(), h = in.color->height();
+static DriverInputs driverInputsOf(const DenoiseInputs& in, const PreparedInputs& prep) {
     DriverInputs di;
     di.color = in.color->view();
     di.variance = in.variance ? in.variance->view() : prep.estimatedVariance.view();
@@ -184,6 +182,13 @@ Image denoiseCpu(const DenoiseInputs& in, const DenoiseOptions& o, const Prepare
     di.depth = viewOf(in.depth);
     di.ids = viewOf(in.ids);
     di.emission = viewOf(in.emission);
+    return di;
+}
+
+Image denoiseCpu(const DenoiseInputs& in, const DenoiseOptions& o, const PreparedInputs& prep, DenoiseReport& rep,
+                 DriverDebug* debug) {
+    const int w = in.color->width(), h = in.color->height();
+    const DriverInputs di = driverInputsOf(in, prep);
     Image out(w, h, 3, Device::Cpu), after(w, h, 3, Device::Cpu), flag(w, h, 1, Device::Cpu);
     DriverOutputs dout;
     dout.out = out.view();
@@ -227,13 +232,10 @@ bool varianceIsEmpty(const Image& v) {
     return true;
 }
 
-}  // namespace
-
-Image denoise(const DenoiseInputs& given, const DenoiseOptions& options) {
-    DenoiseReport local;
-    DenoiseReport& rep = options.report ? *options.report : local;
+// What denoise() and learnedPlanes() do before the driver: an all-zero variance dropped, the
+// inputs validated and the noise estimated (prepareInputs).
+filters::PreparedInputs prepareCall(DenoiseInputs& inputs, const DenoiseOptions& options, DenoiseReport& rep) {
     rep = DenoiseReport{};
-    DenoiseInputs inputs = given;
     const bool varianceIgnored = inputs.variance && inputs.color && !inputs.color->empty() &&
                                  inputs.variance->view().sameSize(inputs.color->view()) &&
                                  varianceIsEmpty(*inputs.variance);
@@ -243,18 +245,62 @@ Image denoise(const DenoiseInputs& given, const DenoiseOptions& options) {
         rep.varianceIgnored = true;
         rep.buffersUsed += ",variance(ignored: all zero, e.g. a 1-spp render; noise estimated)";
     }
-    if (options.device == Device::Cuda) {
-        requireCuda();
-        return filters::denoiseCuda(inputs, options, prep, rep);
-    }
+    return prep;
+}
+
+void requireHostInputs(const DenoiseInputs& inputs) {
     for (const Image* img : {inputs.color, inputs.variance, inputs.albedo, inputs.normal, inputs.position,
                              inputs.depth, inputs.ids, inputs.emission})
         if (img && img->device() != Device::Cpu) {
             // Host path with device inputs: bring them over (rare; the CLI always passes host images).
             throw InputError("denoise on the CPU needs host images (got a CUDA image)");
         }
+}
+
+}  // namespace
+
+Image denoise(const DenoiseInputs& given, const DenoiseOptions& options) {
+    DenoiseReport local;
+    DenoiseReport& rep = options.report ? *options.report : local;
+    DenoiseInputs inputs = given;
+    filters::PreparedInputs prep = prepareCall(inputs, options, rep);
+    if (options.device == Device::Cuda) {
+        requireCuda();
+        return filters::denoiseCuda(inputs, options, prep, rep);
+    }
+    requireHostInputs(inputs);
     return filters::denoiseCpu(inputs, options, prep, rep, nullptr);
 }
+
+namespace filters {
+
+PreparedPlanes learnedPlanes(const DenoiseInputs& given, const DenoiseOptions& options) {
+    DenoiseReport local;
+    DenoiseReport& rep = options.report ? *options.report : local;
+    DenoiseInputs in = given;
+    const PreparedInputs prep = prepareCall(in, options, rep);
+    requireHostInputs(in);
+    const int w = in.color->width(), h = in.color->height();
+    PreparedPlanes p;
+    p.d = Image(w, h, 3), p.var = Image(w, h, 3), p.mod = Image(w, h, 3), p.emission = Image(w, h, 3);
+    if (in.albedo && options.demodulate) p.albedo = Image(w, h, 3);
+    if (in.normal) p.normal = Image(w, h, 3);
+    if (in.depth) p.depth = Image(w, h, 1);
+    DriverPlanes views;
+    views.d = p.d.view(), views.var = p.var.view(), views.mod = p.mod.view(), views.emission = p.emission.view();
+    views.albedo = viewOf(p.albedo.empty() ? nullptr : &p.albedo);
+    views.normal = viewOf(p.normal.empty() ? nullptr : &p.normal);
+    views.depth = viewOf(p.depth.empty() ? nullptr : &p.depth);
+    DriverOutputs dout;
+    dout.planes = &views;
+    DriverConfig cfg{options};
+    cfg.varianceGiven = in.variance != nullptr;
+    setNoiseEstimate(cfg, rep);
+    runDenoise(CpuExec{}, driverInputsOf(in, prep), cfg, dout);
+    return p;
+}
+
+}  // namespace filters
 
 }  // namespace atrous
 

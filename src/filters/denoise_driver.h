@@ -29,12 +29,44 @@ struct DriverInputs {
     ImageView albedo, normal, position, depth, ids, emission;  // invalid when absent
 };
 
+// The learned filter's prepared planes (docs/learned.md), copied out after step 3 for training
+// (filters::learnedPlanes, atrous.learned_planes): views the caller allocated (zero-filled) on the
+// executor's device, each skipped when invalid. With them the driver stops after step 3.
+struct DriverPlanes {
+    ImageView d, var;        // 3 ch: the demodulated, firefly-clamped colour and its variance
+    ImageView albedo;        // 3 ch: the sanitised albedo the demodulation divided by (when used)
+    ImageView normal;        // 3 ch: the sanitised normal (when given)
+    ImageView depth;         // 1 ch: the sanitised depth (when given)
+    ImageView mod;           // 3 ch: the a' Remodulate multiplies by (1 where no albedo)
+    ImageView emission;      // 3 ch: the filtered emission Remodulate adds (left 0 when none)
+};
+
+// Copies the first out.channels channels of `in`.
+struct CopyPlanes {
+    ImageView in, out;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        for (int c = 0; c < out.channels; ++c) out(x, y, c) = in(x, y, c);
+    }
+};
+
+// out = a' of the rule (Remodulate's multiplier; 1 without an albedo).
+struct ModulationOf {
+    AlbedoRule rule;
+    ImageView albedo, out;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        float a[3];
+        rule.at(albedo, x, y, a);
+        for (int c = 0; c < 3; ++c) out(x, y, c) = a[c];
+    }
+};
+
 struct DriverOutputs {
-    ImageView out;           // 3 channels, required
+    ImageView out;           // 3 channels, required (not written when `planes` is set)
     ImageView afterFirefly;  // optional: c_0 after sanitising and firefly suppression (3 ch)
     ImageView fireflyFlag;   // optional: 1 where a firefly was clamped (1 ch)
     ImageView sureS;         // optional: s_i per level (levels channels)
     StageClock* clock = nullptr;  // optional: started by the caller, marked after each stage
+    const DriverPlanes* planes = nullptr;  // optional: copy the prepared planes out and stop after step 3
 };
 
 // The caller's options held whole (as SvgfPipeline holds its SvgfParams), plus what the driver
@@ -193,6 +225,19 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         d.in = d.out = cA.view();
         d.var = vA.view();
         exec.forEachPixel(w, h, d);
+    }
+    if (out.planes) {
+        const DriverPlanes& P = *out.planes;
+        if (P.d.valid()) exec.forEachPixel(w, h, CopyPlanes{cA.view(), P.d});
+        if (P.var.valid()) exec.forEachPixel(w, h, CopyPlanes{vA.view(), P.var});
+        if (P.albedo.valid() && albedo.valid()) exec.forEachPixel(w, h, CopyPlanes{albedo, P.albedo});
+        if (P.normal.valid() && in.normal.valid()) exec.forEachPixel(w, h, CopyPlanes{normal, P.normal});
+        if (P.depth.valid() && in.depth.valid()) exec.forEachPixel(w, h, CopyPlanes{depth, P.depth});
+        if (P.mod.valid()) exec.forEachPixel(w, h, ModulationOf{stillAlbedoRule(o), albedo, P.mod});
+        if (P.emission.valid() && emission.valid()) exec.forEachPixel(w, h, CopyPlanes{emission, P.emission});
+        markStage(out.clock, "demodulate");
+        exec.synchronize();
+        return;
     }
     // The safety net's input y and its summed variance, kept before the cascade overwrites them.
     Image safetyIn, safetyVar;
