@@ -1,17 +1,114 @@
-// CPU path of one learned-filter level: the shared row engine (src/cpu/atrous_rows.h) with the
-// LearnedStop policy (filters/learned.h), the same taps in the same order as the functor.
+// The learned filter v2 on the CPU (filters/learned.h): pass A per pixel (vectorised x loop),
+// pass B row-wise (the 3x3 box as column sums once per row, then the MLP on 16 pixels at a time
+// with the pixel index innermost: the lane loops of learnedMlp<16> become vector instructions),
+// the five levels through the shared row engine (src/cpu/atrous_rows.h) with the LearnedStop
+// policy. Every loop body is ISA-dispatched (cpu::parallelForIsa: baseline, AVX2, AVX-512). With
+// atrousCpuFastPath() off, the functors of learned.h instead (the reference the tests compare).
+#include <tbb/scalable_allocator.h>
+
+#include <chrono>
+#include <memory>
+#include <vector>
+
+#include "atrous/error.h"
 #include "core/parallel.h"
 #include "cpu/atrous_rows.h"
 #include "filters/learned.h"
 
 namespace atrous::filters {
 
-void runLearnedLevel(const CpuExec& exec, const LearnedStop& stop) {
+namespace {
+
+constexpr int kLanes = 16;
+
+// Pass B over rows [y0, y1).
+struct NetRows {
+    const LearnedNet* net;
+    LearnedPlanes P;
+    LearnedTemps T;
+    ImageView acc;
+
+    ATROUS_FORCE_INLINE void operator()(int y0, int y1) const {
+        const int w = P.d.width, h = P.d.height;
+        const size_t stride = size_t(w) + 2;
+        std::vector<float> buf(kLearnedBoxQ * stride + size_t(w));
+        float* V[kLearnedBoxQ];
+        for (int k = 0; k < kLearnedBoxQ; ++k) V[k] = buf.data() + k * stride;
+        float* inv = buf.data() + kLearnedBoxQ * stride;
+        for (int y = y0; y < y1; ++y) {
+            const bool top = y > 0, bottom = y + 1 < h;
+            const size_t o = size_t(y) * size_t(w);
+            // Column sums (rows y - 1, y, y + 1 inside the image, added from 0 in that order), with
+            // one zero column either side.
+            for (int k = 0; k < kLearnedBoxQ; ++k) {
+                const float* s = T.lg.channel(k < 4 ? k : 3) + o;
+                float* ATROUS_RESTRICT v = V[k] + 1;
+                v[-1] = 0.0f, v[w] = 0.0f;
+                if (k < 4) {
+                    for (int x = 0; x < w; ++x) v[x] = 0.0f;
+                    if (top)
+                        for (int x = 0; x < w; ++x) v[x] += s[x - w];
+                    for (int x = 0; x < w; ++x) v[x] += s[x];
+                    if (bottom)
+                        for (int x = 0; x < w; ++x) v[x] += s[x + w];
+                } else {
+                    for (int x = 0; x < w; ++x) v[x] = 0.0f;
+                    if (top)
+                        for (int x = 0; x < w; ++x) v[x] += s[x - w] * s[x - w];
+                    for (int x = 0; x < w; ++x) v[x] += s[x] * s[x];
+                    if (bottom)
+                        for (int x = 0; x < w; ++x) v[x] += s[x + w] * s[x + w];
+                }
+            }
+            const int ny = 1 + int(top) + int(bottom);
+            for (int x = 0; x < w; ++x) inv[x] = 1.0f / float((1 + int(x > 0) + int(x < w - 1)) * ny);
+            for (int x0 = 0; x0 < w; x0 += kLanes) {
+                const int n = w - x0 < kLanes ? w - x0 : kLanes;
+                float in[kLearnedIn][kLanes], out[kLearnedOut][kLanes];
+                learnedPointInputs<kLanes>(P, T.lg, o + size_t(x0), n, in);
+                const float* const Vx[kLearnedBoxQ] = {V[0] + x0, V[1] + x0, V[2] + x0, V[3] + x0, V[4] + x0};
+                learnedBoxInputs<kLanes>(Vx, inv + x0, n, in);
+                learnedMlp<kLanes>(*net, in, out);
+                learnedWriteOutputs<kLanes>(out, P.d, T, acc, o + size_t(x0), n);
+            }
+        }
+    }
+};
+
+double seconds(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+void runLearned(const CpuExec& exec, const LearnedWeights& weights, const LearnedPlanes& in, const ImageView& out,
+                LearnedStageTimes* times) {
+    checkLearnedPlanes(weights, in, out);
+    const int w = in.d.width, h = in.d.height;
+    auto t0 = std::chrono::steady_clock::now();
+    // One block for every temporary, from the scalable allocator (not an Image: no zero fill).
+    const size_t bytes = size_t(kLearnedTempChannels) * size_t(w) * size_t(h) * sizeof(float);
+    std::unique_ptr<float, void (*)(void*)> store(static_cast<float*>(scalable_aligned_malloc(bytes, 64)),
+                                                  scalable_aligned_free);
+    if (!store) throw RuntimeError("out of host memory for the learned filter's planes");
+    const LearnedTemps T = learnedTemps(store.get(), w, h);
+    const LearnedNet* net = &weights.impl->net;
+    if (times) times->allocate = seconds(t0);
     if (!atrousCpuFastPath()) {
-        runAtrousLevelFunctor(exec, stop);
+        runLearnedFunctors(exec, net, in, T, out);
         return;
     }
-    cpu::runAtrousRows(stop, atrousCpuAvx512());
+    t0 = std::chrono::steady_clock::now();
+    exec.forEachPixel(w, h, LearnedLogPass{in.d, T.lg});
+    if (times) times->logs = seconds(t0);
+    t0 = std::chrono::steady_clock::now();
+    cpu::parallelForIsa(cpu::activeIsa(), 0, h, 2, NetRows{net, in, T, out});
+    if (times) times->network = seconds(t0);
+    t0 = std::chrono::steady_clock::now();
+    const bool avx512 = atrousCpuAvx512();
+    for (int i = 0; i + 1 < kLearnedLevels; ++i) cpu::runAtrousRows(learnedStop<false>(in, T, out, i), avx512);
+    cpu::runAtrousRows(learnedStop<true>(in, T, out, kLearnedLevels - 1), avx512);
+    if (times) times->levels = seconds(t0);
 }
 
 }  // namespace atrous::filters

@@ -1,99 +1,249 @@
-// The learned à-trous filter's per-pixel math (docs/learned.md), host and device: LearnedPrepare
-// (the inputs, albedo demodulation and the per-pixel network), LearnedStop (the edge-stop policy of
-// the shared à-trous level, filters/atrous_level.h) and LearnedFinish (remodulation). The same math
-// as python/atrous/learn/model.py; tests/learned_test.cpp holds the two equal on a fixture.
+// The learned filter v2 (docs/learned.md) on the still driver's prepared planes: the functors of
+// its passes, host and device, and the two entry points runLearned (CpuExec: src/cpu/learned_cpu.cpp;
+// CudaExec: src/cuda/learned.cu). The same math as python/atrous/learn/model.py and features.py;
+// tests/learned_test.cpp holds them equal on tests/learned_fixture.bin.
+//
+//   pass A  LearnedLogPass      lg = log1p(max(d, 0)) (3), L = log1p(max(mean_c d_c, 0))
+//   pass B  LearnedNetPixel     the 15 inputs (3x3 box statistics of lg and L), the MLP, and from its
+//                               outputs f, a_i, m_i, b_i (b_0 kappa_0), softmax(beta); acc = beta_0 d_0
+//   level i LearnedStop<kLast>  an edge-stop policy of the shared à-trous level (atrous_level.h):
+//                               w = h(q) exp(-a_i |f_p - f_q|^2 - b_i kappa_i sum_c (d_i(q) - d_i(p))^2),
+//                               centre h(0)^2 (1 + m_i); its finish writes d_{i+1}, acc += beta_{i+1}
+//                               d_{i+1} and b_{i+1} kappa_{i+1} (kappa of d_{i+1}, for the next level)
+// The output is acc. On the CPU, pass B runs row-wise with 16 pixels per MLP call and the levels
+// through the row engine (src/cpu/learned_cpu.cpp); the functors are its reference.
 #pragma once
-#include <cmath>
+#include <cstddef>
 
 #include "atrous/image.h"
+#include "atrous/learned.h"
 #include "filters/atrous_level.h"
-#include "filters/filter_math.h"
+#include "filters/learned_math.h"
 
 namespace atrous {
 struct CpuExec;
-}
+struct CudaExec;
+
+struct LearnedWeights::Impl {
+    filters::LearnedNet net;
+};
+}  // namespace atrous
 
 namespace atrous::filters {
 
-constexpr int kLearnedIn = 11, kLearnedHidden = 16, kLearnedFeat = 8, kLearnedLevels = 5;
-constexpr int kLearnedOut = kLearnedFeat + 2 * kLearnedLevels;
-constexpr float kLearnedAlbedoEps = 1e-3f, kLearnedAlbedoFloor = 0.05f;  // DenoiseOptions' defaults
-constexpr float kLearnedDepthMin = 1e-3f, kLearnedDepthMax = 1e4f;
-
-// The network's parameters (row-major: w1[i * kLearnedHidden + j] maps input i to unit j).
-struct LearnedNet {
-    float w1[kLearnedIn * kLearnedHidden], b1[kLearnedHidden];
-    float w2[kLearnedHidden * kLearnedHidden], b2[kLearnedHidden];
-    float w3[kLearnedHidden * kLearnedOut], b3[kLearnedOut];
+// The prepared planes (views on the executor's device, colour's size): d, var 3 channels;
+// albedo, normal 3 channels and depth (channel 0) invalid views when absent.
+struct LearnedPlanes {
+    ImageView d, var, albedo, normal, depth;
 };
-constexpr int kLearnedParams = int(sizeof(LearnedNet) / sizeof(float));
 
-ATROUS_INLINE float learnedFinite(float v) { return finite(v) ? v : 0.0f; }
-ATROUS_INLINE float learnedSoftplus(float x) { return maxSel(x, 0.0f) + log1pf(expf(-fabsf(x))); }
+// Per-stage wall times of one runLearned call (seconds; the bench's breakdown).
+struct LearnedStageTimes {
+    double allocate = 0, logs = 0, network = 0, levels = 0;
+};
 
-// Per pixel: d = max(c - e, 0) / a' (a' of pixelModulationAlbedo), the inputs
-// x = [log1p d (3), clamp(albedo, 0, 1) (3), normal (3), log clamp(depth), log1p sqrt(mean(var / a'²))]
-// and the network's f (feat, kLearnedFeat planes), a_i (band) and m_i (cw, centre weights), softplus,
-// kLearnedLevels planes each.
-struct LearnedPrepare {
-    const LearnedNet* net;  // on the executor's device
-    ImageView color, variance, albedo, normal, depth, emission;  // inputs (variance/albedo/normal/depth/emission may be invalid)
-    ImageView d, alb, feat, band, cw;  // outputs: 3, 3, kLearnedFeat, kLearnedLevels, kLearnedLevels channels
+// d_out, the filtered demodulated colour, into `out` (3 channels, exec's device); temporaries are
+// allocated on exec's device. Throws InputError for missing or mismatched planes.
+void runLearned(const CpuExec& exec, const LearnedWeights& w, const LearnedPlanes& in, const ImageView& out,
+                LearnedStageTimes* times = nullptr);
+void runLearned(const CudaExec& exec, const LearnedWeights& w, const LearnedPlanes& in, const ImageView& out,
+                LearnedStageTimes* times = nullptr);
+// The checks both entry points make (src/filters/learned_weights.cpp).
+void checkLearnedPlanes(const LearnedWeights& w, const LearnedPlanes& in, const ImageView& out);
 
+// The cascade's temporaries, carved from one block of kLearnedTempChannels planes.
+struct LearnedTemps {
+    ImageView lg;    // 4: log1p d (3), L; after pass B its first 3 channels hold d_1, d_3
+    ImageView feat;  // kLearnedFeat: f
+    ImageView a, m;  // kLearnedLevels each
+    ImageView bk;    // kLearnedLevels: b_i, scaled to b_i kappa_i before level i
+    ImageView beta;  // kLearnedLevels + 1: softmax(beta)
+    ImageView buf;   // 3: d_2, d_4
+};
+constexpr int kLearnedTempChannels = 4 + kLearnedFeat + 3 * kLearnedLevels + (kLearnedLevels + 1) + 3;
+inline LearnedTemps learnedTemps(float* base, int w, int h) {
+    const size_t plane = size_t(w) * size_t(h);
+    LearnedTemps t;
+    int o = 0;
+    auto take = [&](int ch) {
+        ImageView v{base + size_t(o) * plane, w, h, ch};
+        o += ch;
+        return v;
+    };
+    t.lg = take(4), t.feat = take(kLearnedFeat), t.a = take(kLearnedLevels), t.m = take(kLearnedLevels);
+    t.bk = take(kLearnedLevels), t.beta = take(kLearnedLevels + 1), t.buf = take(3);
+    return t;
+}
+
+// Pass A.
+struct LearnedLogPass {
+    ImageView d, lg;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        float a[3];
-        pixelModulationAlbedo(albedo, x, y, kLearnedAlbedoEps, kLearnedAlbedoFloor, a);
-        float in[kLearnedIn], v = 0.0f;
-        for (int c = 0; c < 3; ++c) {
-            const float e = emission.valid() ? learnedFinite(emission(x, y, c)) : 0.0f;
-            const float dc = maxSel(learnedFinite(color(x, y, c)) - e, 0.0f) / a[c];
-            d(x, y, c) = dc;
-            alb(x, y, c) = a[c];
-            in[c] = log1pf(dc);
-            in[3 + c] = albedo.valid() ? minSel(maxSel(learnedFinite(albedo(x, y, c)), 0.0f), 1.0f) : 1.0f;
-            in[6 + c] = normal.valid() ? learnedFinite(normal(x, y, c)) : 0.0f;
-            if (variance.valid()) v += maxSel(learnedFinite(variance(x, y, c)), 0.0f) / (a[c] * a[c]);
-        }
-        const float z = depth.valid() ? learnedFinite(depth(x, y, 0)) : 1.0f;
-        in[9] = logf(minSel(maxSel(z, kLearnedDepthMin), kLearnedDepthMax));
-        in[10] = log1pf(sqrtf(v / 3.0f));
-        float h1[kLearnedHidden], h2[kLearnedHidden];
-        for (int j = 0; j < kLearnedHidden; ++j) {
-            float s = 0.0f;
-            for (int i = 0; i < kLearnedIn; ++i) s += in[i] * net->w1[i * kLearnedHidden + j];
-            h1[j] = maxSel(s + net->b1[j], 0.0f);
-        }
-        for (int j = 0; j < kLearnedHidden; ++j) {
-            float s = 0.0f;
-            for (int i = 0; i < kLearnedHidden; ++i) s += h1[i] * net->w2[i * kLearnedHidden + j];
-            h2[j] = maxSel(s + net->b2[j], 0.0f);
-        }
-        for (int j = 0; j < kLearnedOut; ++j) {
-            float s = 0.0f;
-            for (int i = 0; i < kLearnedHidden; ++i) s += h2[i] * net->w3[i * kLearnedOut + j];
-            s += net->b3[j];
-            if (j < kLearnedFeat) feat(x, y, j) = s;
-            else if (j < kLearnedFeat + kLearnedLevels) band(x, y, j - kLearnedFeat) = learnedSoftplus(s);
-            else cw(x, y, j - kLearnedFeat - kLearnedLevels) = learnedSoftplus(s);
-        }
+        const float r = d(x, y, 0), g = d(x, y, 1), b = d(x, y, 2);
+        lg(x, y, 0) = learnedLogColour(r);
+        lg(x, y, 1) = learnedLogColour(g);
+        lg(x, y, 2) = learnedLogColour(b);
+        lg(x, y, 3) = learnedLum(r, g, b);
     }
 };
 
-// Level i: w = h(q) exp(-a_i(p) |f_p - f_q|²), the centre tap h(0)² (1 + m_i(p)).
+// Inputs 0-10 of the pixels i0 .. i0 + n - 1 (flat index within a row), into lanes 0 .. n - 1;
+// lanes n .. N - 1 are zeroed.
+template <int N>
+ATROUS_FORCE_INLINE ATROUS_INLINE void learnedPointInputs(const LearnedPlanes& P, const ImageView& lg, size_t i0,
+                                                               int n, float (&x)[kLearnedIn][N]) {
+    if (n < N)
+        for (int k = 0; k < kLearnedIn; ++k)
+            for (int l = 0; l < N; ++l) x[k][l] = 0.0f;
+    for (int c = 0; c < 3; ++c) {
+        const float* s = lg.channel(c) + i0;
+        for (int l = 0; l < n; ++l) x[c][l] = s[l];
+    }
+    for (int c = 0; c < 3; ++c) {
+        if (P.albedo.valid()) {
+            const float* s = P.albedo.channel(c) + i0;
+            for (int l = 0; l < n; ++l) x[3 + c][l] = learnedAlbedoIn(s[l]);
+        } else {
+            for (int l = 0; l < n; ++l) x[3 + c][l] = 1.0f;
+        }
+        if (P.normal.valid()) {
+            const float* s = P.normal.channel(c) + i0;
+            for (int l = 0; l < n; ++l) x[6 + c][l] = learnedFinite(s[l]);
+        } else {
+            for (int l = 0; l < n; ++l) x[6 + c][l] = 0.0f;
+        }
+    }
+    if (P.depth.valid()) {
+        const float* s = P.depth.channel(0) + i0;
+        for (int l = 0; l < n; ++l) x[9][l] = learnedDepthIn(s[l]);
+    } else {
+        for (int l = 0; l < n; ++l) x[9][l] = 0.0f;  // log 1
+    }
+    const float *vr = P.var.channel(0) + i0, *vg = P.var.channel(1) + i0, *vb = P.var.channel(2) + i0;
+    for (int l = 0; l < n; ++l) x[10][l] = learnedNoiseIn(vr[l], vg[l], vb[l]);
+}
+
+// The box quantities: log1p d (3), L, L^2.
+constexpr int kLearnedBoxQ = 5;
+
+// Inputs 11-14 of lanes 0 .. n - 1 from column sums: V[k][l], V[k][l + 1], V[k][l + 2] are box
+// quantity k summed over the rows inside the image in the columns left of, at and right of lane
+// l's pixel (0 outside the image); inv[l] = 1 / the number of taps inside.
+template <int N>
+ATROUS_FORCE_INLINE ATROUS_INLINE void learnedBoxInputs(const float* const (&V)[kLearnedBoxQ], const float* inv,
+                                                             int n, float (&x)[kLearnedIn][N]) {
+    for (int c = 0; c < 3; ++c) {
+        const float* v = V[c];
+        for (int l = 0; l < n; ++l) x[11 + c][l] = learnedBox(v[l], v[l + 1], v[l + 2], inv[l]);
+    }
+    const float *vL = V[3], *vL2 = V[4];
+    for (int l = 0; l < n; ++l)
+        x[14][l] = learnedLocalStd(learnedBox(vL[l], vL[l + 1], vL[l + 2], inv[l]),
+                                   learnedBox(vL2[l], vL2[l + 1], vL2[l + 2], inv[l]));
+}
+
+// From the raw outputs y of lanes 0 .. n - 1 (pixels i0 ..): f, a_i, m_i, b_i (b_0 kappa_0 of d),
+// softmax(beta), acc = beta_0 d. Non-finite outputs (only from absurd weights) read as 0.
+template <int N>
+ATROUS_FORCE_INLINE ATROUS_INLINE void learnedWriteOutputs(const float (&y)[kLearnedOut][N], const ImageView& d,
+                                                                const LearnedTemps& T, const ImageView& acc,
+                                                                size_t i0, int n) {
+    for (int k = 0; k < kLearnedFeat; ++k) {
+        float* o = T.feat.channel(k) + i0;
+        for (int l = 0; l < n; ++l) o[l] = learnedFinite(y[k][l]);
+    }
+    const float *dr = d.channel(0) + i0, *dg = d.channel(1) + i0, *db = d.channel(2) + i0;
+    for (int i = 0; i < kLearnedLevels; ++i) {
+        float *oa = T.a.channel(i) + i0, *om = T.m.channel(i) + i0, *ob = T.bk.channel(i) + i0;
+        for (int l = 0; l < n; ++l) oa[l] = learnedSoftplus(learnedFinite(y[kLearnedOutA + i][l]));
+        for (int l = 0; l < n; ++l) om[l] = learnedSoftplus(learnedFinite(y[kLearnedOutM + i][l]));
+        if (i == 0)
+            for (int l = 0; l < n; ++l)
+                ob[l] = learnedSoftplus(learnedFinite(y[kLearnedOutB][l])) * learnedKappa(dr[l], dg[l], db[l]);
+        else
+            for (int l = 0; l < n; ++l) ob[l] = learnedSoftplus(learnedFinite(y[kLearnedOutB + i][l]));
+    }
+    constexpr int J = kLearnedLevels + 1;
+    float e[J][N], mx[N], sum[N];
+    for (int l = 0; l < n; ++l) mx[l] = learnedFinite(y[kLearnedOutBeta][l]);
+    for (int j = 1; j < J; ++j)
+        for (int l = 0; l < n; ++l) mx[l] = maxSel(mx[l], learnedFinite(y[kLearnedOutBeta + j][l]));
+    for (int l = 0; l < n; ++l) sum[l] = 0.0f;
+    for (int j = 0; j < J; ++j)
+        for (int l = 0; l < n; ++l) {
+            e[j][l] = fastExp(learnedFinite(y[kLearnedOutBeta + j][l]) - mx[l]);
+            sum[l] += e[j][l];
+        }
+    for (int l = 0; l < n; ++l) sum[l] = 1.0f / sum[l];  // >= 1: the largest logit's term is 1
+    for (int j = 0; j < J; ++j) {
+        float* o = T.beta.channel(j) + i0;
+        for (int l = 0; l < n; ++l) o[l] = e[j][l] * sum[l];
+    }
+    float *ar = acc.channel(0) + i0, *ag = acc.channel(1) + i0, *ab = acc.channel(2) + i0;
+    const float* b0 = T.beta.channel(0) + i0;
+    for (int l = 0; l < n; ++l) {
+        ar[l] = b0[l] * dr[l];
+        ag[l] = b0[l] * dg[l];
+        ab[l] = b0[l] * db[l];
+    }
+}
+
+// Pass B per pixel (the GPU, and the CPU reference of the row-wise pass in learned_cpu.cpp).
+struct LearnedNetPixel {
+    const LearnedNet* net;  // on the executor's device
+    LearnedPlanes P;
+    LearnedTemps T;
+    ImageView acc;
+
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        const int w = P.d.width, h = P.d.height;
+        const size_t i = P.d.index(x, y);
+        float in[kLearnedIn][1];
+        learnedPointInputs<1>(P, T.lg, i, 1, in);
+        // Column sums of the 3x3 box, in the row loop's order (rows y - 1, y, y + 1 from 0).
+        float cs[kLearnedBoxQ][3];
+        for (int dx = -1; dx <= 1; ++dx) {
+            const int xx = x + dx;
+            for (int k = 0; k < kLearnedBoxQ; ++k) cs[k][dx + 1] = 0.0f;
+            if (xx < 0 || xx >= w) continue;
+            for (int dy = -1; dy <= 1; ++dy) {
+                const int yy = y + dy;
+                if (yy < 0 || yy >= h) continue;
+                const size_t j = P.d.index(xx, yy);
+                for (int c = 0; c < 4; ++c) cs[c][dx + 1] += T.lg.channel(c)[j];
+                const float L = T.lg.channel(3)[j];
+                cs[4][dx + 1] += L * L;
+            }
+        }
+        const int ny = 1 + (y > 0) + (y < h - 1), nx = 1 + (x > 0) + (x < w - 1);
+        const float inv = 1.0f / float(nx * ny);
+        const float* V[kLearnedBoxQ] = {cs[0], cs[1], cs[2], cs[3], cs[4]};
+        learnedBoxInputs<1>(V, &inv, 1, in);
+        float out[kLearnedOut][1];
+        learnedMlp<1>(*net, in, out);
+        learnedWriteOutputs<1>(out, P.d, T, acc, i, 1);
+    }
+};
+
+// Level i: the edge-stop policy (filters/atrous_level.h). kLast: the level that ends the cascade
+// (writes only acc, finite-guarded; no d_{i+1}, no next kappa).
+template <bool kLast>
 struct LearnedStop {
-    int step_ = 1, level = 0;
-    ImageView dIn, dOut, feat, band, cw;
+    int step_ = 1;
+    ImageView dIn, dOut, feat, acc;
+    const float *a = nullptr, *m = nullptr, *bk = nullptr, *beta = nullptr;  // the level's planes; beta_{i+1}
+    float* bkNext = nullptr;  // b_{i+1}, scaled in place by kappa of d_{i+1} (not when kLast)
 
     static constexpr int kSums = 4;  // Σw, Σw d (3)
     static constexpr bool kCentreTap = true, kRowPartialSums = false, kScalarTaps = false;
     struct Row {
-        const float *r, *g, *b, *a, *m;
+        const float *r, *g, *b, *a, *m, *bk, *beta;
         const float* f[kLearnedFeat];
-        float *oR, *oG, *oB;
+        float *oR, *oG, *oB, *accR, *accG, *accB, *bkNext;
     };
     struct Centre {
         float f[kLearnedFeat];
-        float a, m;
+        float a, m, bk, r, g, b;
     };
     struct TapRow {};
 
@@ -104,73 +254,84 @@ struct LearnedStop {
         const size_t o = size_t(y) * size_t(dIn.width);
         Row R;
         R.r = dIn.channel(0) + o, R.g = dIn.channel(1) + o, R.b = dIn.channel(2) + o;
-        R.a = band.channel(level) + o, R.m = cw.channel(level) + o;
+        R.a = a + o, R.m = m + o, R.bk = bk + o, R.beta = beta + o;
         for (int k = 0; k < kLearnedFeat; ++k) R.f[k] = feat.channel(k) + o;
-        R.oR = dOut.channel(0) + o, R.oG = dOut.channel(1) + o, R.oB = dOut.channel(2) + o;
+        R.accR = acc.channel(0) + o, R.accG = acc.channel(1) + o, R.accB = acc.channel(2) + o;
+        if constexpr (kLast) {
+            R.oR = R.oG = R.oB = R.bkNext = nullptr;
+        } else {
+            R.oR = dOut.channel(0) + o, R.oG = dOut.channel(1) + o, R.oB = dOut.channel(2) + o;
+            R.bkNext = bkNext + o;
+        }
         return R;
     }
     ATROUS_FORCE_INLINE ATROUS_HOST_DEVICE Centre centre(const Row& R, int x) const {
         Centre c;
         for (int k = 0; k < kLearnedFeat; ++k) c.f[k] = R.f[k][x];
-        c.a = R.a[x], c.m = R.m[x];
+        c.a = R.a[x], c.m = R.m[x], c.bk = R.bk[x];
+        c.r = R.r[x], c.g = R.g[x], c.b = R.b[x];
         return c;
     }
     ATROUS_HOST_DEVICE TapRow tapRow(int) const { return TapRow{}; }
     template <int QX, bool kCentre>
     ATROUS_FORCE_INLINE ATROUS_HOST_DEVICE void tap(const Row& R, const Centre& c, AtrousSums<kSums>& s, ptrdiff_t q,
                                                     float hxy, const TapRow&) const {
+        const float r = R.r[q], g = R.g[q], b = R.b[q];
         float w;
         if constexpr (kCentre) {
             w = hxy * (1.0f + c.m);
         } else {
-            float d2 = 0.0f;
-            for (int k = 0; k < kLearnedFeat; ++k) d2 += sq(c.f[k] - R.f[k][q]);
-            w = hxy * fastExp(-c.a * d2);
+            float df = 0.0f;
+            for (int k = 0; k < kLearnedFeat; ++k) df += sq(c.f[k] - R.f[k][q]);
+            const float dc = sq(r - c.r) + sq(g - c.g) + sq(b - c.b);
+            w = hxy * fastExp(-(c.a * df + c.bk * dc));  // NaN (0 · inf, absurd weights) gives 0
         }
         s.s[0] += w;
-        s.s[1] += w * R.r[q];
-        s.s[2] += w * R.g[q];
-        s.s[3] += w * R.b[q];
+        s.s[1] += w * r;
+        s.s[2] += w * g;
+        s.s[3] += w * b;
     }
     ATROUS_FORCE_INLINE ATROUS_HOST_DEVICE void finish(const Row& R, int x, int, const AtrousSums<kSums>& s) const {
-        const float inv = 1.0f / s.s[0];  // > 0: the centre tap's weight is at least h(0)²
-        R.oR[x] = s.s[1] * inv;
-        R.oG[x] = s.s[2] * inv;
-        R.oB[x] = s.s[3] * inv;
-    }
-};
-
-// One level through the functor (the GPU; any executor) or, on the CPU, the row engine
-// (src/cpu/learned_cpu.cpp).
-template <class Exec>
-void runLearnedLevel(const Exec& exec, const LearnedStop& stop) {
-    runAtrousLevelFunctor(exec, stop);
-}
-void runLearnedLevel(const CpuExec& exec, const LearnedStop& stop);
-
-// out = d a' + e, non-finite values written as 0.
-struct LearnedFinish {
-    ImageView d, alb, emission, out;
-    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        for (int c = 0; c < 3; ++c) {
-            const float e = emission.valid() ? learnedFinite(emission(x, y, c)) : 0.0f;
-            out(x, y, c) = learnedFinite(d(x, y, c) * alb(x, y, c) + e);
+        const float inv = 1.0f / s.s[0];  // > 0: the centre tap's weight is at least h(0)^2
+        const float r = s.s[1] * inv, g = s.s[2] * inv, b = s.s[3] * inv, bt = R.beta[x];
+        if constexpr (kLast) {
+            R.accR[x] = learnedFinite(R.accR[x] + bt * r);
+            R.accG[x] = learnedFinite(R.accG[x] + bt * g);
+            R.accB[x] = learnedFinite(R.accB[x] + bt * b);
+        } else {
+            R.oR[x] = r, R.oG[x] = g, R.oB[x] = b;
+            R.accR[x] += bt * r;
+            R.accG[x] += bt * g;
+            R.accB[x] += bt * b;
+            R.bkNext[x] *= learnedKappa(r, g, b);
         }
     }
 };
 
-// The cascade on exec: prepare, kLearnedLevels levels (ping-pong d <-> tmp), finish. Every view
-// is on exec's device; `d` ends holding the filtered, demodulated colour.
+// Level i's policy: reads d_i (d, then lg's first channels and buf alternately), writes d_{i+1}.
+template <bool kLast>
+LearnedStop<kLast> learnedStop(const LearnedPlanes& P, const LearnedTemps& T, const ImageView& acc, int i) {
+    const ImageView lg3{T.lg.data, T.lg.width, T.lg.height, 3};
+    LearnedStop<kLast> s;
+    s.step_ = 1 << i;
+    s.dIn = i == 0 ? P.d : (i % 2 == 1 ? lg3 : T.buf);
+    s.dOut = i % 2 == 0 ? lg3 : T.buf;
+    s.feat = T.feat, s.acc = acc;
+    s.a = T.a.channel(i), s.m = T.m.channel(i), s.bk = T.bk.channel(i), s.beta = T.beta.channel(i + 1);
+    s.bkNext = kLast ? nullptr : T.bk.channel(i + 1);
+    return s;
+}
+
+// The whole cascade through the functors on exec (the GPU; the CPU reference): every view on
+// exec's device, net too.
 template <class Exec>
-void runLearnedCascade(const Exec& exec, const LearnedPrepare& prep, const ImageView& tmp, const ImageView& out) {
-    exec.forEachPixel(prep.color.width, prep.color.height, prep);
-    ImageView a = prep.d, b = tmp;
-    for (int i = 0; i < kLearnedLevels; ++i) {
-        runLearnedLevel(exec, LearnedStop{1 << i, i, a, b, prep.feat, prep.band, prep.cw});
-        ImageView t = a;
-        a = b, b = t;
-    }
-    exec.forEachPixel(out.width, out.height, LearnedFinish{a, prep.alb, prep.emission, out});
+void runLearnedFunctors(const Exec& exec, const LearnedNet* net, const LearnedPlanes& P, const LearnedTemps& T,
+                        const ImageView& acc) {
+    const int w = P.d.width, h = P.d.height;
+    exec.forEachPixel(w, h, LearnedLogPass{P.d, T.lg});
+    exec.forEachPixel(w, h, LearnedNetPixel{net, P, T, acc});
+    for (int i = 0; i + 1 < kLearnedLevels; ++i) runAtrousLevelFunctor(exec, learnedStop<false>(P, T, acc, i));
+    runAtrousLevelFunctor(exec, learnedStop<true>(P, T, acc, kLearnedLevels - 1));
 }
 
 }  // namespace atrous::filters

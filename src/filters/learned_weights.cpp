@@ -1,5 +1,7 @@
-// The learned filter's weights (file format: python/atrous/learn/weights.py, docs/learned.md) and
-// its CPU entry point, atrous::learnedDenoise (include/atrous/learned.h).
+// The learned filter's weight file, version 2 (python/atrous/learn/weights.py, docs/learned.md):
+// little-endian "ATRL" | u32 version | u32 n_in, n_hidden, n_feat, n_levels, n_floats | the floats
+// (w1, b1, w2, b2, w3, b3) | u32 FNV-1a 32 of every byte before it. And the plane checks of the
+// two runLearned entry points (filters/learned.h).
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -9,7 +11,6 @@
 
 #include "atrous/error.h"
 #include "atrous/learned.h"
-#include "core/parallel.h"
 #include "filters/learned.h"
 
 namespace atrous::filters {
@@ -19,11 +20,9 @@ extern const std::size_t kLearnedDefaultWeightsSize;
 
 namespace atrous {
 
-struct LearnedWeights::Impl {
-    filters::LearnedNet net;
-};
-
 namespace {
+
+constexpr size_t kHeaderBytes = 28;
 
 std::uint32_t fnv1a(const std::uint8_t* p, size_t n) {
     std::uint32_t h = 0x811C9DC5u;
@@ -35,29 +34,41 @@ std::uint32_t u32(const std::uint8_t* p) {
     return std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 | std::uint32_t(p[3]) << 24;
 }
 
+std::string shapeText(std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d, std::uint32_t n) {
+    return std::to_string(a) + "/" + std::to_string(b) + "/" + std::to_string(c) + "/" + std::to_string(d) + " (" +
+           std::to_string(n) + " floats)";
+}
+
 }  // namespace
 
 LearnedWeights LearnedWeights::parse(const void* data, size_t size, const std::string& name) {
     using namespace filters;
     const auto* p = static_cast<const std::uint8_t*>(data);
-    if (size < 32 || std::memcmp(p, "ATRL", 4) != 0)
+    if (size < 8 || std::memcmp(p, "ATRL", 4) != 0)
         throw InputError(name + ": not an atrous learned-filter weight file (no ATRL header)");
-    const std::uint32_t version = u32(p + 4), nIn = u32(p + 8), nHid = u32(p + 12), nFeat = u32(p + 16),
-                        nLev = u32(p + 20), n = u32(p + 24);
-    if (version != 1)
-        throw InputError(name + ": weight file version " + std::to_string(version) + ", this build reads version 1");
+    const std::uint32_t version = u32(p + 4);
+    if (version == 1) throw InputError(name + ": version 1 (the first network, retired); retrain with make train");
+    if (version != 2)
+        throw InputError(name + ": weight file version " + std::to_string(version) + ", this build reads version 2");
+    if (size < kHeaderBytes + 4) throw InputError(name + ": truncated weight file (" + std::to_string(size) + " bytes)");
+    const std::uint32_t nIn = u32(p + 8), nHid = u32(p + 12), nFeat = u32(p + 16), nLev = u32(p + 20), n = u32(p + 24);
     if (nIn != kLearnedIn || nHid != kLearnedHidden || nFeat != kLearnedFeat || nLev != kLearnedLevels ||
         n != std::uint32_t(kLearnedParams))
-        throw InputError(name + ": network shape " + std::to_string(nIn) + "/" + std::to_string(nHid) + "/" +
-                         std::to_string(nFeat) + "/" + std::to_string(nLev) + " is not this build's " +
-                         std::to_string(kLearnedIn) + "/" + std::to_string(kLearnedHidden) + "/" +
-                         std::to_string(kLearnedFeat) + "/" + std::to_string(kLearnedLevels));
-    if (size != 28 + 4 * size_t(n) + 4) throw InputError(name + ": truncated or over-long weight file");
+        throw InputError(name + ": network shape n_in/n_hidden/n_feat/n_levels " + shapeText(nIn, nHid, nFeat, nLev, n) +
+                         " is not this build's " +
+                         shapeText(kLearnedIn, kLearnedHidden, kLearnedFeat, kLearnedLevels, kLearnedParams));
+    const size_t expect = kHeaderBytes + 4 * size_t(n) + 4;
+    if (size < expect)
+        throw InputError(name + ": truncated weight file (" + std::to_string(size) + " bytes, " +
+                         std::to_string(expect) + " expected)");
+    if (size > expect)
+        throw InputError(name + ": over-long weight file (" + std::to_string(size) + " bytes, " +
+                         std::to_string(expect) + " expected)");
     if (fnv1a(p, size - 4) != u32(p + size - 4)) throw InputError(name + ": weight file checksum mismatch (corrupt)");
     auto impl = std::make_shared<Impl>();
     float* w = reinterpret_cast<float*>(&impl->net);
     for (std::uint32_t i = 0; i < n; ++i) {
-        const std::uint32_t b = u32(p + 28 + 4 * size_t(i));
+        const std::uint32_t b = u32(p + kHeaderBytes + 4 * size_t(i));
         std::memcpy(&w[i], &b, 4);
         if (!std::isfinite(w[i])) throw InputError(name + ": weight " + std::to_string(i) + " is not finite");
     }
@@ -79,25 +90,28 @@ LearnedWeights LearnedWeights::builtin() {
     return w;
 }
 
-Image learnedDenoise(const LearnedInputs& in, const LearnedWeights& weights) {
-    using namespace filters;
-    if (!weights.impl) throw InputError("learned filter: no weights loaded");
-    if (!in.color.valid() || in.color.channels < 3) throw InputError("learned filter: color: missing or not RGB");
-    const int w = in.color.width, h = in.color.height;
-    auto check = [&](const ImageView& v, const char* name, int ch) {
-        if (!v.valid()) return;
-        if (v.width != w || v.height != h)
-            throw InputError(std::string("learned filter: ") + name + ": size differs from the colour's");
-        if (v.channels < ch) throw InputError(std::string("learned filter: ") + name + ": too few channels");
+namespace filters {
+
+void checkLearnedPlanes(const LearnedWeights& w, const LearnedPlanes& in, const ImageView& out) {
+    if (!w.impl) throw InputError("learned filter: no weights loaded");
+    auto need = [&](const ImageView& v, const char* field, int channels, bool optional) {
+        if (!v.valid()) {
+            if (optional) return;
+            throw InputError(std::string("learned filter: ") + field + ": missing");
+        }
+        if (!v.sameSize(in.d))
+            throw InputError(std::string("learned filter: ") + field + ": size " + std::to_string(v.width) + "x" +
+                             std::to_string(v.height) + " differs from d's " + std::to_string(in.d.width) + "x" +
+                             std::to_string(in.d.height));
+        if (v.channels < channels)
+            throw InputError(std::string("learned filter: ") + field + ": " + std::to_string(v.channels) +
+                             " channels, " + std::to_string(channels) + " needed");
     };
-    check(in.variance, "variance", 3), check(in.albedo, "albedo", 3), check(in.normal, "normal", 3);
-    check(in.depth, "depth", 1), check(in.emission, "emission", 3);
-    Image d(w, h, 3), tmp(w, h, 3), alb(w, h, 3), feat(w, h, kLearnedFeat), band(w, h, kLearnedLevels),
-        centre(w, h, kLearnedLevels), out(w, h, 3);
-    LearnedPrepare prep{&weights.impl->net, in.color, in.variance, in.albedo, in.normal, in.depth, in.emission,
-                        d.view(), alb.view(), feat.view(), band.view(), centre.view()};
-    runLearnedCascade(CpuExec{}, prep, tmp.view(), out.view());
-    return out;
+    if (!in.d.valid() || in.d.width <= 0 || in.d.height <= 0) throw InputError("learned filter: d: missing or empty");
+    need(in.d, "d", 3, false), need(in.var, "var", 3, false), need(in.albedo, "albedo", 3, true);
+    need(in.normal, "normal", 3, true), need(in.depth, "depth", 1, true), need(out, "out", 3, false);
 }
+
+}  // namespace filters
 
 }  // namespace atrous

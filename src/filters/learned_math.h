@@ -1,0 +1,135 @@
+// The learned filter v2's per-pixel math (docs/learned.md), host and device: the network's shape,
+// its parameters, the input transfers, the MLP and its output transfers. Written once; the
+// functors of filters/learned.h (the GPU, and the CPU reference) and the CPU row loops of
+// src/cpu/learned_cpu.cpp call these same functions. Lane-parallel where it matters: learnedMlp<N>
+// runs N pixels at once with the pixel index innermost (N = 1 in a functor, 16 in the CPU rows,
+// where the compiler turns the lane loops into vector instructions).
+//
+// The transcendental functions are branch-free polynomials (learnedLog, and fastExp of
+// filters/atrous_math.h) spelled out with fmaf, so the CPU row loops vectorise them (libm's do not
+// without -ffast-math) and host and device compute the same values.
+#pragma once
+#include <cmath>
+#include <cstring>
+
+#include "filters/atrous_math.h"
+
+namespace atrous::filters {
+
+constexpr int kLearnedIn = 15, kLearnedHidden = 24, kLearnedFeat = 8, kLearnedLevels = 5;
+constexpr int kLearnedOut = kLearnedFeat + 3 * kLearnedLevels + (kLearnedLevels + 1);  // 29
+// Output slices, in the weight file's order: f, a_i, m_i, b_i, beta_j.
+constexpr int kLearnedOutA = kLearnedFeat, kLearnedOutM = kLearnedOutA + kLearnedLevels,
+              kLearnedOutB = kLearnedOutM + kLearnedLevels, kLearnedOutBeta = kLearnedOutB + kLearnedLevels;
+constexpr float kLearnedDepthMin = 1e-3f, kLearnedDepthMax = 1e4f, kLearnedKappaEps = 0.01f;
+
+// The network's parameters, the weight file's order (row-major: w1[i * kLearnedHidden + j] maps
+// input i to unit j).
+struct LearnedNet {
+    float w1[kLearnedIn * kLearnedHidden], b1[kLearnedHidden];
+    float w2[kLearnedHidden * kLearnedHidden], b2[kLearnedHidden];
+    float w3[kLearnedHidden * kLearnedOut], b3[kLearnedOut];
+};
+constexpr int kLearnedParams = int(sizeof(LearnedNet) / sizeof(float));
+static_assert(kLearnedParams == 1709, "the v2 network has 1709 parameters");
+
+ATROUS_FORCE_INLINE ATROUS_INLINE float learnedFinite(float v) { return selectF(finite(v), v, 0.0f); }
+
+// ln x for finite x > 0 (normal floats; no special cases): Cephes' logf, branch-free. x = m 2^e with
+// m in [sqrt(1/2), sqrt(2)), ln x = e ln 2 + ln m, ln(1 + t) by a degree-9 polynomial (relative error
+// below 1e-7 on that range); ln 2 in two parts, so e ln 2 adds no rounding.
+ATROUS_FORCE_INLINE ATROUS_INLINE float learnedLog(float x) {
+    int bits;
+    std::memcpy(&bits, &x, sizeof(float));
+    int e = ((bits >> 23) & 0xff) - 126;  // x = m 2^e, m in [0.5, 1)
+    bits = (bits & 0x007fffff) | 0x3f000000;
+    float m;
+    std::memcpy(&m, &bits, sizeof(float));
+    const bool lo = m < 0.707106781186547524f;
+    e -= int(lo);
+    const float t = (m + selectF(lo, m, 0.0f)) - 1.0f;  // exact: 2m - 1 or m - 1
+    const float z = t * t;
+    float y = 7.0376836292e-2f;
+    y = fmaf(y, t, -1.1514610310e-1f);
+    y = fmaf(y, t, 1.1676998740e-1f);
+    y = fmaf(y, t, -1.2420140846e-1f);
+    y = fmaf(y, t, 1.4249322787e-1f);
+    y = fmaf(y, t, -1.6668057665e-1f);
+    y = fmaf(y, t, 2.0000714765e-1f);
+    y = fmaf(y, t, -2.4999993993e-1f);
+    y = fmaf(y, t, 3.3333331174e-1f);
+    y = y * t * z;
+    const float fe = float(e);
+    y = fmaf(fe, -2.12194440e-4f, y);
+    y = fmaf(z, -0.5f, y);
+    return fmaf(fe, 0.693359375f, t + y);
+}
+
+// ln(1 + x) for finite x >= 0: ln u · x / (u - 1) with u = 1 + x corrects the rounding of 1 + x
+// (x itself where u rounds to 1).
+ATROUS_FORCE_INLINE ATROUS_INLINE float learnedLog1p(float x) {
+    const float u = 1.0f + x, d = u - 1.0f;
+    return selectF(d == 0.0f, x, learnedLog(u) * (x / d));
+}
+
+// softplus(x) = max(x, 0) + ln(1 + e^-|x|) (e^-|x| by fastExp: 0 below -80, where it adds < 1e-34).
+ATROUS_FORCE_INLINE ATROUS_INLINE float learnedSoftplus(float x) {
+    return maxSel(x, 0.0f) + learnedLog1p(fastExp(-fabsf(x)));
+}
+
+// kappa = 1 / (0.01 + mean_c d_c^2) of the level's colour at the centre.
+ATROUS_FORCE_INLINE ATROUS_INLINE float learnedKappa(float r, float g, float b) {
+    return 1.0f / (kLearnedKappaEps + (r * r + g * g + b * b) * (1.0f / 3.0f));
+}
+
+// The input transfers (docs/learned.md, "Network inputs"); non-finite plane values read as 0.
+ATROUS_FORCE_INLINE ATROUS_INLINE float learnedLogColour(float d) { return learnedLog1p(maxSel(learnedFinite(d), 0.0f)); }
+ATROUS_FORCE_INLINE ATROUS_INLINE float learnedLum(float r, float g, float b) {
+    return learnedLog1p(maxSel((learnedFinite(r) + learnedFinite(g) + learnedFinite(b)) * (1.0f / 3.0f), 0.0f));
+}
+ATROUS_FORCE_INLINE ATROUS_INLINE float learnedAlbedoIn(float a) { return minSel(maxSel(learnedFinite(a), 0.0f), 1.0f); }
+ATROUS_FORCE_INLINE ATROUS_INLINE float learnedDepthIn(float z) {
+    return learnedLog(minSel(maxSel(learnedFinite(z), kLearnedDepthMin), kLearnedDepthMax));
+}
+ATROUS_FORCE_INLINE ATROUS_INLINE float learnedNoiseIn(float r, float g, float b) {
+    const float v = (learnedFinite(r) + learnedFinite(g) + learnedFinite(b)) * (1.0f / 3.0f);
+    return learnedLog1p(sqrtf(maxSel(v, 0.0f)));
+}
+// The 3x3 box of one quantity from its three column sums (left, centre, right; 0 outside the
+// image), inv = 1 / the number of taps inside the image.
+ATROUS_FORCE_INLINE ATROUS_INLINE float learnedBox(float l, float c, float r, float inv) { return ((l + c) + r) * inv; }
+ATROUS_FORCE_INLINE ATROUS_INLINE float learnedLocalStd(float meanL, float meanL2) {
+    return sqrtf(maxSel(meanL2 - meanL * meanL, 0.0f));
+}
+
+// The MLP on N pixels: x[i][l] input i of lane l -> y[j][l] the 29 raw (linear) outputs.
+template <int N>
+ATROUS_FORCE_INLINE ATROUS_INLINE void learnedMlp(const LearnedNet& net, const float (&x)[kLearnedIn][N],
+                                                       float (&y)[kLearnedOut][N]) {
+    float h1[kLearnedHidden][N], h2[kLearnedHidden][N];
+    for (int j = 0; j < kLearnedHidden; ++j)
+        for (int l = 0; l < N; ++l) h1[j][l] = net.b1[j];
+    for (int i = 0; i < kLearnedIn; ++i)
+        for (int j = 0; j < kLearnedHidden; ++j) {
+            const float w = net.w1[i * kLearnedHidden + j];
+            for (int l = 0; l < N; ++l) h1[j][l] = fmaf(x[i][l], w, h1[j][l]);
+        }
+    for (int j = 0; j < kLearnedHidden; ++j)
+        for (int l = 0; l < N; ++l) h2[j][l] = net.b2[j], h1[j][l] = maxSel(h1[j][l], 0.0f);
+    for (int i = 0; i < kLearnedHidden; ++i)
+        for (int j = 0; j < kLearnedHidden; ++j) {
+            const float w = net.w2[i * kLearnedHidden + j];
+            for (int l = 0; l < N; ++l) h2[j][l] = fmaf(h1[i][l], w, h2[j][l]);
+        }
+    for (int j = 0; j < kLearnedOut; ++j)
+        for (int l = 0; l < N; ++l) y[j][l] = net.b3[j];
+    for (int j = 0; j < kLearnedHidden; ++j)
+        for (int l = 0; l < N; ++l) h2[j][l] = maxSel(h2[j][l], 0.0f);
+    for (int i = 0; i < kLearnedHidden; ++i)
+        for (int j = 0; j < kLearnedOut; ++j) {
+            const float w = net.w3[i * kLearnedOut + j];
+            for (int l = 0; l < N; ++l) y[j][l] = fmaf(h2[i][l], w, y[j][l]);
+        }
+}
+
+}  // namespace atrous::filters
