@@ -1,8 +1,12 @@
 #!/usr/bin/env python3
-"""Train the learned filter (docs/learned.md): `make train` runs this after scripts/train/dataset.py.
-Writes out/train/run/{checkpoint.npz, weights.bin, loss_curve.json, loss_curve.png}; --export also
-regenerates src/filters/learned_weights_default.cpp (the weights the library ships)."""
+"""Train the learned filter v2 (docs/learned.md) on the prepared planes (scripts/train/prepare.py):
+`make train` runs this after dataset.py and prepare.py. Writes <out>/{checkpoint.npz, weights.bin,
+loss_curve.json, loss_curve.png, config.json} (a rerun resumes from the checkpoint); --eval writes
+<out>/eval_jax.json (the held-out split through the JAX forward pass); --export regenerates
+src/filters/learned_weights_default.cpp (the weights the library ships). The ablation switches
+(--no-colour, --no-blend, --no-box) exist for measurements only: C++ implements the full model."""
 import argparse
+import json
 import sys
 from pathlib import Path
 
@@ -13,17 +17,37 @@ from learn import train, weights  # noqa: E402
 
 def main() -> int:
     p = argparse.ArgumentParser(description=__doc__)
-    p.add_argument("--data", default="out/train/data")
+    p.add_argument("--prep", default="out/train/prep", help="prepared planes: <prep>/<split>/*.npz")
     p.add_argument("--out", default="out/train/run")
     p.add_argument("--steps", type=int, default=6000)
     p.add_argument("--minutes", type=float, default=None, help="stop after this long (wall clock)")
     p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--splits", nargs="+", help=f"training splits (default {train.DEFAULTS['splits']})")
+    p.add_argument("--spps", nargs="+", type=int, help=f"default {train.DEFAULTS['spps']}")
+    p.add_argument("--variants", nargs="+", choices=["given", "est"])
+    p.add_argument("--batch", type=int)
+    p.add_argument("--crop", type=int)
+    p.add_argument("--lr", type=float)
+    p.add_argument("--eps", type=float, help="the loss's relMSE epsilon (default 0.01, the metric's)")
+    p.add_argument("--no-colour", dest="colour", action="store_const", const=False)
+    p.add_argument("--no-blend", dest="blend", action="store_const", const=False)
+    p.add_argument("--no-box", dest="box", action="store_const", const=False)
+    p.add_argument("--eval", action="store_true", help="relMSE on <prep>/test (JAX) into <out>/eval_jax.json")
     p.add_argument("--export", action="store_true", help="write src/filters/learned_weights_default.cpp")
     a = p.parse_args()
-    train.train(Path(a.data), Path(a.out), a.steps, seed=a.seed, minutes=a.minutes)
+    over = {k: getattr(a, k) for k in ("splits", "spps", "variants", "batch", "crop", "lr", "eps", "colour", "blend",
+                                       "box")}
+    params = train.train(Path(a.prep), Path(a.out), a.steps, seed=a.seed, minutes=a.minutes, **over)
+    if a.eval:
+        cfg = dict(train.DEFAULTS, **{k: v for k, v in over.items() if v is not None})
+        res = train.evaluate(params, Path(a.prep) / "test", cfg)
+        (Path(a.out) / "eval_jax.json").write_text(json.dumps(res, indent=1))
+        print({k: round(v, 5) for k, v in res.items() if k.startswith("geomean")})
     if a.export:
         data = (Path(a.out) / "weights.bin").read_bytes()
+        weights.from_bytes(data, str(Path(a.out) / "weights.bin"))
         Path("src/filters/learned_weights_default.cpp").write_text(weights.to_cpp(data))
+        print("train: wrote src/filters/learned_weights_default.cpp")
     return 0
 
 

@@ -71,41 +71,49 @@ def _shift(arr, dy: int, dx: int, pad: int):
     return arr[:, pad + dy:pad + dy + h, pad + dx:pad + dx + w]
 
 
+def _level(d, f, ai, mi, bi, s, colour: bool, pad: int):
+    """One level at step s (a traced int: one compiled body serves all levels), every array padded
+    by `pad` >= 2 s; taps outside the image carry validity 0."""
+    bsz, h, w = d.shape[0], d.shape[1], d.shape[2]
+    padw = ((0, 0), (pad, pad), (pad, pad), (0, 0))
+    dp, fp = jnp.pad(d, padw), jnp.pad(f, padw)
+    vp = jnp.pad(jnp.ones((bsz, h, w, 1), d.dtype), padw)
+    bk = bi / (KAPPA_EPS + jnp.mean(jnp.square(d), axis=-1, keepdims=True))
+
+    def tap(arr, qy, qx):
+        return jax.lax.dynamic_slice(arr, (0, pad + qy * s, pad + qx * s, 0), (bsz, h, w, arr.shape[3]))
+
+    num = B3[2] * B3[2] * (1.0 + mi) * d
+    den = B3[2] * B3[2] * (1.0 + mi)
+    for qy in range(-2, 3):
+        for qx in range(-2, 3):
+            if qy == 0 and qx == 0:
+                continue
+            dq, fq, vq = tap(dp, qy, qx), tap(fp, qy, qx), tap(vp, qy, qx)
+            e = ai * jnp.sum(jnp.square(f - fq), axis=-1, keepdims=True)
+            if colour:
+                e = e + bk * jnp.sum(jnp.square(dq - d), axis=-1, keepdims=True)
+            wq = (B3[qy + 2] * B3[qx + 2]) * vq * jnp.exp(-e)
+            num = num + wq * dq
+            den = den + wq
+    return num / den
+
+
 def cascade(d, f, a, m, b, beta, colour: bool = True, blend: bool = True):
     """d: B x H x W x 3 demodulated colour, the rest from network(); returns d_out (B x H x W x 3).
     colour=False drops the colour term (b = 0), blend=False returns d_5 (ablations only)."""
-    ones = jnp.ones(d.shape[:3] + (1,), d.dtype)
-    levels = [d]
-    for i in range(N_LEVELS):
-        s = 1 << i
-        P = 2 * s
-        padw = ((0, 0), (P, P), (P, P), (0, 0))
-        dp, fp, vp = jnp.pad(d, padw), jnp.pad(f, padw), jnp.pad(ones, padw)
-        ai, mi = a[..., i:i + 1], m[..., i:i + 1]
-        bk = b[..., i:i + 1] / (KAPPA_EPS + jnp.mean(jnp.square(d), axis=-1, keepdims=True))
-        num = jnp.zeros_like(d)
-        den = jnp.zeros_like(ones)
-        for qy in range(-2, 3):
-            for qx in range(-2, 3):
-                hxy = B3[qy + 2] * B3[qx + 2]
-                dq = _shift(dp, qy * s, qx * s, P)
-                if qy == 0 and qx == 0:
-                    w = hxy * (1.0 + mi)
-                else:
-                    fq = _shift(fp, qy * s, qx * s, P)
-                    vq = _shift(vp, qy * s, qx * s, P)
-                    e = ai * jnp.sum(jnp.square(f - fq), axis=-1, keepdims=True)
-                    if colour:
-                        e = e + bk * jnp.sum(jnp.square(dq - d), axis=-1, keepdims=True)
-                    w = hxy * vq * jnp.exp(-e)
-                num = num + w * dq
-                den = den + w
-        d = num / den
-        levels.append(d)
+    pad = 2 << (N_LEVELS - 1)
+
+    def body(di, i):
+        sel = lambda t: jax.lax.dynamic_slice_in_dim(t, i, 1, axis=-1)  # noqa: E731
+        dn = _level(di, f, sel(a), sel(m), sel(b), jnp.left_shift(1, i), colour, pad)
+        return dn, dn
+
+    d_last, levels = jax.lax.scan(body, d, jnp.arange(N_LEVELS))
     if not blend:
-        return d
+        return d_last
     wts = jax.nn.softmax(beta, axis=-1)
-    return sum(wts[..., j:j + 1] * levels[j] for j in range(N_LEVELS + 1))
+    return wts[..., :1] * d + jnp.einsum("bhwl,lbhwc->bhwc", wts[..., 1:], levels)
 
 
 def denoise_d(params: dict, x, d, colour: bool = True, blend: bool = True):

@@ -1,10 +1,12 @@
-"""Training loop of the learned filter (docs/learned.md, "Training"): optax Adam on relMSE of the
-remodulated output over random crops of the cached dataset (scripts/train/dataset.py), fixed seed,
-checkpoints (resume), loss curve (JSON + PNG), weight export."""
+"""Training loop of the learned filter v2 (docs/learned.md, "Training"): optax Adam on relMSE of the
+library's output d_out mod + emission over random crops of the prepared planes
+(scripts/train/prepare.py), fixed seed, checkpoints (resume), loss curve (JSON + PNG), weight
+export, and a JAX evaluation on the held-out split (the ablation tables)."""
 from __future__ import annotations
 
 import glob
 import json
+import math
 import time
 from pathlib import Path
 
@@ -15,17 +17,39 @@ import optax
 
 from . import features, model, weights
 
-SPPS = (1, 4, 16)
+DEFAULTS = {
+    "splits": ["train", "corpus_train"],  # prepared training splits (missing ones are skipped)
+    "spps": [1, 4, 16],
+    "variants": ["given", "est"],         # rendered variance / the driver's estimate
+    "batch": 4, "crop": 96, "lr": 3e-3, "eps": 0.01,
+    "colour": True, "blend": True, "box": True,  # ablations (C++ implements all three)
+}
 
 
-def load_split(folder: Path, limit: int | None = None) -> list:
+def item_of(z, variant: str, spp: int, box: bool = True):
+    """(x, d, mod, e, ref) of one prepared image, or None when the npz lacks it."""
+    pre = f"{variant}_{spp}_"
+    if pre + "d" not in z:
+        return None
+    planes = {k[len(pre):]: z[k] for k in z if k.startswith(pre)}
+    x = features.inputs_of(planes)
+    if not box:
+        x[..., features.BOX] = 0.0
+    return x, planes["d"], planes["mod"], planes["emission"], z["reference"]
+
+
+def load_items(folder: Path, spps, variants, box: bool = True, limit: int | None = None) -> list:
     items = []
     for f in sorted(glob.glob(str(folder / "*.npz")))[:limit]:
-        z = np.load(f)
-        for spp in SPPS:
-            x, d, a, e = features.prepare(*(z[f"{b}_{spp}"] for b in ("color", "variance", "albedo", "normal", "depth",
-                                                                        "emission")))
-            items.append((x, d, a, e, np.nan_to_num(z["reference"]).astype(np.float32), spp, Path(f).stem))
+        if f.endswith(".tmp.npz"):
+            continue
+        with np.load(f) as zf:
+            z = {k: zf[k] for k in zf.files}
+        for v in variants:
+            for spp in spps:
+                it = item_of(z, v, spp, box)
+                if it is not None:
+                    items.append(it + (f"{Path(f).stem} {v} {spp}spp",))
     return items
 
 
@@ -34,7 +58,6 @@ def batch(items, rng, n: int, crop: int):
     for _ in range(n):
         it = items[rng.integers(len(items))]
         h, w = it[0].shape[:2]
-        crop = min(crop, h, w)
         y, x = rng.integers(0, h - crop + 1), rng.integers(0, w - crop + 1)
         flip = rng.integers(2)
         for k in range(5):
@@ -43,31 +66,55 @@ def batch(items, rng, n: int, crop: int):
     return [jnp.asarray(np.stack(o)) for o in out]
 
 
-def train(data: Path, out: Path, steps: int, seed: int = 1, batch_size: int = 4, crop: int = 96, lr: float = 3e-3,
-          ckpt_every: int = 200, minutes: float | None = None) -> dict:
+def relmse_np(x, r) -> float:
+    """docs/eval.md's relMSE in float64 (the evaluation's metric)."""
+    x, r = np.nan_to_num(np.asarray(x, np.float64)), np.nan_to_num(np.asarray(r, np.float64))
+    return float(np.mean((x - r) ** 2 / (r * r + 0.01)))
+
+
+def evaluate(params: dict, prep_test: Path, cfg: dict, spps=(4, 16)) -> dict:
+    """JAX relMSE on the held-out split (variant `given`, full images): per image and geomean/spp."""
+    fwd = jax.jit(lambda p, x, d, m, e: model.forward(p, x, d, m, e, cfg["colour"], cfg["blend"]))
+    res = {}
+    for x, d, mod, e, ref, name in load_items(prep_test, spps, ["given"], cfg["box"]):
+        out = fwd(params, *(jnp.asarray(a[None]) for a in (x, d, mod, e)))
+        res[name] = relmse_np(np.asarray(out[0]), ref)
+    for spp in spps:
+        v = [r for k, r in res.items() if k.endswith(f" {spp}spp")]
+        if v:
+            res[f"geomean {spp}spp"] = math.exp(np.mean(np.log(v)))
+    return res
+
+
+def train(prep: Path, out: Path, steps: int, seed: int = 1, minutes: float | None = None, ckpt_every: int = 200,
+          **overrides) -> dict:
+    cfg = dict(DEFAULTS, **{k: v for k, v in overrides.items() if v is not None})
     out.mkdir(parents=True, exist_ok=True)
-    items = load_split(data / "train")
+    t_load = time.time()
+    items = [it for s in cfg["splits"] for it in load_items(prep / s, cfg["spps"], cfg["variants"], cfg["box"])]
     if not items:
-        raise SystemExit(f"train: {data / 'train'}: no scenes (run scripts/train/dataset.py first)")
+        raise SystemExit(f"train: {prep}: no prepared scenes in {cfg['splits']} (run scripts/train/prepare.py first)")
+    crop = min([cfg["crop"]] + [min(it[0].shape[:2]) for it in items])
+    print(f"train: {len(items)} images from {cfg['splits']} loaded in {time.time() - t_load:.0f} s; config {cfg}",
+          flush=True)
     params = model.init_params(seed)
-    opt = optax.chain(optax.clip_by_global_norm(1.0), optax.adam(optax.cosine_decay_schedule(lr, steps, 0.05)))
+    opt = optax.chain(optax.clip_by_global_norm(1.0), optax.adam(optax.cosine_decay_schedule(cfg["lr"], steps, 0.05)))
     state = opt.init(params)
     curve, start = [], 0
     ck = out / "checkpoint.npz"
     if ck.exists():  # resume: parameters, optimiser state, step, curve and the data rng's state
         z = np.load(ck, allow_pickle=True)
-        params = weights.from_bytes(bytes(z["weights"]), str(ck))
-        params = {k: jnp.asarray(v) for k, v in params.items()}
+        params = {k: jnp.asarray(v) for k, v in weights.from_bytes(bytes(z["weights"]), str(ck)).items()}
         state = jax.tree_util.tree_unflatten(jax.tree_util.tree_structure(state), [jnp.asarray(v) for v in z["opt"]])
         start, curve = int(z["step"]), json.loads(str(z["curve"]))
     rng = np.random.default_rng([seed, start])
 
-    def loss_fn(p, x, d, a, e, r):
-        return model.relmse(model.forward(p, x, d, a, e), r)
+    def loss_fn(p, x, d, m, e, r):
+        return model.relmse(model.forward(p, x, d, m, e, cfg["colour"], cfg["blend"]), r, cfg["eps"])
 
     @jax.jit
-    def step_fn(p, s, x, d, a, e, r):
-        l, g = jax.value_and_grad(loss_fn)(p, x, d, a, e, r)
+    def step_fn(p, s, x, d, m, e, r):
+        l, g = jax.value_and_grad(loss_fn)(p, x, d, m, e, r)
         u, s = opt.update(g, s, p)
         return optax.apply_updates(p, u), s, l
 
@@ -77,34 +124,45 @@ def train(data: Path, out: Path, steps: int, seed: int = 1, batch_size: int = 4,
         np.savez(str(ck) + ".tmp.npz", weights=np.frombuffer(weights.to_bytes(params), np.uint8), step=step,
                  curve=json.dumps(curve), opt=np.array([np.asarray(v) for v in jax.tree_util.tree_leaves(state)], dtype=object))
         Path(str(ck) + ".tmp.npz").replace(ck)
+        (out / "weights.bin").write_bytes(weights.to_bytes(params))
 
     step = start
     for step in range(start, steps):
-        params, state, l = step_fn(params, state, *batch(items, rng, batch_size, crop))
+        params, state, l = step_fn(params, state, *batch(items, rng, cfg["batch"], crop))
         run.append(float(l))
         if (step + 1) % 50 == 0:
-            curve.append({"step": step + 1, "loss": float(np.mean(run)), "seconds": round(time.time() - t0, 1)})
+            # mean and median: a mean relMSE is dominated by the odd 1-spp crop
+            curve.append({"step": step + 1, "loss": float(np.mean(run)), "median": float(np.median(run)),
+                          "seconds": round(time.time() - t0, 1)})
             run = []
-            print(f"step {step + 1}/{steps} relMSE {curve[-1]['loss']:.4f} ({time.time() - t0:.0f} s)", flush=True)
+            print(f"step {step + 1}/{steps} relMSE mean {curve[-1]['loss']:.4f} median {curve[-1]['median']:.4f} "
+                  f"({time.time() - t0:.0f} s)", flush=True)
         if (step + 1) % ckpt_every == 0:
             save(step + 1)
         if minutes is not None and time.time() - t0 > 60 * minutes:
             print(f"train: stopping at step {step + 1}: the {minutes}-minute budget is spent", flush=True)
             break
     save(step + 1)
-    (out / "weights.bin").write_bytes(weights.to_bytes(params))
     (out / "loss_curve.json").write_text(json.dumps(curve, indent=1))
+    (out / "config.json").write_text(json.dumps(dict(cfg, steps=steps, seed=seed, stopped_at=step + 1,
+                                                     seconds=round(time.time() - t0, 1)), indent=1))
+    plot_curve(curve, out / "loss_curve.png")
+    return params
+
+
+def plot_curve(curve: list, path: Path) -> None:
     try:
         import matplotlib
 
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
-
-        fig, ax = plt.subplots(figsize=(6, 3.5))
-        ax.semilogy([c["step"] for c in curve], [c["loss"] for c in curve])
-        ax.set_xlabel("step"), ax.set_ylabel("training relMSE (50-step mean)")
-        fig.tight_layout()
-        fig.savefig(out / "loss_curve.png", dpi=100)
     except ImportError:
-        pass
-    return {k: np.asarray(v) for k, v in params.items()}
+        return
+    fig, ax = plt.subplots(figsize=(6, 3.5))
+    ax.semilogy([c["step"] for c in curve], [c["loss"] for c in curve], label="mean")
+    if curve and "median" in curve[0]:
+        ax.semilogy([c["step"] for c in curve], [c["median"] for c in curve], label="median")
+    ax.set_xlabel("step"), ax.set_ylabel("training relMSE (50-step windows)")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
