@@ -1,4 +1,4 @@
-// `atrous denoise`: EAW or SURE-À-Trous on a render directory or on individual EXR/PFM buffers.
+// `atrous denoise`: EAW, SURE-À-Trous or the learned filter on a render directory or on individual EXR/PFM buffers.
 #include <algorithm>
 #include <cstdio>
 #include <iterator>
@@ -8,6 +8,7 @@
 
 #include "atrous/denoise.h"
 #include "atrous/error.h"
+#include "atrous/learned.h"
 #include "cli_flags.h"
 #include "commands.h"
 #include "core/timer.h"
@@ -38,6 +39,20 @@ const char* const kGroupEawSure = "EAW and SURE (--method eaw|sure)";
 const char* const kGroupSure = "SURE (--method sure)";
 const char* const kGroupSvgf = "SVGF (--method svgf)";  // addSvgfOptions' group
 const char* const kGroupBuffers = "Buffers (without --sequence)";
+const char* const kGroupLearned = "Learned (--method learned|auto)";
+
+bool learnedMethod(const std::string& method) { return method == "learned" || method == "auto"; }
+
+// The learned filter runs the still driver's preparation (fireflies, emission filter, albedo rule)
+// and the safety net, not the EAW stops or SURE (include/atrous/denoise.h): the flags it ignores.
+bool ignoredByLearned(const std::string& flag) {
+    for (const ParamField<DenoiseOptions>& f : denoiseParams()) {
+        if (denoiseParams().flag(f) != flag) continue;
+        const std::string g = f.group, name = f.name;
+        return g == "sure" || (g == "eaw" && name.rfind("emission_", 0) != 0);
+    }
+    return false;
+}
 
 // One note line on stderr naming the given flags that the chosen method (or --sequence) ignores.
 void noteIgnoredFlags(const CLI::App& cmd, const std::string& method, bool sequence) {
@@ -46,7 +61,8 @@ void noteIgnoredFlags(const CLI::App& cmd, const std::string& method, bool seque
         if (opt->count() == 0) continue;
         const std::string& g = opt->get_group();
         const bool unused = (g == kGroupEawSure && method == "svgf") || (g == kGroupSure && method != "sure") ||
-                            (g == kGroupSvgf && method != "svgf");
+                            (g == kGroupSvgf && method != "svgf") || (g == kGroupLearned && !learnedMethod(method)) ||
+                            (method == "learned" && ignoredByLearned(opt->get_name()));
         if (unused) ignored += (ignored.empty() ? "" : ", ") + opt->get_name();
         if (g == kGroupBuffers && sequence) ignoredSeq += (ignoredSeq.empty() ? "" : ", ") + opt->get_name();
     }
@@ -106,8 +122,8 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
         throw InputError("-f/--filter: '" + a.oidnFilter + "' is not supported (atrous denoises RT images: use RT)");
     DenoiseOptions& o = a.opt;
     const bool sequence = !a.sequence.empty();
-    if (a.method != "svgf" && a.method != "eaw" && a.method != "sure")
-        throw InputError("--method: unknown denoise method '" + a.method + "' (expected eaw, sure or svgf)");
+    if (a.method != "svgf" && a.method != "eaw" && a.method != "sure" && !learnedMethod(a.method))
+        throw InputError("--method: unknown denoise method '" + a.method + "' (expected eaw, sure, learned, auto or svgf)");
     if (a.method == "svgf" && !sequence)
         throw InputError("--method svgf denoises animated sequences: give --sequence DIR (and an output directory)");
     o.method = a.method == "svgf" ? DenoiseMethod::Sure : parseDenoiseMethod(a.method);
@@ -115,6 +131,9 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     if (a.method == "svgf") checkParamFlags(a.svgf, svgfParams(), cmd);
     o.device = parseDevice(a.device);
     noteIgnoredFlags(cmd, a.method, sequence);
+    // A bad weight file fails here, before any buffer is read or anything written.
+    if (learnedMethod(a.method) && !o.learnedWeights.empty())
+        withFlag("--learned-weights", [&] { return LearnedWeights::load(o.learnedWeights); });
     if (sequence) {
         if (!a.inDir.empty() || !a.color.empty())
             throw InputError("--sequence DIR denoises the frames of DIR: drop --in/--color");
@@ -159,8 +178,12 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
         io::writeExrWithLayers(a.out, *set.layered, {io::ExrOutLayer{a.addPass, &out}});
     else
         io::writeImage(a.out, out);
-    std::printf("denoise: method %s on %s, %dx%d, buffers used: %s\n", denoiseMethodName(o.method),
-                deviceToString(o.device), color.width(), color.height(), rep.buffersUsed.c_str());
+    const std::string method = o.method == DenoiseMethod::Auto
+                                   ? std::string("auto -> ") + denoiseMethodName(rep.methodUsed) +
+                                         (rep.methodUsed == DenoiseMethod::Learned ? " (albedo and normal given)"
+                                                                                  : " (learned needs an albedo and a normal)")
+                                   : std::string(denoiseMethodName(o.method));
+    std::printf("denoise: method %s on %s, %dx%d, buffers used: %s\n", method.c_str(), deviceToString(o.device), color.width(), color.height(), rep.buffersUsed.c_str());
     if (rep.noiseEstimated)
         std::printf("denoise: no variance buffer: noise estimated from the image, per pixel (docs/algorithms.md), at least "
                     "the global MAD sigma = %.4g %.4g %.4g%s\n",
@@ -184,7 +207,8 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
 void addDenoiseCommand(CLI::App& app) {
     auto a = std::make_shared<DenoiseArgs>();
     auto* cmd = app.add_subcommand(
-        "denoise", "Denoise a render with EAW or SURE-based a-trous wavelets, or an animated sequence (also SVGF)");
+        "denoise", "Denoise a render with EAW, SURE-based a-trous wavelets or the learned a-trous filter, or an animated "
+                   "sequence (also SVGF)");
     cmd->add_option("--in", a->inDir,
                     "Render directory (color.exr, variance.exr, albedo.exr, normal.exr, ...) or a layered EXR "
                     "(Blender multilayer, Mitsuba aov): its passes are taken by name (atrous inspect FILE shows which)");
@@ -212,7 +236,12 @@ void addDenoiseCommand(CLI::App& app) {
                     "run's frame_NNNN.exr/.png replace the old ones, and those of an earlier run that this run does "
                     "not write (and an old preview.mp4) are removed, named in a note on stderr")
         ->required();
-    cmd->add_option("--method", a->method, "eaw | sure (| svgf with --sequence)")->capture_default_str();
+    cmd->add_option("--method", a->method,
+                    "eaw | sure | learned | auto (learned with an albedo and a normal, else sure) (| svgf with --sequence)")
+        ->capture_default_str();
+    cmd->add_option("--learned-weights", a->opt.learnedWeights,
+                    "Weight file of the learned filter (version 2, docs/learned.md; default: the built-in weights)")
+        ->group(kGroupLearned);
     cmd->add_option("--device,-d", a->device, "cpu | cuda | auto (cuda when a GPU is present; oidnDenoise's 'default' = auto)")
         ->capture_default_str()
         ->transform([](std::string v) { return v == "default" ? std::string("auto") : v; });

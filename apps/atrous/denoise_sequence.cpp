@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "atrous/error.h"
+#include "atrous/learned.h"
 #include "cli_flags.h"
 #include "core/timer.h"
 #include "io/buffer_set.h"
@@ -184,8 +185,9 @@ private:
 
 int runSequenceDenoise(const SequenceDenoiseArgs& args) {
     const bool svgf = args.method == "svgf";
-    if (!svgf && args.method != "eaw" && args.method != "sure")
-        throw InputError("--method '" + args.method + "' cannot denoise a sequence (expected svgf, eaw or sure)");
+    if (!svgf && args.method != "eaw" && args.method != "sure" && args.method != "learned" && args.method != "auto")
+        throw InputError("--method '" + args.method +
+                         "' cannot denoise a sequence (expected svgf, eaw, sure, learned or auto)");
     if (args.sequenceDir.empty()) throw InputError("--sequence: no directory given");
     if (args.outDir.empty()) throw InputError("--out: no output directory given");
     if (!(args.exposure > 0.0f)) throw InputError("--exposure must be > 0");
@@ -203,7 +205,18 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
         options.method = parseDenoiseMethod(args.method);
         options.device = args.device;
         validateDenoiseOptions(options);
+        // A bad weight file fails before the output directory is touched.
+        if ((options.method == DenoiseMethod::Learned || options.method == DenoiseMethod::Auto) &&
+            !options.learnedWeights.empty()) {
+            try {
+                LearnedWeights::load(options.learnedWeights);
+            } catch (const InputError& e) {
+                throw InputError(std::string("--learned-weights: ") + e.what());
+            }
+        }
     }
+    DenoiseReport frameReport;
+    options.report = &frameReport;
     StagedOutput staged(args.outDir);
     const std::string stage = staged.stage();
 
@@ -249,7 +262,8 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
         io::writeImage((fs::path(stage) / (name + ".exr")).string(), out);
         io::writePng((fs::path(stage) / (name + ".png")).string(), out, args.exposure);
         if (!args.quiet) {
-            std::printf("%s: %s %.1f ms", name.c_str(), args.method.c_str(), ms);
+            std::printf("%s: %s%s%s %.1f ms", name.c_str(), args.method.c_str(), args.method == "auto" ? " -> " : "",
+                        args.method == "auto" ? denoiseMethodName(frameReport.methodUsed) : "", ms);
             if (check.tested > 0) std::printf(", %.0f%% reprojects onto the previous frame", 100 * check.kept);
             if (!f.reference.empty())
                 std::printf(", MSE vs reference %.6g (input %.6g)", meanSquaredError(out, f.reference),

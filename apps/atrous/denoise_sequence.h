@@ -1,6 +1,7 @@
-// `atrous denoise --method svgf|eaw|sure --sequence DIR --out OUTDIR`: denoises every frame of a
+// `atrous denoise --method svgf|eaw|sure|learned|auto --sequence DIR --out OUTDIR`: denoises every frame of a
 // sequence directory (layout in src/io/sequence.h and docs/svgf.md). SVGF carries its history from
-// frame to frame; EAW and SURE denoise each frame on its own through atrous::denoise().
+// frame to frame; EAW, SURE and the learned filter denoise each frame on its own through
+// atrous::denoise() (auto: resolved per frame, by the buffers the frame has).
 #pragma once
 #include <CLI/CLI.hpp>
 
@@ -13,12 +14,12 @@
 namespace atrous::cli {
 
 struct SequenceDenoiseArgs {
-    std::string method = "svgf";  // svgf | eaw | sure
+    std::string method = "svgf";  // svgf | eaw | sure | learned | auto
     std::string sequenceDir;
     std::string outDir;
     Device device = Device::Cpu;
     SvgfParams svgf;              // used by --method svgf
-    DenoiseOptions frameOptions;  // used by eaw/sure (method and device are set from the fields above)
+    DenoiseOptions frameOptions;  // used by eaw/sure/learned/auto (method and device are set from the fields above)
     float exposure = 1.0f;        // of the PNG previews
     bool preview = true;          // animated OUTDIR/preview.mp4 through ffmpeg when it is on PATH
     bool quiet = false;           // no per-frame lines on stdout

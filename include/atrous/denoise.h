@@ -1,4 +1,5 @@
-// Denoising API: EAW (Dammertz et al. 2010) and SURE-based À-Trous (Kim, Moon, Yoon 2016).
+// Denoising API: EAW (Dammertz et al. 2010), SURE-based À-Trous (Kim, Moon, Yoon 2016) and the
+// learned à-trous filter (docs/learned.md).
 // The names below are used by the render command (`atrous render --denoise eaw,sure`), the CLI
 // (`atrous denoise`) and the benchmarks. The math is docs/denoising.md; the
 // parameters and how their defaults are derived are documented in docs/denoising.md.
@@ -12,7 +13,14 @@
 
 namespace atrous {
 
-enum class DenoiseMethod { Eaw, Sure };
+// Learned: the learned à-trous cascade (docs/learned.md) on the same prepared planes (sanitise,
+// emission, fireflies, noise estimate, demodulation) as EAW and SURE, then the same safety net and
+// remodulation. Of the parameters, the firefly pass, the emission filter (emissionLevels/Scale),
+// the albedo rule (demodulate, albedoEpsilon, albedoFloor) and the safety net apply; levels, the
+// σ's and scales of the EAW stops and SureParams do not. Auto: resolved by
+// denoise() to Learned when an albedo and a normal buffer are given, else Sure
+// (DenoiseReport::methodUsed says which).
+enum class DenoiseMethod { Eaw, Sure, Learned, Auto };
 
 // Per-pixel buffers, each a 3-channel planar Image of the colour's size (see docs/rendering.md, "The buffers").
 // Only `color` is required; a missing feature simply removes its edge stop.
@@ -121,11 +129,16 @@ struct DenoiseOptions {
     // Other renderers' albedo is 0 on glass, mirrors, emitters and the sky (docs/algorithms.md).
     // 0.05 is measured on the corpus (docs/quality.md): 0.1 half-demodulated dark texture.
     float albedoFloor = 0.05f;  // [0, 1]
+    // The learned method's weight file (version 2, docs/learned.md); empty = the built-in weights.
+    // Loaded by denoise() before any work: a bad file is an InputError naming it.
+    std::string learnedWeights;
     DenoiseReport* report = nullptr;  // optional: filled with what the run did
 };
 
 // What a denoise() call did, for the CLI and for measurements.
 struct DenoiseReport {
+    // The method that ran: options.method, or what Auto resolved to (Learned or Sure).
+    DenoiseMethod methodUsed = DenoiseMethod::Sure;
     // No variance buffer: the noise was estimated from the image, per pixel, floored at Donoho's
     // MAD of the (demodulated, with an albedo) colour (docs/algorithms.md).
     bool noiseEstimated = false;
@@ -142,7 +155,8 @@ struct DenoiseReport {
     // Per-stage times of the filter, in order: sanitize (NaN/Inf repair, the emission split and,
     // with an emission buffer, the emission filter), fireflies, demodulate (without a variance buffer
     // also the per-pixel noise estimate, docs/algorithms.md), sigma scales, then
-    // "level i" (and for SURE "sure i": the window sums and the choice of s_i) per level, then
+    // "level i" (and for SURE "sure i": the window sums and the choice of s_i) per level (the
+    // learned method: one stage "learned" instead of sigma scales and the levels), then
     // "safety net" (when on) and remodulate. CPU: wall clock; CUDA: cudaEvents on the stream (GPU time, no extra syncs).
     std::vector<StageTime> stages;
 };
@@ -156,7 +170,11 @@ Image denoise(const DenoiseInputs& inputs, const DenoiseOptions& options);
 // parameter is out of range; the ranges are the rows of denoiseParams().
 void validateDenoiseOptions(const DenoiseOptions& options);
 
-DenoiseMethod parseDenoiseMethod(const std::string& name);  // "eaw" | "sure"; InputError otherwise
+// "eaw" | "sure" | "learned" | "auto"; InputError otherwise.
+DenoiseMethod parseDenoiseMethod(const std::string& name);
 const char* denoiseMethodName(DenoiseMethod m);
+// What Auto becomes for these inputs: Learned with an albedo and a normal buffer, else Sure; any
+// other method is returned as it is.
+DenoiseMethod resolveDenoiseMethod(DenoiseMethod m, const DenoiseInputs& inputs);
 
 }  // namespace atrous

@@ -53,7 +53,7 @@ __all__ = [
 
 __version__ = "0.1.0"
 
-METHODS = ("eaw", "sure")
+METHODS = ("eaw", "sure", "learned", "auto")
 
 
 def builtin_scenes() -> list:
@@ -185,9 +185,10 @@ def denoise(
     emission: Any = None,
     method: str = "sure",
     device: str = "auto",
+    learned_weights: Optional["PathLike"] = None,
     **params: Any,
 ) -> Any:
-    """Denoises a Monte Carlo rendering with EAW or SURE-based À-Trous.
+    """Denoises a Monte Carlo rendering with EAW, SURE-based À-Trous or the learned à-trous filter.
 
     color: H x W x 3 mean radiance (linear HDR). variance: the variance of that mean per channel
     (not the sample variance); without it the noise is estimated from the image. albedo, normal
@@ -196,7 +197,11 @@ def denoise(
     emitted radiance seen at the primary hit; the filter works on color - emission and adds it
     back, so a visible light's edge is not smeared.
 
-    method: "eaw" or "sure". device: "auto" (the arrays' device: CUDA arrays on the GPU, numpy on
+    method: "eaw", "sure", "learned" (the learned à-trous filter, docs/learned.md: it uses the
+    firefly, emission, albedo and safety-net parameters, not levels, the sigma's or SURE's) or
+    "auto" (learned when an albedo and a normal are given, else sure). learned_weights: a weight
+    file (version 2) for "learned"/"auto"; None = the built-in weights; a bad file raises
+    ValueError naming it. device: "auto" (the arrays' device: CUDA arrays on the GPU, numpy on
     the CPU), "cpu" or "cuda" (numpy inputs are then copied to the GPU and back).
 
     params: the filter parameters, the rows of :func:`denoise_params` (the CLI's flags with '_'
@@ -210,6 +215,7 @@ def denoise(
         raise ValueError(f"unknown method '{method}' (expected one of {', '.join(METHODS)})")
     if device not in ("auto", "cpu", "cuda"):
         raise ValueError(f"unknown device '{device}' (expected auto, cpu or cuda)")
+    weights = "" if learned_weights is None else os.fsdecode(os.fspath(learned_weights))
     c = _prepare(color, "color", allow_gray=False)
     bufs = {
         name: _prepare(val, name)
@@ -221,14 +227,14 @@ def denoise(
     if device == "cuda" and not on_gpu:
         if not cuda_available():
             raise ValueError("device='cuda': no usable CUDA backend or GPU in this build")
-        return _denoise_numpy_on_gpu(c, bufs, method, params)
+        return _denoise_numpy_on_gpu(c, bufs, method, weights, params)
     if device == "cpu" and on_gpu:
         raise ValueError("device='cpu' with CUDA arrays: move them to the host first")
     for name, b in bufs.items():
         if b is not None and _is_cuda(b) != on_gpu:
             raise ValueError(f"{name}: lives on a different device than color")
     out = _core.denoise(c, bufs["albedo"], bufs["normal"], bufs["position"], bufs["depth"],
-                        bufs["variance"], bufs["ids"], bufs["emission"], method, dict(params))
+                        bufs["variance"], bufs["ids"], bufs["emission"], method, weights, dict(params))
     return _wrap_like(out, color)
 
 
@@ -260,12 +266,12 @@ def learned_planes(color: Any, variance: Any = None, albedo: Any = None, normal:
                                      bufs["emission"], dict(params)))
 
 
-def _denoise_numpy_on_gpu(c, bufs, method, params):  # pragma: no cover - needs a GPU
+def _denoise_numpy_on_gpu(c, bufs, method, weights, params):  # pragma: no cover - needs a GPU
     import cupy
 
     up = {k: (None if v is None else cupy.asarray(v)) for k, v in bufs.items()}
     out = _core.denoise(cupy.asarray(c), up["albedo"], up["normal"], up["position"], up["depth"],
-                        up["variance"], up["ids"], up["emission"], method, dict(params))
+                        up["variance"], up["ids"], up["emission"], method, weights, dict(params))
     return cupy.asnumpy(cupy.from_dlpack(out))
 
 

@@ -205,7 +205,7 @@ nb::list paramRows(const ParamTable<S>& t) {
 
 nb::object pyDenoise(const Array& color, nb::handle albedo, nb::handle normal, nb::handle position, nb::handle depth,
                      nb::handle variance, nb::handle ids, nb::handle emission, const std::string& method,
-                     nb::dict params) {
+                     const std::string& learnedWeights, nb::dict params) {
     using B = io::Buffer;
     Image c = toImage(color, "color");
     Buffers b(c);
@@ -215,6 +215,7 @@ nb::object pyDenoise(const Array& color, nb::handle albedo, nb::handle normal, n
     const DenoiseInputs in = io::denoiseInputs(b.refs);
     DenoiseOptions o;
     o.method = parseDenoiseMethod(method);
+    o.learnedWeights = learnedWeights;  // "" = the built-in weights
     o.device = c.device();
     for (auto [k, v] : params) applyParam(o, denoiseParams(), nb::cast<std::string>(k), v, "denoise");
     Image out;
@@ -393,7 +394,7 @@ NB_MODULE(_core, m) {
     });
     m.def("denoise", &pyDenoise, nb::arg("color"), nb::arg("albedo").none(), nb::arg("normal").none(),
           nb::arg("position").none(), nb::arg("depth").none(), nb::arg("variance").none(), nb::arg("ids").none(),
-          nb::arg("emission").none(), nb::arg("method"), nb::arg("params"));
+          nb::arg("emission").none(), nb::arg("method"), nb::arg("learned_weights"), nb::arg("params"));
     m.def("learned_planes", &pyLearnedPlanes, nb::arg("color"), nb::arg("variance").none(), nb::arg("albedo").none(),
           nb::arg("normal").none(), nb::arg("depth").none(), nb::arg("emission").none(), nb::arg("params"));
     m.def("render", &pyRender, nb::arg("scene"), nb::arg("params"));

@@ -179,6 +179,7 @@ Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const Prepar
     dout.clock = clock.get();
     Timer t;
     DriverConfig cfg{o};
+    cfg.learned = prep.learned;
     cfg.varianceGiven = in.variance != nullptr;
     setNoiseEstimate(cfg, rep);
     if (clock) clock->start();

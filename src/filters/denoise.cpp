@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "atrous/error.h"
+#include "atrous/learned.h"
 #include "atrous/params.h"
 #include "core/parallel.h"
 #include "core/timer.h"
@@ -23,10 +24,27 @@ namespace atrous {
 DenoiseMethod parseDenoiseMethod(const std::string& name) {
     if (name == "eaw") return DenoiseMethod::Eaw;
     if (name == "sure") return DenoiseMethod::Sure;
-    throw InputError("unknown denoise method '" + name + "' (expected eaw or sure)");
+    if (name == "learned") return DenoiseMethod::Learned;
+    if (name == "auto") return DenoiseMethod::Auto;
+    throw InputError("unknown denoise method '" + name + "' (expected eaw, sure, learned or auto)");
 }
 
-const char* denoiseMethodName(DenoiseMethod m) { return m == DenoiseMethod::Eaw ? "eaw" : "sure"; }
+const char* denoiseMethodName(DenoiseMethod m) {
+    switch (m) {
+        case DenoiseMethod::Eaw: return "eaw";
+        case DenoiseMethod::Sure: return "sure";
+        case DenoiseMethod::Learned: return "learned";
+        case DenoiseMethod::Auto: return "auto";
+    }
+    return "?";
+}
+
+// The network was trained with an albedo and a normal (docs/learned.md); without them SURE.
+DenoiseMethod resolveDenoiseMethod(DenoiseMethod m, const DenoiseInputs& in) {
+    if (m != DenoiseMethod::Auto) return m;
+    return in.albedo && !in.albedo->empty() && in.normal && !in.normal->empty() ? DenoiseMethod::Learned
+                                                                               : DenoiseMethod::Sure;
+}
 
 // The ranges are params.h's table (one row per field); the library's own limits must agree.
 static_assert(filters::kMaxLevels == 10 && filters::kMaxSureCandidates == 8, "update params.h's ranges");
@@ -200,6 +218,7 @@ Image denoiseCpu(const DenoiseInputs& in, const DenoiseOptions& o, const Prepare
     dout.clock = clock.get();
     Timer t;
     DriverConfig cfg{o};
+    cfg.learned = prep.learned;
     cfg.varianceGiven = in.variance != nullptr;
     setNoiseEstimate(cfg, rep);
     clock->start();
@@ -263,13 +282,21 @@ Image denoise(const DenoiseInputs& given, const DenoiseOptions& options) {
     DenoiseReport local;
     DenoiseReport& rep = options.report ? *options.report : local;
     DenoiseInputs inputs = given;
-    filters::PreparedInputs prep = prepareCall(inputs, options, rep);
-    if (options.device == Device::Cuda) {
+    DenoiseOptions o = options;
+    o.method = resolveDenoiseMethod(options.method, inputs);
+    // The weights before any work: a bad file is an InputError naming it, nothing computed.
+    LearnedWeights weights;
+    if (o.method == DenoiseMethod::Learned)
+        weights = o.learnedWeights.empty() ? LearnedWeights::builtin() : LearnedWeights::load(o.learnedWeights);
+    filters::PreparedInputs prep = prepareCall(inputs, o, rep);
+    prep.learned = weights;
+    rep.methodUsed = o.method;
+    if (o.device == Device::Cuda) {
         requireCuda();
-        return filters::denoiseCuda(inputs, options, prep, rep);
+        return filters::denoiseCuda(inputs, o, prep, rep);
     }
     requireHostInputs(inputs);
-    return filters::denoiseCpu(inputs, options, prep, rep, nullptr);
+    return filters::denoiseCpu(inputs, o, prep, rep, nullptr);
 }
 
 namespace filters {

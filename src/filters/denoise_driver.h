@@ -1,4 +1,4 @@
-// The level-loop driver of EAW and SURE, written once as a template on the executor (CpuExec in
+// The level-loop driver of EAW, SURE and the learned method, written once as a template on the executor (CpuExec in
 // src/filters/denoise.cpp, CudaExec in src/cuda/cuda_denoise.cu). Inputs and outputs are views on
 // the executor's device; temporaries are allocated there.
 #pragma once
@@ -8,8 +8,10 @@
 
 #include "atrous/denoise.h"
 #include "atrous/image.h"
+#include "atrous/learned.h"
 #include "filters/eaw.h"
 #include "filters/emission_filter.h"
+#include "filters/learned.h"
 #include "filters/modulation.h"
 #include "filters/noise_estimate.h"
 #include "filters/prepass.h"
@@ -80,7 +82,8 @@ inline AlbedoRule stillAlbedoRule(const DenoiseOptions& o) {
 }
 
 struct DriverConfig {
-    DenoiseOptions opts;
+    DenoiseOptions opts;  // opts.method is Eaw, Sure or Learned (Auto resolved by denoise())
+    LearnedWeights learned;  // the learned method's weights (loaded by denoise())
     bool varianceGiven = true;  // false: the variance is a constant estimate
     // Without a variance: the local estimate (noise_estimate.h) over quadrants of this radius
     // (0 = keep the constant), floored at noiseFloorVar (the global estimate times a fraction) and
@@ -132,6 +135,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     const Device dev = exec.device();
     const DenoiseOptions& o = cfg.opts;
     const bool sure = o.method == DenoiseMethod::Sure;
+    const bool learned = o.method == DenoiseMethod::Learned;
     const int levels = o.eaw.levels;
 
     // 1. Non-finite samples and features.
@@ -249,92 +253,104 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     }
     markStage(out.clock, "demodulate");
 
-    // 4. Per-pixel scales of the automatic σ_c and σ_x.
-    Image S(w, h, 1, dev), invX(w, h, 1, dev), invZ(w, h, 1, dev);
-    runColorScale(exec, ColorScale{o.eaw.sigmaColor, o.eaw.colorScale * o.eaw.colorScale, vA.view(), S.view()});
-    runFootprint(exec, Footprint{in.position.valid() ? 1 : 0, o.eaw.sigmaPosition,
-                                 o.eaw.positionScale * o.eaw.positionScale, position, depth, invX.view(),
-                                 invZ.view()});
-    markStage(out.clock, "sigma scales");
-
-    // 5. The cascade. SURE also propagates the variance and keeps Σ s_i d_i in `acc`.
-    Image cB = c0.empty() ? Image(w, h, 3, dev) : std::move(c0);  // fully overwritten by level 0
-    Image vB, detail, boxH, acc;
-    float alpha[kMaxLevels];
-    for (int i = 0; i < kMaxLevels; ++i) alpha[i] = 1.0f;
-    SureChoiceParams choice;
-    if (sure) {
-        vB = v0.empty() ? Image(w, h, 3, dev) : std::move(v0);  // fully overwritten by level 0
-        detail = Image(w, h, 2, dev);
-        boxH = Image(w, h, 2, dev);
-        acc = Image(w, h, 3, dev);
-        if (o.sure.correlatedVariance) sureDetailVarianceFactors(levels, alpha);
-        choice.radius = o.sure.windowRadius;
-        choice.jamesStein = o.sure.mode == SureMode::JamesStein ? 1 : 0;
-        choice.count = int(o.sure.candidates.size());
-        for (int k = 0; k < choice.count && k < kMaxSureCandidates; ++k) choice.candidates[k] = o.sure.candidates[k];
-    }
-    // Each level's 1/σ_c² factors (EawLevel::rS). The CPU level takes its plane from the scalable
-    // allocator per level instead, as it did before the shared cascade (docs/benchmarks.md, "One
-    // cascade": holding an image through the cascade was a suspect of a slower sanitise stage).
-    Image rS = dev == Device::Cpu ? Image() : Image(w, h, 1, dev);
+    // 4-5. The learned method: its cascade (filters/learned.h) on the prepared planes, d_out in
+    // `learnedOut`; a feature that was not given is an invalid plane (the network reads it as absent).
     Image* cur = &cA;
-    Image* nxt = &cB;
-    Image* vcur = &vA;
-    Image* vnxt = &vB;
-    const float invSigmaN2 = o.eaw.sigmaNormal > 0 && in.normal.valid() ? 1.0f / (o.eaw.sigmaNormal * o.eaw.sigmaNormal) : 0.0f;
-    for (int i = 0; i < levels; ++i) {
-        EawLevelParams lp;
-        lp.step = 1 << i;
-        lp.colorMul = std::pow(o.eaw.colorLevelFactor, 2.0f * float(i));
-        lp.invNormal = o.eaw.normalStepScale ? invSigmaN2 / float(lp.step * lp.step) : invSigmaN2;
-        lp.autoPosition = o.eaw.sigmaPosition > 0 ? 0 : 1;
-        lp.invDepth = o.eaw.sigmaDepth > 0 && in.depth.valid() ? 1.0f / (o.eaw.sigmaDepth * o.eaw.sigmaDepth) : 0.0f;
-        lp.idPenalty = o.eaw.useIds && in.ids.valid() ? kIdPenalty : 0.0f;
-        lp.propagate = sure ? 1 : 0;
-        lp.detailVarScale = alpha[i];
-        EawLevel f;
-        f.p = lp;
-        f.cIn = cur->view();
-        f.cOut = nxt->view();
+    Image cB, vB, detail, boxH, acc, learnedOut;
+    if (learned) {
+        learnedOut = Image(w, h, 3, dev);
+        const LearnedPlanes P{cA.view(), vA.view(), albedo, in.normal.valid() ? normal : ImageView{},
+                              in.depth.valid() ? depth : ImageView{}};
+        runLearned(exec, cfg.learned, P, learnedOut.view());
+        cur = &learnedOut;
+        markStage(out.clock, "learned");
+    } else {
+        // 4. Per-pixel scales of the automatic σ_c and σ_x.
+        Image S(w, h, 1, dev), invX(w, h, 1, dev), invZ(w, h, 1, dev);
+        runColorScale(exec, ColorScale{o.eaw.sigmaColor, o.eaw.colorScale * o.eaw.colorScale, vA.view(), S.view()});
+        runFootprint(exec, Footprint{in.position.valid() ? 1 : 0, o.eaw.sigmaPosition,
+                                     o.eaw.positionScale * o.eaw.positionScale, position, depth, invX.view(),
+                                     invZ.view()});
+        markStage(out.clock, "sigma scales");
+
+        // 5. The cascade. SURE also propagates the variance and keeps Σ s_i d_i in `acc`.
+        cB = c0.empty() ? Image(w, h, 3, dev) : std::move(c0);  // fully overwritten by level 0
+        float alpha[kMaxLevels];
+        for (int i = 0; i < kMaxLevels; ++i) alpha[i] = 1.0f;
+        SureChoiceParams choice;
         if (sure) {
-            f.vIn = vcur->view();
-            f.vOut = vnxt->view();
-            f.detail = detail.view();
+            vB = v0.empty() ? Image(w, h, 3, dev) : std::move(v0);  // fully overwritten by level 0
+            detail = Image(w, h, 2, dev);
+            boxH = Image(w, h, 2, dev);
+            acc = Image(w, h, 3, dev);
+            if (o.sure.correlatedVariance) sureDetailVarianceFactors(levels, alpha);
+            choice.radius = o.sure.windowRadius;
+            choice.jamesStein = o.sure.mode == SureMode::JamesStein ? 1 : 0;
+            choice.count = int(o.sure.candidates.size());
+            for (int k = 0; k < choice.count && k < kMaxSureCandidates; ++k) choice.candidates[k] = o.sure.candidates[k];
         }
-        f.S = S.view();
-        f.rS = rS.empty() ? ImageView{} : rS.view();
-        f.normal = normal;
-        f.position = position;
-        f.invX = invX.view();
-        f.depth = depth;
-        f.invZ = invZ.view();
-        f.ids = ids;
-        runEawLevel(exec, f);
-        markStage(out.clock, "level", i);
-        if (sure) {
-            // Levels below sure.firstLevel keep s_i = 0 (their details are dropped, as in EAW): the
-            // per-level risk assumes the levels' noise is independent, but adjacent fine levels'
-            // detail noise correlates at ~0.7 after colour-weighted levels (docs/quality.md), so
-            // their individual SURE choices keep noise. Adding 0·d_i to acc is a no-op, so such a
-            // level runs no window passes unless its s_i map is asked for (it is then all 0).
-            const bool dropped = i < o.sure.firstLevel;
-            if (!dropped || out.sureS.valid()) {
-                runSureBoxH(exec, SureBoxH{choice.radius, detail.view(), boxH.view()});
-                ImageView sOut;
-                if (out.sureS.valid()) sOut = ImageView{out.sureS.channel(i), w, h, 1};
-                SureChoiceParams levelChoice = choice;
-                if (dropped) {
-                    levelChoice.jamesStein = 0;
-                    levelChoice.count = 1;
-                    levelChoice.candidates[0] = 0.0f;
-                }
-                runSureChoose(exec, SureChoose{levelChoice, boxH.view(), cur->view(), nxt->view(), acc.view(), sOut});
+        // Each level's 1/σ_c² factors (EawLevel::rS). The CPU level takes its plane from the scalable
+        // allocator per level instead, as it did before the shared cascade (docs/benchmarks.md, "One
+        // cascade": holding an image through the cascade was a suspect of a slower sanitise stage).
+        Image rS = dev == Device::Cpu ? Image() : Image(w, h, 1, dev);
+        cur = &cA;
+        Image* nxt = &cB;
+        Image* vcur = &vA;
+        Image* vnxt = &vB;
+        const float invSigmaN2 = o.eaw.sigmaNormal > 0 && in.normal.valid() ? 1.0f / (o.eaw.sigmaNormal * o.eaw.sigmaNormal) : 0.0f;
+        for (int i = 0; i < levels; ++i) {
+            EawLevelParams lp;
+            lp.step = 1 << i;
+            lp.colorMul = std::pow(o.eaw.colorLevelFactor, 2.0f * float(i));
+            lp.invNormal = o.eaw.normalStepScale ? invSigmaN2 / float(lp.step * lp.step) : invSigmaN2;
+            lp.autoPosition = o.eaw.sigmaPosition > 0 ? 0 : 1;
+            lp.invDepth = o.eaw.sigmaDepth > 0 && in.depth.valid() ? 1.0f / (o.eaw.sigmaDepth * o.eaw.sigmaDepth) : 0.0f;
+            lp.idPenalty = o.eaw.useIds && in.ids.valid() ? kIdPenalty : 0.0f;
+            lp.propagate = sure ? 1 : 0;
+            lp.detailVarScale = alpha[i];
+            EawLevel f;
+            f.p = lp;
+            f.cIn = cur->view();
+            f.cOut = nxt->view();
+            if (sure) {
+                f.vIn = vcur->view();
+                f.vOut = vnxt->view();
+                f.detail = detail.view();
             }
-            markStage(out.clock, "sure", i);
-            std::swap(vcur, vnxt);
+            f.S = S.view();
+            f.rS = rS.empty() ? ImageView{} : rS.view();
+            f.normal = normal;
+            f.position = position;
+            f.invX = invX.view();
+            f.depth = depth;
+            f.invZ = invZ.view();
+            f.ids = ids;
+            runEawLevel(exec, f);
+            markStage(out.clock, "level", i);
+            if (sure) {
+                // Levels below sure.firstLevel keep s_i = 0 (their details are dropped, as in EAW): the
+                // per-level risk assumes the levels' noise is independent, but adjacent fine levels'
+                // detail noise correlates at ~0.7 after colour-weighted levels (docs/quality.md), so
+                // their individual SURE choices keep noise. Adding 0·d_i to acc is a no-op, so such a
+                // level runs no window passes unless its s_i map is asked for (it is then all 0).
+                const bool dropped = i < o.sure.firstLevel;
+                if (!dropped || out.sureS.valid()) {
+                    runSureBoxH(exec, SureBoxH{choice.radius, detail.view(), boxH.view()});
+                    ImageView sOut;
+                    if (out.sureS.valid()) sOut = ImageView{out.sureS.channel(i), w, h, 1};
+                    SureChoiceParams levelChoice = choice;
+                    if (dropped) {
+                        levelChoice.jamesStein = 0;
+                        levelChoice.count = 1;
+                        levelChoice.candidates[0] = 0.0f;
+                    }
+                    runSureChoose(exec, SureChoose{levelChoice, boxH.view(), cur->view(), nxt->view(), acc.view(), sOut});
+                }
+                markStage(out.clock, "sure", i);
+                std::swap(vcur, vnxt);
+            }
+            std::swap(cur, nxt);
         }
-        std::swap(cur, nxt);
     }
 
     // 6. The safety net: F' = F + s (y - F), s chosen by SURE on the residual (safety_net.h).

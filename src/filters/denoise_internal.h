@@ -4,6 +4,7 @@
 #include "atrous/denoise.h"
 #include "atrous/error.h"
 #include "atrous/image.h"
+#include "atrous/learned.h"
 #include "filters/denoise_driver.h"
 
 namespace atrous::filters {
@@ -12,6 +13,7 @@ struct PreparedInputs {
     // Constant σ² per channel when no variance buffer was given and the colour is on the host
     // (for a GPU colour denoiseCuda fills it on the GPU from DenoiseReport::noiseSigma).
     Image estimatedVariance;
+    LearnedWeights learned;  // the learned method's weights (empty for the other methods)
 };
 
 // Optional extra outputs for tests.

@@ -96,3 +96,68 @@ def test_learned_planes_checks_inputs_like_denoise():
         atrous.learned_planes(b["color"], no_such_thing=1)
     with pytest.raises(ValueError, match="variance"):
         atrous.learned_planes(b["color"], variance=-b["variance"])
+
+
+def _fixture_weights(tmp_path):
+    # The weight file inside tests/learned_fixture.bin (random, non-trivial weights: the tests do
+    # not depend on how the built-in weights were trained). "ATRF" | u32 version | w | h | n | bytes.
+    import struct
+    from pathlib import Path
+
+    b = (Path(__file__).resolve().parents[1] / "learned_fixture.bin").read_bytes()
+    assert b[:4] == b"ATRF"
+    n = struct.unpack("<I", b[16:20])[0]
+    p = tmp_path / "fixture.atrl"
+    p.write_bytes(b[20:20 + n])
+    return p
+
+
+def test_methods_list_learned_and_auto():
+    assert "learned" in atrous.METHODS and "auto" in atrous.METHODS
+
+
+def test_learned_denoise_is_finite_filters_and_takes_a_path(tmp_path):
+    w = _fixture_weights(tmp_path)
+    b = _synthetic(5)
+    b["color"][4, 4] = np.nan
+    kw = dict(variance=b["variance"], albedo=b["albedo"], normal=b["normal"], depth=b["depth"],
+              emission=b["emission"])
+    out = atrous.denoise(b["color"], method="learned", learned_weights=w, **kw)
+    assert out.shape == (H, W, 3) and out.dtype == np.float32 and np.isfinite(out).all()
+    assert np.abs(out - np.nan_to_num(b["color"])).max() > 1e-3
+    # str and PathLike give the same; levels is not a parameter of the learned filter.
+    again = atrous.denoise(b["color"], method="learned", learned_weights=str(w), levels=2, **kw)
+    np.testing.assert_array_equal(out, again)
+    # auto with albedo and normal is learned, without a normal it is sure.
+    np.testing.assert_array_equal(atrous.denoise(b["color"], method="auto", learned_weights=w, **kw), out)
+    kw.pop("normal")
+    np.testing.assert_array_equal(atrous.denoise(b["color"], method="auto", learned_weights=w, **kw),
+                                  atrous.denoise(b["color"], method="sure", **kw))
+
+
+def test_learned_denoise_is_the_filtered_planes_remodulated(tmp_path):
+    # A constant colour is a fixed point of the cascade (every level is a normalised average and
+    # the blend a convex combination), so the output must be the colour again: the driver divided
+    # by the albedo (d = 1.2) and multiplied it back. A missing remodulation gives 1.2, a doubled
+    # one 0.3. rtol 1e-5: the float sums of the cascade's weights (~1e-7 each).
+    w = _fixture_weights(tmp_path)
+    c = np.full((H, W, 3), 0.6, np.float32)
+    a = np.full((H, W, 3), 0.5, np.float32)
+    n = np.zeros((H, W, 3), np.float32)
+    n[..., 2] = 1
+    out = atrous.denoise(c, variance=np.full_like(c, 0.01), albedo=a, normal=n, method="learned",
+                         learned_weights=w)
+    np.testing.assert_allclose(out, c, rtol=1e-5)
+
+
+def test_bad_weights_raise_value_error_naming_the_file(tmp_path):
+    b = _synthetic()
+    missing = tmp_path / "none.atrl"
+    with pytest.raises(ValueError, match="none.atrl"):
+        atrous.denoise(b["color"], method="learned", learned_weights=missing)
+    junk = tmp_path / "junk.atrl"
+    junk.write_bytes(b"ATRL\x02\x00\x00\x00 truncated")
+    with pytest.raises(ValueError, match="junk.atrl"):
+        atrous.denoise(b["color"], albedo=b["albedo"], normal=b["normal"], method="auto", learned_weights=junk)
+    with pytest.raises(ValueError, match="unknown method"):
+        atrous.denoise(b["color"], method="learnt")
