@@ -1,30 +1,112 @@
 // `atrous inspect FILE.exr`: the parts, layers and channels of an EXR, and which of them
 // `atrous denoise --in FILE.exr` would take for each buffer (the same io::mapPasses).
+// `--export DIR` also writes those buffers, as atrous reads them (io::loadBuffers: every
+// convention applied), as plain EXRs in DIR. A render directory (color.exr, albedo.exr, ...: a
+// Mitsuba separate-files render has that layout) is taken as `denoise --in DIR` takes it.
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "atrous/error.h"
 #include "cli_flags.h"
 #include "commands.h"
+#include "io/buffer_set.h"
 #include "io/exr_layers.h"
+#include "io/image_io.h"
 #include "io/pass_map.h"
 
 namespace atrous::cli {
 
+namespace fs = std::filesystem;
+
 namespace {
 
 struct InspectArgs {
-    std::string file, layer;
+    std::string file, layer, exportDir;
     std::vector<std::string> passes;
 };
 
+// The file name of buffer b in an export (and in a render directory); the ids take object_id's slot.
+std::string exportName(io::Buffer b) {
+    if (b == io::Buffer::ObjectId) return "ids.exr";
+    return std::string(io::bufferName(b)) + ".exr";
+}
+
+// A buffer as a plain 3-channel image: 1 channel repeated, 2 (motion) with B = 0.
+Image asRgb(const Image& src) {
+    if (src.channels() == 3) {
+        Image out(src.width(), src.height(), 3);
+        std::copy(src.data(), src.data() + src.size(), out.data());
+        return out;
+    }
+    Image out(src.width(), src.height(), 3);
+    const size_t n = src.plane();
+    for (int c = 0; c < 3; ++c) {
+        const int from = src.channels() == 1 ? 0 : c;
+        if (from >= src.channels()) continue;  // stays 0
+        std::copy(src.data() + size_t(from) * n, src.data() + size_t(from + 1) * n, out.data() + size_t(c) * n);
+    }
+    return out;
+}
+
+// Writes every buffer of `set` into dir (each file atomically); removes the files of buffers this
+// input has not (an earlier export's), so that DIR describes this input alone.
+void exportBuffers(const io::BufferSet& set, const std::string& dir) {
+    io::ensureWritableDirectory(dir);
+    std::vector<std::pair<std::string, Image>> files;
+    for (int b = 0; b < io::kBufferCount; ++b) {
+        if (io::Buffer(b) == io::Buffer::MaterialId) continue;  // inside ids.exr (G)
+        const Image* img = set.get(io::Buffer(b));
+        if (img) files.emplace_back(exportName(io::Buffer(b)), asRgb(*img));
+    }
+    for (const auto& [name, img] : files) io::writeExr((fs::path(dir) / name).string(), img);
+    for (int b = 0; b < io::kBufferCount; ++b) {
+        if (io::Buffer(b) == io::Buffer::MaterialId || set.get(io::Buffer(b))) continue;
+        const fs::path stale = fs::path(dir) / exportName(io::Buffer(b));
+        std::error_code ec;
+        if (fs::is_regular_file(stale, ec) && fs::remove(stale, ec))
+            std::printf("export: removed %s (an earlier export's: this input has no %s)\n", stale.string().c_str(),
+                        io::bufferName(io::Buffer(b)));
+    }
+    std::printf("export: wrote");
+    for (const auto& f : files) std::printf(" %s", f.first.c_str());
+    std::printf(" to %s\n", dir.c_str());
+}
+
+io::BufferSet load(const InspectArgs& a, const std::vector<io::PassRequest>& requests) {
+    io::BufferFiles f;
+    f.in = a.file;
+    f.passes = requests;
+    f.viewLayer = a.layer;
+    return io::loadBuffers(f);
+}
+
 void run(const InspectArgs& a) {
-    const io::ExrInfo info = io::inspectExr(a.file);
     std::vector<io::PassRequest> requests;
     for (const std::string& p : a.passes)
         requests.push_back(withFlag("--pass", [&] { return io::parsePassRequest(p); }));
+    std::error_code ec;
+    if (fs::is_directory(a.file, ec)) {  // a render directory: what denoise --in DIR takes
+        const io::BufferSet set = load(a, requests);
+        if (!a.exportDir.empty()) io::ensureWritableDirectory(a.exportDir);
+        std::printf("%s: render directory, %dx%d\natrous denoise --in %s takes:\n", a.file.c_str(),
+                    set.image[0].width(), set.image[0].height(), a.file.c_str());
+        for (int b = 0; b < io::kBufferCount; ++b)
+            std::printf("  %-12s %s\n", io::bufferName(io::Buffer(b)), set.from[b].empty() ? "-" : set.from[b].c_str());
+        if (!a.exportDir.empty()) exportBuffers(set, a.exportDir);
+        return;
+    }
+    const io::ExrInfo info = io::inspectExr(a.file);
+    // With --export, read every buffer and check DIR first: bad input stops here, before anything is
+    // printed or written.
+    std::unique_ptr<io::BufferSet> set;
+    if (!a.exportDir.empty()) {
+        set = std::make_unique<io::BufferSet>(load(a, requests));
+        io::ensureWritableDirectory(a.exportDir);
+    }
     std::printf("%s: %dx%d, %zu part%s, %zu channels\n", a.file.c_str(), info.width, info.height, info.parts.size(),
                 info.parts.size() == 1 ? "" : "s", info.channels.size());
     for (size_t p = 0; p < info.parts.size(); ++p)
@@ -46,6 +128,10 @@ void run(const InspectArgs& a) {
     }
     if (!m.pass[size_t(io::Buffer::Color)].found())
         std::printf("no colour pass: name one with --pass color=LAYER\n");
+    if (set) {
+        for (const std::string& n : set->notes) std::printf("note: %s\n", n.c_str());
+        exportBuffers(*set, a.exportDir);
+    }
 }
 
 }  // namespace
@@ -53,9 +139,13 @@ void run(const InspectArgs& a) {
 void addInspectCommand(CLI::App& app) {
     auto a = std::make_shared<InspectArgs>();
     auto* cmd = app.add_subcommand("inspect", "List the parts, layers and channels of an EXR and the passes atrous denoise takes");
-    cmd->add_option("file", a->file, "EXR file")->required();
+    cmd->add_option("file", a->file, "EXR file (or a render directory: color.exr, albedo.exr, ...)")->required();
     cmd->add_option("--pass", a->passes, "BUFFER=NAME, as for atrous denoise (repeatable)");
     cmd->add_option("--layer", a->layer, "View layer, as for atrous denoise");
+    cmd->add_option("--export", a->exportDir,
+                    "Write the buffers atrous takes from FILE, every convention applied (normals, depth background "
+                    "1e30, albedo in [0, 1], Blender's Vector as atrous motion, ids R object G material), into DIR "
+                    "as color.exr, albedo.exr, normal.exr, depth.exr, ... (3-channel EXRs, each written atomically)");
     cmd->callback([a] { run(*a); });
 }
 
