@@ -24,6 +24,19 @@ MODES = {
 }
 
 
+# The training split (docs/corpus.md, "Training split"): scenes tr_mi_NN / tr_cy_NN, never the test
+# scenes above. Scene k's noisy renders use seed seed_base + 1000 k + spp, its reference
+# ref_seed + k (independent of every noisy seed and of the test corpus's seeds).
+TRAIN = dict(res=128, spp=[1, 4, 16], ref_spp=1024, seed_base=3000000, ref_seed=4000003)
+
+
+def train_jobs(k):
+    """(spp, seed, file stem) of training scene k's renders: the noisy ones, then the reference."""
+    jobs = [(spp, TRAIN["seed_base"] + 1000 * k + spp, f"spp{spp:04d}") for spp in TRAIN["spp"]]
+    jobs.append((TRAIN["ref_spp"], TRAIN["ref_seed"] + k, f"ref{TRAIN['ref_spp']:04d}"))
+    return jobs
+
+
 def exr_channels(path):
     """{part name: [channel names]} of an EXR file, via the OpenEXR Python bindings."""
     import OpenEXR

@@ -4,6 +4,7 @@
     scripts/corpus/render.py --quick            # CI subset: 64x64, 2 stills + 4-frame sequence per renderer
     scripts/corpus/render.py --full             # the corpus: 256x256 stills, 2048-spp references, 20-frame sequences
     scripts/corpus/render.py --full --only mitsuba --scenes mi_glass,mi_orbit
+    scripts/corpus/render.py --train            # the TRAINING split (tr_mi_NN, tr_cy_NN) -> out/corpus/train/
 
 Runs with any python3: it calls scripts/corpus/setup.sh (creates .venv-corpus once) and then runs
 mitsuba_render.py and cycles_render.py inside .venv-corpus, one process per renderer. What already
@@ -11,6 +12,7 @@ exists is skipped, so a second run is quick and an interrupted run resumes.
 """
 import argparse
 import os
+import re
 import subprocess
 import sys
 import time
@@ -34,11 +36,13 @@ def main():
     g = ap.add_mutually_exclusive_group()
     g.add_argument("--quick", action="store_true", help="CI-sized subset (default)")
     g.add_argument("--full", action="store_true", help="the full corpus")
+    g.add_argument("--train", action="store_true",
+                   help="the training split (mitsuba_train.py, cycles_train.py): never the test scenes")
     ap.add_argument("--out", default=None, help="output root (default out/corpus/quick or out/corpus/full)")
     ap.add_argument("--only", choices=["mitsuba", "cycles"], help="one renderer")
     ap.add_argument("--scenes", default="", help="comma-separated scene names (default: all of the mode)")
     a = ap.parse_args()
-    mode = "full" if a.full else "quick"
+    mode = "train" if a.train else "full" if a.full else "quick"
     out = Path(a.out) if a.out else ROOT / "out" / "corpus" / mode
     out.mkdir(parents=True, exist_ok=True)
     subprocess.run([str(HERE / "setup.sh")], check=True)
@@ -49,7 +53,10 @@ def main():
     for r in ("mitsuba", "cycles"):
         if a.only and a.only != r:
             continue
-        cmd = ["nice", "-n", "10", str(VPY), str(HERE / f"{r}_render.py"), "--mode", mode, "--out", str(out)]
+        script = f"{r}_train.py" if mode == "train" else f"{r}_render.py"
+        cmd = ["nice", "-n", "10", str(VPY), str(HERE / script), "--out", str(out)]
+        if mode != "train":
+            cmd += ["--mode", mode]
         if a.scenes:
             cmd += ["--scenes", a.scenes]
         t = time.time()
@@ -58,7 +65,9 @@ def main():
         with subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True) as p:
             for line in p.stdout:  # Blender prints a line per sample: keep ours and errors
                 tail = (tail + [line])[-60:]
-                if not line.startswith(("Fra:", "0", " ")) or "rror" in line:
+                # ours: "HH:MM:SS mitsuba|cycles ..." (common.log), shown even before 10:00
+                ours = re.match(r"\d\d:\d\d:\d\d (mitsuba|cycles) ", line)
+                if ours or not line.startswith(("Fra:", "0", " ")) or "rror" in line:
                     print(line, end="", flush=True)
         if p.returncode != 0:
             print("".join(tail), file=sys.stderr)

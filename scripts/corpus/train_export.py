@@ -1,0 +1,103 @@
+#!/usr/bin/env python3
+"""The corpus's training split as the learned filter's raw training files (docs/corpus.md,
+"Training split"): each scene of out/corpus/train/ (render.py --train) becomes one
+out/train/data/corpus_train/scene_<name>.npz in scripts/train/dataset.py's format.
+
+    .venv-corpus/bin/python scripts/corpus/train_export.py --atrous build-h4/atrous
+
+Every buffer is what atrous itself takes from the renderer's file: `atrous inspect FILE --export
+DIR` (the same reader and conventions as `atrous denoise --in FILE`), read back with OpenEXR.
+Keys per spp in (1, 4, 16): color_{spp}, albedo_{spp}, normal_{spp}, depth_{spp} (3 channels,
+background 1e30), emission_{spp} (zeros where the renderer gives none); no variance_{spp} (the
+renderers give none: the driver estimates it); reference (the >= 1024-spp render's colour);
+kind ("mitsuba" / "cycles"); scene_json (the scene's manifest). All arrays H x W x 3 float32.
+Written under a temporary name and renamed; a scene whose npz is newer than its manifest is skipped.
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parents[1]
+sys.path.insert(0, str(HERE))
+from common import TRAIN  # noqa: E402
+
+KEYS = ("color", "albedo", "normal", "depth", "emission")
+
+
+def read_rgb(path):
+    import OpenEXR
+    with OpenEXR.File(str(path)) as f:
+        ch = f.channels()
+        return np.ascontiguousarray(np.asarray(ch["RGB"].pixels, np.float32))
+
+
+def export(atrous, src, tmp):
+    """The buffers atrous takes from `src` (a layered EXR or a render directory), by name."""
+    out = Path(tempfile.mkdtemp(dir=tmp))
+    r = subprocess.run([atrous, "inspect", str(src), "--export", str(out)], capture_output=True, text=True)
+    if r.returncode != 0:
+        sys.exit(f"train_export: atrous inspect {src} failed: {r.stdout}{r.stderr}")
+    return {p.stem: read_rgb(p) for p in out.glob("*.exr")}
+
+
+def scene_arrays(atrous, d, man, tmp):
+    arrays = {}
+    for stem, f in man["files"].items():
+        src = d / (f["file"] if "file" in f else f["folder"])
+        b = export(atrous, src, tmp)
+        if stem == man["reference"]:
+            arrays["reference"] = b["color"]
+            continue
+        spp = f["spp"]
+        for k in KEYS:
+            arrays[f"{k}_{spp}"] = b[k] if k in b else np.zeros_like(b["color"])
+    for spp in TRAIN["spp"]:
+        for k in KEYS:
+            assert f"{k}_{spp}" in arrays, (d, k, spp)
+    for k, v in arrays.items():
+        if not np.isfinite(v).all() and not k.startswith("depth"):
+            bad = int((~np.isfinite(v)).any(-1).sum())
+            print(f"train_export: {d.name} {k}: {bad} non-finite pixels (left: the driver sanitises)", flush=True)
+    arrays["kind"] = np.array("mitsuba" if man["renderer"] == "mitsuba" else "cycles")
+    arrays["scene_json"] = np.array(json.dumps(man))
+    return arrays
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--atrous", default=str(ROOT / "build" / "atrous"))
+    ap.add_argument("--corpus", default=str(ROOT / "out" / "corpus" / "train"))
+    ap.add_argument("--out", default=str(ROOT / "out" / "train" / "data" / "corpus_train"))
+    a = ap.parse_args()
+    dest = Path(a.out)
+    dest.mkdir(parents=True, exist_ok=True)
+    n = 0
+    for man_path in sorted(Path(a.corpus).glob("*/tr_*/manifest.json")):
+        d = man_path.parent
+        target = dest / f"scene_{d.name}.npz"
+        if target.exists() and target.stat().st_mtime >= man_path.stat().st_mtime:
+            n += 1
+            continue
+        man = json.loads(man_path.read_text())
+        t = time.time()
+        with tempfile.TemporaryDirectory(dir=dest) as tmp:
+            arrays = scene_arrays(a.atrous, d, man, tmp)
+            part = Path(tmp) / "scene.npz"
+            np.savez_compressed(part, **arrays)
+            os.replace(part, target)
+        n += 1
+        print(f"train_export: {target} ({time.time() - t:.1f}s; render {sum(man['render_seconds'].values()):.0f}s)",
+              flush=True)
+    print(f"train_export: {n} scenes in {dest}", flush=True)
+
+
+if __name__ == "__main__":
+    main()
