@@ -1,4 +1,5 @@
-// `atrous bench`: timings of every render and denoise path at several resolutions, as JSON.
+// `atrous bench`: timings of every render and denoise path (EAW, SURE, the learned filter, SVGF) at
+// several resolutions, as JSON.
 // Each figure is the median of --runs timed runs after --warmup untimed ones. Denoiser times are
 // the filter alone (inputs already in place; on CUDA the driver ends with a stream synchronise, so
 // the time covers every kernel); `total_ms` is the whole public denoise() call (validation, the
@@ -16,6 +17,7 @@
 
 #include "atrous/denoise.h"
 #include "atrous/error.h"
+#include "atrous/learned.h"
 #include "atrous/render.h"
 #include "atrous/svgf.h"
 #include "commands.h"
@@ -29,7 +31,8 @@ namespace {
 struct BenchArgs {
     std::string device = "auto";
     std::string sizes = "512x512,1280x720,1920x1080,3840x2160";
-    std::string what = "eaw,sure,svgf,render";
+    std::string what = "eaw,sure,learned,svgf,render";
+    std::string learnedWeights;  // "" = the built-in weights
     std::string scene = "cornell";
     int runs = 0;  // 0: 50 on CUDA, 10 on the CPU
     int warmup = 3;
@@ -131,9 +134,16 @@ void run(const BenchArgs& a) {
     if (a.warmup < 0) throw InputError("--warmup must be >= 0");
     std::vector<std::string> what = split(a.what);
     for (auto& w : what)
-        if (w != "eaw" && w != "sure" && w != "svgf" && w != "render")
-            throw InputError("--what: unknown item '" + w + "' (expected eaw, sure, svgf, render)");
+        if (w != "eaw" && w != "sure" && w != "learned" && w != "svgf" && w != "render")
+            throw InputError("--what: unknown item '" + w + "' (expected eaw, sure, learned, svgf, render)");
     auto wants = [&](const char* k) { return std::find(what.begin(), what.end(), k) != what.end(); };
+    if (wants("learned") && !a.learnedWeights.empty()) {
+        try {
+            LearnedWeights::load(a.learnedWeights);  // a bad file: one line before any timing
+        } catch (const InputError& e) {
+            throw InputError(std::string("--learned-weights: ") + e.what());
+        }
+    }
     std::vector<std::pair<int, int>> sizes;
     for (auto& s : split(a.sizes)) sizes.push_back(parseSize(s));
     if (sizes.empty()) throw InputError("--sizes: no size given");
@@ -193,7 +203,7 @@ void run(const BenchArgs& a) {
         // On CUDA the inputs are uploaded once, outside the timed calls: the filters then read
         // them in place (as the viewer and DLPack callers do) and total_ms covers no transfer.
         RenderBuffers onDevice;
-        if (device == Device::Cuda && (wants("eaw") || wants("sure") || wants("svgf"))) {
+        if (device == Device::Cuda && (wants("eaw") || wants("sure") || wants("learned") || wants("svgf"))) {
             for (auto [dst, src] : {std::pair<Image*, const Image*>{&onDevice.color, &b.color},
                                     {&onDevice.variance, &b.variance}, {&onDevice.albedo, &b.albedo},
                                     {&onDevice.normal, &b.normal}, {&onDevice.position, &b.position},
@@ -202,12 +212,14 @@ void run(const BenchArgs& a) {
                 *dst = src->to(Device::Cuda);
         }
         const RenderBuffers& inputs = device == Device::Cuda ? onDevice : b;
-        for (const char* m : {"eaw", "sure"}) {
+        for (const char* m : {"eaw", "sure", "learned"}) {
             if (!wants(m)) continue;
             DenoiseInputs in = denoiseInputsOf(inputs);
             DenoiseReport rep;
             DenoiseOptions o;
             o.method = parseDenoiseMethod(m);
+            o.learnedWeights = a.learnedWeights;
+            const bool learned = o.method == DenoiseMethod::Learned;
             o.device = device;
             o.report = &rep;
             std::vector<double> total;
@@ -226,11 +238,14 @@ void run(const BenchArgs& a) {
             r["device"] = deviceToString(device);
             r["width"] = w;
             r["height"] = h;
-            r["levels"] = o.eaw.levels;
+            if (learned)
+                r["weights"] = a.learnedWeights.empty() ? "built-in" : a.learnedWeights;
+            else
+                r["levels"] = o.eaw.levels;
             r["total_ms"] = median(total);
             r["mpixels_per_s"] = double(w) * h / (median(t) * 1e3);
             r["stages"] = stages.json();
-            if (device == Device::Cuda) {
+            if (device == Device::Cuda && !learned) {
                 // Achieved bandwidth of the compulsory traffic, against the GPU's peak.
                 const double bytes = cudaDenoiseTrafficBytes(o, in, w, h);
                 const double peak = detail::cudaPeakBandwidthGBs();
@@ -296,7 +311,9 @@ void addBenchCommand(CLI::App& app) {
     auto* cmd = app.add_subcommand("bench", "Time every render and denoise path at several resolutions");
     cmd->add_option("--device", args->device, "cpu, cuda or auto (cuda when a GPU is present)")->capture_default_str();
     cmd->add_option("--sizes", args->sizes, "comma-separated WxH list")->capture_default_str();
-    cmd->add_option("--what", args->what, "comma-separated: eaw, sure, svgf, render")->capture_default_str();
+    cmd->add_option("--what", args->what, "comma-separated: eaw, sure, learned, svgf, render")->capture_default_str();
+    cmd->add_option("--learned-weights", args->learnedWeights,
+                    "weight file of the learned filter (default: the built-in weights)");
     cmd->add_option("--scene", args->scene, "scene whose buffers are denoised")->capture_default_str();
     cmd->add_option("--runs", args->runs,
                     "timed runs per denoiser figure (0: 50 on CUDA, 10 on the CPU); render rows time max(3, runs/10) "

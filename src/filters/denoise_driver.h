@@ -83,7 +83,7 @@ inline AlbedoRule stillAlbedoRule(const DenoiseOptions& o) {
 
 struct DriverConfig {
     DenoiseOptions opts;  // opts.method is Eaw, Sure or Learned (Auto resolved by denoise())
-    LearnedWeights learned;  // the learned method's weights (loaded by denoise())
+    LearnedWeights learned{};  // the learned method's weights (loaded by denoise())
     bool varianceGiven = true;  // false: the variance is a constant estimate
     // Without a variance: the local estimate (noise_estimate.h) over quadrants of this radius
     // (0 = keep the constant), floored at noiseFloorVar (the global estimate times a fraction) and

@@ -161,3 +161,28 @@ def test_bad_weights_raise_value_error_naming_the_file(tmp_path):
         atrous.denoise(b["color"], albedo=b["albedo"], normal=b["normal"], method="auto", learned_weights=junk)
     with pytest.raises(ValueError, match="unknown method"):
         atrous.denoise(b["color"], method="learnt")
+
+
+def test_eval_takes_learned_and_auto(tmp_path):
+    # python -m atrous.eval --methods noisy,eaw,sure,learned,oidn: accepted, learned/auto are
+    # atrous methods with the weight file passed through; the default set is unchanged.
+    ev = pytest.importorskip("atrous.eval")
+    w = _fixture_weights(tmp_path)
+    cfg = ev.parse_args(["--methods", "noisy,eaw,sure,learned,auto,oidn", "--learned-weights", str(w)])
+    assert cfg.methods == ["noisy", "eaw", "sure", "learned", "auto", "oidn"]
+    assert cfg.learned_weights == str(w)
+    assert ev.parse_args([]).methods == list(ev.DEFAULT_METHODS)
+    with pytest.raises(SystemExit) as e:
+        ev.parse_args(["--methods", "learned", "--learned-weights", str(tmp_path / "none.atrl")])
+    assert e.value.code == 2
+    methods = ev.build_methods(["learned", "auto"], [], str(w))
+    b = atrous.render("cornell", width=24, height=20, spp=2, seed=1)
+    want = atrous.denoise(b["color"], albedo=b["albedo"], normal=b["normal"], position=b["position"],
+                          depth=b["depth"], variance=b["variance"], ids=b["ids"], emission=b["emission"],
+                          method="learned", learned_weights=w)
+    for name in ("learned", "auto"):
+        np.testing.assert_array_equal(methods[name](b), want)
+    # The report compares the best atrous method (learned among them) with OIDN.
+    from atrous.eval import report
+
+    assert "learned" in report.ATROUS_METHODS and "learned" in report.COLORS

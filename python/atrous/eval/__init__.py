@@ -4,7 +4,8 @@
     python -m atrous.eval --out eval-out                # all built-in scenes, 256x256, spp 4/16/64
 
 For every scene x spp it renders a noisy input and a reference (the same renderer at --ref-spp
-samples with another seed), runs each method (noisy = the input itself, eaw, sure, oidn), and
+samples with another seed), runs each method (noisy = the input itself, eaw, sure, oidn; learned
+and auto on request), and
 measures relMSE, PSNR, SSIM (atrous.metrics), FLIP (HDR, flip_evaluator) and the denoise time
 (median of --runs runs after a warm-up). It adds an equal-time comparison (the denoiser's time
 spent on more samples instead, rendered and measured), runtime vs resolution, and, when given a
@@ -31,7 +32,11 @@ import atrous
 
 __all__ = ["EvalConfig", "run_eval", "main", "load_oidn", "time_call", "score"]
 
-ALL_METHODS = ("noisy", "eaw", "sure", "oidn")
+ALL_METHODS = ("noisy", "eaw", "sure", "learned", "auto", "oidn")
+# The default set (--methods not given). learned (the learned à-trous filter, docs/learned.md) and
+# auto (learned with an albedo and a normal, which every render here has: the same as learned) are
+# taken when asked for: --methods noisy,eaw,sure,learned,oidn.
+DEFAULT_METHODS = ("noisy", "eaw", "sure", "oidn")
 QUICK_SCENES = ("cornell", "cornell-spheres")
 
 
@@ -45,7 +50,8 @@ class EvalConfig:
     width: int = 256
     height: int = 256
     ref_spp: int = 1024
-    methods: List[str] = field(default_factory=lambda: list(ALL_METHODS))
+    methods: List[str] = field(default_factory=lambda: list(DEFAULT_METHODS))
+    learned_weights: Optional[str] = None  # weight file of learned/auto (None: the built-in weights)
     runs: int = 5
     seed: int = 1
     ref_seed: int = 1000003
@@ -94,7 +100,7 @@ def _takes_emission() -> bool:
         return False
 
 
-def _atrous_method(name: str) -> Callable:
+def _atrous_method(name: str, learned_weights: Optional[str] = None) -> Callable:
     # Sequences from `atrous render --frames` carry emission.exr; newer atrous.denoise filters
     # colour - emission and adds it back (no leak of visible lights), older ones have no keyword.
     extra_kw = ("emission",) if _takes_emission() else ()
@@ -106,20 +112,24 @@ def _atrous_method(name: str) -> Callable:
         if var is not None and not np.any(var > 0):
             var = None
         kw = {k: b[k] for k in extra_kw if b.get(k) is not None}
+        if name in ("learned", "auto") and learned_weights:
+            kw["learned_weights"] = learned_weights
         return atrous.denoise(b["color"], albedo=b.get("albedo"), normal=b.get("normal"),
                               position=b.get("position"), depth=b.get("depth"),
                               variance=var, ids=b.get("ids"), method=name, **kw)
     return run
 
 
-def build_methods(names: Sequence[str], notes: List[str]) -> Dict[str, Optional[Callable]]:
-    """name -> callable (None for "noisy"); unavailable methods are left out with a note."""
+def build_methods(names: Sequence[str], notes: List[str],
+                  learned_weights: Optional[str] = None) -> Dict[str, Optional[Callable]]:
+    """name -> callable (None for "noisy"); unavailable methods are left out with a note.
+    learned_weights: the weight file of learned/auto (None: the built-in weights)."""
     out: Dict[str, Optional[Callable]] = {}
     for name in names:
         if name == "noisy":
             out[name] = None
         elif name in atrous.METHODS:
-            out[name] = _atrous_method(name)
+            out[name] = _atrous_method(name, learned_weights)
         elif name == "oidn":
             fn, note = load_oidn()
             if fn is None:
@@ -232,7 +242,7 @@ def run_eval(cfg: EvalConfig) -> Dict[str, Any]:
     out = Path(cfg.out)
     out.mkdir(parents=True, exist_ok=True)
     notes: List[str] = []
-    methods = build_methods(cfg.methods, notes)
+    methods = build_methods(cfg.methods, notes, cfg.learned_weights)
     for s in cfg.spp:
         if cfg.ref_spp < 64 * s:
             notes.append(f"the reference ({cfg.ref_spp} spp) has only {cfg.ref_spp // s}x the samples of "
@@ -479,7 +489,10 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> EvalConfig:
     p.add_argument("--spp", help="comma list of input samples per pixel (default 4,16,64)")
     p.add_argument("--size", help="image size, N or WxH (default 256)")
     p.add_argument("--ref-spp", type=int, help="samples per pixel of the references (default 1024)")
-    p.add_argument("--methods", help=f"comma list from {','.join(ALL_METHODS)} (default: all)")
+    p.add_argument("--methods", help=f"comma list from {','.join(ALL_METHODS)} "
+                   f"(default: {','.join(DEFAULT_METHODS)})")
+    p.add_argument("--learned-weights", metavar="FILE",
+                   help="weight file of the learned filter for learned/auto (default: the built-in weights)")
     p.add_argument("--runs", type=int, help="timed runs per method, after a warm-up; the median is kept (default 5)")
     p.add_argument("--seed", type=int, help="seed of the noisy inputs, 0..2^32-1 (references use another)")
     p.add_argument("--resolutions", help="comma list of square sizes for runtime vs resolution (default 128,256,512; "
@@ -518,6 +531,10 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> EvalConfig:
         if bad or not cfg.methods:
             raise UsageError(f"--methods: unknown {', '.join(bad) or repr(a.methods)} "
                              f"(expected {', '.join(ALL_METHODS)})")
+    if a.learned_weights is not None:
+        if not os.path.isfile(a.learned_weights):
+            raise UsageError(f"--learned-weights: '{a.learned_weights}' is not a file")
+        cfg.learned_weights = a.learned_weights
     if a.runs is not None:
         if a.runs < 1:
             raise UsageError(f"--runs: must be at least 1, got {a.runs}")

@@ -10,8 +10,9 @@ from typing import Any, Dict, List, Optional
 
 import numpy as np
 
-ATROUS_METHODS = ("eaw", "sure")
-COLORS = {"noisy": "#7f7f7f", "eaw": "#1f77b4", "sure": "#2ca02c", "oidn": "#d62728", "svgf": "#9467bd",
+ATROUS_METHODS = ("eaw", "sure", "learned", "auto")
+COLORS = {"noisy": "#7f7f7f", "eaw": "#1f77b4", "sure": "#2ca02c", "learned": "#ff7f0e", "auto": "#8c564b",
+          "oidn": "#d62728", "svgf": "#9467bd",
           "render 1 spp": "#000000"}
 
 
@@ -380,6 +381,9 @@ def write_html(data: Dict[str, Any], images: Dict[str, Dict[str, Any]], path: Pa
              f"{env.get('load_average')} (a shared machine: timings are noisy)</p>",
              "<p>Methods: <b>noisy</b> = the path-traced input; <b>eaw</b> and <b>sure</b> = atrous's "
              "edge-avoiding and SURE-based à-trous filters (default parameters, every feature buffer); "
+             "<b>learned</b> = atrous's learned à-trous filter (a per-pixel network steering an à-trous "
+             "cascade, docs/learned.md) and <b>auto</b> = learned with an albedo and a normal, else sure "
+             "(when run); "
              "<b>oidn</b> = Intel Open Image Denoise (RT filter, HDR, colour + albedo + normal, quality high) "
              f"via pyoidn {html.escape(str(env.get('pyoidn')))}. Metrics: relMSE = mean((x-r)²/(r²+0.01)); PSNR and "
              "SSIM on tonemapped images (x/(1+x), gamma 1/2.2); FLIP = mean HDR-FLIP "

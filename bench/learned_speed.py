@@ -1,0 +1,183 @@
+#!/usr/bin/env python3
+"""The learned filter's speed against EAW, SURE and Intel Open Image Denoise, in one run.
+
+    .venv/bin/python bench/learned_speed.py --atrous build/atrous            # 512x512 and 1920x1080
+    .venv/bin/python bench/learned_speed.py --atrous build/atrous --runs 20 --out learned_speed.json
+
+It calls `atrous bench --json --what eaw,sure,learned` (the filter alone, inputs in place: the
+median of --runs runs after --warmup; docs/benchmarks.md) and, in the same run, times OIDN on the
+same inputs (the scene at 2 spp, seed 7, as `atrous bench` renders them, through atrous.render):
+
+* ``oidn_denoise``: ``pyoidn.denoise(color, albedo, normal, hdr=True, quality="high")``, the call
+  python/atrous/eval makes (pyoidn keeps its device and filter between calls, but binds the images
+  and commits the filter in every call);
+* ``oidn_filter``: pyoidn's object API, a ``pyoidn.Filter`` ("RT", hdr, quality high) created,
+  bound and committed once, then only ``execute()`` timed: OIDN's own cost.
+
+Both are a warm-up call, then the median of --runs calls (as atrous.eval's time_call). The result
+is one JSON document on stdout (and in --out): every median, the ratios learned / OIDN (against
+both OIDN timings), the machine, the date and the commit. Run it on an idle machine: the other
+processes' load is in every figure.
+"""
+from __future__ import annotations
+
+import argparse
+import datetime as _dt
+import json
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _git_commit() -> str:
+    try:
+        head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True,
+                              check=True).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=ROOT,
+                               capture_output=True, text=True, check=True).stdout.strip()
+        return head + ("+uncommitted" if dirty else "")
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
+def _cpu_model() -> str:
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown"
+
+
+def _median_ms(fn, runs: int, warmup: int = 1) -> float:
+    for _ in range(max(1, warmup)):
+        fn()
+    times = []
+    for _ in range(max(1, runs)):
+        t0 = time.perf_counter()
+        fn()
+        times.append((time.perf_counter() - t0) * 1e3)
+    return statistics.median(times)
+
+
+def _oidn_inputs(b):
+    # What python/atrous/eval's load_oidn passes: finite non-negative colour, albedo in [0, 1],
+    # normals in [-1, 1], float32, C-contiguous H x W x 3.
+    color = np.ascontiguousarray(np.maximum(np.nan_to_num(b["color"], nan=0.0, posinf=0.0), 0.0), np.float32)
+    albedo = np.ascontiguousarray(np.clip(np.nan_to_num(b["albedo"]), 0.0, 1.0), np.float32)
+    normal = np.ascontiguousarray(np.clip(np.nan_to_num(b["normal"]), -1.0, 1.0), np.float32)
+    return color, albedo, normal
+
+
+def time_oidn(b, runs: int, warmup: int) -> dict:
+    import pyoidn
+
+    color, albedo, normal = _oidn_inputs(b)
+    out = {"oidn_denoise_ms": _median_ms(
+        lambda: pyoidn.denoise(color, albedo, normal, hdr=True, quality="high"), runs, warmup)}
+    dev = pyoidn.Device()
+    dev.commit()
+    flt = pyoidn.Filter(dev, pyoidn.OIDN_FILTER_TYPE_RT)
+    result = np.zeros_like(color)
+    for name, img in ((pyoidn.OIDN_IMAGE_COLOR, color), (pyoidn.OIDN_IMAGE_ALBEDO, albedo),
+                      (pyoidn.OIDN_IMAGE_NORMAL, normal), (pyoidn.OIDN_IMAGE_OUTPUT, result)):
+        flt.set_image(name, img, pyoidn.OIDN_FORMAT_FLOAT3)
+    flt.set_bool("hdr", True)
+    flt.set_quality(pyoidn.OIDN_QUALITY_HIGH)
+    flt.commit()
+    err = dev.get_error()
+    if err:
+        raise RuntimeError(f"OIDN filter set-up failed: {err}")
+    out["oidn_filter_ms"] = _median_ms(flt.execute, runs, warmup)
+    err = dev.get_error()
+    if err:
+        raise RuntimeError(f"OIDN execute failed: {err}")
+    flt.release()
+    dev.release()
+    version = getattr(getattr(pyoidn, "version", None), "__version__", None)
+    out["pyoidn"] = version or "unknown"
+    return out
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--atrous", default=str(ROOT / "build" / "atrous"), help="the atrous CLI (default build/atrous)")
+    p.add_argument("--sizes", default="512x512,1920x1080", help="comma list of WxH (default 512x512,1920x1080)")
+    p.add_argument("--runs", type=int, default=10, help="timed runs per figure (default 10)")
+    p.add_argument("--warmup", type=int, default=3, help="untimed runs first (default 3)")
+    p.add_argument("--scene", default="cornell", help="scene whose 2-spp buffers are denoised (default cornell)")
+    p.add_argument("--device", default="cpu", help="atrous bench's --device (default cpu; OIDN runs on the CPU)")
+    p.add_argument("--learned-weights", help="weight file for the learned filter (default: the built-in weights)")
+    p.add_argument("--out", help="also write the JSON here")
+    a = p.parse_args(argv)
+    if a.runs < 1 or a.warmup < 0:
+        p.error("--runs must be >= 1 and --warmup >= 0")
+    if not os.access(a.atrous, os.X_OK):
+        p.error(f"--atrous: '{a.atrous}' is not an executable (build it: cmake --build build --target atrous)")
+    sizes = []
+    for s in a.sizes.split(","):
+        try:
+            w, h = (int(v) for v in s.lower().split("x"))
+        except ValueError:
+            p.error(f"--sizes: '{s}' is not WxH")
+        sizes.append((w, h))
+
+    cmd = [a.atrous, "bench", "--json", "--what", "eaw,sure,learned", "--sizes", a.sizes, "--runs", str(a.runs),
+           "--warmup", str(a.warmup), "--scene", a.scene, "--device", a.device]
+    if a.learned_weights:
+        cmd += ["--learned-weights", a.learned_weights]
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    if proc.returncode != 0:
+        sys.stderr.write(f"learned_speed: {' '.join(cmd)} failed ({proc.returncode}): {proc.stderr.strip()}\n")
+        return 2
+    bench = json.loads(proc.stdout)
+
+    import atrous  # the project's package (.venv): the same renderer and inputs as `atrous bench`
+
+    rows = []
+    for w, h in sizes:
+        row = {"width": w, "height": h}
+        for r in bench["results"]:
+            if r["width"] == w and r["height"] == h and r["what"] in ("eaw", "sure", "learned"):
+                row[f"{r['what']}_ms"] = r["median_ms"]
+                row[f"{r['what']}_total_ms"] = r["total_ms"]
+        b = atrous.render(a.scene, width=w, height=h, spp=2, seed=7)
+        row.update(time_oidn(b, a.runs, a.warmup))
+        for k in ("oidn_denoise_ms", "oidn_filter_ms"):
+            if row.get("learned_ms") and row.get(k):
+                row["learned_over_" + k[:-3]] = row["learned_ms"] / row[k]
+        rows.append(row)
+
+    doc = {
+        "what": "learned filter speed vs EAW, SURE and OIDN (bench/learned_speed.py)",
+        "date_utc": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M:%S"),
+        "commit": _git_commit(),
+        "machine": {"host": platform.node(), "cpu": _cpu_model(), "cpu_count": os.cpu_count(),
+                    "load_average": list(os.getloadavg()) if hasattr(os, "getloadavg") else None},
+        "atrous_device": bench.get("device"), "atrous_device_name": bench.get("device_name"),
+        "scene": a.scene, "input_spp": 2, "runs": a.runs, "warmup": a.warmup,
+        "learned_weights": a.learned_weights or "built-in",
+        "oidn_api": {"oidn_denoise": "pyoidn.denoise(color, albedo, normal, hdr=True, quality='high') per call",
+                     "oidn_filter": "pyoidn.Filter RT (hdr, quality high) committed once, execute() timed"},
+        "atrous_timing": "atrous bench median_ms (the filter alone, inputs in place); *_total_ms = the whole denoise()",
+        "command": " ".join(cmd),
+        "results": rows,
+    }
+    text = json.dumps(doc, indent=2)
+    print(text)
+    if a.out:
+        Path(a.out).write_text(text + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
