@@ -37,9 +37,11 @@ struct LearnedPlanes {
     ImageView d, var, albedo, normal, depth;
 };
 
-// Per-stage wall times of one runLearned call (seconds; the bench's breakdown).
+// Per-stage times of one runLearned call on the CPU (seconds; the bench's breakdown): wall clock,
+// and process CPU time (std::clock, all threads: what counts on a shared machine).
 struct LearnedStageTimes {
     double allocate = 0, logs = 0, network = 0, levels = 0;
+    double cpuLogs = 0, cpuNetwork = 0, cpuLevels = 0;
 };
 
 // d_out, the filtered demodulated colour, into `out` (3 channels, exec's device); temporaries are

@@ -102,34 +102,42 @@ ATROUS_FORCE_INLINE ATROUS_INLINE float learnedLocalStd(float meanL, float meanL
     return sqrtf(maxSel(meanL2 - meanL * meanL, 0.0f));
 }
 
+// The lane loops (the pixel index, innermost): `omp simd` on the host compiler, so that GCC
+// vectorises them rather than unrolling them into scalar code; nothing for nvcc (N = 1 there).
+#if defined(__GNUC__) && !defined(__CUDACC__)
+#define ATROUS_LANES _Pragma("omp simd")
+#else
+#define ATROUS_LANES
+#endif
+
+// One dense layer on N pixels: y[j][l] = act(b[j] + sum_i x[i][l] w[i * NO + j]), the sum from the
+// bias in the order of i.
+template <int NI, int NO, bool kRelu, int N>
+ATROUS_FORCE_INLINE ATROUS_INLINE void learnedLayer(const float* w, const float* b, const float (&x)[NI][N],
+                                                    float (&y)[NO][N]) {
+    for (int j = 0; j < NO; ++j) {
+        float a[N];
+        const float bj = b[j];
+        ATROUS_LANES
+        for (int l = 0; l < N; ++l) a[l] = bj;
+        for (int i = 0; i < NI; ++i) {
+            const float wij = w[i * NO + j];
+            ATROUS_LANES
+            for (int l = 0; l < N; ++l) a[l] = fmaf(x[i][l], wij, a[l]);
+        }
+        ATROUS_LANES
+        for (int l = 0; l < N; ++l) y[j][l] = kRelu ? maxSel(a[l], 0.0f) : a[l];
+    }
+}
+
 // The MLP on N pixels: x[i][l] input i of lane l -> y[j][l] the 29 raw (linear) outputs.
 template <int N>
 ATROUS_FORCE_INLINE ATROUS_INLINE void learnedMlp(const LearnedNet& net, const float (&x)[kLearnedIn][N],
-                                                       float (&y)[kLearnedOut][N]) {
+                                                  float (&y)[kLearnedOut][N]) {
     float h1[kLearnedHidden][N], h2[kLearnedHidden][N];
-    for (int j = 0; j < kLearnedHidden; ++j)
-        for (int l = 0; l < N; ++l) h1[j][l] = net.b1[j];
-    for (int i = 0; i < kLearnedIn; ++i)
-        for (int j = 0; j < kLearnedHidden; ++j) {
-            const float w = net.w1[i * kLearnedHidden + j];
-            for (int l = 0; l < N; ++l) h1[j][l] = fmaf(x[i][l], w, h1[j][l]);
-        }
-    for (int j = 0; j < kLearnedHidden; ++j)
-        for (int l = 0; l < N; ++l) h2[j][l] = net.b2[j], h1[j][l] = maxSel(h1[j][l], 0.0f);
-    for (int i = 0; i < kLearnedHidden; ++i)
-        for (int j = 0; j < kLearnedHidden; ++j) {
-            const float w = net.w2[i * kLearnedHidden + j];
-            for (int l = 0; l < N; ++l) h2[j][l] = fmaf(h1[i][l], w, h2[j][l]);
-        }
-    for (int j = 0; j < kLearnedOut; ++j)
-        for (int l = 0; l < N; ++l) y[j][l] = net.b3[j];
-    for (int j = 0; j < kLearnedHidden; ++j)
-        for (int l = 0; l < N; ++l) h2[j][l] = maxSel(h2[j][l], 0.0f);
-    for (int i = 0; i < kLearnedHidden; ++i)
-        for (int j = 0; j < kLearnedOut; ++j) {
-            const float w = net.w3[i * kLearnedOut + j];
-            for (int l = 0; l < N; ++l) y[j][l] = fmaf(h2[i][l], w, y[j][l]);
-        }
+    learnedLayer<kLearnedIn, kLearnedHidden, true>(net.w1, net.b1, x, h1);
+    learnedLayer<kLearnedHidden, kLearnedHidden, true>(net.w2, net.b2, h1, h2);
+    learnedLayer<kLearnedHidden, kLearnedOut, false>(net.w3, net.b3, h2, y);
 }
 
 }  // namespace atrous::filters
