@@ -105,32 +105,43 @@ TEST(LearnedMethod, IsRunLearnedOnThePreparedPlanesThenRemodulate) {
     // denoise(Learned) must be runLearned on learnedPlanes' planes, then d_out * mod + emission:
     // the same code on the same floats, so equal bit for bit (no tolerance). Covers a given and an
     // estimated variance, the emission filter and the firefly pass; a driver that passed other
-    // planes (a zero normal for an absent one, the colour before demodulation) or added a step
-    // fails it.
+    // planes (a zero plane for an absent albedo or depth, the colour before demodulation) or
+    // added a step fails it.
     test::TempDir dir;
     const std::string wpath = writeFixtureWeights(dir);
     const LearnedWeights w = LearnedWeights::load(wpath);
     const Synth sc;
-    for (bool variance : {true, false})
-        for (bool normal : {true, false}) {
-            DenoiseInputs in = sc.inputs(variance);
-            if (!normal) in.normal = nullptr;
-            const DenoiseOptions o = learnedOptions(wpath);
-            const Image out = denoise(in, o);
-            filters::PreparedPlanes p = filters::learnedPlanes(in, o);
-            ASSERT_EQ(p.normal.empty(), !normal);
-            const filters::LearnedPlanes P{p.d.view(), p.var.view(), p.albedo.view(),
-                                           p.normal.empty() ? ImageView{} : p.normal.view(), p.depth.view()};
-            Image dOut(40, 32, 3);
-            filters::runLearned(CpuExec{}, w, P, dOut.view());
-            Image expect(40, 32, 3);
-            for (int y = 0; y < 32; ++y)
-                for (int x = 0; x < 40; ++x)
-                    for (int c = 0; c < 3; ++c) expect(x, y, c) = dOut(x, y, c) * p.mod(x, y, c) + p.emission(x, y, c);
-            EXPECT_EQ(firstDifference(out, expect), -1) << "variance " << variance << " normal " << normal;
-            // And it filtered: not the input.
-            EXPECT_GT(firstDifference(out, sc.s.noisy), -1);
-        }
+    // Each buffer left out once: an absent albedo or depth read from a zero plane instead of as
+    // absent (albedo 1, depth 1) changes the network's inputs, so it fails here.
+    struct Case {
+        bool variance, albedo, normal, depth;
+    };
+    for (const Case& k : {Case{true, true, true, true}, Case{false, true, true, true}, Case{true, false, true, true},
+                          Case{true, true, false, true}, Case{true, true, true, false}}) {
+        DenoiseInputs in = sc.inputs(k.variance);
+        if (!k.albedo) in.albedo = nullptr;
+        if (!k.normal) in.normal = nullptr;
+        if (!k.depth) in.depth = nullptr;
+        const DenoiseOptions o = learnedOptions(wpath);
+        const Image out = denoise(in, o);
+        filters::PreparedPlanes p = filters::learnedPlanes(in, o);
+        ASSERT_EQ(p.albedo.empty(), !k.albedo);
+        ASSERT_EQ(p.normal.empty(), !k.normal);
+        ASSERT_EQ(p.depth.empty(), !k.depth);
+        auto viewOr = [](const Image& i) { return i.empty() ? ImageView{} : i.view(); };
+        const filters::LearnedPlanes P{p.d.view(), p.var.view(), viewOr(p.albedo), viewOr(p.normal), viewOr(p.depth)};
+        Image dOut(40, 32, 3);
+        filters::runLearned(CpuExec{}, w, P, dOut.view());
+        Image expect(40, 32, 3);
+        for (int y = 0; y < 32; ++y)
+            for (int x = 0; x < 40; ++x)
+                for (int c = 0; c < 3; ++c) expect(x, y, c) = dOut(x, y, c) * p.mod(x, y, c) + p.emission(x, y, c);
+        const std::string what = std::string("variance ") + char('0' + k.variance) + " albedo " + char('0' + k.albedo) +
+                                 " normal " + char('0' + k.normal) + " depth " + char('0' + k.depth);
+        EXPECT_EQ(firstDifference(out, expect), -1) << what;
+        // And it filtered: not the input.
+        EXPECT_GT(firstDifference(out, sc.s.noisy), -1) << what;
+    }
 }
 
 TEST(LearnedMethod, IgnoresLevelsAndTheEawParametersButNotTheSafetyNet) {

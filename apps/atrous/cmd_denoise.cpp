@@ -35,7 +35,7 @@ struct DenoiseArgs {
 };
 
 // Option groups: the flags of one method are ignored by the others (a note says which).
-const char* const kGroupEawSure = "EAW and SURE (--method eaw|sure)";
+const char* const kGroupEawSure = "EAW, SURE and learned (--method eaw|sure|learned|auto; learned: see docs/denoising.md)";
 const char* const kGroupSure = "SURE (--method sure)";
 const char* const kGroupSvgf = "SVGF (--method svgf)";  // addSvgfOptions' group
 const char* const kGroupBuffers = "Buffers (without --sequence)";
