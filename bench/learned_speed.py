@@ -14,7 +14,8 @@ same inputs (the scene at 2 spp, seed 7, as `atrous bench` renders them, through
 * ``oidn_filter``: pyoidn's object API, a ``pyoidn.Filter`` ("RT", hdr, quality high) created,
   bound and committed once, then only ``execute()`` timed: OIDN's own cost.
 
-Both are a warm-up call, then the median of --runs calls (as atrous.eval's time_call). The result
+Both are --warmup untimed calls (at least one), then the median of --runs calls (atrous.eval's
+time_call does the same with one warm-up call), the same counts as the atrous rows. The result
 is one JSON document on stdout (and in --out): every median, the ratios learned / OIDN (against
 both OIDN timings), the machine, the date and the commit. Run it on an idle machine: the other
 processes' load is in every figure.
@@ -103,8 +104,13 @@ def time_oidn(b, runs: int, warmup: int) -> dict:
         raise RuntimeError(f"OIDN execute failed: {err}")
     flt.release()
     dev.release()
-    version = getattr(getattr(pyoidn, "version", None), "__version__", None)
-    out["pyoidn"] = version or "unknown"
+    try:
+        from importlib.metadata import version as _dist_version
+
+        out["pyoidn"] = _dist_version("pyoidn")
+    except Exception:
+        out["pyoidn"] = "unknown"
+    out["oidn"] = getattr(getattr(pyoidn, "version", None), "oidn_version", "unknown")
     return out
 
 
