@@ -25,6 +25,23 @@ namespace {
 constexpr int kLanes = 16;
 constexpr uintptr_t kHuge = uintptr_t(2) << 20;
 
+// Pass A over the flat pixel range [i0, i1) (LearnedLogPass's math, contiguous pointers).
+struct LogRange {
+    const float *r, *g, *b;
+    float *lr, *lg, *lb, *L;
+    ATROUS_FORCE_INLINE void operator()(size_t i0, size_t i1) const {
+        const float *ATROUS_RESTRICT R = r, *ATROUS_RESTRICT G = g, *ATROUS_RESTRICT B = b;
+        float *ATROUS_RESTRICT oR = lr, *ATROUS_RESTRICT oG = lg, *ATROUS_RESTRICT oB = lb, *ATROUS_RESTRICT oL = L;
+#pragma omp simd
+        for (size_t i = i0; i < i1; ++i) {
+            oR[i] = learnedLogColour(R[i]);
+            oG[i] = learnedLogColour(G[i]);
+            oB[i] = learnedLogColour(B[i]);
+            oL[i] = learnedLum(R[i], G[i], B[i]);
+        }
+    }
+};
+
 // Pass B over rows [y0, y1).
 struct NetRows {
     const LearnedNet* net;
@@ -122,7 +139,9 @@ void runLearned(const CpuExec& exec, const LearnedWeights& weights, const Learne
         runLearnedFunctors(exec, net, in, T, out);
         return;
     }
-    exec.forEachPixel(w, h, LearnedLogPass{in.d, T.lg});
+    cpu::parallelForIsa(cpu::activeIsa(), size_t(0), in.d.plane(), size_t(16384),
+                        LogRange{in.d.channel(0), in.d.channel(1), in.d.channel(2), T.lg.channel(0), T.lg.channel(1),
+                                 T.lg.channel(2), T.lg.channel(3)});
     clock.mark(t.logs, t.cpuLogs);
     cpu::parallelForIsa(cpu::activeIsa(), 0, h, 2, NetRows{net, in, T, out});
     clock.mark(t.network, t.cpuNetwork);

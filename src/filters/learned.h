@@ -169,7 +169,7 @@ ATROUS_FORCE_INLINE ATROUS_INLINE void learnedWriteOutputs(const float (&y)[kLea
     float e[J][N], mx[N], sum[N];
     for (int l = 0; l < n; ++l) mx[l] = learnedFinite(y[kLearnedOutBeta][l]);
     for (int j = 1; j < J; ++j)
-        for (int l = 0; l < n; ++l) mx[l] = maxSel(mx[l], learnedFinite(y[kLearnedOutBeta + j][l]));
+        for (int l = 0; l < n; ++l) mx[l] = learnedMax(mx[l], learnedFinite(y[kLearnedOutBeta + j][l]));
     for (int l = 0; l < n; ++l) sum[l] = 0.0f;
     for (int j = 0; j < J; ++j)
         for (int l = 0; l < n; ++l) {
