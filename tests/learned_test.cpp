@@ -164,6 +164,22 @@ TEST(Learned, HugeWeightsGiveFiniteOutput) {
     }
 }
 
+// Non-finite plane values (the driver sanitises them; the filter guards anyway): NaN and Inf in d,
+// var, albedo, normal and depth give a finite output on both paths.
+TEST(Learned, NonFinitePlanesGiveFiniteOutput) {
+    const Fixture& fx = fixture();
+    Image d = fx.d.clone(), var = fx.var.clone(), albedo = fx.albedo.clone(), normal = fx.normal.clone(),
+          depth = fx.depth.clone();
+    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+    d(5, 5, 0) = nan, d(6, 5, 1) = inf, d(0, 0, 2) = -inf, var(7, 7, 0) = nan, var(8, 7, 2) = inf;
+    albedo(3, 9, 1) = nan, normal(10, 10, 0) = inf, depth(11, 3, 0) = nan, depth(12, 3, 0) = inf;
+    const LearnedPlanes p{d.view(), var.view(), albedo.view(), normal.view(), depth.view()};
+    for (bool fast : {true, false}) {
+        const Image out = run(p, fixtureWeights(), fast);
+        for (size_t i = 0; i < out.size(); ++i) ASSERT_TRUE(std::isfinite(out.data()[i])) << fast << " " << i;
+    }
+}
+
 // The built-in weights (src/filters/learned_weights_default.cpp) parse and give finite output.
 TEST(Learned, BuiltinWeightsLoadAndRun) {
     const Image out = run(fixture().planes(), LearnedWeights::builtin(), true);
