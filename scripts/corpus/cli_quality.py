@@ -5,7 +5,8 @@ hands it over (`atrous denoise --in FILE.exr` or `--in DIR`), against the corpus
   scripts/corpus/cli_quality.py [--corpus out/corpus/quick] [--atrous build/atrous] [--json OUT]
       [--methods eaw,sure] [--max-ratio R] [--bounds FILE] [--write-bounds FILE --margin M]
 
-Needs only the CLI and the rendered corpus (scripts/corpus/render.py), not Mitsuba or Blender.
+--methods takes any `atrous denoise --method` (e.g. eaw,sure,learned: the learned filter with the
+built-in weights, or a weight file with --extra '--learned-weights FILE'). Needs only the CLI and the rendered corpus (scripts/corpus/render.py), not Mitsuba or Blender.
 With --max-ratio R it exits 1 when any filter's relMSE is above R times the noisy input's; with
 --bounds FILE when any relMSE is above its bound there ("scene/spp/method": relMSE); the CI check
 (scripts/corpus_check.sh) uses the bounds. --write-bounds writes today's figures times M.

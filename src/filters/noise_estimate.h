@@ -116,17 +116,35 @@ void globalNoiseSigma(const Exec& exec, const ImageView& color, const ImageView&
 // light's edge or a one-pixel strip of wall beside it does not read as noise.
 constexpr float kNoiseNormalDist2 = 0.1f;  // |n_p - n_q|² (about 18 degrees)
 constexpr float kNoiseDepthRel = 0.05f;
+// DetailEnergy's albedo fit needs this much albedo variance over the taps (a standard deviation
+// of 0.003): below it the albedo is flat and explains nothing.
+constexpr float kNoiseFitMinVar = 1e-5f;
 struct DetailEnergy {
     ImageView color, energy;  // color: c_0 demodulated (Demodulate into a copy), energy: out (3 ch)
     ImageView normal, depth;  // sanitised (zeros when absent)
     // A tap further from p than this (squared, per channel) is across an edge in the colour itself
     // (a visible light in a wall of the same normal and depth), left out as a geometric edge is.
     float maxDiff2[3] = {3.0e38f, 3.0e38f, 3.0e38f};
+    // Optional, off while invalid (the driver does not set it yet): the albedo buffer. The part of
+    // the detail that the albedo's own detail explains (a least-squares fit of c on a, per
+    // channel, over the same taps) is signal, not noise: a component the albedo does not multiply
+    // (a dielectric's specular layer over a fine texture) leaves the demodulation c / a' with the
+    // texture's pattern, and read as noise it opened the colour stop across the texture. Measured
+    // with the driver setting it (docs/quality.md has the default's table; cli_quality.py on
+    // out/corpus/full, 2026-12-02): 16 spp best/OIDN geomean 1.005 -> 0.976, cy_textures_box 16 spp
+    // EAW 0.01329 -> 0.01138, SURE 0.01097 -> 0.00946 (noisy 0.00954), cy_sunsky_thin 16 spp -11%;
+    // 4 spp 1.009 -> 1.013 (cy_interior +6%, mi_glass +3%: the fit also takes pure noise's energy
+    // where the albedo varies, p's leverage: up to 27% on a 1-pixel checker, tests/noise_fit_test.cpp;
+    // a fit shrunk by its significance, 1 - s / (R^2 n_eff), gave s = 1: 0.982 / 1.011, s = 2:
+    // 0.988 / 1.010). Off until the whole table says it pays.
+    ImageView albedo;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         const int w = color.width, h = color.height;
         const float nx = normal(x, y, 0), ny = normal(x, y, 1), nz = normal(x, y, 2), zp = depth(x, y, 0);
         const float cp[3] = {color(x, y, 0), color(x, y, 1), color(x, y, 2)};
         float s[3] = {0, 0, 0}, ws = 0, w2 = 0;
+        float sa[3] = {0, 0, 0}, saa[3] = {0, 0, 0}, sac[3] = {0, 0, 0};
+        const bool fit = albedo.valid();
         for (int qy = -2; qy <= 2; ++qy)
             for (int qx = -2; qx <= 2; ++qx) {
                 const int xx = clampIdx(x + qx, w - 1), yy = clampIdx(y + qy, h - 1);
@@ -139,13 +157,26 @@ struct DetailEnergy {
                 ws += wt;
                 w2 += wt * wt;
                 for (int c = 0; c < 3; ++c) s[c] += wt * color(xx, yy, c);
+                if (fit)
+                    for (int c = 0; c < 3; ++c) {
+                        const float a = albedo(xx, yy, c);
+                        const float af = finite(a) ? a : 0.0f;
+                        sa[c] += wt * af;
+                        saa[c] += wt * af * af;
+                        sac[c] += wt * af * color(xx, yy, c);
+                    }
             }
         // var(c_p - Σ w_q c_q / W) = σ² (1 - 2 w_p/W + Σ w_q²/W²) for white noise: the same
         // unbiasing as kDetailVarFactor, for the renormalised weights.
         const float wp = b3(0) * b3(0);
         const float factor = 1.0f - 2.0f * wp / ws + w2 / (ws * ws);
         for (int c = 0; c < 3; ++c) {
-            const float d = color(x, y, c) - s[c] / ws;
+            float d = color(x, y, c) - s[c] / ws;
+            if (fit) {
+                const float ma = sa[c] / ws, va = saa[c] / ws - ma * ma;
+                const float ap = albedo(x, y, c);
+                if (va > kNoiseFitMinVar && finite(ap)) d -= (sac[c] / ws - ma * s[c] / ws) / va * (ap - ma);
+            }
             energy(x, y, c) = factor > 1e-3f ? d * d / factor : 0.0f;
         }
     }
