@@ -96,6 +96,18 @@ struct NetRows {
     }
 };
 
+// Transparent huge pages where the kernel leaves them to madvise: the planes are first touched by
+// the passes, and 4 KiB page faults cost ~15% of the cascade at 1080p (perf).
+void adviseHugePages(float* p, size_t bytes) {
+#ifdef MADV_HUGEPAGE
+    const uintptr_t a = (reinterpret_cast<uintptr_t>(p) + kHuge - 1) & ~(kHuge - 1);
+    const uintptr_t e = (reinterpret_cast<uintptr_t>(p) + bytes) & ~(kHuge - 1);
+    if (e > a) madvise(reinterpret_cast<void*>(a), e - a, MADV_HUGEPAGE);
+#else
+    (void)p, (void)bytes;
+#endif
+}
+
 // Wall and process CPU time since the last mark.
 struct StageClock {
     std::chrono::steady_clock::time_point t = std::chrono::steady_clock::now();
@@ -116,21 +128,22 @@ void runLearned(const CpuExec& exec, const LearnedWeights& weights, const Learne
     const int w = in.d.width, h = in.d.height;
     StageClock clock;
     double unused = 0;
-    // One block for every temporary, from the scalable allocator (not an Image: no zero fill).
-    const size_t bytes = size_t(kLearnedTempChannels) * size_t(w) * size_t(h) * sizeof(float);
-    std::unique_ptr<float, void (*)(void*)> store(static_cast<float*>(scalable_aligned_malloc(bytes, 64)),
-                                                  scalable_aligned_free);
-    if (!store) throw RuntimeError("out of host memory for the learned filter's planes");
-#ifdef MADV_HUGEPAGE
-    // Transparent huge pages where the kernel leaves them to madvise: the block is first touched
-    // by the passes below, and 4 KiB page faults cost ~15% of the cascade at 1080p (perf).
-    {
-        const uintptr_t a = (reinterpret_cast<uintptr_t>(store.get()) + kHuge - 1) & ~(kHuge - 1);
-        const uintptr_t e = (reinterpret_cast<uintptr_t>(store.get()) + bytes) & ~(kHuge - 1);
-        if (e > a) madvise(reinterpret_cast<void*>(a), e - a, MADV_HUGEPAGE);
-    }
-#endif
-    const LearnedTemps T = learnedTemps(store.get(), w, h);
+    // The temporaries from the scalable allocator (not Images: no zero fill), one allocation per
+    // view: at 512x512 each is at most 8 MiB, which the allocator's cache hands back on the next
+    // call (one 36 MiB block was new memory, first touched, every call).
+    std::vector<std::unique_ptr<float, void (*)(void*)>> stores;
+    const size_t plane = size_t(w) * size_t(h);
+    auto alloc = [&](int channels) {
+        const size_t bytes = size_t(channels) * plane * sizeof(float);
+        stores.emplace_back(static_cast<float*>(scalable_aligned_malloc(bytes, 64)), scalable_aligned_free);
+        float* p = stores.back().get();
+        if (!p) throw RuntimeError("out of host memory for the learned filter's planes");
+        adviseHugePages(p, bytes);
+        return ImageView{p, w, h, channels};
+    };
+    LearnedTemps T;
+    T.lg = alloc(4), T.feat = alloc(kLearnedFeat), T.a = alloc(kLearnedLevels), T.m = alloc(kLearnedLevels);
+    T.bk = alloc(kLearnedLevels), T.beta = alloc(kLearnedLevels + 1), T.buf = alloc(3);
     const LearnedNet* net = &weights.impl->net;
     LearnedStageTimes local;
     LearnedStageTimes& t = times ? *times : local;
