@@ -136,7 +136,10 @@ struct DetailEnergy {
     // 4 spp 1.009 -> 1.013 (cy_interior +6%, mi_glass +3%: the fit also takes pure noise's energy
     // where the albedo varies, p's leverage: up to 27% on a 1-pixel checker, tests/noise_fit_test.cpp;
     // a fit shrunk by its significance, 1 - s / (R^2 n_eff), gave s = 1: 0.982 / 1.011, s = 2:
-    // 0.988 / 1.010). Off until the whole table says it pays.
+    // 0.988 / 1.010; the energy divided by the fit residual's exact white-noise variance, so that
+    // pure noise keeps all of it: 0.987 / 1.011, cy_interior 4 spp still +6%). The quick set's 16
+    // cases are all better with it (worst filter/noisy 0.736 -> 0.654). Off until the whole table
+    // says it pays (and the learned filter's training planes, which use this estimate, agree).
     ImageView albedo;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         const int w = color.width, h = color.height;
