@@ -230,16 +230,16 @@ gtest() {  # binary name
 bench_size() {  # WxH
   if [ "$DRY" = 1 ]; then
     # flags and JSON through the CPU path, then the CUDA path must refuse cleanly (exit 2) without a GPU
-    "$WORK/atrous" bench --device cpu --json --sizes 64x64 --what render,eaw,sure,svgf --runs 1 --warmup 0 \
+    "$WORK/atrous" bench --device cpu --json --sizes 64x64 --what render,eaw,sure,svgf,learned --runs 1 --warmup 0 \
       > "$OUTDIR/bench/atrous_bench_cpu_dry.json" || return 1
     python3 -m json.tool "$OUTDIR/bench/atrous_bench_cpu_dry.json" > /dev/null || return 1
-    "$WORK/atrous" bench --device cuda --json --sizes "$1" --what render,eaw,sure,svgf > /dev/null 2> "$LOGS/bench-cuda-dry.err"
+    "$WORK/atrous" bench --device cuda --json --sizes "$1" --what render,eaw,sure,svgf,learned > /dev/null 2> "$LOGS/bench-cuda-dry.err"
     local rc=$?
     cat "$LOGS/bench-cuda-dry.err"
     [ $rc = 2 ] || { echo "atrous bench --device cuda without a GPU: exit $rc, expected 2"; return 1; }
     return 0
   fi
-  "$WORK/atrous" bench --device cuda --json --sizes "$1" --what render,eaw,sure,svgf > "$OUTDIR/bench/atrous_bench_cuda_$1.json" \
+  "$WORK/atrous" bench --device cuda --json --sizes "$1" --what render,eaw,sure,svgf,learned > "$OUTDIR/bench/atrous_bench_cuda_$1.json" \
     && python3 -m json.tool "$OUTDIR/bench/atrous_bench_cuda_$1.json" > /dev/null
 }
 bench_render() {

@@ -76,6 +76,8 @@ cp "$CM/atrous" "$CM/gpu_bandwidth" "$ST/"
 cp "$CM/bench/bench_gpu_render" "$ST/bench/"
 for t in "${TESTS[@]}"; do cp "$CM/tests/$t" "$ST/tests/"; done
 cp -r "$SRC/scenes" "$ST/src/scenes"
+# Data files the CUDA tests read through ATROUS_SOURCE_DIR (the learned filter's JAX parity fixture).
+mkdir -p "$ST/src/tests" && cp "$SRC/tests/learned_fixture.bin" "$ST/src/tests/"
 BINS=("$ST/atrous" "$ST/gpu_bandwidth" "$ST/bench/bench_gpu_render")
 for t in "${TESTS[@]}"; do BINS+=("$ST/tests/$t"); done
 strip --strip-unneeded "${BINS[@]}"
