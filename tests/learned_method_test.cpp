@@ -13,7 +13,6 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <string>
 #include <vector>
 
@@ -26,22 +25,18 @@
 #include "filters/denoise_internal.h"
 #include "filters/learned.h"
 #include "io/image_io.h"
+#include "learned_fixture.h"
 #include "render_test_util.h"
 #include "test_util.h"
 
 namespace atrous {
 namespace {
 
-// The weight file inside the fixture: "ATRF" | u32 version | u32 w | u32 h | u32 n | n bytes | ...
+// The fixture's weight file (tests/learned_fixture.h), written where a path is wanted.
 std::string writeFixtureWeights(const test::TempDir& dir) {
-    std::ifstream f(std::string(ATROUS_SOURCE_DIR) + "/tests/learned_fixture.bin", std::ios::binary);
-    const std::vector<char> b((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-    EXPECT_GT(b.size(), 20u);
-    EXPECT_EQ(std::memcmp(b.data(), "ATRF", 4), 0);
-    std::uint32_t n = 0;
-    std::memcpy(&n, b.data() + 16, 4);
+    const std::vector<std::uint8_t>& b = test::fixture().weights;
     const std::string path = dir / "fixture.atrl";
-    std::ofstream(path, std::ios::binary).write(b.data() + 20, n);
+    std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(b.data()), std::streamsize(b.size()));
     return path;
 }
 
