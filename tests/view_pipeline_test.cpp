@@ -95,7 +95,7 @@ pt::Camera turned(const ViewPipeline& pl, float yaw) {
 }  // namespace
 
 TEST(ViewPipeline, MethodNamesRoundTripAndUnknownOnesAreInputErrors) {
-    for (Method m : {Method::None, Method::Eaw, Method::Sure, Method::Svgf}) EXPECT_EQ(parseMethod(methodName(m)), m);
+    for (Method m : {Method::None, Method::Eaw, Method::Sure, Method::Svgf, Method::Learned}) EXPECT_EQ(parseMethod(methodName(m)), m);
     EXPECT_THROW(parseMethod("bilateral"), InputError);
     EXPECT_THROW(ViewPipeline(cornell(), 0, kH, Device::Cpu, 1), InputError);
 }
@@ -261,7 +261,7 @@ TEST(ViewPipeline, SlotsFollowTheMethodAndTheSplit) {
 
 TEST(ViewPipeline, EverySlotMethodRunsAndSvgfTakesTheFramesOwnSamples) {
     ViewPipeline pl(cornell(), kW, kH, Device::Cpu, 1);
-    for (Method m : {Method::Sure, Method::Svgf, Method::Eaw, Method::Svgf}) {
+    for (Method m : {Method::Sure, Method::Svgf, Method::Eaw, Method::Svgf, Method::Learned}) {
         pl.step(settings(m));
         const SlotResult& r = pl.slot(0);
         EXPECT_EQ(r.method, m);

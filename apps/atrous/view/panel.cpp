@@ -17,11 +17,11 @@
 namespace atrous::view {
 namespace {
 
-const char* const kMethodNames[] = {"none", "eaw", "sure", "svgf"};
+const char* const kMethodNames[] = {"none", "eaw", "sure", "svgf", "learned"};  // view::Method order
 
 bool comboMethod(const char* label, Method& m) {
     int i = int(m);
-    const bool changed = ImGui::Combo(label, &i, kMethodNames, 4);
+    const bool changed = ImGui::Combo(label, &i, kMethodNames, int(sizeof kMethodNames / sizeof kMethodNames[0]));
     m = Method(i);
     return changed;
 }

@@ -34,6 +34,8 @@ const char* methodName(Method m) {
             return "sure";
         case Method::Svgf:
             return "svgf";
+        case Method::Learned:
+            return "learned";
     }
     return "?";
 }
@@ -43,7 +45,8 @@ Method parseMethod(const std::string& name) {
     if (name == "eaw") return Method::Eaw;
     if (name == "sure") return Method::Sure;
     if (name == "svgf") return Method::Svgf;
-    throw InputError("unknown method \"" + name + "\" (expected none, eaw, sure or svgf)");
+    if (name == "learned") return Method::Learned;
+    throw InputError("unknown method \"" + name + "\" (expected none, eaw, sure, svgf or learned)");
 }
 
 namespace {
@@ -287,7 +290,7 @@ DenoiseInputs ViewPipeline::accumulatedInputs() const {
 
 DenoiseOptions ViewPipeline::denoiseOptions(Method m, const PipelineSettings& s) const {
     DenoiseOptions o = s.denoise;
-    o.method = m == Method::Sure ? DenoiseMethod::Sure : DenoiseMethod::Eaw;
+    o.method = m == Method::Sure ? DenoiseMethod::Sure : m == Method::Learned ? DenoiseMethod::Learned : DenoiseMethod::Eaw;
     o.device = mDevice;
     o.report = nullptr;
     return o;

@@ -23,9 +23,9 @@ class CudaBvhRenderer;  // render/bvh_render.h
 
 namespace atrous::view {
 
-enum class Method { None = 0, Eaw = 1, Sure = 2, Svgf = 3 };
+enum class Method { None = 0, Eaw = 1, Sure = 2, Svgf = 3, Learned = 4 };
 const char* methodName(Method m);
-Method parseMethod(const std::string& name);  // none | eaw | sure | svgf; InputError otherwise
+Method parseMethod(const std::string& name);  // none | eaw | sure | svgf | learned; InputError otherwise
 
 // Everything the user can change between frames.
 struct PipelineSettings {

@@ -12,7 +12,7 @@ import sys
 from typing import Any, Dict, List, Optional, Sequence
 
 from . import jobs
-from .items import DENOISE_METHODS, EVAL_METHODS, FarmInputError, parse_assignments
+from .items import DENOISE_METHODS, EVAL_CHOICES, EVAL_METHODS, FarmInputError, parse_assignments
 from .runner import JobResult, print_summary
 
 PROG = "python -m atrous.farm"
@@ -75,7 +75,7 @@ def _parser() -> argparse.ArgumentParser:
     e = sub.add_parser("evaluate", help="the quality benchmark: methods x scenes x spp against references")
     e.add_argument("--scenes", default="cornell,cornell-spheres")
     e.add_argument("--spp", default="4,16")
-    e.add_argument("--methods", default=",".join(EVAL_METHODS), help=f"comma list from {','.join(EVAL_METHODS)}")
+    e.add_argument("--methods", default=",".join(EVAL_METHODS), help=f"comma list from {','.join(EVAL_CHOICES)} (default {','.join(EVAL_METHODS)})")
     _eval_flags(e)
     e.add_argument("--runs", type=int, default=3, help="timed denoise runs per item after a warm-up (median kept)")
     _run_flags(e)

@@ -10,7 +10,7 @@ from typing import Any, Dict, List, Optional, Sequence, Union
 import atrous
 
 from . import dataset as _dataset
-from .items import (DENOISE_METHODS, EVAL_METHODS, FarmInputError, Item, check_denoise_params, check_scenes,
+from .items import (DENOISE_METHODS, EVAL_CHOICES, EVAL_METHODS, FarmInputError, Item, check_denoise_params, check_scenes,
                     discover_inputs, grid_points, int_list, name_list, params_label, positive_int, scene_label)
 from .manifest import Manifest
 from .runner import JobResult, run_job
@@ -38,8 +38,8 @@ def render(out: PathLike, scenes: Any, spp: Any = (16,), *, width: int = 512, he
     frames = positive_int(frames, "frames", 0, 100000)
     methods = name_list(denoise, "denoise") if denoise else []
     for m in methods:
-        if m not in ("eaw", "sure"):
-            raise FarmInputError(f"denoise: unknown method '{m}' (expected eaw or sure)")
+        if m not in ("eaw", "sure", "learned", "auto"):
+            raise FarmInputError(f"denoise: unknown method '{m}' (expected eaw, sure, learned or auto)")
     if frames and methods:
         raise FarmInputError("denoise: not with frames (denoise the sequence with the denoise job)")
     if camera_path not in CAMERA_PATHS:
@@ -187,8 +187,8 @@ def evaluate(out: PathLike, scenes: Any = ("cornell", "cornell-spheres"), spp: A
         raise FarmInputError("ref_seed: must differ from seed (the reference would share the input's noise)")
     methods = name_list(methods, "methods")
     for m in methods:
-        if m not in EVAL_METHODS:
-            raise FarmInputError(f"methods: unknown '{m}' (expected {', '.join(EVAL_METHODS)})")
+        if m not in EVAL_CHOICES:
+            raise FarmInputError(f"methods: unknown '{m}' (expected {', '.join(EVAL_CHOICES)})")
     runs = positive_int(runs, "runs", 1, 1000)
     items = _references(scenes, size, ref_spp, ref_seed, max_depth)
     items += _scored("evaluate", scenes, spp, size, seed, max_depth, None, methods, runs)
