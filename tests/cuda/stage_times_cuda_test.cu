@@ -17,7 +17,7 @@ using namespace atrous;
 TEST(StageTimesCuda, DenoiseStagesMatchTheCpuListAndFitInTheTotal) {
     if (!cudaAvailable()) GTEST_SKIP() << "no CUDA device";
     const test::SyntheticScene scene = test::makeScene(96, 80, 0.4f, 5);
-    for (auto m : {DenoiseMethod::Eaw, DenoiseMethod::Sure}) {
+    for (auto m : {DenoiseMethod::Eaw, DenoiseMethod::Sure, DenoiseMethod::Learned}) {
         DenoiseOptions o;
         o.method = m;
         DenoiseReport cpu, gpu;
