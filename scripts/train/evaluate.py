@@ -71,6 +71,8 @@ def main() -> int:
     p.add_argument("--data", default="out/train/data/test")
     p.add_argument("--weights", default=None, help="a v2 weight file (default: the built-in weights)")
     p.add_argument("--methods", nargs="+", default=list(METHODS), choices=METHODS)
+    p.add_argument("--no-variance", action="store_true",
+                   help="withhold the variance buffer (every atrous method then estimates it, as for other renderers)")
     p.add_argument("--json")
     a = p.parse_args()
     sys.path.append(str(ROOT / "python"))  # pyoidn, where it is a source tree (after the installed atrous)
@@ -83,6 +85,8 @@ def main() -> int:
         for spp in (4, 16):
             key = f"{Path(f).stem} {spp}spp"
             b = buffers(z, spp)
+            if a.no_variance:
+                b.pop("variance", None)
             r = res.setdefault(key, {})
             for m in a.methods:
                 r[m] = relmse(run_method(m, b, a.weights), z["reference"])
