@@ -181,6 +181,7 @@ def main(argv=None) -> int:
     text = json.dumps(doc, indent=2)
     print(text)
     if a.out:
+        Path(a.out).parent.mkdir(parents=True, exist_ok=True)
         Path(a.out).write_text(text + "\n")
     return 0
 
