@@ -65,11 +65,15 @@ clean:
 
 # The learned filter (docs/learned.md): its training venv (.venv-train), the dataset (out/train/data,
 # resumable), the library's prepared planes (out/train/prep, through the atrous module in .venv) and
-# the training run (out/train/run, resumable), which regenerates src/filters/learned_weights_default.cpp.
+# the training run (out/train/run, then the fine-tuning out/train/run_ft, both resumable), which
+# regenerates src/filters/learned_weights_default.cpp.
 # Within 2 hours from nothing on 2 cores: TRAIN_MINUTES of training. `train-smoke`: a few scenes and steps.
 TRAIN_BUILD ?= build-learn
 TRAIN_STEPS ?= 4000
 TRAIN_MINUTES ?= 60
+# Phase 2: fine-tuning with the `noem` images too (variance and emission withheld, docs/learned.md).
+TRAIN_FT_STEPS ?= 2000
+TRAIN_FT_MINUTES ?= 15
 .PHONY: train train-smoke
 train: python
 	@./scripts/train/setup.sh
@@ -77,7 +81,9 @@ train: python
 	@cmake --build $(TRAIN_BUILD) -j $(JOBS) --target atrous
 	@.venv-train/bin/python scripts/train/dataset.py --atrous $(TRAIN_BUILD)/atrous --scenes 160 --test-scenes 16
 	@.venv/bin/python scripts/train/prepare.py --splits train test corpus_train
-	@.venv-train/bin/python scripts/train/train.py --steps $(TRAIN_STEPS) --minutes $(TRAIN_MINUTES) --eval --export
+	@.venv-train/bin/python scripts/train/train.py --variants given est --steps $(TRAIN_STEPS) --minutes $(TRAIN_MINUTES) --eval
+	@.venv-train/bin/python scripts/train/train.py --out out/train/run_ft --init out/train/run/weights.bin --lr 1e-3 \
+	  --steps $(TRAIN_FT_STEPS) --minutes $(TRAIN_FT_MINUTES) --eval --export
 
 train-smoke: python
 	@./scripts/train/setup.sh

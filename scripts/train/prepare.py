@@ -6,7 +6,9 @@ sanitise, emission split, firefly clamp, noise estimate, demodulation), so that 
 on exactly what it sees in atrous::denoise (docs/learned.md, "Training").
 
 Each scene is prepared twice where it has a variance buffer: `given` (the rendered variance) and
-`est` (variance withheld: the driver's per-pixel estimate, what other renderers' output gets).
+`est` (variance withheld: the driver's per-pixel estimate, what other renderers' output gets), and
+`noem` (variance and emission withheld: what a renderer that writes neither gives, e.g. Mitsuba's
+aov integrator; a visible light then stays in d and its edge must be kept by the network itself).
 Scenes without one (the corpus training split) get `est` only. Output: out/train/prep/<split>/
 <name>.npz with keys "<variant>_<spp>_<plane>" (plane: d, var, albedo, normal, depth, mod,
 emission; absent planes have no key) and "reference"; written under a temporary name and renamed,
@@ -43,8 +45,12 @@ def prepare_scene(z, planes_fn, variants=("given", "est")) -> dict:
             if v == "given" and bufs["variance"] is None:
                 continue
             kw = dict(bufs)
-            if v == "est":
+            if v in ("est", "noem"):
                 kw["variance"] = None
+            if v == "noem":
+                if bufs["emission"] is None:  # the `est` variant is the same image already
+                    continue
+                kw["emission"] = None
             color = kw.pop("color")
             planes = planes_fn(color, **kw)
             for p in PLANES:
@@ -58,7 +64,7 @@ def main(argv=None, planes_fn=None) -> int:
     p.add_argument("--data", default="out/train/data", help="raw scenes: <data>/<split>/*.npz")
     p.add_argument("--out", default="out/train/prep")
     p.add_argument("--splits", nargs="+", default=["train", "test", "corpus_train"])
-    p.add_argument("--variants", nargs="+", default=["given", "est"], choices=["given", "est"])
+    p.add_argument("--variants", nargs="+", default=["given", "est", "noem"], choices=["given", "est", "noem"])
     a = p.parse_args(argv)
     if planes_fn is None:
         import atrous

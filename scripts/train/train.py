@@ -24,7 +24,8 @@ def main() -> int:
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--splits", nargs="+", help=f"training splits (default {train.DEFAULTS['splits']})")
     p.add_argument("--spps", nargs="+", type=int, help=f"default {train.DEFAULTS['spps']}")
-    p.add_argument("--variants", nargs="+", choices=["given", "est"])
+    p.add_argument("--variants", nargs="+", choices=["given", "est", "noem"])
+    p.add_argument("--init", help="start from this weight file (fine-tuning) instead of the seed's initialisation")
     p.add_argument("--batch", type=int)
     p.add_argument("--crop", type=int)
     p.add_argument("--lr", type=float)
@@ -37,7 +38,7 @@ def main() -> int:
     a = p.parse_args()
     over = {k: getattr(a, k) for k in ("splits", "spps", "variants", "batch", "crop", "lr", "eps", "colour", "blend",
                                        "box")}
-    params = train.train(Path(a.prep), Path(a.out), a.steps, seed=a.seed, minutes=a.minutes, **over)
+    params = train.train(Path(a.prep), Path(a.out), a.steps, seed=a.seed, minutes=a.minutes, init=a.init, **over)
     if a.eval:
         cfg = dict(train.DEFAULTS, **{k: v for k, v in over.items() if v is not None})
         res = train.evaluate(params, Path(a.prep) / "test", cfg)

@@ -20,7 +20,7 @@ from . import features, model, weights
 DEFAULTS = {
     "splits": ["train", "corpus_train"],  # prepared training splits (missing ones are skipped)
     "spps": [1, 4, 16],
-    "variants": ["given", "est"],         # rendered variance / the driver's estimate
+    "variants": ["given", "est", "noem"],  # rendered variance / the driver's estimate / also no emission
     "batch": 4, "crop": 96, "lr": 3e-3, "eps": 0.01,
     "colour": True, "blend": True, "box": True,  # ablations (C++ implements all three)
 }
@@ -87,7 +87,7 @@ def evaluate(params: dict, prep_test: Path, cfg: dict, spps=(4, 16)) -> dict:
 
 
 def train(prep: Path, out: Path, steps: int, seed: int = 1, minutes: float | None = None, ckpt_every: int = 200,
-          **overrides) -> dict:
+          init: str | None = None, **overrides) -> dict:
     cfg = dict(DEFAULTS, **{k: v for k, v in overrides.items() if v is not None})
     out.mkdir(parents=True, exist_ok=True)
     t_load = time.time()
@@ -98,6 +98,8 @@ def train(prep: Path, out: Path, steps: int, seed: int = 1, minutes: float | Non
     print(f"train: {len(items)} images from {cfg['splits']} loaded in {time.time() - t_load:.0f} s; config {cfg}",
           flush=True)
     params = model.init_params(seed)
+    if init:  # fine-tuning: start from a weight file (the seed still drives the crops)
+        params = {k: jnp.asarray(v) for k, v in weights.from_bytes(Path(init).read_bytes(), init).items()}
     opt = optax.chain(optax.clip_by_global_norm(1.0), optax.adam(optax.cosine_decay_schedule(cfg["lr"], steps, 0.05)))
     state = opt.init(params)
     curve, start = [], 0
