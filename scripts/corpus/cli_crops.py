@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
-"""Side-by-side images of the CLI's output on the third-party corpus: noisy | EAW | SURE | reference,
+"""Side-by-side images of the CLI's output on the third-party corpus: noisy | EAW | SURE | reference
+(or noisy | the --methods given | reference),
 tonemapped (x / (1 + x), sRGB-like gamma), one PNG per scene and spp.
 
   .venv/bin/python scripts/corpus/cli_crops.py --corpus out/corpus/full --out docs/images \\
-      --scenes mi_glass,cy_glass_mirror --spp 16 [--atrous build/atrous]
+      --scenes mi_glass,cy_glass_mirror --spp 16 [--atrous build/atrous] [--methods sure,learned]
 
 Runs in the project venv (numpy, Pillow from matplotlib) with OpenEXR from .venv-corpus, as
 quality.py does; each input is denoised as a user hands it over (`atrous denoise --in FILE`).
@@ -49,6 +50,7 @@ def main():
     ap.add_argument("--atrous", default="build/atrous")
     ap.add_argument("--scenes", default="")
     ap.add_argument("--spp", type=int, default=16)
+    ap.add_argument("--methods", default="eaw,sure", help="comma list of atrous denoise methods (default eaw,sure)")
     a = ap.parse_args()
     want = set(a.scenes.split(",")) if a.scenes else None
     with tempfile.TemporaryDirectory() as tmp:
@@ -56,14 +58,16 @@ def main():
             if spp != a.spp or (want and scene not in want):
                 continue
             outs = []
-            for m in ("eaw", "sure"):
+            methods = a.methods.split(",")
+            for m in methods:
                 o = os.path.join(tmp, m + ".exr")
                 subprocess.run([a.atrous, "denoise", "--in", inp, "--method", m, "--out", o], check=True,
                                capture_output=True)
                 outs.append(rgb(o))
             noisy = rgb(inp if inp.endswith(".exr") else os.path.join(inp, "color.exr"))
             strip = np.concatenate([tonemap(x) for x in [noisy] + outs + [rgb(ref)]], 1)
-            path = Path(a.out) / f"corpus_{scene}_{spp}spp.png"
+            tag = "" if methods == ["eaw", "sure"] else "_" + "_".join(methods)
+            path = Path(a.out) / f"corpus_{scene}_{spp}spp{tag}.png"
             Image.fromarray(strip).save(path)
             print(path)
 
