@@ -161,9 +161,11 @@ PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, D
     }
     if (in.albedo) used += o.demodulate ? ",albedo" : ",albedo(unused: demodulation off)";
     if (in.normal) used += ",normal";
-    if (in.position) used += ",position";
-    if (in.depth) used += o.eaw.sigmaDepth > 0 ? ",depth" : ",depth(unused: sigma-depth 0)";
-    if (in.ids) used += o.eaw.useIds ? ",ids" : ",ids(unused)";
+    // The learned filter's network reads depth (and no position or ids); EAW/SURE the reverse by default.
+    const bool learned = o.method == DenoiseMethod::Learned;
+    if (in.position) used += learned ? ",position(unused by learned)" : ",position";
+    if (in.depth) used += learned || o.eaw.sigmaDepth > 0 ? ",depth" : ",depth(unused: sigma-depth 0)";
+    if (in.ids) used += learned ? ",ids(unused by learned)" : o.eaw.useIds ? ",ids" : ",ids(unused)";
     if (in.emission) used += ",emission";
     rep.buffersUsed = used;
     return p;

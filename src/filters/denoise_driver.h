@@ -203,7 +203,8 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         d.rule = stillAlbedoRule(o);
         d.albedo = albedo, d.in = cA.view(), d.out = demod.view();
         exec.forEachPixel(w, h, d);
-        DetailEnergy de{demod.view(), energy.view(), normal, depth};
+        DetailEnergy de;
+        de.color = demod.view(), de.energy = energy.view(), de.normal = normal, de.depth = depth;  // albedo fit off
         for (int c = 0; c < 3; ++c) de.maxDiff2[c] = kNoiseEdgeSigmas2 * kNoiseCapMul * cfg.noiseFloorVar[c];
         exec.forEachPixel(w, h, de);
         Image rows(w, h, 8, dev);
