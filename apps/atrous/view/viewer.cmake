@@ -14,7 +14,7 @@ set(ATROUS_VIEW_CORE_SOURCES ${CMAKE_CURRENT_LIST_DIR}/view_pipeline.cpp ${CMAKE
 add_library(atrous_view_core STATIC ${ATROUS_VIEW_CORE_SOURCES})
 target_include_directories(atrous_view_core PUBLIC ${CMAKE_CURRENT_LIST_DIR}/..)
 target_link_libraries(atrous_view_core PUBLIC atrous_internal)
-target_compile_options(atrous_view_core PRIVATE -Wall -Wextra ${ATROUS_CPU_ARCH_FLAGS})
+target_compile_options(atrous_view_core PRIVATE -Wall -Wextra ${ATROUS_CPU_ARCH_FLAGS} -fopenmp-simd)
 
 set(ATROUS_HAVE_VIEWER OFF)
 if(ATROUS_BUILD_VIEWER)
