@@ -30,6 +30,18 @@ MODES = {
 TRAIN = dict(res=128, spp=[1, 4, 16], ref_spp=1024, seed_base=3000000, ref_seed=4000003)
 
 
+def parse_train_args(renderer, prefix, count):
+    """The training split's command line (--out, --scenes): (output root, names prefix_00.. to render)."""
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--scenes", default="")
+    a = ap.parse_args()
+    names = [f"{prefix}_{k:02d}" for k in range(count)]
+    if a.scenes:
+        names = [n for n in a.scenes.split(",") if n in names]
+    return Path(a.out) / renderer, names
+
+
 def train_jobs(k):
     """(spp, seed, file stem) of training scene k's renders: the noisy ones, then the reference."""
     jobs = [(spp, TRAIN["seed_base"] + 1000 * k + spp, f"spp{spp:04d}") for spp in TRAIN["spp"]]

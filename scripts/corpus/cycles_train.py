@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import TRAIN, done, exr_channels, log, merged_render_seconds, train_jobs, write_manifest  # noqa: E402
+from common import TRAIN, parse_train_args, done, exr_channels, log, merged_render_seconds, train_jobs, write_manifest  # noqa: E402
 import cycles_render as cr  # noqa: E402  (its main() does not run)
 
 bpy = cr.bpy
@@ -114,15 +114,7 @@ def scene(sc, k):
 
 
 def main():
-    import argparse
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--out", required=True)
-    ap.add_argument("--scenes", default="")
-    a = ap.parse_args()
-    names = [f"tr_cy_{k:02d}" for k in range(N_SCENES)]
-    if a.scenes:
-        names = [n for n in a.scenes.split(",") if n in names]
-    root = Path(a.out) / "cycles"
+    root, names = parse_train_args("cycles", "tr_cy", N_SCENES)
     res = TRAIN["res"]
     for name in names:
         k = int(name[-2:])

@@ -345,6 +345,31 @@ def write_motion(path, motion):
         f.write(str(path))
 
 
+def render_still(name, layout, objects, cam, res, rfilter, jobs, d):
+    """Every (spp, seed, stem) job of one still into folder d, in the scene's layout ("aov": one
+    EXR per job; else a folder of separate EXRs), skipping what is done. Returns the manifest's
+    `files` entries and the seconds of the renders run now."""
+    d.mkdir(parents=True, exist_ok=True)
+    times, files = {}, {}
+    for spp, seed, stem in jobs:
+        if layout == "aov":
+            target = d / f"{stem}.exr"
+            if not done(target):
+                log(f"mitsuba {name} {stem} ...")
+                times[stem] = render_aov(objects, cam, res, rfilter, spp, seed, target)
+                log(f"mitsuba {name} {stem} {times[stem]:.1f}s")
+            files[stem] = {"spp": spp, "seed": seed, "file": target.name, "channels": exr_channels(target)}
+        else:
+            folder = d / stem
+            if not done(folder / "DONE"):
+                log(f"mitsuba {name} {stem} ...")
+                times[stem] = render_separate(objects, cam, res, rfilter, spp, seed, folder)
+                log(f"mitsuba {name} {stem} {times[stem]:.1f}s")
+            files[stem] = {"spp": spp, "seed": seed, "folder": stem,
+                           "files": {p.name: exr_channels(p) for p in sorted(folder.glob("*.exr"))}}
+    return files, times
+
+
 def main():
     a, mode, root, names = parse_render_args("mitsuba", QUICK, STILLS)
     res = mode["res"]
@@ -352,25 +377,7 @@ def main():
         fn, layout, rfilter = STILLS[name]
         objects, cam, what, bg = fn()
         d = root / name
-        d.mkdir(parents=True, exist_ok=True)
-        times = {}
-        files = {}
-        for spp, seed, stem in still_jobs(mode):
-            if layout == "aov":
-                target = d / f"{stem}.exr"
-                if not done(target):
-                    log(f"mitsuba {name} {stem} ...")
-                    times[stem] = render_aov(objects, cam, res, rfilter, spp, seed, target)
-                    log(f"mitsuba {name} {stem} {times[stem]:.1f}s")
-                files[stem] = {"spp": spp, "seed": seed, "file": target.name, "channels": exr_channels(target)}
-            else:
-                folder = d / stem
-                if not done(folder / "DONE"):
-                    log(f"mitsuba {name} {stem} ...")
-                    times[stem] = render_separate(objects, cam, res, rfilter, spp, seed, folder)
-                    log(f"mitsuba {name} {stem} {times[stem]:.1f}s")
-                files[stem] = {"spp": spp, "seed": seed, "folder": stem,
-                               "files": {p.name: exr_channels(p) for p in sorted(folder.glob("*.exr"))}}
+        files, times = render_still(name, layout, objects, cam, res, rfilter, still_jobs(mode), d)
         man_path = d / "manifest.json"
         write_manifest(man_path, {
             "scene": name, "renderer": "mitsuba", "version": mi.__version__, "variant": VARIANT,

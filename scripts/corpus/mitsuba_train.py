@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import TRAIN, done, exr_channels, log, merged_render_seconds, train_jobs, write_manifest  # noqa: E402
+from common import TRAIN, parse_train_args, merged_render_seconds, train_jobs, write_manifest  # noqa: E402
 import mitsuba_render as mr  # noqa: E402  (sets the variant; its main() does not run)
 
 T = mr.T
@@ -112,39 +112,14 @@ def scene(k):
 
 
 def main():
-    import argparse
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--out", required=True)
-    ap.add_argument("--scenes", default="")
-    a = ap.parse_args()
-    names = [f"tr_mi_{k:02d}" for k in range(N_SCENES)]
-    if a.scenes:
-        names = [n for n in a.scenes.split(",") if n in names]
-    root = Path(a.out) / "mitsuba"
+    root, names = parse_train_args("mitsuba", "tr_mi", N_SCENES)
     res = TRAIN["res"]
     for name in names:
         k = int(name[-2:])
         objects, cam, rfilter, what = scene(k)
         layout = "separate" if k in SEP else "aov"
         d = root / name
-        d.mkdir(parents=True, exist_ok=True)
-        times, files = {}, {}
-        for spp, seed, stem in train_jobs(k):
-            if layout == "aov":
-                target = d / f"{stem}.exr"
-                if not done(target):
-                    log(f"mitsuba {name} {stem} ...")
-                    times[stem] = mr.render_aov(objects, cam, res, rfilter, spp, seed, target)
-                    log(f"mitsuba {name} {stem} {times[stem]:.1f}s")
-                files[stem] = {"spp": spp, "seed": seed, "file": target.name, "channels": exr_channels(target)}
-            else:
-                folder = d / stem
-                if not done(folder / "DONE"):
-                    log(f"mitsuba {name} {stem} ...")
-                    times[stem] = mr.render_separate(objects, cam, res, rfilter, spp, seed, folder)
-                    log(f"mitsuba {name} {stem} {times[stem]:.1f}s")
-                files[stem] = {"spp": spp, "seed": seed, "folder": stem,
-                               "files": {p.name: exr_channels(p) for p in sorted(folder.glob("*.exr"))}}
+        files, times = mr.render_still(name, layout, objects, cam, res, rfilter, train_jobs(k), d)
         man_path = d / "manifest.json"
         write_manifest(man_path, {
             "scene": name, "split": "train", "renderer": "mitsuba", "version": mr.mi.__version__, "variant": mr.VARIANT,
