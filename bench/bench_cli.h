@@ -6,6 +6,8 @@
 
 #include <cstdio>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace atrous::bench {
 
@@ -27,6 +29,19 @@ inline void parseSize(const std::string& text, int& w, int& h) {
     char tail = 0;
     if (std::sscanf(text.c_str(), "%dx%d%c", &w, &h, &tail) != 2 || w < 1 || h < 1)
         throw CLI::ValidationError("--size", "expects WxH with positive numbers, e.g. 512x512 (got '" + text + "')");
+}
+
+// --size WxH: replaces `sizes` (the program's default list) by that one size; a bad value is a
+// ValidationError from parseArgs (exit 2).
+inline void addSizeOption(CLI::App& app, std::vector<std::pair<int, int>>& sizes) {
+    app.add_option_function<std::string>(
+        "--size",
+        [&sizes](const std::string& text) {
+            int w = 0, h = 0;
+            parseSize(text, w, h);
+            sizes = {{w, h}};
+        },
+        "time only this size, WxH (default: 512x512 and 1920x1080)");
 }
 
 }  // namespace atrous::bench

@@ -73,23 +73,16 @@ int main(int argc, char** argv) {
     std::vector<std::pair<int, int>> sizes = {{512, 512}, {1920, 1080}};
     std::vector<DenoiseMethod> methods = {DenoiseMethod::Eaw, DenoiseMethod::Sure};
     int threads = 0;  // 0: TBB's default
-    std::string deviceText = "cpu", sizeText, methodText;
+    std::string deviceText = "cpu", methodText;
     CLI::App app{"Speed of EAW and SURE-A-Trous (defaults: 5 levels, all buffers) at 512x512 and 1920x1080; prints JSON",
                  "bench_denoise"};
     app.add_option("--runs", runs, "timed runs after warm-up; fewer than 20 are raised to 20")
         ->check(CLI::Range(1, 100000))->capture_default_str();
     app.add_option("--device", deviceText, "cpu | cuda")->check(CLI::IsMember({"cpu", "cuda"}))->capture_default_str();
-    app.add_option("--size", sizeText, "time only this size, WxH (default: 512x512 and 1920x1080)");
+    atrous::bench::addSizeOption(app, sizes);
     app.add_option("--method", methodText, "time only this method")->check(CLI::IsMember({"eaw", "sure"}));
     app.add_option("--threads", threads, "TBB threads (0 = all cores; 1 measures the work alone on a loaded machine)")
         ->check(CLI::Range(0, 4096))->capture_default_str();
-    app.callback([&] {
-        if (!sizeText.empty()) {
-            int w = 0, h = 0;
-            atrous::bench::parseSize(sizeText, w, h);
-            sizes = {{w, h}};
-        }
-    });
     if (int rc = atrous::bench::parseArgs(app, argc, argv); rc >= 0) return rc;
     runs = std::max(20, runs);
     try {

@@ -62,7 +62,7 @@ double minOf(const std::vector<double>& v) { return *std::min_element(v.begin(),
 int main(int argc, char** argv) {
     int runs = 20, threads = 0;
     std::vector<std::pair<int, int>> sizes = {{512, 512}, {1920, 1080}};
-    std::string deviceText = "cpu", sizeText, weightsPath, only;
+    std::string deviceText = "cpu", weightsPath, only;
     CLI::App app{"Speed of the learned filter (cascade alone on the CPU, and denoise() with the learned method) at "
                  "512x512 and 1920x1080; prints JSON",
                  "bench_learned"};
@@ -70,17 +70,10 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1, 100000))->capture_default_str();
     app.add_option("--device", deviceText, "device of the denoise() runs: cpu | cuda")
         ->check(CLI::IsMember({"cpu", "cuda"}))->capture_default_str();
-    app.add_option("--size", sizeText, "time only this size, WxH (default: 512x512 and 1920x1080)");
+    atrous::bench::addSizeOption(app, sizes);
     app.add_option("--threads", threads, "TBB threads (0 = all cores)")->check(CLI::Range(0, 4096))->capture_default_str();
     app.add_option("--only", only, "time only the cascade or only denoise()")->check(CLI::IsMember({"cascade", "denoise"}));
     app.add_option("--weights", weightsPath, "weight file (version 2; default: the built-in weights)");
-    app.callback([&] {
-        if (!sizeText.empty()) {
-            int w = 0, h = 0;
-            atrous::bench::parseSize(sizeText, w, h);
-            sizes = {{w, h}};
-        }
-    });
     if (int rc = atrous::bench::parseArgs(app, argc, argv); rc >= 0) return rc;
     runs = std::max(20, runs);
     Device device = Device::Cpu;
