@@ -29,18 +29,10 @@ import tempfile
 import time
 from pathlib import Path
 
+from bench_machine import cpu_model  # bench/ (the script's own folder is on sys.path)
+
 REPO = Path(__file__).resolve().parents[1]
 SIZES = {"tiny": {"width": 32, "height": 32, "spp": 2}, "medium": {"width": 128, "height": 128, "spp": 64}}
-
-
-def _cpu_model() -> str:
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown"
 
 
 def _mem_gib() -> float:
@@ -105,7 +97,7 @@ def main() -> int:
         "benchmark": "atrous.farm render job vs the bare CLI",
         "date_utc": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
         "command": "python bench/farm_bench.py " + " ".join(sys.argv[1:]),
-        "machine": {"cpu": _cpu_model(), "cores": os.cpu_count(), "memory_gib": _mem_gib(),
+        "machine": {"cpu": cpu_model(), "cores": os.cpu_count(), "memory_gib": _mem_gib(),
                     "python": platform.python_version(), "ray": ray.__version__},
         "load_average_before": [round(x, 2) for x in os.getloadavg()],
         "items_per_job": a.items, "runs": a.runs, "sizes": {}, "ray_init_s": {},

@@ -33,6 +33,8 @@ import sys
 import time
 from pathlib import Path
 
+from bench_machine import cpu_model  # bench/ (the script's own folder is on sys.path)
+
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -47,16 +49,6 @@ def _git_commit() -> str:
         return head + ("+uncommitted" if dirty else "")
     except (OSError, subprocess.CalledProcessError):
         return "unknown"
-
-
-def _cpu_model() -> str:
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown"
 
 
 def _median_ms(fn, runs: int, warmup: int = 1) -> float:
@@ -167,7 +159,7 @@ def main(argv=None) -> int:
         "what": "learned filter speed vs EAW, SURE and OIDN (bench/learned_speed.py)",
         "date_utc": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M:%S"),
         "commit": _git_commit(),
-        "machine": {"host": platform.node(), "cpu": _cpu_model(), "cpu_count": os.cpu_count(),
+        "machine": {"host": platform.node(), "cpu": cpu_model(), "cpu_count": os.cpu_count(),
                     "load_average": list(os.getloadavg()) if hasattr(os, "getloadavg") else None},
         "atrous_device": bench.get("device"), "atrous_device_name": bench.get("device_name"),
         "scene": a.scene, "input_spp": 2, "runs": a.runs, "warmup": a.warmup,

@@ -13,10 +13,11 @@ import argparse
 import datetime
 import json
 import os
-import platform
 import subprocess
 import sys
 import time
+
+from bench_machine import cpu_model  # bench/ (the script's own folder is on sys.path)
 
 SCENES = ["cornell", "cornell-point", "cornell-spheres", "sphere-env"]
 
@@ -27,17 +28,6 @@ def run(cmd):
     if r.returncode != 0:
         sys.exit("failed (%d): %s\n%s" % (r.returncode, " ".join(cmd), r.stdout))
     return r.stdout, time.time() - t
-
-
-def cpu_name():
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown CPU"
 
 
 def main():
@@ -87,7 +77,7 @@ def main():
                 imgs[0]["mse"] / imgs[2]["mse"], imgs[1]["mse"] / imgs[2]["mse"]), flush=True)
     lines = []
     lines.append("Generated %s UTC on %s; `%s`; %dx%d, references %d spp (seed 4099), noisy seed 1." % (
-        datetime.datetime.utcnow().strftime("%Y-%m-%d %H:%M"), cpu_name(),
+        datetime.datetime.utcnow().strftime("%Y-%m-%d %H:%M"), cpu_model("unknown CPU"),
         " ".join(["python3"] + sys.argv), args.size, args.size, args.ref_spp))
     lines.append("")
     lines.append("| scene | spp | MSE noisy | MSE EAW | MSE SURE | noisy/EAW | EAW/SURE | relMSE noisy | relMSE EAW | relMSE SURE | SSIM EAW | SSIM SURE |")
