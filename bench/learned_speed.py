@@ -15,7 +15,7 @@ same inputs (the scene at 2 spp, seed 7, as `atrous bench` renders them, through
   bound and committed once, then only ``execute()`` timed: OIDN's own cost.
 
 Both are --warmup untimed calls (at least one), then the median of --runs calls (atrous.eval's
-time_call does the same with one warm-up call), the same counts as the atrous rows. The result
+time_call), the same counts as the atrous rows. The result
 is one JSON document on stdout (and in --out): every median, the ratios learned / OIDN (against
 both OIDN timings), the machine, the date and the commit. Run it on an idle machine: the other
 processes' load is in every figure.
@@ -27,7 +27,6 @@ import datetime as _dt
 import json
 import os
 import platform
-import statistics
 import subprocess
 import sys
 import time
@@ -51,32 +50,13 @@ def _git_commit() -> str:
         return "unknown"
 
 
-def _median_ms(fn, runs: int, warmup: int = 1) -> float:
-    for _ in range(max(1, warmup)):
-        fn()
-    times = []
-    for _ in range(max(1, runs)):
-        t0 = time.perf_counter()
-        fn()
-        times.append((time.perf_counter() - t0) * 1e3)
-    return statistics.median(times)
-
-
-def _oidn_inputs(b):
-    # What python/atrous/eval's load_oidn passes: finite non-negative colour, albedo in [0, 1],
-    # normals in [-1, 1], float32, C-contiguous H x W x 3.
-    color = np.ascontiguousarray(np.maximum(np.nan_to_num(b["color"], nan=0.0, posinf=0.0), 0.0), np.float32)
-    albedo = np.ascontiguousarray(np.clip(np.nan_to_num(b["albedo"]), 0.0, 1.0), np.float32)
-    normal = np.ascontiguousarray(np.clip(np.nan_to_num(b["normal"]), -1.0, 1.0), np.float32)
-    return color, albedo, normal
-
-
 def time_oidn(b, runs: int, warmup: int) -> dict:
     import pyoidn
+    from atrous.eval import oidn_inputs, time_call  # what atrous.eval's OIDN column passes and how it times
 
-    color, albedo, normal = _oidn_inputs(b)
-    out = {"oidn_denoise_ms": _median_ms(
-        lambda: pyoidn.denoise(color, albedo, normal, hdr=True, quality="high"), runs, warmup)}
+    color, albedo, normal = oidn_inputs(b)
+    out = {"oidn_denoise_ms": time_call(
+        lambda: pyoidn.denoise(color, albedo, normal, hdr=True, quality="high"), runs, warmup)[1]}
     dev = pyoidn.Device()
     dev.commit()
     flt = pyoidn.Filter(dev, pyoidn.OIDN_FILTER_TYPE_RT)
@@ -90,7 +70,7 @@ def time_oidn(b, runs: int, warmup: int) -> dict:
     err = dev.get_error()
     if err:
         raise RuntimeError(f"OIDN filter set-up failed: {err}")
-    out["oidn_filter_ms"] = _median_ms(flt.execute, runs, warmup)
+    out["oidn_filter_ms"] = time_call(flt.execute, runs, warmup)[1]
     err = dev.get_error()
     if err:
         raise RuntimeError(f"OIDN execute failed: {err}")

@@ -30,7 +30,7 @@ import numpy as np
 
 import atrous
 
-__all__ = ["EvalConfig", "run_eval", "main", "load_oidn", "time_call", "score"]
+__all__ = ["EvalConfig", "run_eval", "main", "load_oidn", "oidn_inputs", "time_call", "score"]
 
 ALL_METHODS = ("noisy", "eaw", "sure", "learned", "auto", "oidn")
 # The default set (--methods not given). learned (the learned à-trous filter, docs/learned.md) and
@@ -72,6 +72,15 @@ def quick_config(out: str = "eval-out") -> EvalConfig:
 
 # ------------------------------------------------------------------------------------ methods
 
+def oidn_inputs(b: Dict[str, np.ndarray]) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(color, albedo, normal) as OIDN takes them: finite non-negative HDR colour, albedo in [0, 1],
+    normals in [-1, 1], float32, C-contiguous."""
+    color = np.ascontiguousarray(np.maximum(np.nan_to_num(b["color"], nan=0.0, posinf=0.0), 0.0), np.float32)
+    albedo = np.ascontiguousarray(np.clip(np.nan_to_num(b["albedo"]), 0.0, 1.0), np.float32)
+    normal = np.ascontiguousarray(np.clip(np.nan_to_num(b["normal"]), -1.0, 1.0), np.float32)
+    return color, albedo, normal
+
+
 def load_oidn() -> Tuple[Optional[Callable], str]:
     """The OIDN denoiser as f(bufs) -> image, or (None, why it is missing)."""
     try:
@@ -82,10 +91,7 @@ def load_oidn() -> Tuple[Optional[Callable], str]:
     def run(b: Dict[str, np.ndarray]) -> np.ndarray:
         # OIDN wants finite non-negative HDR colour, albedo in [0, 1] and normals in [-1, 1]; the
         # "RT" filter with both auxiliary images (they are noisy too, so cleanAux stays off).
-        color = np.maximum(np.nan_to_num(b["color"], nan=0.0, posinf=0.0), 0.0).astype(np.float32)
-        albedo = np.clip(np.nan_to_num(b["albedo"]), 0.0, 1.0).astype(np.float32)
-        normal = np.clip(np.nan_to_num(b["normal"]), -1.0, 1.0).astype(np.float32)
-        return pyoidn.denoise(color, albedo, normal, hdr=True, quality="high")
+        return pyoidn.denoise(*oidn_inputs(b), hdr=True, quality="high")
 
     version = getattr(getattr(pyoidn, "version", None), "__version__", None)
     return run, f"pyoidn {version or ''}".strip()
@@ -141,10 +147,11 @@ def build_methods(names: Sequence[str], notes: List[str],
     return out
 
 
-def time_call(fn: Callable[[], Any], runs: int) -> Tuple[Any, float, List[float]]:
-    """Runs fn once to warm up (caches, thread pools, OIDN's lazy device), then `runs` times;
-    returns (the last result, median ms, every run's ms)."""
-    result = fn()
+def time_call(fn: Callable[[], Any], runs: int, warmup: int = 1) -> Tuple[Any, float, List[float]]:
+    """Runs fn `warmup` times (at least once) to warm up (caches, thread pools, OIDN's lazy device),
+    then `runs` times; returns (the last result, median ms, every run's ms)."""
+    for _ in range(max(1, warmup)):
+        result = fn()
     times = []
     for _ in range(max(1, runs)):
         t0 = time.perf_counter()
