@@ -85,7 +85,9 @@ inline double mse(const Image& a, const Image& b) {
     return s / double(a.size());
 }
 
+// Max |a - b| over every value; +inf when the two differ in size or channel count.
 inline double maxAbsDiff(const Image& a, const Image& b) {
+    if (a.width() != b.width() || a.height() != b.height() || a.channels() != b.channels()) return INFINITY;
     double m = 0;
     for (size_t i = 0; i < a.size(); ++i) m = std::max(m, double(std::fabs(a.data()[i] - b.data()[i])));
     return m;

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <string>
 
+#include "denoise_test_util.h"
 #include "io/buffer_set.h"
 #include "io/exr_layers.h"
 #include "io/image_io.h"
@@ -25,14 +26,6 @@ Image ramp(int w, int h, int channels, float base) {
         for (int y = 0; y < h; ++y)
             for (int x = 0; x < w; ++x) img(x, y, c) = base + 0.1f * c + 0.01f * float(x + w * y);
     return img;
-}
-
-// Max |a - b| over every value; both 3-channel and the same size (else +inf).
-double maxDiff(const Image& a, const Image& b) {
-    if (a.width() != b.width() || a.height() != b.height() || a.channels() != b.channels()) return INFINITY;
-    double m = 0;
-    for (size_t i = 0; i < a.size(); ++i) m = std::max(m, double(std::fabs(a.data()[i] - b.data()[i])));
-    return m;
 }
 
 int lines(const std::string& s) {
@@ -93,7 +86,7 @@ TEST(InspectExport, LayeredFileBuffersAsAtrousReadsThem) {
     const std::pair<Buffer, const char*> pairs[] = {{Buffer::Color, "color.exr"}, {Buffer::Albedo, "albedo.exr"},
                                                     {Buffer::Normal, "normal.exr"}, {Buffer::Depth, "depth.exr"},
                                                     {Buffer::ObjectId, "ids.exr"}, {Buffer::Emission, "emission.exr"}};
-    for (const auto& [b, f] : pairs) EXPECT_EQ(maxDiff(readImage(std::filesystem::path(dir) / f), *set.get(b)), 0.0) << f;
+    for (const auto& [b, f] : pairs) EXPECT_EQ(maxAbsDiff(readImage(std::filesystem::path(dir) / f), *set.get(b)), 0.0) << f;
 
     // And the conventions are the ones applied (not the file's raw values).
     const Image albedo = readImage(dir + "/albedo.exr"), normal = readImage(dir + "/normal.exr"),
@@ -134,7 +127,7 @@ TEST(InspectExport, RenderDirectoryAsMitsubaSeparateFiles) {
     ASSERT_EQ(res.exitCode, 0) << res.output;
     EXPECT_NE(res.output.find("render directory"), std::string::npos) << res.output;
     EXPECT_EQ(countEntries(out / "b"), 4);
-    EXPECT_EQ(maxDiff(readImage(out / "b/color.exr"), color), 0.0);
+    EXPECT_EQ(maxAbsDiff(readImage(out / "b/color.exr"), color), 0.0);
     const Image d = readImage(out / "b/depth.exr");
     EXPECT_EQ(d(1, 1, 0), 1e30f);
     EXPECT_EQ(d(2, 1, 0), depth1(2, 1, 0));
