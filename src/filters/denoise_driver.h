@@ -43,14 +43,6 @@ struct DriverPlanes {
     ImageView emission;      // 3 ch: the filtered emission Remodulate adds (left 0 when none)
 };
 
-// Copies the first out.channels channels of `in`.
-struct CopyPlanes {
-    ImageView in, out;
-    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        for (int c = 0; c < out.channels; ++c) out(x, y, c) = in(x, y, c);
-    }
-};
-
 // out = a' of the rule (Remodulate's multiplier; 1 without an albedo).
 struct ModulationOf {
     AlbedoRule rule;
@@ -233,13 +225,13 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     }
     if (out.planes) {
         const DriverPlanes& P = *out.planes;
-        if (P.d.valid()) exec.forEachPixel(w, h, CopyPlanes{cA.view(), P.d});
-        if (P.var.valid()) exec.forEachPixel(w, h, CopyPlanes{vA.view(), P.var});
-        if (P.albedo.valid() && albedo.valid()) exec.forEachPixel(w, h, CopyPlanes{albedo, P.albedo});
-        if (P.normal.valid() && in.normal.valid()) exec.forEachPixel(w, h, CopyPlanes{normal, P.normal});
-        if (P.depth.valid() && in.depth.valid()) exec.forEachPixel(w, h, CopyPlanes{depth, P.depth});
+        if (P.d.valid()) exec.forEachPixel(w, h, Copy3{cA.view(), P.d});
+        if (P.var.valid()) exec.forEachPixel(w, h, Copy3{vA.view(), P.var});
+        if (P.albedo.valid() && albedo.valid()) exec.forEachPixel(w, h, Copy3{albedo, P.albedo});
+        if (P.normal.valid() && in.normal.valid()) exec.forEachPixel(w, h, Copy3{normal, P.normal});
+        if (P.depth.valid() && in.depth.valid()) exec.forEachPixel(w, h, CopyChannels<1>{depth, P.depth});
         if (P.mod.valid()) exec.forEachPixel(w, h, ModulationOf{stillAlbedoRule(o), albedo, P.mod});
-        if (P.emission.valid() && emission.valid()) exec.forEachPixel(w, h, CopyPlanes{emission, P.emission});
+        if (P.emission.valid() && emission.valid()) exec.forEachPixel(w, h, Copy3{emission, P.emission});
         markStage(out.clock, "demodulate");
         exec.synchronize();
         return;

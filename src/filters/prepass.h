@@ -80,15 +80,15 @@ ImageView sanitizedFeature(const Exec& exec, ImageView in, int width, int height
 }
 ImageView sanitizedFeature(const CpuExec& exec, ImageView in, int width, int height, int channels, Image& storage);
 
-// Plain 3-channel copy.
-struct Copy3 {
+// Plain copy of the first N channels.
+template <int N>
+struct CopyChannels {
     ImageView in, out;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        out(x, y, 0) = in(x, y, 0);
-        out(x, y, 1) = in(x, y, 1);
-        out(x, y, 2) = in(x, y, 2);
+        for (int c = 0; c < N; ++c) out(x, y, c) = in(x, y, c);
     }
 };
+using Copy3 = CopyChannels<3>;
 
 // Firefly suppression: L(p) above m + k·sqrt(s² + v̄) is scaled down to that bound, where m and s²
 // are the mean and variance of the 3×3 neighbours' luminance without the brightest neighbour (so
