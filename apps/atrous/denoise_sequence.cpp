@@ -12,7 +12,6 @@
 #include <vector>
 
 #include "atrous/error.h"
-#include "atrous/learned.h"
 #include "cli_flags.h"
 #include "core/timer.h"
 #include "io/buffer_set.h"
@@ -205,15 +204,7 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
         options.method = parseDenoiseMethod(args.method);
         options.device = args.device;
         validateDenoiseOptions(options);
-        // A bad weight file fails before the output directory is touched.
-        if ((options.method == DenoiseMethod::Learned || options.method == DenoiseMethod::Auto) &&
-            !options.learnedWeights.empty()) {
-            try {
-                LearnedWeights::load(options.learnedWeights);
-            } catch (const InputError& e) {
-                throw InputError(std::string("--learned-weights: ") + e.what());
-            }
-        }
+        // A bad --learned-weights file has failed already, in cmd_denoise.cpp (its one caller).
     }
     DenoiseReport frameReport;
     options.report = &frameReport;
