@@ -81,6 +81,9 @@ train: python
 	@cmake --build $(TRAIN_BUILD) -j $(JOBS) --target atrous
 	@.venv-train/bin/python scripts/train/dataset.py --atrous $(TRAIN_BUILD)/atrous --scenes 160 --test-scenes 16
 	@.venv/bin/python scripts/train/prepare.py --splits train test corpus_train
+	@# Where the corpus's test stills are rendered (make quality), --eval also reports them (never trained on).
+	@if [ -d out/corpus/full ] && [ -x .venv-corpus/bin/python ]; then .venv-corpus/bin/python scripts/corpus/train_export.py --test --atrous $(TRAIN_BUILD)/atrous \
+	  && .venv/bin/python scripts/train/prepare.py --splits corpus_test --variants est; fi
 	@.venv-train/bin/python scripts/train/train.py --variants given est --steps $(TRAIN_STEPS) --minutes $(TRAIN_MINUTES) --eval
 	@.venv-train/bin/python scripts/train/train.py --out out/train/run_ft --init out/train/run/weights.bin --lr 1e-3 \
 	  --steps $(TRAIN_FT_STEPS) --minutes $(TRAIN_FT_MINUTES) --eval --export

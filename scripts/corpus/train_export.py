@@ -48,7 +48,7 @@ def export(atrous, src, tmp):
     return {p.stem: read_rgb(p) for p in out.glob("*.exr")}
 
 
-def scene_arrays(atrous, d, man, tmp):
+def scene_arrays(atrous, d, man, tmp, spps=TRAIN["spp"]):
     arrays = {}
     for stem, f in man["files"].items():
         src = d / (f["file"] if "file" in f else f["folder"])
@@ -59,7 +59,7 @@ def scene_arrays(atrous, d, man, tmp):
         spp = f["spp"]
         for k in KEYS:
             arrays[f"{k}_{spp}"] = b[k] if k in b else np.zeros_like(b["color"])
-    for spp in TRAIN["spp"]:
+    for spp in spps:
         for k in KEYS:
             assert f"{k}_{spp}" in arrays, (d, k, spp)
     for k, v in arrays.items():
@@ -76,12 +76,21 @@ def main():
     ap.add_argument("--atrous", default=str(ROOT / "build" / "atrous"))
     ap.add_argument("--corpus", default=str(ROOT / "out" / "corpus" / "train"))
     ap.add_argument("--out", default=str(ROOT / "out" / "train" / "data" / "corpus_train"))
+    ap.add_argument("--test", action="store_true",
+                    help="export the corpus's test stills instead (--corpus out/corpus/full, default --out "
+                         "out/train/data/corpus_test): for evaluating a network in JAX only; no training split "
+                         "reads them")
     a = ap.parse_args()
+    if a.test and a.out == ap.get_default("out"):
+        a.out = str(ROOT / "out" / "train" / "data" / "corpus_test")
+    pattern, spps = ("*/[cm][yi]_*/manifest.json", (4, 16)) if a.test else ("*/tr_*/manifest.json", TRAIN["spp"])
     dest = Path(a.out)
     dest.mkdir(parents=True, exist_ok=True)
     n = 0
-    for man_path in sorted(Path(a.corpus).glob("*/tr_*/manifest.json")):
+    for man_path in sorted(Path(a.corpus).glob(pattern)):
         d = man_path.parent
+        if "files" not in json.loads(man_path.read_text()):  # a sequence (frames, not stills)
+            continue
         target = dest / f"scene_{d.name}.npz"
         if target.exists() and target.stat().st_mtime >= man_path.stat().st_mtime:
             n += 1
@@ -89,7 +98,7 @@ def main():
         man = json.loads(man_path.read_text())
         t = time.time()
         with tempfile.TemporaryDirectory(dir=dest) as tmp:
-            arrays = scene_arrays(a.atrous, d, man, tmp)
+            arrays = scene_arrays(a.atrous, d, man, tmp, spps)
             part = Path(tmp) / "scene.npz"
             np.savez_compressed(part, **arrays)
             os.replace(part, target)

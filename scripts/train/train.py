@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
-"""Train the learned filter v2 (docs/learned.md) on the prepared planes (scripts/train/prepare.py):
+"""Train the learned filter v3 (docs/learned.md) on the prepared planes (scripts/train/prepare.py):
 `make train` runs this after dataset.py and prepare.py. Writes <out>/{checkpoint.npz, weights.bin,
 loss_curve.json, loss_curve.png, config.json} (a rerun resumes from the checkpoint); --eval writes
 <out>/eval_jax.json (the held-out split through the JAX forward pass); --export regenerates
 src/filters/learned_weights_default.cpp (the weights the library ships). The ablation switches
-(--no-colour, --no-blend, --no-box) exist for measurements only: C++ implements the full model."""
+(--no-colour, --no-vcolour, --no-blend, --no-box) exist for measurements only: C++ implements the full model."""
 import argparse
 import json
 import sys
@@ -31,19 +31,24 @@ def main() -> int:
     p.add_argument("--lr", type=float)
     p.add_argument("--eps", type=float, help="the loss's relMSE epsilon (default 0.01, the metric's)")
     p.add_argument("--no-colour", dest="colour", action="store_const", const=False)
+    p.add_argument("--no-vcolour", dest="vcolour", action="store_const", const=False)
     p.add_argument("--no-blend", dest="blend", action="store_const", const=False)
     p.add_argument("--no-box", dest="box", action="store_const", const=False)
     p.add_argument("--eval", action="store_true", help="relMSE on <prep>/test (JAX) into <out>/eval_jax.json")
     p.add_argument("--export", action="store_true", help="write src/filters/learned_weights_default.cpp")
     a = p.parse_args()
-    over = {k: getattr(a, k) for k in ("splits", "spps", "variants", "batch", "crop", "lr", "eps", "colour", "blend",
-                                       "box")}
+    over = {k: getattr(a, k) for k in ("splits", "spps", "variants", "batch", "crop", "lr", "eps", "colour", "vcolour",
+                                       "blend", "box")}
     params = train.train(Path(a.prep), Path(a.out), a.steps, seed=a.seed, minutes=a.minutes, init=a.init, **over)
     if a.eval:
         cfg = dict(train.DEFAULTS, **{k: v for k, v in over.items() if v is not None})
         res = train.evaluate(params, Path(a.prep) / "test", cfg)
         (Path(a.out) / "eval_jax.json").write_text(json.dumps(res, indent=1))
         print({k: round(v, 5) for k, v in res.items() if k.startswith("geomean")})
+        if (Path(a.prep) / "corpus_test").is_dir():  # other renderers' test stills, as the CLI prepares them
+            res = train.evaluate(params, Path(a.prep) / "corpus_test", cfg, variants=("est",))
+            (Path(a.out) / "eval_corpus_jax.json").write_text(json.dumps(res, indent=1))
+            print("corpus test", {k: round(v, 5) for k, v in res.items() if k.startswith("geomean")})
     if a.export:
         data = (Path(a.out) / "weights.bin").read_bytes()
         weights.from_bytes(data, str(Path(a.out) / "weights.bin"))

@@ -55,6 +55,12 @@ def inputs(d, var, albedo=None, normal=None, depth=None) -> np.ndarray:
     return np.concatenate([ld, alb, nrm, z, sd, m[..., :3], std], axis=2).astype(np.float32)
 
 
+def variance_plane(var) -> np.ndarray:
+    """The cascade's noise plane v (H x W x 1): max(mean_c var_c, 0), non-finite read as 0 (learned.h's
+    LearnedLogPass writes the same)."""
+    return np.maximum(_finite(var).mean(axis=2, keepdims=True), 0.0).astype(np.float32)
+
+
 def inputs_of(planes: dict, suffix: str = "") -> np.ndarray:
     """inputs() of a dict holding d, var and optionally albedo, normal, depth (keys + suffix)."""
     g = planes.get

@@ -1,4 +1,4 @@
-"""Training loop of the learned filter v2 (docs/learned.md, "Training"): optax Adam on relMSE of the
+"""Training loop of the learned filter v3 (docs/learned.md, "Training"): optax Adam on relMSE of the
 library's output d_out mod + emission over random crops of the prepared planes
 (scripts/train/prepare.py), fixed seed, checkpoints (resume), loss curve (JSON + PNG), weight
 export, and a JAX evaluation on the held-out split (the ablation tables)."""
@@ -22,12 +22,12 @@ DEFAULTS = {
     "spps": [1, 4, 16],
     "variants": ["given", "est", "noem"],  # rendered variance / the driver's estimate / also no emission
     "batch": 4, "crop": 96, "lr": 3e-3, "eps": 0.01,
-    "colour": True, "blend": True, "box": True,  # ablations (C++ implements all three)
+    "colour": True, "vcolour": True, "blend": True, "box": True,  # ablations (C++ implements all four)
 }
 
 
 def item_of(z, variant: str, spp: int, box: bool = True):
-    """(x, d, mod, e, ref) of one prepared image, or None when the npz lacks it."""
+    """(x, d, v, mod, e, ref) of one prepared image, or None when the npz lacks it."""
     pre = f"{variant}_{spp}_"
     if pre + "d" not in z:
         return None
@@ -35,7 +35,7 @@ def item_of(z, variant: str, spp: int, box: bool = True):
     x = features.inputs_of(planes)
     if not box:
         x[..., features.BOX] = 0.0
-    return x, planes["d"], planes["mod"], planes["emission"], z["reference"]
+    return x, planes["d"], features.variance_plane(planes["var"]), planes["mod"], planes["emission"], z["reference"]
 
 
 def load_items(folder: Path, spps, variants, box: bool = True, limit: int | None = None) -> list:
@@ -54,13 +54,13 @@ def load_items(folder: Path, spps, variants, box: bool = True, limit: int | None
 
 
 def batch(items, rng, n: int, crop: int):
-    out = [[] for _ in range(5)]
+    out = [[] for _ in range(6)]
     for _ in range(n):
         it = items[rng.integers(len(items))]
         h, w = it[0].shape[:2]
         y, x = rng.integers(0, h - crop + 1), rng.integers(0, w - crop + 1)
         flip = rng.integers(2)
-        for k in range(5):
+        for k in range(6):
             c = it[k][y:y + crop, x:x + crop]
             out[k].append(c[:, ::-1] if flip else c)
     return [jnp.asarray(np.stack(o)) for o in out]
@@ -72,12 +72,13 @@ def relmse_np(x, r) -> float:
     return float(np.mean((x - r) ** 2 / (r * r + 0.01)))
 
 
-def evaluate(params: dict, prep_test: Path, cfg: dict, spps=(4, 16)) -> dict:
-    """JAX relMSE on the held-out split (variant `given`, full images): per image and geomean/spp."""
-    fwd = jax.jit(lambda p, x, d, m, e: model.forward(p, x, d, m, e, cfg["colour"], cfg["blend"]))
+def evaluate(params: dict, prep_test: Path, cfg: dict, spps=(4, 16), variants=("given",)) -> dict:
+    """JAX relMSE on a held-out split (default variant `given`, full images): per image and geomean/spp."""
+    fwd = jax.jit(lambda p, x, d, v, m, e: model.forward(p, x, d, v, m, e, cfg["colour"], cfg["blend"],
+                                                         cfg["vcolour"]))
     res = {}
-    for x, d, mod, e, ref, name in load_items(prep_test, spps, ["given"], cfg["box"]):
-        out = fwd(params, *(jnp.asarray(a[None]) for a in (x, d, mod, e)))
+    for x, d, v, mod, e, ref, name in load_items(prep_test, spps, list(variants), cfg["box"]):
+        out = fwd(params, *(jnp.asarray(a[None]) for a in (x, d, v, mod, e)))
         res[name] = relmse_np(np.asarray(out[0]), ref)
     for spp in spps:
         v = [r for k, r in res.items() if k.endswith(f" {spp}spp")]
@@ -111,12 +112,12 @@ def train(prep: Path, out: Path, steps: int, seed: int = 1, minutes: float | Non
         start, curve = int(z["step"]), json.loads(str(z["curve"]))
     rng = np.random.default_rng([seed, start])
 
-    def loss_fn(p, x, d, m, e, r):
-        return model.relmse(model.forward(p, x, d, m, e, cfg["colour"], cfg["blend"]), r, cfg["eps"])
+    def loss_fn(p, x, d, v, m, e, r):
+        return model.relmse(model.forward(p, x, d, v, m, e, cfg["colour"], cfg["blend"], cfg["vcolour"]), r, cfg["eps"])
 
     @jax.jit
-    def step_fn(p, s, x, d, m, e, r):
-        l, g = jax.value_and_grad(loss_fn)(p, x, d, m, e, r)
+    def step_fn(p, s, x, d, v, m, e, r):
+        l, g = jax.value_and_grad(loss_fn)(p, x, d, v, m, e, r)
         u, s = opt.update(g, s, p)
         return optax.apply_updates(p, u), s, l
 

@@ -1,8 +1,9 @@
-"""The learned filter's weight file, version 2 (docs/learned.md, "Weight file"), read by
+"""The learned filter's weight file, version 3 (docs/learned.md, "Weight file"), read by
 src/filters/learned_weights.cpp: little-endian
   "ATRL" | u32 version (2) | u32 n_in | u32 n_hidden | u32 n_feat | u32 n_levels | u32 n_floats
   | n_floats f32 (w1 [n_in][n_hidden], b1, w2 [n_hidden][n_hidden], b2, w3 [n_hidden][n_out], b3)
-  | u32 FNV-1a of every byte before it. Version 1 (the first network, 11 -> 16 -> 16 -> 18) is refused."""
+  | u32 FNV-1a of every byte before it (n_out = n_feat + 4 n_levels + n_levels + 1). Versions 1 (the first
+  network, 11 -> 16 -> 16 -> 18) and 2 (15 -> 24 -> 24 -> 29, no noise-relative colour term) are refused."""
 from __future__ import annotations
 
 import struct
@@ -12,7 +13,8 @@ import numpy as np
 from .model import N_FEAT, N_HIDDEN, N_IN, N_LEVELS, SHAPES
 
 MAGIC = b"ATRL"
-VERSION = 2
+VERSION = 3
+RETIRED = {1: "the first network", 2: "the network without the noise-relative colour term"}
 
 
 def fnv1a(data: bytes) -> int:
@@ -32,8 +34,8 @@ def from_bytes(data: bytes, name: str = "weights") -> dict:
     if len(data) < 32 or data[:4] != MAGIC:
         raise ValueError(f"{name}: not an atrous learned-filter weight file (no ATRL header)")
     version, n_in, n_hid, n_feat, n_lev, n = struct.unpack("<6I", data[4:28])
-    if version == 1:
-        raise ValueError(f"{name}: version 1 (the first network, retired); retrain with make train")
+    if version in RETIRED:
+        raise ValueError(f"{name}: version {version} ({RETIRED[version]}, retired); retrain with make train")
     if version != VERSION:
         raise ValueError(f"{name}: version {version}, this build reads version {VERSION}")
     if (n_in, n_hid, n_feat, n_lev) != (N_IN, N_HIDDEN, N_FEAT, N_LEVELS):
