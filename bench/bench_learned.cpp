@@ -1,4 +1,4 @@
-// Speed of the learned filter v2 (docs/learned.md, "Speed") at 512x512 and 1920x1080: the learned
+// Speed of the learned filter v3 (docs/learned.md, "Speed") at 512x512 and 1920x1080: the learned
 // cascade alone on prepared planes (filters::runLearned on the CPU, per stage: allocate, pass A
 // logs, pass B network, the 5 levels), and the whole atrous::denoise with the learned method on
 // --device (the driver's stages included, per stage from DenoiseReport). Prints JSON: medians (and
@@ -73,7 +73,7 @@ int main(int argc, char** argv) {
     atrous::bench::addSizeOption(app, sizes);
     app.add_option("--threads", threads, "TBB threads (0 = all cores)")->check(CLI::Range(0, 4096))->capture_default_str();
     app.add_option("--only", only, "time only the cascade or only denoise()")->check(CLI::IsMember({"cascade", "denoise"}));
-    app.add_option("--weights", weightsPath, "weight file (version 2; default: the built-in weights)");
+    app.add_option("--weights", weightsPath, "weight file (version 3; default: the built-in weights)");
     if (int rc = atrous::bench::parseArgs(app, argc, argv); rc >= 0) return rc;
     runs = std::max(20, runs);
     Device device = Device::Cpu;

@@ -309,7 +309,17 @@ TEST(LearnedMethodCli, MethodsWeightsAndExitCodes) {
     // A missing or corrupt weight file: exit 2, one line naming the file, nothing written.
     const std::string junk = dir / "junk.atrl";
     std::ofstream(junk) << "ATRL but not really";
-    for (const std::string& bad : {dir / "missing.atrl", junk}) {
+    // A retired version-2 file (the fixture's bytes relabelled, checksum fixed).
+    const std::string v2 = dir / "v2.atrl";
+    {
+        std::vector<std::uint8_t> w = test::fixture().weights;
+        w[4] = 2;
+        std::uint32_t h = 0x811C9DC5u;
+        for (size_t i = 0; i + 4 < w.size(); ++i) h = (h ^ w[i]) * 0x01000193u;
+        std::memcpy(&w[w.size() - 4], &h, 4);
+        std::ofstream(v2, std::ios::binary).write(reinterpret_cast<const char*>(w.data()), std::streamsize(w.size()));
+    }
+    for (const std::string& bad : {dir / "missing.atrl", junk, v2}) {
         r = test::runCli("denoise --in " + in + " --out " + out + " --method learned --learned-weights " + bad);
         EXPECT_EQ(r.exitCode, 2) << r.output;
         EXPECT_NE(r.output.find(bad), std::string::npos) << r.output;
@@ -317,6 +327,11 @@ TEST(LearnedMethodCli, MethodsWeightsAndExitCodes) {
         EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
         EXPECT_FALSE(std::filesystem::exists(out));
     }
+    r = test::runCli("denoise --in " + in + " --out " + out + " --method learned --learned-weights " + v2);
+    EXPECT_NE(r.output.find("version 2 (the network without the noise-relative colour term, retired); retrain with "
+                            "make train"),
+              std::string::npos)
+        << r.output;
     r = test::runCli("denoise --in " + in + " --out " + out + " --method learnt");
     EXPECT_EQ(r.exitCode, 2) << r.output;
     // --levels is noted as ignored by learned; --learned-weights as ignored by eaw.

@@ -1,4 +1,4 @@
-// The learned filter v2 on the CPU (filters/learned.h): pass A per pixel (vectorised x loop),
+// The learned filter v3 on the CPU (filters/learned.h): pass A per pixel (vectorised x loop),
 // pass B row-wise (the 3x3 box as column sums once per row, then the MLP on 16 pixels at a time
 // with the pixel index innermost: the lane loops of learnedMlp<16> become vector instructions),
 // the five levels through the shared row engine (src/cpu/atrous_rows.h) with the LearnedStop
@@ -27,17 +27,20 @@ constexpr uintptr_t kHuge = uintptr_t(2) << 20;
 
 // Pass A over the flat pixel range [i0, i1) (LearnedLogPass's math, contiguous pointers).
 struct LogRange {
-    const float *r, *g, *b;
-    float *lr, *lg, *lb, *L;
+    const float *r, *g, *b, *vr, *vg, *vb;
+    float *lr, *lg, *lb, *L, *v;
     ATROUS_FORCE_INLINE void operator()(size_t i0, size_t i1) const {
         const float *ATROUS_RESTRICT R = r, *ATROUS_RESTRICT G = g, *ATROUS_RESTRICT B = b;
-        float *ATROUS_RESTRICT oR = lr, *ATROUS_RESTRICT oG = lg, *ATROUS_RESTRICT oB = lb, *ATROUS_RESTRICT oL = L;
+        const float *ATROUS_RESTRICT VR = vr, *ATROUS_RESTRICT VG = vg, *ATROUS_RESTRICT VB = vb;
+        float *ATROUS_RESTRICT oR = lr, *ATROUS_RESTRICT oG = lg, *ATROUS_RESTRICT oB = lb, *ATROUS_RESTRICT oL = L,
+                               *ATROUS_RESTRICT oV = v;
 #pragma omp simd
         for (size_t i = i0; i < i1; ++i) {
             oR[i] = learnedLogColour(R[i]);
             oG[i] = learnedLogColour(G[i]);
             oB[i] = learnedLogColour(B[i]);
             oL[i] = learnedLum(R[i], G[i], B[i]);
+            oV[i] = learnedVariance(VR[i], VG[i], VB[i]);
         }
     }
 };
@@ -143,7 +146,8 @@ void runLearned(const CpuExec& exec, const LearnedWeights& weights, const Learne
     };
     LearnedTemps T;
     T.lg = alloc(4), T.feat = alloc(kLearnedFeat), T.a = alloc(kLearnedLevels), T.m = alloc(kLearnedLevels);
-    T.bk = alloc(kLearnedLevels), T.beta = alloc(kLearnedLevels + 1), T.buf = alloc(3);
+    T.bk = alloc(kLearnedLevels), T.c = alloc(kLearnedLevels), T.beta = alloc(kLearnedLevels + 1), T.buf = alloc(3);
+    T.v = alloc(1);
     const LearnedNet* net = &weights.impl->net;
     LearnedStageTimes local;
     LearnedStageTimes& t = times ? *times : local;
@@ -153,8 +157,9 @@ void runLearned(const CpuExec& exec, const LearnedWeights& weights, const Learne
         return;
     }
     cpu::parallelForIsa(cpu::activeIsa(), size_t(0), in.d.plane(), size_t(16384),
-                        LogRange{in.d.channel(0), in.d.channel(1), in.d.channel(2), T.lg.channel(0), T.lg.channel(1),
-                                 T.lg.channel(2), T.lg.channel(3)});
+                        LogRange{in.d.channel(0), in.d.channel(1), in.d.channel(2), in.var.channel(0),
+                                 in.var.channel(1), in.var.channel(2), T.lg.channel(0), T.lg.channel(1),
+                                 T.lg.channel(2), T.lg.channel(3), T.v.channel(0)});
     clock.mark(t.logs, t.cpuLogs);
     cpu::parallelForIsa(cpu::activeIsa(), 0, h, 2, NetRows{net, in, T, out});
     clock.mark(t.network, t.cpuNetwork);

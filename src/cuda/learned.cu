@@ -1,4 +1,4 @@
-// The learned filter v2 on the GPU: the functors of filters/learned.h launched by CudaExec (pass A,
+// The learned filter v3 on the GPU: the functors of filters/learned.h launched by CudaExec (pass A,
 // pass B one thread per pixel with the MLP in registers, the five levels as AtrousLevel<LearnedStop>).
 // The weights are copied to the device once per call; the temporaries are one device image.
 #include <chrono>

@@ -1,15 +1,18 @@
-// The learned filter v2 (docs/learned.md) on the still driver's prepared planes: the functors of
+// The learned filter v3 (docs/learned.md) on the still driver's prepared planes: the functors of
 // its passes, host and device, and the two entry points runLearned (CpuExec: src/cpu/learned_cpu.cpp;
 // CudaExec: src/cuda/learned.cu). The same math as python/atrous/learn/model.py and features.py;
 // tests/learned_test.cpp holds them equal on tests/learned_fixture.bin.
 //
-//   pass A  LearnedLogPass      lg = log1p(max(d, 0)) (3), L = log1p(max(mean_c d_c, 0))
+//   pass A  LearnedLogPass      lg = log1p(max(d, 0)) (3), L = log1p(max(mean_c d_c, 0)),
+//                               v = max(mean_c var_c, 0) (the noise plane, every level's)
 //   pass B  LearnedNetPixel     the 15 inputs (3x3 box statistics of lg and L), the MLP, and from its
-//                               outputs f, a_i, m_i, b_i (b_0 kappa_0), softmax(beta); acc = beta_0 d_0
+//                               outputs f, a_i, m_i, b_i (b_0 kappa_0), c_i, softmax(beta); acc = beta_0 d_0
 //   level i LearnedStop<kLast>  an edge-stop policy of the shared à-trous level (atrous_level.h):
-//                               w = h(q) exp(-a_i |f_p - f_q|^2 - b_i kappa_i sum_c (d_i(q) - d_i(p))^2),
-//                               centre h(0)^2 (1 + m_i); its finish writes d_{i+1}, acc += beta_{i+1}
-//                               d_{i+1} and b_{i+1} kappa_{i+1} (kappa of d_{i+1}, for the next level)
+//                               w = h(q) exp(-a_i |f_p - f_q|^2 - (b_i kappa_i + c_i nu_i(p, q)) D),
+//                               D = sum_c (d_i(q) - d_i(p))^2, nu_i = 1 / (v(p) + v(q) + 0.001 (0.01 +
+//                               mean_c d_i(p)^2)), centre h(0)^2 (1 + m_i); its finish writes d_{i+1},
+//                               acc += beta_{i+1} d_{i+1} and b_{i+1} kappa_{i+1} (kappa of d_{i+1}, for
+//                               the next level)
 // The output is acc. On the CPU, pass B runs row-wise with 16 pixels per MLP call and the levels
 // through the row engine (src/cpu/learned_cpu.cpp); the functors are its reference.
 #pragma once
@@ -59,10 +62,12 @@ struct LearnedTemps {
     ImageView feat;  // kLearnedFeat: f
     ImageView a, m;  // kLearnedLevels each
     ImageView bk;    // kLearnedLevels: b_i, scaled to b_i kappa_i before level i
+    ImageView c;     // kLearnedLevels: c_i
     ImageView beta;  // kLearnedLevels + 1: softmax(beta)
     ImageView buf;   // 3: d_2, d_4
+    ImageView v;     // 1: the noise plane v
 };
-constexpr int kLearnedTempChannels = 4 + kLearnedFeat + 3 * kLearnedLevels + (kLearnedLevels + 1) + 3;
+constexpr int kLearnedTempChannels = 4 + kLearnedFeat + 4 * kLearnedLevels + (kLearnedLevels + 1) + 3 + 1;
 inline LearnedTemps learnedTemps(float* base, int w, int h) {
     const size_t plane = size_t(w) * size_t(h);
     LearnedTemps t;
@@ -73,19 +78,21 @@ inline LearnedTemps learnedTemps(float* base, int w, int h) {
         return v;
     };
     t.lg = take(4), t.feat = take(kLearnedFeat), t.a = take(kLearnedLevels), t.m = take(kLearnedLevels);
-    t.bk = take(kLearnedLevels), t.beta = take(kLearnedLevels + 1), t.buf = take(3);
+    t.bk = take(kLearnedLevels), t.c = take(kLearnedLevels), t.beta = take(kLearnedLevels + 1), t.buf = take(3);
+    t.v = take(1);
     return t;
 }
 
 // Pass A.
 struct LearnedLogPass {
-    ImageView d, lg;
+    ImageView d, var, lg, v;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         const float r = d(x, y, 0), g = d(x, y, 1), b = d(x, y, 2);
         lg(x, y, 0) = learnedLogColour(r);
         lg(x, y, 1) = learnedLogColour(g);
         lg(x, y, 2) = learnedLogColour(b);
         lg(x, y, 3) = learnedLum(r, g, b);
+        v(x, y, 0) = learnedVariance(var(x, y, 0), var(x, y, 1), var(x, y, 2));
     }
 };
 
@@ -144,7 +151,7 @@ ATROUS_FORCE_INLINE ATROUS_INLINE void learnedBoxInputs(const float* const (&V)[
                                    learnedBox(vL2[l], vL2[l + 1], vL2[l + 2], inv[l]));
 }
 
-// From the raw outputs y of lanes 0 .. n - 1 (pixels i0 ..): f, a_i, m_i, b_i (b_0 kappa_0 of d),
+// From the raw outputs y of lanes 0 .. n - 1 (pixels i0 ..): f, a_i, m_i, b_i (b_0 kappa_0 of d), c_i,
 // softmax(beta), acc = beta_0 d. Non-finite outputs (only from absurd weights) read as 0.
 template <int N>
 ATROUS_FORCE_INLINE ATROUS_INLINE void learnedWriteOutputs(const float (&y)[kLearnedOut][N], const ImageView& d,
@@ -156,9 +163,11 @@ ATROUS_FORCE_INLINE ATROUS_INLINE void learnedWriteOutputs(const float (&y)[kLea
     }
     const float *dr = d.channel(0) + i0, *dg = d.channel(1) + i0, *db = d.channel(2) + i0;
     for (int i = 0; i < kLearnedLevels; ++i) {
-        float *oa = T.a.channel(i) + i0, *om = T.m.channel(i) + i0, *ob = T.bk.channel(i) + i0;
+        float *oa = T.a.channel(i) + i0, *om = T.m.channel(i) + i0, *ob = T.bk.channel(i) + i0,
+              *oc = T.c.channel(i) + i0;
         for (int l = 0; l < n; ++l) oa[l] = learnedSoftplus(learnedFinite(y[kLearnedOutA + i][l]));
         for (int l = 0; l < n; ++l) om[l] = learnedSoftplus(learnedFinite(y[kLearnedOutM + i][l]));
+        for (int l = 0; l < n; ++l) oc[l] = learnedSoftplus(learnedFinite(y[kLearnedOutC + i][l]));
         if (i == 0)
             for (int l = 0; l < n; ++l)
                 ob[l] = learnedSoftplus(learnedFinite(y[kLearnedOutB][l])) * learnedKappa(dr[l], dg[l], db[l]);
@@ -233,19 +242,20 @@ template <bool kLast>
 struct LearnedStop {
     int step_ = 1;
     ImageView dIn, dOut, feat, acc;
-    const float *a = nullptr, *m = nullptr, *bk = nullptr, *beta = nullptr;  // the level's planes; beta_{i+1}
+    // The level's planes; beta_{i+1}; v, the noise plane (every level's).
+    const float *a = nullptr, *m = nullptr, *bk = nullptr, *c = nullptr, *beta = nullptr, *v = nullptr;
     float* bkNext = nullptr;  // b_{i+1}, scaled in place by kappa of d_{i+1} (not when kLast)
 
     static constexpr int kSums = 4;  // Σw, Σw d (3)
     static constexpr bool kCentreTap = true, kRowPartialSums = false, kScalarTaps = false;
     struct Row {
-        const float *r, *g, *b, *a, *m, *bk, *beta;
+        const float *r, *g, *b, *a, *m, *bk, *c, *beta, *v;
         const float* f[kLearnedFeat];
         float *oR, *oG, *oB, *accR, *accG, *accB, *bkNext;
     };
     struct Centre {
         float f[kLearnedFeat];
-        float a, m, bk, r, g, b;
+        float a, m, bk, c, vf, r, g, b;  // vf: nu's floor v(p) + NU_REL (0.01 + mean d_i(p)^2)
     };
     struct TapRow {};
 
@@ -256,7 +266,7 @@ struct LearnedStop {
         const size_t o = size_t(y) * size_t(dIn.width);
         Row R;
         R.r = dIn.channel(0) + o, R.g = dIn.channel(1) + o, R.b = dIn.channel(2) + o;
-        R.a = a + o, R.m = m + o, R.bk = bk + o, R.beta = beta + o;
+        R.a = a + o, R.m = m + o, R.bk = bk + o, R.c = c + o, R.beta = beta + o, R.v = v + o;
         for (int k = 0; k < kLearnedFeat; ++k) R.f[k] = feat.channel(k) + o;
         R.accR = acc.channel(0) + o, R.accG = acc.channel(1) + o, R.accB = acc.channel(2) + o;
         if constexpr (kLast) {
@@ -270,8 +280,9 @@ struct LearnedStop {
     ATROUS_FORCE_INLINE ATROUS_HOST_DEVICE Centre centre(const Row& R, int x) const {
         Centre c;
         for (int k = 0; k < kLearnedFeat; ++k) c.f[k] = R.f[k][x];
-        c.a = R.a[x], c.m = R.m[x], c.bk = R.bk[x];
+        c.a = R.a[x], c.m = R.m[x], c.bk = R.bk[x], c.c = R.c[x];
         c.r = R.r[x], c.g = R.g[x], c.b = R.b[x];
+        c.vf = learnedNuFloor(R.v[x], c.r, c.g, c.b);
         return c;
     }
     ATROUS_HOST_DEVICE TapRow tapRow(int) const { return TapRow{}; }
@@ -286,7 +297,9 @@ struct LearnedStop {
             float df = 0.0f;
             for (int k = 0; k < kLearnedFeat; ++k) df += sq(c.f[k] - R.f[k][q]);
             const float dc = sq(r - c.r) + sq(g - c.g) + sq(b - c.b);
-            w = hxy * fastExp(-(c.a * df + c.bk * dc));  // NaN (0 · inf, absurd weights) gives 0
+            // c.vf > 0 and v(q) >= 0: the division is finite (or c / inf = 0 for an infinite v).
+            const float cnu = c.c / (c.vf + R.v[q]);  // c_i nu_i(p, q)
+            w = hxy * fastExp(-(c.a * df + (c.bk + cnu) * dc));  // NaN (0 · inf, absurd weights) gives 0
         }
         s.s[0] += w;
         s.s[1] += w * r;
@@ -319,7 +332,8 @@ LearnedStop<kLast> learnedStop(const LearnedPlanes& P, const LearnedTemps& T, co
     s.dIn = i == 0 ? P.d : (i % 2 == 1 ? lg3 : T.buf);
     s.dOut = i % 2 == 0 ? lg3 : T.buf;
     s.feat = T.feat, s.acc = acc;
-    s.a = T.a.channel(i), s.m = T.m.channel(i), s.bk = T.bk.channel(i), s.beta = T.beta.channel(i + 1);
+    s.a = T.a.channel(i), s.m = T.m.channel(i), s.bk = T.bk.channel(i), s.c = T.c.channel(i);
+    s.beta = T.beta.channel(i + 1), s.v = T.v.channel(0);
     s.bkNext = kLast ? nullptr : T.bk.channel(i + 1);
     return s;
 }
@@ -330,7 +344,7 @@ template <class Exec>
 void runLearnedFunctors(const Exec& exec, const LearnedNet* net, const LearnedPlanes& P, const LearnedTemps& T,
                         const ImageView& acc) {
     const int w = P.d.width, h = P.d.height;
-    exec.forEachPixel(w, h, LearnedLogPass{P.d, T.lg});
+    exec.forEachPixel(w, h, LearnedLogPass{P.d, P.var, T.lg, T.v});
     exec.forEachPixel(w, h, LearnedNetPixel{net, P, T, acc});
     for (int i = 0; i + 1 < kLearnedLevels; ++i) runAtrousLevelFunctor(exec, learnedStop<false>(P, T, acc, i));
     runAtrousLevelFunctor(exec, learnedStop<true>(P, T, acc, kLearnedLevels - 1));

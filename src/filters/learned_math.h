@@ -1,4 +1,4 @@
-// The learned filter v2's per-pixel math (docs/learned.md), host and device: the network's shape,
+// The learned filter v3's per-pixel math (docs/learned.md), host and device: the network's shape,
 // its parameters, the input transfers, the MLP and its output transfers. Written once; the
 // functors of filters/learned.h (the GPU, and the CPU reference) and the CPU row loops of
 // src/cpu/learned_cpu.cpp call these same functions. Lane-parallel where it matters: learnedMlp<N>
@@ -17,11 +17,15 @@
 namespace atrous::filters {
 
 constexpr int kLearnedIn = 15, kLearnedHidden = 24, kLearnedFeat = 8, kLearnedLevels = 5;
-constexpr int kLearnedOut = kLearnedFeat + 3 * kLearnedLevels + (kLearnedLevels + 1);  // 29
-// Output slices, in the weight file's order: f, a_i, m_i, b_i, beta_j.
+constexpr int kLearnedOut = kLearnedFeat + 4 * kLearnedLevels + (kLearnedLevels + 1);  // 34
+// Output slices, in the weight file's order: f, a_i, m_i, b_i, c_i, beta_j.
 constexpr int kLearnedOutA = kLearnedFeat, kLearnedOutM = kLearnedOutA + kLearnedLevels,
-              kLearnedOutB = kLearnedOutM + kLearnedLevels, kLearnedOutBeta = kLearnedOutB + kLearnedLevels;
+              kLearnedOutB = kLearnedOutM + kLearnedLevels, kLearnedOutC = kLearnedOutB + kLearnedLevels,
+              kLearnedOutBeta = kLearnedOutC + kLearnedLevels;
 constexpr float kLearnedDepthMin = 1e-3f, kLearnedDepthMax = 1e4f, kLearnedKappaEps = 0.01f;
+// nu's floor relative to the pixel's brightness 0.01 + mean_c d^2 (model.py's NU_REL): with v >= 0
+// it keeps nu's denominator >= 1e-5.
+constexpr float kLearnedNuRel = 0.001f;
 
 // The network's parameters, the weight file's order (row-major: w1[i * kLearnedHidden + j] maps
 // input i to unit j).
@@ -31,7 +35,7 @@ struct LearnedNet {
     float w3[kLearnedHidden * kLearnedOut], b3[kLearnedOut];
 };
 constexpr int kLearnedParams = int(sizeof(LearnedNet) / sizeof(float));
-static_assert(kLearnedParams == 1709, "the v2 network has 1709 parameters");
+static_assert(kLearnedParams == 1834, "the v3 network has 1834 parameters");
 
 ATROUS_FORCE_INLINE ATROUS_INLINE float learnedFinite(float v) { return selectF(finite(v), v, 0.0f); }
 // maxSel/minSel (the same values, NaN a gives b) as bit selects: after learnedFinite's select GCC
@@ -81,9 +85,17 @@ ATROUS_FORCE_INLINE ATROUS_INLINE float learnedSoftplus(float x) {
     return learnedMax(x, 0.0f) + learnedLog1p(fastExp(-fabsf(x)));
 }
 
-// kappa = 1 / (0.01 + mean_c d_c^2) of the level's colour at the centre.
+// The brightness 0.01 + mean_c d_c^2 of the level's colour at the centre, and kappa = 1 / it.
+ATROUS_FORCE_INLINE ATROUS_INLINE float learnedBright(float r, float g, float b) {
+    return kLearnedKappaEps + (r * r + g * g + b * b) * (1.0f / 3.0f);
+}
 ATROUS_FORCE_INLINE ATROUS_INLINE float learnedKappa(float r, float g, float b) {
-    return 1.0f / (kLearnedKappaEps + (r * r + g * g + b * b) * (1.0f / 3.0f));
+    return 1.0f / learnedBright(r, g, b);
+}
+// The noise-relative term's floor at the centre: v(p) + NU_REL (0.01 + mean_c d_c^2) (> 0 for v >= 0);
+// nu(p, q) = 1 / (it + v(q)).
+ATROUS_FORCE_INLINE ATROUS_INLINE float learnedNuFloor(float v, float r, float g, float b) {
+    return v + kLearnedNuRel * learnedBright(r, g, b);
 }
 
 // The input transfers (docs/learned.md, "Network inputs"); non-finite plane values read as 0.
@@ -95,9 +107,12 @@ ATROUS_FORCE_INLINE ATROUS_INLINE float learnedAlbedoIn(float a) { return learne
 ATROUS_FORCE_INLINE ATROUS_INLINE float learnedDepthIn(float z) {
     return learnedLog(learnedMin(learnedMax(learnedFinite(z), kLearnedDepthMin), kLearnedDepthMax));
 }
+// The cascade's noise plane v = max(mean_c var_c, 0), non-finite var read as 0 (features.variance_plane).
+ATROUS_FORCE_INLINE ATROUS_INLINE float learnedVariance(float r, float g, float b) {
+    return learnedMax((learnedFinite(r) + learnedFinite(g) + learnedFinite(b)) * (1.0f / 3.0f), 0.0f);
+}
 ATROUS_FORCE_INLINE ATROUS_INLINE float learnedNoiseIn(float r, float g, float b) {
-    const float v = (learnedFinite(r) + learnedFinite(g) + learnedFinite(b)) * (1.0f / 3.0f);
-    return learnedLog1p(sqrtf(learnedMax(v, 0.0f)));
+    return learnedLog1p(sqrtf(learnedVariance(r, g, b)));
 }
 // The 3x3 box of one quantity from its three column sums (left, centre, right; 0 outside the
 // image), inv = 1 / the number of taps inside the image.
@@ -135,7 +150,7 @@ ATROUS_FORCE_INLINE ATROUS_INLINE void learnedLayer(const float* w, const float*
     }
 }
 
-// The MLP on N pixels: x[i][l] input i of lane l -> y[j][l] the 29 raw (linear) outputs.
+// The MLP on N pixels: x[i][l] input i of lane l -> y[j][l] the 34 raw (linear) outputs.
 template <int N>
 ATROUS_FORCE_INLINE ATROUS_INLINE void learnedMlp(const LearnedNet& net, const float (&x)[kLearnedIn][N],
                                                   float (&y)[kLearnedOut][N]) {

@@ -1,4 +1,4 @@
-// The learned filter's weight file, version 2 (python/atrous/learn/weights.py, docs/learned.md):
+// The learned filter's weight file, version 3 (python/atrous/learn/weights.py, docs/learned.md):
 // little-endian "ATRL" | u32 version | u32 n_in, n_hidden, n_feat, n_levels, n_floats | the floats
 // (w1, b1, w2, b2, w3, b3) | u32 FNV-1a 32 of every byte before it. And the plane checks of the
 // two runLearned entry points (filters/learned.h).
@@ -47,9 +47,13 @@ LearnedWeights LearnedWeights::parse(const void* data, size_t size, const std::s
     if (size < 8 || std::memcmp(p, "ATRL", 4) != 0)
         throw InputError(name + ": not an atrous learned-filter weight file (no ATRL header)");
     const std::uint32_t version = u32(p + 4);
+    // The retired versions, named as python/atrous/learn/weights.py names them.
     if (version == 1) throw InputError(name + ": version 1 (the first network, retired); retrain with make train");
-    if (version != 2)
-        throw InputError(name + ": weight file version " + std::to_string(version) + ", this build reads version 2");
+    if (version == 2)
+        throw InputError(name + ": version 2 (the network without the noise-relative colour term, retired); " +
+                         "retrain with make train");
+    if (version != 3)
+        throw InputError(name + ": weight file version " + std::to_string(version) + ", this build reads version 3");
     if (size < kHeaderBytes + 4) throw InputError(name + ": truncated weight file (" + std::to_string(size) + " bytes)");
     const std::uint32_t nIn = u32(p + 8), nHid = u32(p + 12), nFeat = u32(p + 16), nLev = u32(p + 20), n = u32(p + 24);
     if (nIn != kLearnedIn || nHid != kLearnedHidden || nFeat != kLearnedFeat || nLev != kLearnedLevels ||

@@ -1,4 +1,4 @@
-// The learned filter v2 on the GPU (src/cuda/learned.cu: the functors of filters/learned.h through
+// The learned filter v3 on the GPU (src/cuda/learned.cu: the functors of filters/learned.h through
 // CudaExec) against the CPU row engine and the JAX forward pass on tests/learned_fixture.bin.
 // Skips without a CUDA device.
 #include <gtest/gtest.h>
