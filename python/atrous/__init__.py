@@ -200,7 +200,7 @@ def denoise(
     method: "eaw", "sure", "learned" (the learned à-trous filter, docs/learned.md: it uses the
     firefly, emission, albedo and safety-net parameters, not levels, the sigma's or SURE's) or
     "auto" (learned when an albedo and a normal are given, else sure). learned_weights: a weight
-    file (version 2) for "learned"/"auto"; None = the built-in weights; a bad file raises
+    file (version 3) for "learned"/"auto"; None = the built-in weights; a bad file raises
     ValueError naming it. device: "auto" (the arrays' device: CUDA arrays on the GPU, numpy on
     the CPU), "cpu" or "cuda" (numpy inputs are then copied to the GPU and back).
 

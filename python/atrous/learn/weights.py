@@ -1,6 +1,6 @@
 """The learned filter's weight file, version 3 (docs/learned.md, "Weight file"), read by
 src/filters/learned_weights.cpp: little-endian
-  "ATRL" | u32 version (2) | u32 n_in | u32 n_hidden | u32 n_feat | u32 n_levels | u32 n_floats
+  "ATRL" | u32 version (3) | u32 n_in | u32 n_hidden | u32 n_feat | u32 n_levels | u32 n_floats
   | n_floats f32 (w1 [n_in][n_hidden], b1, w2 [n_hidden][n_hidden], b2, w3 [n_hidden][n_out], b3)
   | u32 FNV-1a of every byte before it (n_out = n_feat + 4 n_levels + n_levels + 1). Versions 1 (the first
   network, 11 -> 16 -> 16 -> 18) and 2 (15 -> 24 -> 24 -> 29, no noise-relative colour term) are refused."""
