@@ -1,4 +1,4 @@
-"""The learned filter v2's per-pixel inputs (docs/learned.md, "Inputs"), in numpy, from the still
+"""The learned filter's per-pixel inputs (docs/learned.md, "Inputs"), in numpy, from the still
 driver's prepared planes (atrous.learned_planes: d, var, albedo, normal, depth), exactly as
 src/filters/learned.h computes them. No JAX here: the inputs are not differentiated.
 
