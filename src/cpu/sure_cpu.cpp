@@ -1,4 +1,5 @@
-// CPU fast path of the SURE window passes (filters::SureBoxH, filters::SureChoose). The generic
+// CPU fast path of the SURE window passes (filters::SureBoxH, filters::SureChoose) and of the albedo
+// give-back's window sums (filters::BoxSum, safety_net.h). The generic
 // functors clamp every window index, which kept their x loops scalar; here the horizontal pass
 // adds one window offset at a time over the columns whose window is inside the row (the border columns
 // through the functor), and the vertical pass adds the clamped window rows into a row buffer one
@@ -14,6 +15,7 @@
 
 #include "core/parallel.h"
 #include "cpu/isa_dispatch.h"
+#include "filters/safety_net.h"
 #include "filters/sure.h"
 
 namespace atrous::filters {
@@ -96,6 +98,176 @@ void runSureChoose(const CpuExec&, const SureChoose& f) {
             chooseRows<1>(f, range0, range1);
         else
             chooseRows<0>(f, range0, range1);
+    });
+}
+
+// BoxSum along x: the border columns (whose window leaves the row) through the functor, the rest
+// one tap offset at a time, as runSureBoxH; along y: the window's rows added into the output row in
+// order. Both add the same taps in the same order as the functor.
+void runBoxSum(const CpuExec& exec, const BoxSum<false>& f) {
+    const int w = f.in.width, h = f.in.height, r = f.radius;
+    if (w <= 2 * r) {
+        exec.forEachPixel(w, h, f);
+        return;
+    }
+    cpu::parallelForIsa(cpu::activeIsa(), 0, h, 16, [&](int range0, int range1) {
+        const BoxSum<false> g = f;
+        for (int y = range0; y < range1; ++y) {
+            for (int x = 0; x < r; ++x) g(x, y);
+            for (int c = 0; c < g.in.channels; ++c) {
+                const size_t o = size_t(y) * w;
+                const float* ATROUS_RESTRICT in = g.in.channel(c) + o;
+                float* ATROUS_RESTRICT out = g.out.channel(c) + o;
+                for (int x = r; x < w - r; ++x) out[x] = 0.0f;
+                for (int dx = -r; dx <= r; ++dx) {
+#pragma omp simd
+                    for (int x = r; x < w - r; ++x) out[x] += in[x + dx];
+                }
+            }
+            for (int x = w - r; x < w; ++x) g(x, y);
+        }
+    });
+}
+
+void runBoxSum(const CpuExec&, const BoxSum<true>& f) {
+    const int w = f.in.width, h = f.in.height, r = f.radius;
+    cpu::parallelForIsa(cpu::activeIsa(), 0, h, 16, [&](int range0, int range1) {
+        for (int y = range0; y < range1; ++y) {
+            const int lo = y - r < 0 ? 0 : y - r, hi = y + r > h - 1 ? h - 1 : y + r;
+            for (int c = 0; c < f.in.channels; ++c) {
+                float* ATROUS_RESTRICT out = f.out.channel(c) + size_t(y) * w;
+                for (int x = 0; x < w; ++x) out[x] = 0.0f;
+                for (int j = lo; j <= hi; ++j) {
+                    const float* ATROUS_RESTRICT in = f.in.channel(c) + size_t(j) * w;
+#pragma omp simd
+                    for (int x = 0; x < w; ++x) out[x] += in[x];
+                }
+            }
+        }
+    });
+}
+
+namespace {
+
+// Window sums along a row over the in-row taps, in tap order (as BoxSum<false>): the border columns
+// one by one, the rest one tap offset at a time.
+void rowWindowSums(const float* ATROUS_RESTRICT in, float* ATROUS_RESTRICT out, int w, int r) {
+    auto border = [&](int x) {
+        const int lo = x - r < 0 ? 0 : x - r, hi = x + r > w - 1 ? w - 1 : x + r;
+        float s = 0.0f;
+        for (int j = lo; j <= hi; ++j) s += in[j];
+        out[x] = s;
+    };
+    for (int x = 0; x < r; ++x) border(x);
+    for (int x = r; x < w - r; ++x) out[x] = 0.0f;
+    for (int dx = -r; dx <= r; ++dx) {
+#pragma omp simd
+        for (int x = r; x < w - r; ++x) out[x] += in[x + dx];
+    }
+    for (int x = w - r; x < w; ++x) border(x);
+}
+
+// The window's column sums (rows y - r..y + r inside the image, added in order, as BoxSum<true>) of
+// row-summed rows, for the rows y0..y1 - 1 of a band: rowFn(j, dst) writes row j's `channels` × w
+// values into dst; each is computed once per band into a ring of 2r + 1 rows (so the row sums of
+// the whole image are never stored), and use(y, sums) takes each row's column sums.
+template <class RowFn, class UseFn>
+void bandColumnSums(int y0, int y1, int h, int w, int r, int channels, RowFn rowFn, UseFn use) {
+    const int slots = 2 * r + 1;
+    const size_t rowSize = size_t(channels) * w;
+    std::vector<float> ring(rowSize * slots), sums(rowSize);
+    int next = y0 - r < 0 ? 0 : y0 - r;  // the first row not computed yet
+    for (int y = y0; y < y1; ++y) {
+        const int lo = y - r < 0 ? 0 : y - r, hi = y + r > h - 1 ? h - 1 : y + r;
+        for (; next <= hi; ++next) rowFn(next, ring.data() + rowSize * size_t(next % slots));
+        float* ATROUS_RESTRICT out = sums.data();
+        for (size_t i = 0; i < rowSize; ++i) out[i] = 0.0f;
+        for (int j = lo; j <= hi; ++j) {
+            const float* ATROUS_RESTRICT in = ring.data() + rowSize * size_t(j % slots);
+#pragma omp simd
+            for (size_t i = 0; i < rowSize; ++i) out[i] += in[i];
+        }
+        use(y, sums.data());
+    }
+}
+
+}  // namespace
+
+// The give-back's passes fused into row loops over bands of rows: (1) each row's moments
+// (GiveBackMoments) summed along x, their column sums and the fit (giveBackSlope) per pixel into
+// the coefficients; (2) the coefficients summed along x, their column sums and cN ← F +
+// giveBackTerm. The same per-pixel arithmetic and order of additions as the functors
+// (tests/albedo_giveback_test.cpp compares the two), with no image-sized window sums stored.
+void runAlbedoGiveBack(const CpuExec& exec, const ImageView& input, const ImageView& cN, const ImageView& detailSum,
+                       const ImageView& albedo, int radius, float significance) {
+    const int w = input.width, h = input.height, r = radius;
+    if (w <= 2 * r) {
+        runAlbedoGiveBack<CpuExec>(exec, input, cN, detailSum, albedo, radius, significance);
+        return;
+    }
+    constexpr int K = kGiveBackMoments;
+    constexpr int kBand = 64;  // rows per task: the ring's 2r rows recomputed per band are ~12% more
+    Image coefStore(w, h, 6);
+    const ImageView C = coefStore.view();
+    const bool sure = detailSum.valid();
+    cpu::parallelForIsa(cpu::activeIsa(), 0, h, kBand, [&](int y0, int y1) {
+        std::vector<float> m(size_t(K) * w);
+        auto moments = [&](int j, float* dst) {
+            const size_t o = size_t(j) * w;
+            for (int c = 0; c < 3; ++c) {
+                const float* ATROUS_RESTRICT in = input.channel(c) + o;
+                const float* ATROUS_RESTRICT fc = cN.channel(c) + o;
+                const float* ATROUS_RESTRICT ds = sure ? detailSum.channel(c) + o : fc;
+                const float* ATROUS_RESTRICT al = albedo.channel(c) + o;
+                float* ATROUS_RESTRICT m0 = m.data() + size_t(5 * c) * w;
+                for (int x = 0; x < w; ++x) {
+                    float f = fc[x];
+                    if (sure) f += ds[x];
+                    const float rr = in[x] - f, a = al[x];
+                    m0[x] = a;
+                    m0[w + x] = rr;
+                    m0[2 * w + x] = a * a;
+                    m0[3 * w + x] = a * rr;
+                    m0[4 * w + x] = rr * rr;
+                }
+            }
+            for (int k = 0; k < K; ++k) rowWindowSums(m.data() + size_t(k) * w, dst + size_t(k) * w, w, r);
+        };
+        auto fit = [&](int y, const float* s) {
+            const size_t o = size_t(y) * w;
+            for (int c = 0; c < 3; ++c) {
+                const float* ATROUS_RESTRICT q = s + size_t(5 * c) * w;
+                float* ATROUS_RESTRICT A = C.channel(c) + o;
+                float* ATROUS_RESTRICT b = C.channel(3 + c) + o;
+#pragma omp simd
+                for (int x = 0; x < w; ++x)
+                    giveBackSlope(significance, boxTaps(r, x, y, w, h), q[x], q[w + x], q[2 * w + x], q[3 * w + x],
+                                  q[4 * w + x], A[x], b[x]);
+            }
+        };
+        bandColumnSums(y0, y1, h, w, r, K, moments, fit);
+    });
+    cpu::parallelForIsa(cpu::activeIsa(), 0, h, kBand, [&](int y0, int y1) {
+        auto coefRow = [&](int j, float* dst) {
+            for (int k = 0; k < 6; ++k) rowWindowSums(C.channel(k) + size_t(j) * w, dst + size_t(k) * w, w, r);
+        };
+        auto apply = [&](int y, const float* s) {
+            const size_t o = size_t(y) * w;
+            for (int c = 0; c < 3; ++c) {
+                float* ATROUS_RESTRICT fc = cN.channel(c) + o;
+                const float* ATROUS_RESTRICT ds = sure ? detailSum.channel(c) + o : fc;
+                const float* ATROUS_RESTRICT al = albedo.channel(c) + o;
+                const float* sA = s + size_t(c) * w;
+                const float* sB = s + size_t(3 + c) * w;
+#pragma omp simd
+                for (int x = 0; x < w; ++x) {
+                    float f = fc[x];
+                    if (sure) f += ds[x];
+                    fc[x] = f + giveBackTerm(sA[x], sB[x], boxTaps(r, x, y, w, h), al[x]);
+                }
+            }
+        };
+        bandColumnSums(y0, y1, h, w, r, 6, coefRow, apply);
     });
 }
 

@@ -82,6 +82,9 @@ struct DriverConfig {
     // capped at kNoiseCapMul times it.
     int noiseRadius = 0;
     float noiseFloorVar[3] = {0, 0, 0};
+    // EAW and SURE with an albedo: the residual the albedo explains goes back after the cascade
+    // (safety_net.h, runAlbedoGiveBack). Off only for tests that measure without it.
+    bool albedoGiveBack = true;
 };
 
 // α_i = true var(d_i) / independence-propagated var(d_i) for the unweighted B3 cascade on white
@@ -237,11 +240,15 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         return;
     }
     // The safety net's input y and its summed variance, kept before the cascade overwrites them.
+    // The albedo give-back reads the same y.
+    const bool giveBack = cfg.albedoGiveBack && !learned && albedo.valid();
     Image safetyIn, safetyVar;
-    if (o.safety.enabled) {
+    if (o.safety.enabled || giveBack) {
         safetyIn = Image(w, h, 3, dev);
-        safetyVar = Image(w, h, 1, dev);
         exec.forEachPixel(w, h, Copy3{cA.view(), safetyIn.view()});
+    }
+    if (o.safety.enabled) {
+        safetyVar = Image(w, h, 1, dev);
         exec.forEachPixel(w, h, SafetyVariance{vA.view(), safetyVar.view()});
     }
     markStage(out.clock, "demodulate");
@@ -346,8 +353,14 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         }
     }
 
-    // 6. The safety net: F' = F + s (y - F), s chosen by SURE on the residual (safety_net.h).
+    // 6. The albedo give-back, F' = F + the part of y - F that the albedo explains (its time is
+    // counted in the next stage), then the safety net: F' = F + s (y - F), s chosen by SURE on the
+    // residual (safety_net.h).
     ImageView detailSum = sure ? acc.view() : ImageView{};
+    if (giveBack) {
+        runAlbedoGiveBack(exec, safetyIn.view(), cur->view(), detailSum, albedo);
+        detailSum = ImageView{};
+    }
     if (o.safety.enabled) {
         if (!sure) {
             detail = Image(w, h, 2, dev);

@@ -72,4 +72,156 @@ struct SafetyBlend {
     }
 };
 
+// The albedo give-back (docs/algorithms.md): the part of the residual r = y - F (demodulated) that
+// the albedo explains is signal the filter took for noise, and goes back into F. Where a renderer's
+// albedo pass does not describe how the texture shades (Cycles' albedo of a diffuse floor differs
+// from what the colour carries; a specular layer the albedo does not multiply), the demodulation
+// c / a' keeps the texture's pattern, the noise estimate reads it as noise and the filter smooths
+// it away. Per channel, over the (2R+1)² window W(p) (in-image taps, n of them):
+//     A = cov_W(a, r) / var_W(a), shrunk by its significance: A · max(0, 1 - k / (n R²)),
+// R² = cov² / (var(a) var(r)) (n R² is the fit's χ² statistic, about 1 on pure noise); then, as a
+// guided filter, F' = F + mean_W(A) a(p) + mean_W(b), b = -A mean_W(a): the slope's part only, not
+// the residual's mean (giving that back too returned the filter's low-frequency noise: 16-spp
+// best/OIDN geomean 1.18 in a prototype). Measured on out/corpus/full (cli_quality.py, docs/quality.md):
+// 16 spp best/OIDN geomean 1.005 -> 0.946, 4 spp 1.009 -> 0.972; cy_textures_box 16 spp EAW
+// 0.0133 -> 0.00934 and SURE 0.0110 -> 0.00834 (input 0.00954), cy_sunsky_thin -24%; no case
+// worse by more than 0.6%. R 4, k 4 (R 3..8, k 1..16 tried; k below 4 let noise back on
+// cy_interior at 4 spp, larger k or R kept less of the texture).
+constexpr int kGiveBackRadius = 4;
+constexpr float kGiveBackSignificance = 4.0f;
+// The albedo must vary over the window by this much (a standard deviation of 0.003, as the noise
+// estimate's fit, kNoiseFitMinVar) for the fit to be taken.
+constexpr float kGiveBackMinVar = 1e-5f;
+constexpr int kGiveBackMoments = 15;  // a, r, a², a r, r² per colour channel
+
+// Per pixel, the five moments of (a, r) per channel: m, 15 channels (5 per colour channel).
+// F = cN + detailSum (SURE) or cN.
+struct GiveBackMoments {
+    ImageView input, cN, detailSum, albedo, m;  // detailSum may be invalid
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        for (int c = 0; c < 3; ++c) {
+            float f = cN(x, y, c);
+            if (detailSum.valid()) f += detailSum(x, y, c);
+            const float r = input(x, y, c) - f, a = albedo(x, y, c);
+            m(x, y, 5 * c + 0) = a;
+            m(x, y, 5 * c + 1) = r;
+            m(x, y, 5 * c + 2) = a * a;
+            m(x, y, 5 * c + 3) = a * r;
+            m(x, y, 5 * c + 4) = r * r;
+        }
+    }
+};
+
+// Window sums of every channel along x (kVertical false: x - R..x + R) or y, over the taps inside
+// the image, added in tap order. The CPU overload of runBoxSum (src/cpu/sure_cpu.cpp) adds the same
+// taps in the same order in vectorised row loops.
+template <bool kVertical>
+struct BoxSum {
+    int radius;
+    ImageView in, out;  // the same channel count
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        const int n = kVertical ? in.height : in.width, i = kVertical ? y : x;
+        const int lo = i - radius < 0 ? 0 : i - radius, hi = i + radius > n - 1 ? n - 1 : i + radius;
+        for (int c = 0; c < in.channels; ++c) {
+            float s = 0.0f;
+            for (int j = lo; j <= hi; ++j) s += kVertical ? in(x, j, c) : in(j, y, c);
+            out(x, y, c) = s;
+        }
+    }
+};
+template <class Exec, bool kVertical>
+void runBoxSum(const Exec& exec, const BoxSum<kVertical>& f) {
+    exec.forEachPixel(f.in.width, f.in.height, f);
+}
+void runBoxSum(const CpuExec& exec, const BoxSum<false>& f);
+void runBoxSum(const CpuExec& exec, const BoxSum<true>& f);
+
+// The number of in-image taps of p's window.
+ATROUS_INLINE float boxTaps(int radius, int x, int y, int w, int h) {
+    const int nx = (x + radius < w - 1 ? x + radius : w - 1) - (x - radius > 0 ? x - radius : 0) + 1;
+    const int ny = (y + radius < h - 1 ? y + radius : h - 1) - (y - radius > 0 ? y - radius : 0) + 1;
+    return float(nx * ny);
+}
+
+// The window's shrunk slope A and offset b = -A mean(a) from its sums of a, r, a², a r, r² over n taps.
+ATROUS_INLINE void giveBackSlope(float significance, float n, float sa, float sr, float saa, float sar, float srr,
+                                 float& A, float& b) {
+    const float inv = 1.0f / n;
+    const float ma = sa * inv, mr = sr * inv;
+    const float va = saa * inv - ma * ma, car = sar * inv - ma * mr, vr = srr * inv - mr * mr;
+    float s = 0.0f;
+    if (va > kGiveBackMinVar && vr > 0.0f) {
+        const float r2 = car * car / (va * vr);  // in [0, 1] up to rounding
+        const float keep = minSel(maxSel(1.0f - significance / (n * maxSel(r2, 1e-30f)), 0.0f), 1.0f);
+        s = car / va * keep;
+    }
+    A = finite(s) ? s : 0.0f;
+    b = -A * ma;
+}
+
+// What goes back at p: mean_W(A) a(p) + mean_W(b) from the window sums of A and b over n taps
+// (0 where not finite).
+ATROUS_INLINE float giveBackTerm(float sumA, float sumB, float n, float a) {
+    const float inv = 1.0f / n;
+    const float g = sumA * inv * a + sumB * inv;
+    return finite(g) ? g : 0.0f;
+}
+
+// The window's shrunk slope A_c and offset b_c = -A_c mean_W(a_c) per channel (coef: 6 channels,
+// A rgb then b rgb), from the window sums of the moments.
+struct GiveBackFit {
+    int radius = kGiveBackRadius;
+    float significance = kGiveBackSignificance;
+    ImageView sums, coef;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        const float n = boxTaps(radius, x, y, sums.width, sums.height);
+        for (int c = 0; c < 3; ++c) {
+            float A, b;
+            giveBackSlope(significance, n, sums(x, y, 5 * c), sums(x, y, 5 * c + 1), sums(x, y, 5 * c + 2),
+                          sums(x, y, 5 * c + 3), sums(x, y, 5 * c + 4), A, b);
+            coef(x, y, c) = A;
+            coef(x, y, 3 + c) = b;
+        }
+    }
+};
+
+// cN ← F + mean_W(A) a(p) + mean_W(b) in place, from the window sums of the coefficients (detailSum
+// folded in: Remodulate then runs without it).
+struct GiveBackApply {
+    int radius = kGiveBackRadius;
+    ImageView sums, albedo, cN, detailSum;  // detailSum may be invalid
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        const float n = boxTaps(radius, x, y, sums.width, sums.height);
+        for (int c = 0; c < 3; ++c) {
+            float f = cN(x, y, c);
+            if (detailSum.valid()) f += detailSum(x, y, c);
+            cN(x, y, c) = f + giveBackTerm(sums(x, y, c), sums(x, y, 3 + c), n, albedo(x, y, c));
+        }
+    }
+};
+
+// The passes on `exec`: cN ← F + the albedo-explained residual of y (input) against F. The CpuExec
+// overload (src/cpu/sure_cpu.cpp) fuses them into row loops with the same arithmetic.
+template <class Exec>
+void runAlbedoGiveBack(const Exec& exec, const ImageView& input, const ImageView& cN, const ImageView& detailSum,
+                       const ImageView& albedo, int radius = kGiveBackRadius,
+                       float significance = kGiveBackSignificance) {
+    const int w = input.width, h = input.height;
+    const Device dev = exec.device();
+    Image m(w, h, kGiveBackMoments, dev), t(w, h, kGiveBackMoments, dev);
+    exec.forEachPixel(w, h, GiveBackMoments{input, cN, detailSum, albedo, m.view()});
+    runBoxSum(exec, BoxSum<false>{radius, m.view(), t.view()});
+    runBoxSum(exec, BoxSum<true>{radius, t.view(), m.view()});
+    // The coefficients and their sums in the first 6 planes of the same buffers.
+    const ImageView coefM{m.data(), w, h, 6}, coefT{t.data(), w, h, 6};
+    exec.forEachPixel(w, h, GiveBackFit{radius, significance, m.view(), coefT});
+    runBoxSum(exec, BoxSum<false>{radius, coefT, coefM});
+    runBoxSum(exec, BoxSum<true>{radius, coefM, coefT});
+    exec.forEachPixel(w, h, GiveBackApply{radius, coefT, albedo, cN, detailSum});
+    exec.synchronize();  // before the temporaries die
+}
+void runAlbedoGiveBack(const CpuExec& exec, const ImageView& input, const ImageView& cN, const ImageView& detailSum,
+                       const ImageView& albedo, int radius = kGiveBackRadius,
+                       float significance = kGiveBackSignificance);
+
 }  // namespace atrous::filters
