@@ -368,6 +368,7 @@ TEST(SvgfParamsTest, EveryFieldChangesTheOutput) {
         {"emissionAlpha", [](SvgfParams& p) { p.emissionAlpha = 0.5f; }, &base},
         {"emissionMotionAlpha", [](SvgfParams& p) { p.emissionMotionAlpha = 0.0f; }, &base},
         {"historyClip", [](SvgfParams& p) { p.historyClip = 0.0f; }, &base},
+        {"learnedSpatial", [](SvgfParams& p) { p.learnedSpatial = true; }, &base},
     };
     for (const auto& c : cases) {
         SvgfParams p;

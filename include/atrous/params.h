@@ -206,6 +206,8 @@ inline const ParamField<P> kSvgf[] = {
      "minimum temporal blend factor of the emission (3x3-clamped history; 1 = the raw emission)"},
     {"emission_motion_alpha", &at<&P::emissionMotionAlpha>, paramAtLeast(0),
      "emission blend factor at least this times the motion across a light's edge, pixels per frame (0 = off)"},
+    {"learned_spatial", &at<&P::learnedSpatial>, {},
+     "the learned a-trous cascade (built-in weights) as the spatial filter instead of SVGF's a-trous"},
 };
 
 // threads: a ceiling, since tbb::task_arena aborts in its destructor from 65537 threads on

@@ -58,6 +58,12 @@ struct SvgfParams {
     // (0 = off). Defaults measured on cornell orbit / cornell-moving (docs/quality.md, SVGF).
     float emissionAlpha = 0.1f;
     float emissionMotionAlpha = 4.0f;
+    // The spatial filter: false = SVGF's à-trous (the edge stops above), true = the learned
+    // à-trous cascade with the built-in weights (docs/learned.md) on the accumulated illumination,
+    // SVGF's variance (scaled to the accumulation's, svgf_learned.h) and the frame's albedo, normal
+    // and depth. The temporal half is the same: with feedbackTap >= 0 SVGF's à-trous levels
+    // 0..feedbackTap still run for the colour history only, so the history is SVGF's own.
+    bool learnedSpatial = false;
 };
 
 // Throws ParamError (atrous/params.h: an InputError naming the field, `sigma_l`) when a
@@ -80,7 +86,7 @@ struct SvgfFrame {
 
 // What the last timed frame did: per-stage times (SvgfDenoiser::setReport).
 struct SvgfReport {
-    std::vector<StageTime> stages;  // demodulate, reproject, accumulate, variance, level i, remodulate, taa
+    std::vector<StageTime> stages;  // demodulate, reproject, accumulate, variance, level i, learned, remodulate, taa
     double milliseconds = 0;        // sum of the stages (the frame's filter time, uploads excluded)
 };
 

@@ -8,12 +8,15 @@
 #include <utility>
 
 #include "atrous/error.h"
+#include "atrous/learned.h"
 #include "atrous/svgf.h"
+#include "filters/learned.h"
 #include "filters/stage_clock.h"
 #include "filters/svgf_accumulate.h"
 #include "filters/svgf_atrous.h"
 #include "filters/svgf_emission.h"
 #include "filters/svgf_gbuffer.h"
+#include "filters/svgf_learned.h"
 #include "filters/svgf_reproject.h"
 #include "filters/svgf_taa.h"
 #include "filters/svgf_variance.h"
@@ -61,6 +64,7 @@ struct SvgfState {
     Image levelIllum[2], levelVariance[2], nextHistIllum;
     Image output, taaOutput, accEmission, accEmissionLength;
     Image lumStop;  // the à-trous level's luminance stop (Atrous::lumStop)
+    Image learnedVar, learnedOut;  // learnedSpatial: the cascade's var and d_out (3 channels each)
     const Image* result = nullptr;  // output or taaHistory after the last run
 
     void allocate(int w, int h, Device d) {
@@ -77,6 +81,7 @@ struct SvgfState {
         accIllum = make(3), accMoments = make(2), accLength = make(1), variance = make(1);
         for (int i = 0; i < 2; ++i) levelIllum[i] = make(3), levelVariance[i] = make(1);
         nextHistIllum = make(3), lumStop = make(1);
+        learnedVar = Image(), learnedOut = Image();  // made by the first learned frame
         output = make(3), taaOutput = make(3);
         histEmission = make(3), histEmissionLength = make(1), accEmission = make(3), accEmissionLength = make(1);
         result = nullptr;
@@ -88,6 +93,7 @@ class SvgfPipeline {
 public:
     explicit SvgfPipeline(const SvgfParams& params, Exec exec = Exec{}) : mParams(params), mExec(exec) {
         validateSvgfParams(params);
+        if (params.learnedSpatial) mLearned = LearnedWeights::builtin();
     }
 
     void reset() {
@@ -168,9 +174,12 @@ public:
         filters::markStage(clock, "variance");
 
         // À-trous levels, ping-ponging between two buffers; the level at the feedback tap writes
-        // straight into next frame's colour history instead (no copy).
+        // straight into next frame's colour history instead (no copy). With the learned spatial
+        // filter only the levels up to the feedback tap run, for the history alone.
+        const int svgfLevels =
+            mParams.learnedSpatial ? (mParams.levels > 0 ? mParams.feedbackTap + 1 : 0) : mParams.levels;
         ImageView inIllum = s.accIllum.view(), inVar = s.variance.view();
-        for (int level = 0; level < mParams.levels; ++level) {
+        for (int level = 0; level < svgfLevels; ++level) {
             Atrous at;
             at.sigmaL = mParams.sigmaL, at.sigmaN = mParams.sigmaN, at.sigmaZ = mParams.sigmaZ;
             at.step = 1 << level;
@@ -183,6 +192,19 @@ public:
             filters::markStage(clock, "level", level);
             inIllum = at.outIllum;
             inVar = at.outVariance;
+        }
+        if (mParams.learnedSpatial) {
+            // The learned cascade on the accumulation (svgf_learned.h): its output is what is
+            // remodulated; the frame's own albedo, normal and depth where they were given.
+            if (s.learnedOut.empty()) s.learnedVar = Image(w, h, 3, dev), s.learnedOut = Image(w, h, 3, dev);
+            mExec.forEachPixel(w, h, LearnedInputVariance{mParams.alpha, s.variance.view(), s.accLength.view(),
+                                                          s.learnedVar.view()});
+            const filters::LearnedPlanes planes{s.accIllum.view(), s.learnedVar.view(), albedo,
+                                                normalIn.valid() ? s.normal.view() : ImageView{},
+                                                depthIn.valid() ? s.depth.view() : ImageView{}};
+            filters::runLearned(mExec, mLearned, planes, s.learnedOut.view());
+            filters::markStage(clock, "learned");
+            inIllum = s.learnedOut.view();
         }
 
         // Emission: with a buffer and emissionAlpha < 1 the accumulated emission is added back
@@ -259,6 +281,7 @@ public:
 
 private:
     SvgfParams mParams;
+    LearnedWeights mLearned;  // learnedSpatial: the built-in weights
     Exec mExec;
     SvgfState mState;
     SvgfReport* mReport = nullptr;

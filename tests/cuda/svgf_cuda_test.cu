@@ -76,3 +76,32 @@ TEST(SvgfCuda, MatchesTheCpuBackend) {
         }
     }
 }
+
+// The learned spatial filter (SvgfParams::learnedSpatial): the same SVGF stages and the learned
+// cascade's functors on both sides (filters/learned.h; the CPU runs its row engine, held to the
+// functors by tests/svgf_learned_test.cpp). The same bound as above: the cascade alone is held to
+// 1e-5 (tests/cuda/learned_cuda_test.cu), SVGF's own stages dominate.
+TEST(SvgfCuda, LearnedSpatialMatchesTheCpuBackend) {
+    if (!cudaAvailable()) GTEST_SKIP() << "no CUDA device";
+    for (int tap : {0, -1}) {
+        SvgfParams p;
+        p.learnedSpatial = true;
+        p.feedbackTap = tap;
+        SvgfDenoiser cpu(p, Device::Cpu), gpu(p, Device::Cuda);
+        for (int t = 0; t < 5; ++t) {
+            Frame f = makeFrame(96, 64, t);
+            SvgfFrame in;
+            in.color = &f.color, in.albedo = &f.albedo, in.normal = &f.normal;
+            in.depth = &f.depth, in.ids = &f.ids, in.motion = &f.motion, in.emission = &f.emission;
+            Image a = cpu.denoiseFrame(in);
+            Image b = gpu.denoiseFrame(in);
+            ASSERT_EQ(a.size(), b.size());
+            float maxDiff = 0.0f;
+            for (size_t i = 0; i < a.size(); ++i) {
+                ASSERT_TRUE(std::isfinite(b.data()[i]));
+                maxDiff = std::fmax(maxDiff, std::fabs(a.data()[i] - b.data()[i]) / (1.0f + std::fabs(a.data()[i])));
+            }
+            EXPECT_LT(maxDiff, 2e-3f) << "frame " << t << ", feedback tap " << tap;
+        }
+    }
+}
