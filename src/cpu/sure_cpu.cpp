@@ -220,6 +220,7 @@ void runAlbedoGiveBack(const CpuExec& exec, const ImageView& input, const ImageV
                 const float* ATROUS_RESTRICT ds = sure ? detailSum.channel(c) + o : fc;
                 const float* ATROUS_RESTRICT al = albedo.channel(c) + o;
                 float* ATROUS_RESTRICT m0 = m.data() + size_t(5 * c) * w;
+#pragma omp simd
                 for (int x = 0; x < w; ++x) {
                     float f = fc[x];
                     if (sure) f += ds[x];
