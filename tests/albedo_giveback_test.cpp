@@ -178,3 +178,27 @@ TEST(AlbedoGiveBack, CpuRowLoopsMatchTheFunctors) {
         }
     }
 }
+
+TEST(AlbedoGiveBack, ExtremeAlbedoKeepsTheOutputFinite) {
+    // The driver hands over a sanitised albedo (finite, in [0, 1]); called directly with albedo
+    // values whose squares overflow (1e30) and non-finite ones, the fit's moments become Inf/NaN
+    // and what goes back must then be 0, not NaN (giveBackSlope, giveBackTerm), on both paths.
+    Image a = checkerAlbedo(), y(kW, kH, 3), F(kW, kH, 3);
+    const float odd[3] = {1e30f, NAN, INFINITY};
+    for (int yy = 0; yy < kH; yy += 3)
+        for (int x = 0; x < kW; x += 5)
+            for (int c = 0; c < 3; ++c) a(x, yy, c) = odd[(x + yy + c) % 3];
+    std::mt19937 rng(8);
+    std::normal_distribution<float> gauss(0.0f, 0.1f);
+    for (size_t i = 0; i < y.size(); ++i) F.data()[i] = 0.6f, y.data()[i] = 0.6f + gauss(rng);
+    for (const bool rows : {false, true}) {
+        Image out = F.clone();
+        if (rows)
+            runAlbedoGiveBack(CpuExec{}, y.view(), out.view(), ImageView{}, a.view());
+        else
+            runAlbedoGiveBack<CpuExec>(CpuExec{}, y.view(), out.view(), ImageView{}, a.view());
+        size_t bad = 0;
+        for (size_t i = 0; i < out.size(); ++i) bad += std::isfinite(out.data()[i]) ? 0 : 1;
+        EXPECT_EQ(bad, 0u) << (rows ? "row loops" : "functors");
+    }
+}
