@@ -175,7 +175,7 @@ TEST(SvgfSequence, EveryParamHasAFlag) {
                           "--svgf-moments-alpha", "0.4", "--svgf-history-cap", "16", "--svgf-levels", "4",
                           "--svgf-feedback-tap", "1", "--svgf-spatial-variance-frames", "2", "--svgf-depth-tolerance", "5",
                           "--svgf-normal-cos", "0.5", "--taa", "--taa-alpha", "0.25", "--svgf-emission-alpha", "0.5",
-                          "--svgf-emission-motion-alpha", "0.75"};
+                          "--svgf-emission-motion-alpha", "0.75", "--svgf-learned-spatial"};
     app.parse(int(sizeof(argv) / sizeof(argv[0])), argv);
     EXPECT_EQ(p.sigmaL, 2.0f);
     EXPECT_EQ(p.sigmaN, 64.0f);
@@ -192,6 +192,26 @@ TEST(SvgfSequence, EveryParamHasAFlag) {
     EXPECT_EQ(p.taaAlpha, 0.25f);
     EXPECT_EQ(p.emissionAlpha, 0.5f);
     EXPECT_EQ(p.emissionMotionAlpha, 0.75f);
+    EXPECT_TRUE(p.learnedSpatial);
+}
+
+// The command with the learned spatial filter (--svgf-learned-spatial): every frame written,
+// finite, and closer to the truth than the input, with the same bound as the SVGF case above.
+TEST(SvgfSequence, DenoiseCommandWithTheLearnedSpatialFilter) {
+    test::TempDir dir;
+    cli::SequenceDenoiseArgs args = sequenceArgs(dir, 48, 32, 0.2f, 4);
+    args.svgf.learnedSpatial = true;
+    SceneOptions o;
+    o.width = 48, o.height = 32;
+    o.noiseSigma = 0.2f;
+    EXPECT_EQ(cli::runSequenceDenoise(args), 0);
+    for (int t = 0; t < 4; ++t) {
+        std::string name = io::sequenceFrameName(t);
+        Image out = io::readImage(dir / ("out/" + name + ".exr"));
+        SynthFrame f = makeFrame(o, t);
+        ASSERT_TRUE(allFinite(out)) << name;
+        EXPECT_LT(mse(out, f.truth), 0.5 * mse(f.color, f.truth)) << name;
+    }
 }
 
 TEST(SvgfSequence, PerFrameEawAlsoRuns) {

@@ -253,7 +253,8 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
         io::writeImage((fs::path(stage) / (name + ".exr")).string(), out);
         io::writePng((fs::path(stage) / (name + ".png")).string(), out, args.exposure);
         if (!args.quiet) {
-            std::printf("%s: %s%s%s %.1f ms", name.c_str(), args.method.c_str(), args.method == "auto" ? " -> " : "",
+            std::printf("%s: %s%s%s %.1f ms", name.c_str(), args.method.c_str(),
+                        args.method == "auto" ? " -> " : (svgf && args.svgf.learnedSpatial ? " (learned spatial)" : ""),
                         args.method == "auto" ? denoiseMethodName(frameReport.methodUsed) : "", ms);
             if (check.tested > 0) std::printf(", %.0f%% reprojects onto the previous frame", 100 * check.kept);
             if (!f.reference.empty())
