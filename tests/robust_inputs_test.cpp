@@ -262,10 +262,12 @@ TEST(RobustInputs, DarkTextureIsDemodulatedWhole) {
             const double now = mse(denoise(s.inputs(withVariance), o), s.truth);
             o.albedoFloor = 0.1f;
             const double before = mse(denoise(s.inputs(withVariance), o), s.truth);
-            // Measured: noisy 0.0154; now 4.5e-6 (EAW) and 5e-5 (SURE), with or without the
-            // variance; floor 0.1: 0.051 with it, 0.103 without (3-7x the noisy input).
+            // Measured: noisy 0.0154; now 4.6e-6 (EAW) and 5e-5 (SURE), with or without the
+            // variance; floor 0.1: 4.3e-4 to 6.6e-4, 8.8x (SURE, variance false) to 100x now (before the
+            // albedo give-back, safety_net.h: 0.051 with the variance, 0.103 without, 3-7x the noisy input).
+            // 4x: half the smallest measured ratio.
             EXPECT_LT(now, noisy / 100) << denoiseMethodName(m) << " variance " << withVariance;
-            EXPECT_GT(before, noisy) << denoiseMethodName(m) << " variance " << withVariance;
+            EXPECT_GT(before, 4 * now) << denoiseMethodName(m) << " variance " << withVariance;
         }
     }
 }
