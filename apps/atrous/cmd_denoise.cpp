@@ -39,7 +39,7 @@ const char* const kGroupEawSure = "EAW, SURE and learned (--method eaw|sure|lear
 const char* const kGroupSure = "SURE (--method sure)";
 const char* const kGroupSvgf = "SVGF (--method svgf)";  // addSvgfOptions' group
 const char* const kGroupBuffers = "Buffers (without --sequence)";
-const char* const kGroupLearned = "Learned (--method learned|auto)";
+const char* const kGroupLearned = "Learned (--method learned|auto, or svgf --svgf-learned-spatial)";
 
 bool learnedMethod(const std::string& method) { return method == "learned" || method == "auto"; }
 
@@ -55,13 +55,15 @@ bool ignoredByLearned(const std::string& flag) {
 }
 
 // One note line on stderr naming the given flags that the chosen method (or --sequence) ignores.
-void noteIgnoredFlags(const CLI::App& cmd, const std::string& method, bool sequence) {
+// learnedSvgf: --method svgf with --svgf-learned-spatial (which reads --learned-weights).
+void noteIgnoredFlags(const CLI::App& cmd, const std::string& method, bool sequence, bool learnedSvgf) {
     std::string ignored, ignoredSeq;
     for (const CLI::Option* opt : cmd.get_options()) {
         if (opt->count() == 0) continue;
         const std::string& g = opt->get_group();
         const bool unused = (g == kGroupEawSure && method == "svgf") || (g == kGroupSure && method != "sure") ||
-                            (g == kGroupSvgf && method != "svgf") || (g == kGroupLearned && !learnedMethod(method)) ||
+                            (g == kGroupSvgf && method != "svgf") ||
+                            (g == kGroupLearned && !learnedMethod(method) && !learnedSvgf) ||
                             (method == "learned" && ignoredByLearned(opt->get_name()));
         if (unused) ignored += (ignored.empty() ? "" : ", ") + opt->get_name();
         if (g == kGroupBuffers && sequence) ignoredSeq += (ignoredSeq.empty() ? "" : ", ") + opt->get_name();
@@ -130,14 +132,16 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     checkParamFlags(o, denoiseParams(), cmd);
     if (a.method == "svgf") checkParamFlags(a.svgf, svgfParams(), cmd);
     o.device = parseDevice(a.device);
-    noteIgnoredFlags(cmd, a.method, sequence);
+    const bool learnedSvgf = a.method == "svgf" && a.svgf.learnedSpatial;
+    noteIgnoredFlags(cmd, a.method, sequence, learnedSvgf);
     // A bad weight file fails here, before any buffer is read or anything written.
-    if (learnedMethod(a.method) && !o.learnedWeights.empty())
-        withFlag("--learned-weights", [&] { return LearnedWeights::load(o.learnedWeights); });
+    LearnedWeights weights;
+    if ((learnedMethod(a.method) || learnedSvgf) && !o.learnedWeights.empty())
+        weights = withFlag("--learned-weights", [&] { return LearnedWeights::load(o.learnedWeights); });
     if (sequence) {
         if (!a.inDir.empty() || !a.color.empty())
             throw InputError("--sequence DIR denoises the frames of DIR: drop --in/--color");
-        runSequenceDenoise(SequenceDenoiseArgs{a.method, a.sequence, a.out, o.device, a.svgf, o});
+        runSequenceDenoise(SequenceDenoiseArgs{a.method, a.sequence, a.out, o.device, a.svgf, o, weights});
         return;
     }
     const std::string ext = io::extensionOf(a.out);

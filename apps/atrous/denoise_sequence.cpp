@@ -199,7 +199,8 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
     std::unique_ptr<SvgfDenoiser> svgfDenoiser;
     DenoiseOptions options = args.frameOptions;
     if (svgf) {
-        svgfDenoiser = std::make_unique<SvgfDenoiser>(args.svgf, args.device);
+        // The weight file was read and checked by cmd_denoise.cpp, before the frames.
+        svgfDenoiser = std::make_unique<SvgfDenoiser>(args.svgf, args.device, args.svgfLearnedWeights);
     } else {
         options.method = parseDenoiseMethod(args.method);
         options.device = args.device;

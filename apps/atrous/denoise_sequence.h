@@ -9,6 +9,7 @@
 
 #include "atrous/denoise.h"
 #include "atrous/device.h"
+#include "atrous/learned.h"
 #include "atrous/svgf.h"
 
 namespace atrous::cli {
@@ -20,6 +21,7 @@ struct SequenceDenoiseArgs {
     Device device = Device::Cpu;
     SvgfParams svgf;              // used by --method svgf
     DenoiseOptions frameOptions;  // used by eaw/sure/learned/auto (method and device are set from the fields above)
+    LearnedWeights svgfLearnedWeights;  // svgf.learnedSpatial's (--learned-weights); empty = the built-in ones
     float exposure = 1.0f;        // of the PNG previews
     bool preview = true;          // animated OUTDIR/preview.mp4 through ffmpeg when it is on PATH
     bool quiet = false;           // no per-frame lines on stdout

@@ -6,6 +6,7 @@
 
 #include "atrous/device.h"
 #include "atrous/image.h"
+#include "atrous/learned.h"
 #include "atrous/stage_time.h"
 
 namespace atrous {
@@ -59,10 +60,11 @@ struct SvgfParams {
     float emissionAlpha = 0.1f;
     float emissionMotionAlpha = 4.0f;
     // The spatial filter: false = SVGF's à-trous (the edge stops above), true = the learned
-    // à-trous cascade with the built-in weights (docs/learned.md) on the accumulated illumination,
-    // SVGF's variance (scaled to the accumulation's, svgf_learned.h) and the frame's albedo, normal
-    // and depth. The temporal half is the same: with feedbackTap >= 0 SVGF's à-trous levels
-    // 0..feedbackTap still run for the colour history only, so the history is SVGF's own.
+    // à-trous cascade (docs/learned.md; the built-in weights or SvgfDenoiser's learnedWeights) on
+    // the accumulated illumination, SVGF's variance (scaled to the accumulation's, svgf_learned.h)
+    // and the frame's albedo, normal and depth. The temporal half is the same: with feedbackTap
+    // >= 0 SVGF's à-trous levels 0..feedbackTap still run for the colour history only, so the
+    // history is SVGF's own.
     bool learnedSpatial = false;
 };
 
@@ -98,8 +100,11 @@ class SvgfBackend;
 // starts a new history. Not thread-safe: one denoiser per stream of frames.
 class SvgfDenoiser {
 public:
-    // Throws InputError for bad params or an unusable device.
-    explicit SvgfDenoiser(const SvgfParams& params = {}, Device device = Device::Cpu);
+    // Throws InputError for bad params or an unusable device. learnedWeights: the learned spatial
+    // filter's (params.learnedSpatial; LearnedWeights::load for a weight file); empty (the
+    // default, no impl) = the built-in weights; unused without learnedSpatial.
+    explicit SvgfDenoiser(const SvgfParams& params = {}, Device device = Device::Cpu,
+                          const LearnedWeights& learnedWeights = {});
     ~SvgfDenoiser();
     SvgfDenoiser(SvgfDenoiser&&) noexcept;
     SvgfDenoiser& operator=(SvgfDenoiser&&) noexcept;

@@ -363,10 +363,14 @@ class Svgf:
 {params}
     """
 
-    def __init__(self, device: str = "auto", **params: Any) -> None:
+    def __init__(self, device: str = "auto", *, learned_weights: Optional["PathLike"] = None,
+                 **params: Any) -> None:
         """device: "auto" (CUDA when this build has a usable GPU, else the CPU, as everywhere in
-        atrous), "cpu" or "cuda". Frames on another device than the filter's are copied over."""
-        self._impl = _core.Svgf(device, dict(params))
+        atrous), "cpu" or "cuda". Frames on another device than the filter's are copied over.
+        learned_weights: a weight file (version 3) for learned_spatial=True; None = the built-in
+        weights; a bad file raises ValueError naming it; unused without learned_spatial."""
+        weights = "" if learned_weights is None else os.fsdecode(os.fspath(learned_weights))
+        self._impl = _core.Svgf(device, weights, dict(params))
 
     def denoise_frame(self, color: Any, *, albedo: Any = None, normal: Any = None, depth: Any = None,
                       ids: Any = None, motion: Any = None, emission: Any = None) -> Any:

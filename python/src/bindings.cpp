@@ -256,10 +256,13 @@ nb::dict pyLearnedPlanes(const Array& color, nb::handle variance, nb::handle alb
 
 class PySvgf {
 public:
-    PySvgf(const std::string& device, nb::dict params) {
+    // learnedWeights: a weight file for learned_spatial ("" = the built-in weights).
+    PySvgf(const std::string& device, const std::string& learnedWeights, nb::dict params) {
         SvgfParams p;
         for (auto [k, v] : params) applyParam(p, svgfParams(), nb::cast<std::string>(k), v, "SVGF");
-        mDenoiser = std::make_unique<SvgfDenoiser>(p, parseDevice(device));
+        const LearnedWeights w = p.learnedSpatial && !learnedWeights.empty() ? LearnedWeights::load(learnedWeights)
+                                                                             : LearnedWeights{};
+        mDenoiser = std::make_unique<SvgfDenoiser>(p, parseDevice(device), w);
     }
     nb::object denoiseFrame(const Array& color, nb::handle albedo, nb::handle normal, nb::handle depth, nb::handle ids,
                             nb::handle motion, nb::handle emission) {
@@ -413,7 +416,8 @@ NB_MODULE(_core, m) {
     m.def("cuda_compiled", &cudaCompiled);
     m.def("device_name", [](const std::string& d) { return deviceName(parseDevice(d)); });
     nb::class_<PySvgf>(m, "Svgf")
-        .def(nb::init<const std::string&, nb::dict>(), nb::arg("device"), nb::arg("params"))
+        .def(nb::init<const std::string&, const std::string&, nb::dict>(), nb::arg("device"), nb::arg("learned_weights"),
+             nb::arg("params"))
         .def("denoise_frame", &PySvgf::denoiseFrame, nb::arg("color"), nb::arg("albedo").none(), nb::arg("normal").none(),
              nb::arg("depth").none(), nb::arg("ids").none(), nb::arg("motion").none(), nb::arg("emission").none())
         .def("reset", &PySvgf::reset)

@@ -126,28 +126,36 @@ struct StageClock {
 }  // namespace
 
 void runLearned(const CpuExec& exec, const LearnedWeights& weights, const LearnedPlanes& in, const ImageView& out,
-                LearnedStageTimes* times) {
+                LearnedStageTimes* times, LearnedCache* cache) {
     checkLearnedPlanes(weights, in, out);
     const int w = in.d.width, h = in.d.height;
     StageClock clock;
     double unused = 0;
     // The temporaries from the scalable allocator (not Images: no zero fill), one allocation per
     // view: at 512x512 each is at most 8 MiB, which the allocator's cache hands back on the next
-    // call (one 36 MiB block was new memory, first touched, every call).
-    std::vector<std::unique_ptr<float, void (*)(void*)>> stores;
-    const size_t plane = size_t(w) * size_t(h);
-    auto alloc = [&](int channels) {
-        const size_t bytes = size_t(channels) * plane * sizeof(float);
-        stores.emplace_back(static_cast<float*>(scalable_aligned_malloc(bytes, 64)), scalable_aligned_free);
-        float* p = stores.back().get();
-        if (!p) throw RuntimeError("out of host memory for the learned filter's planes");
-        adviseHugePages(p, bytes);
-        return ImageView{p, w, h, channels};
-    };
+    // call (one 36 MiB block was new memory, first touched, every call). With a cache they are
+    // kept there for the next call.
+    using Stores = std::vector<std::unique_ptr<float, void (*)(void*)>>;
     LearnedTemps T;
-    T.lg = alloc(4), T.feat = alloc(kLearnedFeat), T.a = alloc(kLearnedLevels), T.m = alloc(kLearnedLevels);
-    T.bk = alloc(kLearnedLevels), T.c = alloc(kLearnedLevels), T.beta = alloc(kLearnedLevels + 1), T.buf = alloc(3);
-    T.v = alloc(1);
+    std::shared_ptr<Stores> stores;
+    if (cache && cache->holds(weights, w, h)) {
+        T = cache->temps;
+    } else {
+        stores = std::make_shared<Stores>();
+        const size_t plane = size_t(w) * size_t(h);
+        auto alloc = [&](int channels) {
+            const size_t bytes = size_t(channels) * plane * sizeof(float);
+            stores->emplace_back(static_cast<float*>(scalable_aligned_malloc(bytes, 64)), scalable_aligned_free);
+            float* p = stores->back().get();
+            if (!p) throw RuntimeError("out of host memory for the learned filter's planes");
+            adviseHugePages(p, bytes);
+            return ImageView{p, w, h, channels};
+        };
+        T.lg = alloc(4), T.feat = alloc(kLearnedFeat), T.a = alloc(kLearnedLevels), T.m = alloc(kLearnedLevels);
+        T.bk = alloc(kLearnedLevels), T.c = alloc(kLearnedLevels), T.beta = alloc(kLearnedLevels + 1), T.buf = alloc(3);
+        T.v = alloc(1);
+        if (cache) *cache = LearnedCache{w, h, weights.impl, stores, T, &weights.impl->net};
+    }
     const LearnedNet* net = &weights.impl->net;
     LearnedStageTimes local;
     LearnedStageTimes& t = times ? *times : local;

@@ -1,6 +1,7 @@
 // The learned filter v3 on the GPU: the functors of filters/learned.h launched by CudaExec (pass A,
 // pass B one thread per pixel with the MLP in registers, the five levels as AtrousLevel<LearnedStop>).
-// The weights are copied to the device once per call; the temporaries are one device image.
+// The weights are copied to the device and the temporaries (one device image) made once per call,
+// or once for all the calls that share a LearnedCache (SVGF's frames).
 #include <chrono>
 
 #include "atrous/error.h"
@@ -11,15 +12,25 @@
 namespace atrous::filters {
 
 void runLearned(const CudaExec& exec, const LearnedWeights& weights, const LearnedPlanes& in, const ImageView& out,
-                LearnedStageTimes* times) {
+                LearnedStageTimes* times, LearnedCache* cache) {
     checkLearnedPlanes(weights, in, out);
     const int w = in.d.width, h = in.d.height;
     const auto t0 = std::chrono::steady_clock::now();
-    cuda::DeviceBuffer<LearnedNet> net(1);
-    net.upload(&weights.impl->net, 1);
-    Image temps(w, h, kLearnedTempChannels, Device::Cuda);
-    const LearnedTemps T = learnedTemps(temps.data(), w, h);
-    runLearnedFunctors(exec, net.data(), in, T, out);
+    // The network's device copy and the temporaries: made here, or kept in the cache.
+    struct Store {
+        cuda::DeviceBuffer<LearnedNet> net{1};
+        Image temps;
+    };
+    LearnedCache local;
+    LearnedCache& c = cache ? *cache : local;
+    if (!c.holds(weights, w, h)) {
+        c = LearnedCache{};  // the old copy goes first (device memory)
+        auto store = std::make_shared<Store>();
+        store->net.upload(&weights.impl->net, 1);
+        store->temps = Image(w, h, kLearnedTempChannels, Device::Cuda);
+        c = LearnedCache{w, h, weights.impl, store, learnedTemps(store->temps.data(), w, h), store->net.data()};
+    }
+    runLearnedFunctors(exec, c.net, in, c.temps, out);
     exec.synchronize();
     if (times) times->levels = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }

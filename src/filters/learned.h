@@ -17,6 +17,7 @@
 // through the row engine (src/cpu/learned_cpu.cpp); the functors are its reference.
 #pragma once
 #include <cstddef>
+#include <memory>
 
 #include "atrous/image.h"
 #include "atrous/learned.h"
@@ -47,12 +48,15 @@ struct LearnedStageTimes {
     double cpuLogs = 0, cpuNetwork = 0, cpuLevels = 0;
 };
 
+struct LearnedCache;
+
 // d_out, the filtered demodulated colour, into `out` (3 channels, exec's device); temporaries are
-// allocated on exec's device. Throws InputError for missing or mismatched planes.
+// allocated on exec's device, or kept in *cache between calls. Throws InputError for missing or
+// mismatched planes.
 void runLearned(const CpuExec& exec, const LearnedWeights& w, const LearnedPlanes& in, const ImageView& out,
-                LearnedStageTimes* times = nullptr);
+                LearnedStageTimes* times = nullptr, LearnedCache* cache = nullptr);
 void runLearned(const CudaExec& exec, const LearnedWeights& w, const LearnedPlanes& in, const ImageView& out,
-                LearnedStageTimes* times = nullptr);
+                LearnedStageTimes* times = nullptr, LearnedCache* cache = nullptr);
 // The checks both entry points make (src/filters/learned_weights.cpp).
 void checkLearnedPlanes(const LearnedWeights& w, const LearnedPlanes& in, const ImageView& out);
 
@@ -67,6 +71,20 @@ struct LearnedTemps {
     ImageView buf;   // 3: d_2, d_4
     ImageView v;     // 1: the noise plane v
 };
+// What runLearned keeps between calls of one caller (SVGF, frame after frame) instead of allocating
+// the temporaries and, on CUDA, uploading the network every call: made on the first call, remade
+// when the size or the weights change. One cache per executor (its memory is that device's).
+struct LearnedCache {
+    int width = 0, height = 0;
+    std::shared_ptr<const LearnedWeights::Impl> weights;  // the weights `net` is a copy of
+    std::shared_ptr<void> store;                          // owns the temporaries (and CUDA's copy of the net)
+    LearnedTemps temps;
+    const LearnedNet* net = nullptr;                      // on the executor's device
+    bool holds(const LearnedWeights& w, int width_, int height_) const {
+        return store && weights == w.impl && width == width_ && height == height_;
+    }
+};
+
 constexpr int kLearnedTempChannels = 4 + kLearnedFeat + 4 * kLearnedLevels + (kLearnedLevels + 1) + 3 + 1;
 inline LearnedTemps learnedTemps(float* base, int w, int h) {
     const size_t plane = size_t(w) * size_t(h);

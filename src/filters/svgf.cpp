@@ -54,7 +54,8 @@ std::unique_ptr<SvgfBackend> makeSvgfCudaBackend(const SvgfParams&) {
 
 }  // namespace detail
 
-SvgfDenoiser::SvgfDenoiser(const SvgfParams& params, Device device) : mParams(params), mDevice(device) {
+SvgfDenoiser::SvgfDenoiser(const SvgfParams& params, Device device, const LearnedWeights& learnedWeights)
+    : mParams(params), mDevice(device) {
     validateSvgfParams(params);
     if (device == Device::Cuda) {
         requireCuda();
@@ -62,6 +63,7 @@ SvgfDenoiser::SvgfDenoiser(const SvgfParams& params, Device device) : mParams(pa
     } else {
         mImpl = detail::makeSvgfCpuBackend(params);
     }
+    if (params.learnedSpatial && learnedWeights.impl) mImpl->setLearnedWeights(learnedWeights);
 }
 
 SvgfDenoiser::~SvgfDenoiser() = default;

@@ -31,6 +31,7 @@ public:
     virtual const Image& denoiseFrameOnDevice(const SvgfFrame& frame) = 0;
     virtual void reset() = 0;
     virtual void setReport(SvgfReport* report) = 0;
+    virtual void setLearnedWeights(const LearnedWeights& weights) = 0;
 };
 
 std::unique_ptr<SvgfBackend> makeSvgfCpuBackend(const SvgfParams& params);
@@ -65,6 +66,7 @@ struct SvgfState {
     Image output, taaOutput, accEmission, accEmissionLength;
     Image lumStop;  // the à-trous level's luminance stop (Atrous::lumStop)
     Image learnedVar, learnedOut;  // learnedSpatial: the cascade's var and d_out (3 channels each)
+    filters::LearnedCache learnedCache;  // learnedSpatial: the cascade's temporaries and device network
     const Image* result = nullptr;  // output or taaHistory after the last run
 
     void allocate(int w, int h, Device d) {
@@ -94,6 +96,12 @@ public:
     explicit SvgfPipeline(const SvgfParams& params, Exec exec = Exec{}) : mParams(params), mExec(exec) {
         validateSvgfParams(params);
         if (params.learnedSpatial) mLearned = LearnedWeights::builtin();
+    }
+
+    // The learned spatial filter's weights (learnedSpatial; the built-in ones until this is called).
+    void setLearnedWeights(const LearnedWeights& weights) {
+        if (!weights.impl) throw InputError("SVGF: empty learned weights");
+        mLearned = weights;
     }
 
     void reset() {
@@ -202,7 +210,7 @@ public:
             const filters::LearnedPlanes planes{s.accIllum.view(), s.learnedVar.view(), albedo,
                                                 normalIn.valid() ? s.normal.view() : ImageView{},
                                                 depthIn.valid() ? s.depth.view() : ImageView{}};
-            filters::runLearned(mExec, mLearned, planes, s.learnedOut.view());
+            filters::runLearned(mExec, mLearned, planes, s.learnedOut.view(), nullptr, &s.learnedCache);
             filters::markStage(clock, "learned");
             inIllum = s.learnedOut.view();
         }
@@ -281,7 +289,7 @@ public:
 
 private:
     SvgfParams mParams;
-    LearnedWeights mLearned;  // learnedSpatial: the built-in weights
+    LearnedWeights mLearned;  // learnedSpatial: the built-in weights or setLearnedWeights
     Exec mExec;
     SvgfState mState;
     SvgfReport* mReport = nullptr;
@@ -299,6 +307,7 @@ public:
     }
     void reset() override { mPipeline.reset(); }
     void setReport(SvgfReport* report) override { mPipeline.setReport(report); }
+    void setLearnedWeights(const LearnedWeights& weights) override { mPipeline.setLearnedWeights(weights); }
 
 private:
     SvgfPipeline<Exec> mPipeline;

@@ -7,6 +7,7 @@
 
 #include "atrous/device.h"
 #include "atrous/svgf.h"
+#include "../learned_fixture.h"
 
 using namespace atrous;
 
@@ -102,6 +103,37 @@ TEST(SvgfCuda, LearnedSpatialMatchesTheCpuBackend) {
                 maxDiff = std::fmax(maxDiff, std::fabs(a.data()[i] - b.data()[i]) / (1.0f + std::fabs(a.data()[i])));
             }
             EXPECT_LT(maxDiff, 2e-3f) << "frame " << t << ", feedback tap " << tap;
+        }
+    }
+}
+
+// Given weights (the parity fixture's) on both backends, across a change of size: CUDA keeps the
+// network's device copy and the cascade's temporaries between frames (filters::LearnedCache), so a
+// stale copy or stale planes would show here; same bound as above. The weights reach the GPU's
+// cascade: the built-in ones give another output.
+TEST(SvgfCuda, LearnedSpatialRunsTheGivenWeightsAcrossSizes) {
+    if (!cudaAvailable()) GTEST_SKIP() << "no CUDA device";
+    const LearnedWeights w = LearnedWeights::parse(test::fixture().weights.data(), test::fixture().weights.size(), "fixture");
+    SvgfParams p;
+    p.learnedSpatial = true;
+    SvgfDenoiser cpu(p, Device::Cpu, w), gpu(p, Device::Cuda, w), gpuBuiltin(p, Device::Cuda);
+    const int sizes[][2] = {{96, 64}, {64, 40}};
+    for (const auto& sz : sizes) {
+        for (int t = 0; t < 3; ++t) {
+            Frame f = makeFrame(sz[0], sz[1], t);
+            SvgfFrame in;
+            in.color = &f.color, in.albedo = &f.albedo, in.normal = &f.normal;
+            in.depth = &f.depth, in.ids = &f.ids, in.motion = &f.motion, in.emission = &f.emission;
+            Image a = cpu.denoiseFrame(in), b = gpu.denoiseFrame(in), c = gpuBuiltin.denoiseFrame(in);
+            ASSERT_EQ(a.size(), b.size());
+            float maxDiff = 0.0f, other = 0.0f;
+            for (size_t i = 0; i < a.size(); ++i) {
+                ASSERT_TRUE(std::isfinite(b.data()[i]));
+                maxDiff = std::fmax(maxDiff, std::fabs(a.data()[i] - b.data()[i]) / (1.0f + std::fabs(a.data()[i])));
+                other = std::fmax(other, std::fabs(b.data()[i] - c.data()[i]));
+            }
+            EXPECT_LT(maxDiff, 2e-3f) << sz[0] << "x" << sz[1] << " frame " << t;
+            EXPECT_GT(other, 1e-2f) << sz[0] << "x" << sz[1] << " frame " << t;
         }
     }
 }
