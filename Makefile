@@ -71,9 +71,10 @@ clean:
 TRAIN_BUILD ?= build-learn
 TRAIN_STEPS ?= 4000
 TRAIN_MINUTES ?= 60
-# Phase 2: fine-tuning with the `noem` images too (variance and emission withheld, docs/learned.md).
+# Phase 2: fine-tuning with the `noem` images too (variance and emission withheld) and a quarter of the
+# crops from the corpus's training split (docs/learned.md).
 TRAIN_FT_STEPS ?= 2000
-TRAIN_FT_MINUTES ?= 15
+TRAIN_FT_MINUTES ?= 25
 .PHONY: train train-smoke
 train: python
 	@./scripts/train/setup.sh
@@ -86,7 +87,7 @@ train: python
 	  && .venv/bin/python scripts/train/prepare.py --splits corpus_test --variants est; fi
 	@.venv-train/bin/python scripts/train/train.py --variants given est --steps $(TRAIN_STEPS) --minutes $(TRAIN_MINUTES) --eval
 	@.venv-train/bin/python scripts/train/train.py --out out/train/run_ft --init out/train/run/weights.bin --lr 1e-3 \
-	  --steps $(TRAIN_FT_STEPS) --minutes $(TRAIN_FT_MINUTES) --eval --export
+	  --corpus-share 0.25 --steps $(TRAIN_FT_STEPS) --minutes $(TRAIN_FT_MINUTES) --eval --export
 
 train-smoke: python
 	@./scripts/train/setup.sh

@@ -22,6 +22,7 @@ DEFAULTS = {
     "spps": [1, 4, 16],
     "variants": ["given", "est", "noem"],  # rendered variance / the driver's estimate / also no emission
     "batch": 4, "crop": 96, "lr": 3e-3, "eps": 0.01,
+    "corpus_share": None,  # None: crops drawn uniformly from all images; else this fraction from corpus_train
     "colour": True, "vcolour": True, "blend": True, "box": True,  # ablations (C++ implements all four)
 }
 
@@ -53,10 +54,17 @@ def load_items(folder: Path, spps, variants, box: bool = True, limit: int | None
     return items
 
 
-def batch(items, rng, n: int, crop: int):
+def batch(items, rng, n: int, crop: int, groups=None):
+    """n random crops (horizontal flips) of items; groups = (share, indices of the favoured items):
+    each crop comes from the favoured items with probability share, else from the others."""
     out = [[] for _ in range(6)]
     for _ in range(n):
-        it = items[rng.integers(len(items))]
+        if groups is None:
+            it = items[rng.integers(len(items))]
+        else:
+            share, fav, rest = groups
+            pool = fav if rng.random() < share else rest
+            it = items[pool[rng.integers(len(pool))]]
         h, w = it[0].shape[:2]
         y, x = rng.integers(0, h - crop + 1), rng.integers(0, w - crop + 1)
         flip = rng.integers(2)
@@ -92,7 +100,13 @@ def train(prep: Path, out: Path, steps: int, seed: int = 1, minutes: float | Non
     cfg = dict(DEFAULTS, **{k: v for k, v in overrides.items() if v is not None})
     out.mkdir(parents=True, exist_ok=True)
     t_load = time.time()
-    items = [it for s in cfg["splits"] for it in load_items(prep / s, cfg["spps"], cfg["variants"], cfg["box"])]
+    items = [it + (s,) for s in cfg["splits"] for it in load_items(prep / s, cfg["spps"], cfg["variants"], cfg["box"])]
+    groups = None
+    if cfg["corpus_share"] is not None:
+        fav = [i for i, it in enumerate(items) if it[-1] == "corpus_train"]
+        rest = [i for i, it in enumerate(items) if it[-1] != "corpus_train"]
+        if fav and rest:
+            groups = (cfg["corpus_share"], fav, rest)
     if not items:
         raise SystemExit(f"train: {prep}: no prepared scenes in {cfg['splits']} (run scripts/train/prepare.py first)")
     crop = min([cfg["crop"]] + [min(it[0].shape[:2]) for it in items])
@@ -131,7 +145,7 @@ def train(prep: Path, out: Path, steps: int, seed: int = 1, minutes: float | Non
 
     step = start
     for step in range(start, steps):
-        params, state, l = step_fn(params, state, *batch(items, rng, cfg["batch"], crop))
+        params, state, l = step_fn(params, state, *batch(items, rng, cfg["batch"], crop, groups))
         run.append(float(l))
         if (step + 1) % 50 == 0:
             # mean and median: a mean relMSE is dominated by the odd 1-spp crop
