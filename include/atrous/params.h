@@ -207,7 +207,8 @@ inline const ParamField<P> kSvgf[] = {
     {"emission_motion_alpha", &at<&P::emissionMotionAlpha>, paramAtLeast(0),
      "emission blend factor at least this times the motion across a light's edge, pixels per frame (0 = off)"},
     {"learned_spatial", &at<&P::learnedSpatial>, {},
-     "the learned a-trous cascade (built-in weights) as the spatial filter instead of SVGF's a-trous"},
+     "the learned a-trous cascade (built-in weights, or learned_weights / --learned-weights) as the spatial "
+     "filter instead of SVGF's a-trous"},
 };
 
 // threads: a ceiling, since tbb::task_arena aborts in its destructor from 65537 threads on

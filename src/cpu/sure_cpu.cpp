@@ -1,5 +1,5 @@
 // CPU fast path of the SURE window passes (filters::SureBoxH, filters::SureChoose) and of the albedo
-// give-back's window sums (filters::BoxSum, safety_net.h). The generic
+// give-back (filters::runAlbedoGiveBack, safety_net.h). The generic
 // functors clamp every window index, which kept their x loops scalar; here the horizontal pass
 // adds one window offset at a time over the columns whose window is inside the row (the border columns
 // through the functor), and the vertical pass adds the clamped window rows into a row buffer one
@@ -98,52 +98,6 @@ void runSureChoose(const CpuExec&, const SureChoose& f) {
             chooseRows<1>(f, range0, range1);
         else
             chooseRows<0>(f, range0, range1);
-    });
-}
-
-// BoxSum along x: the border columns (whose window leaves the row) through the functor, the rest
-// one tap offset at a time, as runSureBoxH; along y: the window's rows added into the output row in
-// order. Both add the same taps in the same order as the functor.
-void runBoxSum(const CpuExec& exec, const BoxSum<false>& f) {
-    const int w = f.in.width, h = f.in.height, r = f.radius;
-    if (w <= 2 * r) {
-        exec.forEachPixel(w, h, f);
-        return;
-    }
-    cpu::parallelForIsa(cpu::activeIsa(), 0, h, 16, [&](int range0, int range1) {
-        const BoxSum<false> g = f;
-        for (int y = range0; y < range1; ++y) {
-            for (int x = 0; x < r; ++x) g(x, y);
-            for (int c = 0; c < g.in.channels; ++c) {
-                const size_t o = size_t(y) * w;
-                const float* ATROUS_RESTRICT in = g.in.channel(c) + o;
-                float* ATROUS_RESTRICT out = g.out.channel(c) + o;
-                for (int x = r; x < w - r; ++x) out[x] = 0.0f;
-                for (int dx = -r; dx <= r; ++dx) {
-#pragma omp simd
-                    for (int x = r; x < w - r; ++x) out[x] += in[x + dx];
-                }
-            }
-            for (int x = w - r; x < w; ++x) g(x, y);
-        }
-    });
-}
-
-void runBoxSum(const CpuExec&, const BoxSum<true>& f) {
-    const int w = f.in.width, h = f.in.height, r = f.radius;
-    cpu::parallelForIsa(cpu::activeIsa(), 0, h, 16, [&](int range0, int range1) {
-        for (int y = range0; y < range1; ++y) {
-            const int lo = y - r < 0 ? 0 : y - r, hi = y + r > h - 1 ? h - 1 : y + r;
-            for (int c = 0; c < f.in.channels; ++c) {
-                float* ATROUS_RESTRICT out = f.out.channel(c) + size_t(y) * w;
-                for (int x = 0; x < w; ++x) out[x] = 0.0f;
-                for (int j = lo; j <= hi; ++j) {
-                    const float* ATROUS_RESTRICT in = f.in.channel(c) + size_t(j) * w;
-#pragma omp simd
-                    for (int x = 0; x < w; ++x) out[x] += in[x];
-                }
-            }
-        }
     });
 }
 

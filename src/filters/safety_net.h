@@ -113,8 +113,8 @@ struct GiveBackMoments {
 };
 
 // Window sums of every channel along x (kVertical false: x - R..x + R) or y, over the taps inside
-// the image, added in tap order. The CPU overload of runBoxSum (src/cpu/sure_cpu.cpp) adds the same
-// taps in the same order in vectorised row loops.
+// the image, added in tap order (the CPU's fused give-back, src/cpu/sure_cpu.cpp, adds the same taps
+// in the same order in its row loops).
 template <bool kVertical>
 struct BoxSum {
     int radius;
@@ -133,8 +133,6 @@ template <class Exec, bool kVertical>
 void runBoxSum(const Exec& exec, const BoxSum<kVertical>& f) {
     exec.forEachPixel(f.in.width, f.in.height, f);
 }
-void runBoxSum(const CpuExec& exec, const BoxSum<false>& f);
-void runBoxSum(const CpuExec& exec, const BoxSum<true>& f);
 
 // The number of in-image taps of p's window.
 ATROUS_INLINE float boxTaps(int radius, int x, int y, int w, int h) {
