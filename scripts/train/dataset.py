@@ -62,6 +62,38 @@ def _obj_prism(path: Path, sides: int, radius: float, height: float) -> None:
     path.write_text("\n".join(lines) + "\n")
 
 
+def _obj_boxes(path: Path, boxes) -> None:
+    """An OBJ of axis-aligned boxes, each (x0, x1, y0, y1, z0, z1), faces wound outward."""
+    lines, faces = [], []
+    for x0, x1, y0, y1, z0, z1 in boxes:
+        b = len(lines)
+        lines += [f"v {x:.5f} {y:.5f} {z:.5f}" for x in (x0, x1) for y in (y0, y1) for z in (z0, z1)]
+        # vertex (i, j, k) of (x, y, z) is b + 4 i + 2 j + k + 1
+        v = lambda i, j, k: b + 4 * i + 2 * j + k + 1  # noqa: E731
+        faces += [f"f {v(0,0,0)} {v(0,0,1)} {v(0,1,1)} {v(0,1,0)}", f"f {v(1,0,0)} {v(1,1,0)} {v(1,1,1)} {v(1,0,1)}",
+                  f"f {v(0,0,0)} {v(1,0,0)} {v(1,0,1)} {v(0,0,1)}", f"f {v(0,1,0)} {v(0,1,1)} {v(1,1,1)} {v(1,1,0)}",
+                  f"f {v(0,0,0)} {v(0,1,0)} {v(1,1,0)} {v(1,0,0)}", f"f {v(0,0,1)} {v(1,0,1)} {v(1,1,1)} {v(0,1,1)}"]
+    path.write_text("\n".join(lines + faces) + "\n")
+
+
+def _fence(rng: np.random.Generator, d: Path, name: str) -> dict:
+    """Thin geometry (issue 12's fine detail; the corpus's slats and wires): a fence of n slats 0.5-2
+    pixels wide at the usual camera distance, with or without rails, of unit-ish size."""
+    n = int(rng.integers(8, 28))
+    width = float(rng.uniform(0.012, 0.05))
+    gap = float(rng.uniform(1.0, 4.0)) * width
+    height = float(rng.uniform(0.5, 1.6))
+    total = n * width + (n - 1) * gap
+    x0 = -total / 2
+    boxes = [(x0 + k * (width + gap), x0 + k * (width + gap) + width, 0.0, height, -width / 2, width / 2)
+             for k in range(n)]
+    if rng.random() < 0.5:  # rails across the slats
+        for y in (0.3 * height, 0.85 * height):
+            boxes.append((x0, x0 + total, y, y + width, -width, width))
+    _obj_boxes(d / f"{name}.obj", boxes)
+    return {"file": f"{name}.obj"}
+
+
 def _texture(path: Path, rng: np.random.Generator) -> None:
     from PIL import Image  # matplotlib's dependency, in .venv-train
 
@@ -75,9 +107,14 @@ def _texture(path: Path, rng: np.random.Generator) -> None:
     Image.fromarray((np.clip(img, 0, 1) ** (1 / 2.2) * 255).astype(np.uint8)).save(path)
 
 
-def _envmap(path: Path, rng: np.random.Generator) -> None:
+def _write_exr(path: Path, img: np.ndarray) -> None:
     import OpenEXR
 
+    OpenEXR.File({"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage},
+                 {"RGB": img.astype(np.float32)}).write(str(path))
+
+
+def _envmap(path: Path, rng: np.random.Generator) -> None:
     h, w = 64, 128
     v, u = (np.mgrid[0:h, 0:w] + 0.5) / np.array([h, w])[:, None, None]
     up = np.cos(np.pi * v)  # +1 at the top row
@@ -88,8 +125,7 @@ def _envmap(path: Path, rng: np.random.Generator) -> None:
         cu, cv, s = rng.uniform(0, 1), rng.uniform(0.1, 0.5), rng.uniform(0.02, 0.08)
         d2 = ((u - cu) ** 2 + (v - cv) ** 2) / s**2
         img = img + np.exp(-d2)[..., None] * rng.uniform(5, 60) * rng.uniform(0.6, 1.0, 3)
-    OpenEXR.File({"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage},
-                 {"RGB": img.astype(np.float32)}).write(str(path))
+    _write_exr(path, img)
 
 
 def _material(rng: np.random.Generator, d: Path, name: str, allow_specular: bool = True) -> dict:
@@ -115,8 +151,10 @@ def _material(rng: np.random.Generator, d: Path, name: str, allow_specular: bool
     return {"type": "dielectric", "ior": round(float(rng.uniform(1.3, 1.7)), 3)}
 
 
-def make_scene(seed: int, index: int, d: Path, kind: str) -> dict:
-    """The JSON scene of (seed, index, kind), its OBJ/texture/env files written into d."""
+def make_scene(seed: int, index: int, d: Path, kind: str, extras: bool = True) -> dict:
+    """The JSON scene of (seed, index, kind), its OBJ/texture/env files written into d; extras: data
+    version 2's fences and windows (the training split; the held-out split stays version 1, so its
+    figures compare across versions)."""
     rng = np.random.default_rng([seed, index, TYPES.index(kind)])
     mats: dict = {"ground": _material(rng, d, "ground", allow_specular=False)}
     objs: list = [{"type": "quad", "name": "ground", "corner": [-6, 0, -6], "edge1": [0, 0, 12], "edge2": [12, 0, 0],
@@ -175,9 +213,52 @@ def make_scene(seed: int, index: int, d: Path, kind: str) -> dict:
             _obj_prism(d / f"prism{k}.obj", sides, 1.0, float(rng.uniform(0.6, 2.0)))
             objs.append({"type": "mesh", "name": f"o{k}", "file": f"prism{k}.obj", "material": name,
                          "transform": {"scale": size, "rotateY": float(rng.uniform(0, 180)), "translate": [x, 0.0, z]}})
+    if extras:
+        _extras(np.random.default_rng([seed, index, TYPES.index(kind), 2]), d, kind, mats, objs, lights)
+    if kind == "room" and any(o.get("name") == "front" for o in objs):
+        # A window-lit room is closed: the camera stands inside it, objects kept off its side.
+        cam = [float(v) for v in np.random.default_rng([seed, index, 3]).uniform([-1.5, 1.0, 2.2], [1.5, 2.6, 2.8])]
+        objs[:] = [o for o in objs if not (o["name"].startswith("o") and _object_z(o) > 1.2)]
     return {"_comment": f"atrous training scene {index} ({kind}), seed {seed}",
             "camera": {"position": cam, "lookAt": target, "fov": round(float(rng.uniform(30, 55)), 1)},
             "materials": mats, "objects": objs, "lights": lights}
+
+
+def _object_z(o: dict) -> float:
+    return float(o["center"][2]) if "center" in o else float(o["transform"]["translate"][2])
+
+
+def _extras(rng: np.random.Generator, d: Path, kind: str, mats: dict, objs: list, lights: list) -> None:
+    """Data version 2 (docs/learned.md, "Data"): the corpus's test stills showed the filter blurring
+    what the generator never drew. A fence of thin slats (probability 0.4) and, in a room, a window
+    in the right wall with the sun and sky outside it (probability 0.5; the lamp then stays on with
+    probability 0.3): the sunlit patches and the mostly indirect light of an interior."""
+    if rng.random() < 0.4:
+        mats["fence"] = _material(rng, d, "fence")
+        f = _fence(rng, d, "fence")
+        x, z = (float(v) for v in rng.uniform(-1.8, 1.8, 2))
+        objs.append({"type": "mesh", "name": "ofence", "material": "fence", **f,
+                     "transform": {"scale": float(rng.uniform(0.8, 1.6)), "rotateY": float(rng.uniform(-60, 60)),
+                                   "translate": [x, 0.0, z]}})
+    if kind != "room" or rng.random() >= 0.5:
+        return
+    H = 4.0
+    za, zb = sorted(float(v) for v in rng.uniform(-2.5, 2.0, 2))
+    zb = max(zb, za + 0.8)
+    ya, yb = float(rng.uniform(0.6, 1.6)), float(rng.uniform(2.4, 3.6))
+    right = [o for o in objs if o.get("name") == "right"][0]
+    objs.remove(right)
+    m = right["material"]
+    objs += [{"type": "quad", "name": "right_low", "corner": [3, 0, -3], "edge1": [0, 0, 6], "edge2": [0, ya, 0], "material": m},
+             {"type": "quad", "name": "right_high", "corner": [3, yb, -3], "edge1": [0, 0, 6], "edge2": [0, H - yb, 0], "material": m},
+             {"type": "quad", "name": "right_a", "corner": [3, ya, -3], "edge1": [0, 0, za + 3], "edge2": [0, yb - ya, 0], "material": m},
+             {"type": "quad", "name": "right_b", "corner": [3, ya, zb], "edge1": [0, 0, 3 - zb], "edge2": [0, yb - ya, 0], "material": m},
+             {"type": "quad", "name": "front", "corner": [-3, 0, 3], "edge1": [0, H, 0], "edge2": [6, 0, 0], "material": "wall"}]
+    th, ph = float(rng.uniform(0.25, 0.8)), float(rng.uniform(-0.6, 0.6))
+    lights.append({"type": "sky", "sunDirection": [math.cos(th) * math.cos(ph), math.sin(th), math.cos(th) * math.sin(ph)],
+                   "sunRadius": round(float(rng.uniform(0.5, 2.0)), 2), "scale": round(float(rng.uniform(0.5, 1.5)), 2)})
+    if rng.random() >= 0.3:
+        objs[:] = [o for o in objs if o.get("name") != "lamp"]
 
 
 def read_exr(path: Path) -> np.ndarray:
@@ -201,12 +282,14 @@ def scene_kind(seed: int, index: int, held_out: str) -> str:
 
 def build_scene(args, index: int, split: str, kind: str) -> Path:
     dest = Path(args.out) / "data" / split / f"scene_{index:04d}.npz"
-    if dest.exists():
-        return dest
     dest.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=Path(args.out)) as tmp:
         t = Path(tmp)
-        scene = make_scene(args.seed, index, t, kind)
+        scene = make_scene(args.seed, index, t, kind, extras=split == "train")
+        if dest.exists():  # cached: kept while it is this generator's scene (a changed generator redraws it)
+            with np.load(dest) as z:
+                if "scene_json" in z.files and str(z["scene_json"]) == json.dumps(scene):
+                    return dest
         (t / "scene.json").write_text(json.dumps(scene, indent=1))
         arrays = {}
         for spp in SPPS:
@@ -249,9 +332,10 @@ def main(argv=None) -> int:
     order = sorted(jobs, key=lambda j: (j[0] % 100000) * (1 if j[1] == "train" else a.scenes / max(a.test_scenes, 1)))
     for n, (i, split, kind) in enumerate(order):
         t1 = time.time()
-        was = (Path(a.out) / "data" / split / f"scene_{i:04d}.npz").exists()
+        dest = Path(a.out) / "data" / split / f"scene_{i:04d}.npz"
+        was = dest.stat().st_mtime if dest.exists() else None
         build_scene(a, i, split, kind)
-        if not was:
+        if was is None or dest.stat().st_mtime != was:
             print(f"[{n + 1}/{len(order)}] {split} {i} {kind}: {time.time() - t1:.1f} s (total {time.time() - t0:.0f} s)",
                   flush=True)
     return 0

@@ -78,8 +78,8 @@ def main(argv=None, planes_fn=None) -> int:
             if f.endswith(".tmp.npz"):  # a scene being written (dataset.py renames it when done)
                 continue
             target = dest / Path(f).name
-            if target.exists():
-                continue
+            if target.exists() and target.stat().st_mtime >= Path(f).stat().st_mtime:
+                continue  # prepared from this version of the scene (dataset.py redraws a changed one)
             try:
                 planes = prepare_scene(np.load(f), planes_fn, a.variants)
             except (ValueError, KeyError) as e:
