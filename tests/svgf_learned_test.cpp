@@ -128,8 +128,8 @@ TEST(SvgfLearned, StaticNoisySceneIsFiniteAndDenoised) {
         input = mse(f.color, f.truth);
         std::printf("frame %d: MSE %.5f (input %.4f)\n", t, e, input);
     }
-    // Measured (64x48, sigma 0.3, input MSE ~0.09) with the built-in weights of ee1ce7d: frame 0
-    // 0.00261, frame 9 0.00137 (0.52x; f77885d's: 0.00255, 0.00132). The input bound is SVGF's own (tests/svgf_test.cpp,
+    // Measured (64x48, sigma 0.3, input MSE ~0.09) with the built-in weights retrained on data
+    // version 2: frame 0 0.00332, frame 9 0.00118 (0.36x; ee1ce7d's: 0.00261, 0.00137). The input bound is SVGF's own (tests/svgf_test.cpp,
     // StaticNoisySceneApproachesTheTruth); SVGF's 0.5x from frame 0 to 9 is not: the cascade
     // alone removes more of frame 0's noise than SVGF's à-trous, leaving the history less to do.
     // 0.7x still fails without the accumulation (every frame would stay at frame 0's level).
