@@ -122,7 +122,13 @@ def test_a_killed_worker_costs_a_retry_not_the_job(cluster, tmp_path):
     while killed is None and time.time() - t0 < 120 and job.poll() is None:
         pids = [p for p in cluster.worker_pids(TASK) if p not in before]
         if pids:
-            time.sleep(0.2)  # into the render
+            # Into the render: the item's staging directory (OUT/.partial/<item>.<pid>.<random>) is made
+            # only after the task has reported its start to the tracker (tasks.py), so a kill from then
+            # on is counted as an attempt. A fixed sleep was not enough on a loaded machine: the kill
+            # landed before the start was counted and the retry showed 1 attempt.
+            t1 = time.time()
+            while time.time() - t1 < 60 and not list((out / ".partial").glob(f"*.{pids[0]}.*")):
+                time.sleep(0.01)
             try:
                 os.kill(pids[0], signal.SIGKILL)
                 killed = pids[0]
