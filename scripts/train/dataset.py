@@ -213,9 +213,7 @@ def make_scene(seed: int, index: int, d: Path, kind: str, extras: bool = True) -
             _obj_prism(d / f"prism{k}.obj", sides, 1.0, float(rng.uniform(0.6, 2.0)))
             objs.append({"type": "mesh", "name": f"o{k}", "file": f"prism{k}.obj", "material": name,
                          "transform": {"scale": size, "rotateY": float(rng.uniform(0, 180)), "translate": [x, 0.0, z]}})
-    if extras:
-        _extras(np.random.default_rng([seed, index, TYPES.index(kind), 2]), d, kind, mats, objs, lights)
-    if kind == "room" and any(o.get("name") == "front" for o in objs):
+    if extras and _extras(np.random.default_rng([seed, index, TYPES.index(kind), 2]), d, kind, mats, objs, lights):
         # A window-lit room is closed: the camera stands inside it, objects kept off its side.
         cam = [float(v) for v in np.random.default_rng([seed, index, 3]).uniform([-1.5, 1.0, 2.2], [1.5, 2.6, 2.8])]
         objs[:] = [o for o in objs if not (o["name"].startswith("o") and _object_z(o) > 1.2)]
@@ -228,11 +226,12 @@ def _object_z(o: dict) -> float:
     return float(o["center"][2]) if "center" in o else float(o["transform"]["translate"][2])
 
 
-def _extras(rng: np.random.Generator, d: Path, kind: str, mats: dict, objs: list, lights: list) -> None:
+def _extras(rng: np.random.Generator, d: Path, kind: str, mats: dict, objs: list, lights: list) -> bool:
     """Data version 2 (docs/learned.md, "Data"): the corpus's test stills showed the filter blurring
     what the generator never drew. A fence of thin slats (probability 0.4) and, in a room, a window
     in the right wall with the sun and sky outside it (probability 0.5; the lamp then stays on with
-    probability 0.3): the sunlit patches and the mostly indirect light of an interior."""
+    probability 0.3): the sunlit patches and the mostly indirect light of an interior. Returns
+    whether it closed the room (the caller then moves the camera inside)."""
     if rng.random() < 0.4:
         mats["fence"] = _material(rng, d, "fence")
         f = _fence(rng, d, "fence")
@@ -241,7 +240,7 @@ def _extras(rng: np.random.Generator, d: Path, kind: str, mats: dict, objs: list
                      "transform": {"scale": float(rng.uniform(0.8, 1.6)), "rotateY": float(rng.uniform(-60, 60)),
                                    "translate": [x, 0.0, z]}})
     if kind != "room" or rng.random() >= 0.5:
-        return
+        return False
     H = 4.0
     za, zb = sorted(float(v) for v in rng.uniform(-2.5, 2.0, 2))
     zb = max(zb, za + 0.8)
@@ -259,6 +258,7 @@ def _extras(rng: np.random.Generator, d: Path, kind: str, mats: dict, objs: list
                    "sunRadius": round(float(rng.uniform(0.5, 2.0)), 2), "scale": round(float(rng.uniform(0.5, 1.5)), 2)})
     if rng.random() >= 0.3:
         objs[:] = [o for o in objs if o.get("name") != "lamp"]
+    return True
 
 
 def read_exr(path: Path) -> np.ndarray:
