@@ -76,22 +76,6 @@ class LocalCluster:
             time.sleep(0.5)
         raise RuntimeError(f"the local Ray cluster did not reach {n} nodes in {timeout:.0f} s ({self.temp})")
 
-    def worker_pids(self, task_name: str) -> List[int]:
-        """Worker processes of this cluster now running a task called `task_name` (Ray sets a
-        worker's process title to ray::<task name> while it runs one)."""
-        pids = []
-        for d in Path("/proc").iterdir():
-            if not d.name.isdigit():
-                continue
-            try:
-                cmd = (d / "cmdline").read_bytes().decode(errors="replace")
-                env = (d / "environ").read_bytes().decode(errors="replace")
-            except OSError:
-                continue
-            if cmd.startswith(f"ray::{task_name}") and f"RAY_AUTH_TOKEN_PATH={self.env['RAY_AUTH_TOKEN_PATH']}" in env:
-                pids.append(int(d.name))
-        return pids
-
     def stop(self) -> None:
         for p in reversed(self.procs):  # workers first, then the head
             if p.poll() is None:
