@@ -2,7 +2,6 @@
 seeds never meet the test corpus's, and train_export.py turns a render into dataset.py's npz
 format through `atrous inspect --export` (the CLI's reader and conventions)."""
 import json
-import os
 import subprocess
 import sys
 from pathlib import Path
@@ -13,6 +12,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scripts" / "corpus"))
 import common  # noqa: E402
+from atrous_cli import atrous_cli  # noqa: E402
 
 
 def test_training_seeds_are_distinct_and_never_the_test_corpus_seeds():
@@ -28,17 +28,10 @@ def test_training_seeds_are_distinct_and_never_the_test_corpus_seeds():
     assert spps[:-1] == [1, 4, 16] and spps[-1] >= 1024
 
 
-def _cli():
-    for p in (os.environ.get("ATROUS_CLI", ""), ROOT / "build" / "atrous"):
-        if p and Path(p).is_file():
-            return str(p)
-    return None
-
-
 def test_train_export_writes_dataset_format_from_what_atrous_reads(tmp_path):
     atrous = pytest.importorskip("atrous")
     vpy = ROOT / ".venv-corpus" / "bin" / "python"  # OpenEXR lives there (docs/corpus.md)
-    cli = _cli()
+    cli = atrous_cli()
     if not vpy.exists() or cli is None:
         pytest.skip("needs .venv-corpus (scripts/corpus/setup.sh) and the atrous CLI (build/atrous or ATROUS_CLI)")
     h, w = 6, 7

@@ -4,8 +4,6 @@ room) are drawn from their own stream, so a scene without them is version 1's sc
 closed with the camera inside it; the held-out split never gets the extras; the CLI renders every kind
 of scene; a cached scene that the generator no longer draws is redrawn."""
 import json
-import os
-import subprocess
 import sys
 import types
 from pathlib import Path
@@ -16,6 +14,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scripts" / "train"))
 import dataset  # noqa: E402
+from atrous_cli import atrous_cli  # noqa: E402
 
 
 @pytest.fixture(autouse=True)
@@ -24,13 +23,6 @@ def _exr_through_the_library(monkeypatch):
     atrous = pytest.importorskip("atrous")
     monkeypatch.setattr(dataset, "_write_exr", lambda path, img: atrous.write_image(str(path), img.astype(np.float32)))
     monkeypatch.setattr(dataset, "read_exr", lambda path: np.asarray(atrous.read_image(str(path)), np.float32))
-
-
-def _cli():
-    for p in (os.environ.get("ATROUS_CLI", ""), ROOT / "build" / "atrous"):
-        if p and Path(p).is_file():
-            return str(p)
-    return None
 
 
 def _names(scene):
@@ -98,7 +90,7 @@ def test_fence_obj_is_closed_boxes(tmp_path):
     assert max(int(k) for line in faces for k in line.split()[1:]) == len(v)
 
 
-@pytest.mark.skipif(_cli() is None, reason="needs the atrous CLI (build/atrous or ATROUS_CLI)")
+@pytest.mark.skipif(atrous_cli() is None, reason="needs the atrous CLI (build/atrous or ATROUS_CLI)")
 def test_cli_renders_every_kind_and_a_changed_scene_is_redrawn(tmp_path):
     picks = {}
     for i in range(60):
@@ -107,7 +99,7 @@ def test_cli_renders_every_kind_and_a_changed_scene_is_redrawn(tmp_path):
         tag = (kind, "front" in _names(s), "ofence" in _names(s))
         picks.setdefault(tag, i)
     assert len(picks) >= 5
-    args = types.SimpleNamespace(out=str(tmp_path / "cache"), atrous=_cli(), seed=1, size=16, ref_spp=1024)
+    args = types.SimpleNamespace(out=str(tmp_path / "cache"), atrous=atrous_cli(), seed=1, size=16, ref_spp=1024)
     for (kind, _, _), i in picks.items():
         dest = dataset.build_scene(args, i, "train", kind)
         with np.load(dest) as z:

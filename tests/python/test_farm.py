@@ -17,13 +17,7 @@ from atrous.eval import score
 from atrous.farm.dataset import random_scene
 
 from farm_cluster import LocalCluster
-
-REPO = Path(__file__).resolve().parents[2]
-
-
-def _cli():
-    cand = os.environ.get("ATROUS_CLI") or shutil.which("atrous") or str(REPO / "build" / "atrous")
-    return cand if cand and os.access(cand, os.X_OK) else None
+from atrous_cli import atrous_cli
 
 
 @pytest.fixture(scope="module")
@@ -60,7 +54,7 @@ def no_partial_left(out: Path):
 
 
 def test_twelve_renders_equal_the_cli_bit_for_bit(cluster, tmp_path):
-    cli = _cli()
+    cli = atrous_cli()
     if cli is None:
         pytest.skip("no atrous CLI (set ATROUS_CLI or build build/atrous)")
     out = tmp_path / "farm"
@@ -88,7 +82,7 @@ def test_twelve_renders_equal_the_cli_bit_for_bit(cluster, tmp_path):
 
 
 def test_frames_and_svgf_equal_the_cli(cluster, tmp_path):
-    cli = _cli()
+    cli = atrous_cli()
     if cli is None:
         pytest.skip("no atrous CLI (set ATROUS_CLI or build build/atrous)")
     out, seq = tmp_path / "farm", tmp_path / "cli"
@@ -294,7 +288,7 @@ def test_evaluate_sweep_dataset_and_denoise_jobs(cluster, tmp_path):
     r = farm(["denoise", "--in", str(ds), "--method", "eaw", "--param", "levels=3",
               "--address", cluster.address, "--out", str(dn), "--quiet"], env=env)
     assert r.returncode == 0, r.stderr
-    cli = _cli()
+    cli = atrous_cli()
     if cli is not None:
         c = subprocess.run([cli, "denoise", "--in", str(ds / "scene_000000" / "spp_2"), "--method", "eaw",
                             "--levels", "3", "--device", "cpu", "--out", str(tmp_path / "cli.exr")],

@@ -1,6 +1,4 @@
 """atrous.read_image / atrous.write_image: the library's OpenEXR/PFM/PNG code seen from Python."""
-import os
-import shutil
 import struct
 import subprocess
 from pathlib import Path
@@ -9,8 +7,7 @@ import numpy as np
 import pytest
 
 import atrous
-
-REPO = Path(__file__).resolve().parents[2]
+from atrous_cli import atrous_cli
 
 
 def _random_image(h=7, w=5, seed=0):
@@ -77,15 +74,10 @@ def test_rendered_buffers_round_trip_with_their_shape(tmp_path):
         np.testing.assert_array_equal(back, arr, err_msg=name)
 
 
-def _cli():
-    cand = os.environ.get("ATROUS_CLI") or shutil.which("atrous") or str(REPO / "build" / "atrous")
-    return cand if cand and os.access(cand, os.X_OK) else None
-
-
 def test_reads_what_atrous_render_writes(tmp_path):
     # The pip build has no CLI (ATROUS_BUILD_CLI=OFF); the C++ build's build/atrous (or
     # $ATROUS_CLI) is used when it is there.
-    cli = _cli()
+    cli = atrous_cli()
     if cli is None:
         pytest.skip("no atrous CLI (set ATROUS_CLI or build build/atrous)")
     out = tmp_path / "r"

@@ -1,0 +1,17 @@
+"""Where the Python tests find the atrous CLI: $ATROUS_CLI, else the build that `make test` made
+(build/atrous), else an `atrous` on PATH; None when there is none (the tests that need it skip)."""
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+from typing import Optional
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def atrous_cli() -> Optional[str]:
+    for cand in (os.environ.get("ATROUS_CLI"), str(REPO / "build" / "atrous"), shutil.which("atrous")):
+        if cand and os.path.isfile(cand) and os.access(cand, os.X_OK):
+            return cand
+    return None
