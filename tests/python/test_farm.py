@@ -126,7 +126,7 @@ def test_a_killed_worker_costs_a_retry_not_the_job(cluster, tmp_path):
         # then on is counted as an attempt (a fixed sleep was not enough on a loaded machine). Ray reuses a
         # worker for several items, and the item may finish between the look and the kill: the kill hit
         # it only if its staging directory is still there once the worker is dead.
-        staged = sorted((out / ".partial").glob("*.*.*")) if (out / ".partial").exists() else []
+        staged = sorted((out / ".partial").glob("*.*.*"))  # none while the directory does not exist
         if not staged:
             time.sleep(0.01)
             continue
@@ -135,10 +135,10 @@ def test_a_killed_worker_costs_a_retry_not_the_job(cluster, tmp_path):
             os.kill(int(pid), signal.SIGKILL)
         except ProcessLookupError:
             continue
-        t1 = time.time()
-        while _alive(int(pid)) and time.time() - t1 < 10:
-            time.sleep(0.01)
         killed = int(pid)
+        t1 = time.time()
+        while _alive(killed) and time.time() - t1 < 10:
+            time.sleep(0.01)
         if staged[0].exists():
             hit = item
         else:
