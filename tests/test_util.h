@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <random>
 #include <string>
@@ -67,8 +68,15 @@ inline CliResult runShell(const std::string& command) {
     return r;
 }
 
+// The CLI under test: build/atrous, or $ATROUS_TEST_CLI when set (to show that a test fails on
+// an older build: ATROUS_TEST_CLI=/path/to/old/atrous build/tests/some_test).
+inline std::string cliPath() {
+    const char* env = std::getenv("ATROUS_TEST_CLI");
+    return env && *env ? env : ATROUS_CLI;
+}
+
 // Runs `build/atrous <args>` through the shell and captures its output and exit code.
-inline CliResult runCli(const std::string& args) { return runShell(std::string(ATROUS_CLI) + " " + args); }
+inline CliResult runCli(const std::string& args) { return runShell(cliPath() + " " + args); }
 
 // Counts the entries of a directory (to check that a failed command wrote nothing).
 inline int countEntries(const std::string& dir) {

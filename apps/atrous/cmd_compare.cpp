@@ -12,6 +12,7 @@
 #include "atrous/metrics.h"
 #include "commands.h"
 #include "io/image_io.h"
+#include "io/paths.h"
 
 namespace atrous::cli {
 
@@ -25,7 +26,17 @@ struct CompareArgs {
 
 void run(const CompareArgs& a) {
     if (a.images.empty()) throw InputError("compare: give at least one image to compare with --ref");
-    if (!a.errorMaps.empty()) io::ensureWritableDirectory(a.errorMaps);
+    if (!a.errorMaps.empty()) {
+        // The error maps never overwrite an image being compared (io/paths.h).
+        std::vector<std::string> inputs = a.images;
+        inputs.push_back(a.ref);
+        for (const std::string& img : a.images)
+            for (const char* suffix : {"_se.exr", "_relse.exr"})
+                io::refuseOverwrite("--error-maps",
+                                    (std::filesystem::path(a.errorMaps) / (std::filesystem::path(img).stem().string() + suffix)).string(),
+                                    inputs);
+        io::ensureWritableDirectory(a.errorMaps);
+    }
     // PNG is an 8-bit, clamped, display-encoded preview: accepted (LDR images can be compared), but
     // the figures are then not of the HDR radiance the metrics are meant for.
     auto notePng = [](const std::string& p) {

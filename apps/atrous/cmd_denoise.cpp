@@ -16,6 +16,7 @@
 #include "core/srgb.h"
 #include "io/buffer_set.h"
 #include "io/image_io.h"
+#include "io/paths.h"
 
 namespace atrous::cli {
 
@@ -97,8 +98,7 @@ io::BufferFiles bufferFiles(const DenoiseArgs& a) {
     f.file[int(io::Buffer::ObjectId)] = a.ids;
     f.file[int(io::Buffer::Emission)] = a.emission;
     f.viewLayer = a.layer;
-    for (const std::string& p : a.passes)
-        f.passes.push_back(withFlag("--pass", [&] { return io::parsePassRequest(p); }));
+    f.passes = withFlag("--pass", [&] { return io::parsePassRequests(a.passes); });
     return f;
 }
 
@@ -141,7 +141,18 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     if (sequence) {
         if (!a.inDir.empty() || !a.color.empty())
             throw InputError("--sequence DIR denoises the frames of DIR: drop --in/--color");
-        runSequenceDenoise(SequenceDenoiseArgs{a.method, a.sequence, a.out, o.device, a.svgf, o, weights});
+        SequenceDenoiseArgs s;
+        s.method = a.method;
+        s.sequenceDir = a.sequence;
+        s.outDir = a.out;
+        s.device = o.device;
+        s.svgf = a.svgf;
+        s.frameOptions = o;
+        s.svgfLearnedWeights = weights;
+        s.layers.passes = withFlag("--pass", [&] { return io::parsePassRequests(a.passes); });
+        s.layers.viewLayer = a.layer;
+        s.addPass = a.addPass;
+        runSequenceDenoise(s);
         return;
     }
     const std::string ext = io::extensionOf(a.out);
@@ -150,7 +161,9 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     if (a.inDir.empty() == a.color.empty())
         throw InputError("give exactly one of --in RENDER_DIR, --in LAYERED.exr or --color FILE (--hdr/--ldr)");
     checkOutputFile(a.out);
-    io::BufferSet set = io::loadBuffers(bufferFiles(a));
+    const io::BufferFiles files = bufferFiles(a);
+    io::refuseOverwrite("--out", a.out, io::inputFiles(files));
+    io::BufferSet set = io::loadBuffers(files);
     if (!a.addPass.empty() && (!set.layered || ext != ".exr"))
         throw InputError("--add-pass '" + a.addPass + "' writes a copy of a layered EXR: give --in FILE.exr and --out COPY.exr");
     Image& color = set.image[int(io::Buffer::Color)];
@@ -168,12 +181,11 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
         out = denoise(in, o);
     } catch (const InputError& e) {
         // Name the buffer's file: library messages name the buffer ("variance buffer has ...").
-        std::string msg = e.what();
-        for (size_t i = 0; i < std::size(kLabelled); ++i) {
-            const std::string& from = set.from[int(kLabelled[i])];
-            if (!from.empty() && msg.rfind(kLibraryNames[i], 0) == 0) msg = "'" + from + "': " + msg;
-        }
-        throw InputError(msg);
+        throw InputError(io::withSourceFile(e.what(), [&](const std::string& name) {
+            for (size_t i = 0; i < std::size(kLabelled); ++i)
+                if (name == kLibraryNames[i]) return set.from[int(kLabelled[i])];
+            return std::string();
+        }, ""));
     }
     const double ms = t.ms();
     if (a.ldr) clampUnit(out);
@@ -221,9 +233,12 @@ void addDenoiseCommand(CLI::App& app) {
                     "material_id, emission, motion) from the layer or channel NAME of a layered EXR (repeatable)");
     cmd->add_option("--layer", a->layer, "View layer of a layered EXR with several (Blender: the ViewLayer name)");
     cmd->add_option("--add-pass", a->addPass,
-                    "With --in FILE.exr: write --out as a copy of FILE with the denoised colour added as this pass");
+                    "With --in FILE.exr: write --out as a copy of FILE with the denoised colour added as this pass "
+                    "(with --sequence of layered EXRs: each frame_NNNN.exr is such a copy of its frame)");
     cmd->add_option("--sequence", a->sequence,
-                    "Sequence directory of frame_NNNN/ folders (atrous render --frames); --out is then a directory");
+                    "Sequence directory: frame_NNNN/ folders (atrous render --frames) or numbered layered EXRs "
+                    "(Blender's render0001.exr ...; --pass, --layer and --add-pass apply to every frame); --out is then "
+                    "a directory, never the sequence directory or inside it");
     cmd->add_option("--color,--hdr", a->color, "Noisy colour (EXR/PFM; --hdr as in oidnDenoise)");
     cmd->add_option("--ldr", a->ldrColor, "Noisy LDR colour in [0, 1] (oidnDenoise's --ldr): the output is clamped to [0, 1]");
     cmd->add_flag("--srgb", a->srgb, "With --ldr: the colour is sRGB-encoded (decoded before, encoded after)");
@@ -260,12 +275,6 @@ void addDenoiseCommand(CLI::App& app) {
         return std::string(f.group) == "sure" ? kGroupSure : kGroupEawSure;
     });
     addSvgfOptions(*cmd, a->svgf);
-    // CLI11 reads an empty value ("--sigma-depth ''") as 0 without a word (found by tests/fuzz):
-    // every option that takes a value refuses an empty one.
-    static const CLI::Validator kNonEmpty(
-        [](std::string& v) { return v.empty() ? std::string("an empty value") : std::string(); }, "", "non-empty");
-    for (CLI::Option* opt : cmd->get_options())
-        if (opt->get_expected_min() > 0) opt->check(kNonEmpty);
     cmd->callback([a, cmd] { run(*a, *cmd); });
 }
 

@@ -17,6 +17,7 @@
 #include "io/exr_layers.h"
 #include "io/image_io.h"
 #include "io/pass_map.h"
+#include "io/paths.h"
 
 namespace atrous::cli {
 
@@ -84,10 +85,20 @@ io::BufferSet load(const InspectArgs& a, const std::vector<io::PassRequest>& req
     return io::loadBuffers(f);
 }
 
+// --export DIR never writes (or removes as an earlier export's) a file the input is read from.
+void refuseExportOverInputs(const InspectArgs& a, const std::vector<io::PassRequest>& requests) {
+    if (a.exportDir.empty()) return;
+    io::BufferFiles f;
+    f.in = a.file;
+    f.passes = requests;
+    const std::vector<std::string> inputs = io::inputFiles(f);
+    for (int b = 0; b < io::kBufferCount; ++b)
+        io::refuseOverwrite("--export", (fs::path(a.exportDir) / exportName(io::Buffer(b))).string(), inputs);
+}
+
 void run(const InspectArgs& a) {
-    std::vector<io::PassRequest> requests;
-    for (const std::string& p : a.passes)
-        requests.push_back(withFlag("--pass", [&] { return io::parsePassRequest(p); }));
+    const std::vector<io::PassRequest> requests = withFlag("--pass", [&] { return io::parsePassRequests(a.passes); });
+    refuseExportOverInputs(a, requests);
     std::error_code ec;
     if (fs::is_directory(a.file, ec)) {  // a render directory: what denoise --in DIR takes
         const io::BufferSet set = load(a, requests);

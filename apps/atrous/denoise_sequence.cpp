@@ -16,6 +16,7 @@
 #include "core/timer.h"
 #include "io/buffer_set.h"
 #include "io/image_io.h"
+#include "io/paths.h"
 #include "io/sequence.h"
 #include "sequence_checks.h"
 
@@ -193,9 +194,14 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
 
     // Everything that can be checked before writing is checked first; what only decoding finds
     // (a truncated EXR) fails inside the loop, before anything reaches OUTDIR (StagedOutput).
+    // OUTDIR in the sequence directory would take its frame_NNNN.exr names (io/paths.h).
+    io::refuseOutputInside("--out", args.outDir, args.sequenceDir);
     std::vector<std::string> frames = io::listSequenceFrames(args.sequenceDir);
+    if (!args.addPass.empty() && fs::is_directory(frames.front()))
+        throw InputError("--add-pass '" + args.addPass + "': copies a layered EXR frame, and " + args.sequenceDir +
+                         " holds frame_NNNN folders of plain EXRs");
     int width = 0, height = 0;
-    const std::vector<std::string> present = io::validateSequence(frames, width, height);
+    const std::vector<std::string> present = io::validateSequence(frames, width, height, args.layers);
     std::unique_ptr<SvgfDenoiser> svgfDenoiser;
     DenoiseOptions options = args.frameOptions;
     if (svgf) {
@@ -216,7 +222,7 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
     bool idsTrusted = true, warnedSign = false, notedMotion = false;
     io::SequenceFrame prev;
     for (const auto& path : frames) {
-        io::SequenceFrame f = io::loadSequenceFrame(path, present);
+        io::SequenceFrame f = io::loadSequenceFrame(path, present, args.layers);
         if (firstIndex < 0) firstIndex = f.index;
         std::string name = io::sequenceFrameName(f.index);
         // Other renderers' sequences: how much reprojects, with which sign, and whether ids hold.
@@ -246,12 +252,21 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
         // Every buffer the frame has (emission included), through the one input assembly.
         io::BufferRefs refs = io::refsOf(f);
         if (!idsTrusted) refs.set(io::Buffer::ObjectId, nullptr);
-        if (svgf)
-            out = svgfDenoiser->denoiseFrame(io::svgfFrame(refs));
-        else
-            out = denoise(io::denoiseInputs(refs), options);
+        try {
+            if (svgf)
+                out = svgfDenoiser->denoiseFrame(io::svgfFrame(refs));
+            else
+                out = denoise(io::denoiseInputs(refs), options);
+        } catch (const InputError& e) {
+            // The library names the buffer; the message names the frame's file too.
+            throw InputError(io::withSourceFile(e.what(), [&](const std::string& b) { return f.fileOf(b); }, f.dir));
+        }
         double ms = timer.ms();
-        io::writeImage((fs::path(stage) / (name + ".exr")).string(), out);
+        const std::string exrOut = (fs::path(stage) / (name + ".exr")).string();
+        if (!args.addPass.empty())
+            io::writeExrWithLayers(exrOut, *f.layered, {io::ExrOutLayer{args.addPass, &out}});
+        else
+            io::writeImage(exrOut, out);
         io::writePng((fs::path(stage) / (name + ".png")).string(), out, args.exposure);
         if (!args.quiet) {
             std::printf("%s: %s%s%s %.1f ms", name.c_str(), args.method.c_str(),

@@ -11,6 +11,7 @@
 #include "atrous/device.h"
 #include "atrous/learned.h"
 #include "atrous/svgf.h"
+#include "io/sequence.h"
 
 namespace atrous::cli {
 
@@ -22,6 +23,8 @@ struct SequenceDenoiseArgs {
     SvgfParams svgf;              // used by --method svgf
     DenoiseOptions frameOptions;  // used by eaw/sure/learned/auto (method and device are set from the fields above)
     LearnedWeights svgfLearnedWeights;  // svgf.learnedSpatial's (--learned-weights); empty = the built-in ones
+    io::SequenceOptions layers;   // --pass and --layer, applied to every layered frame
+    std::string addPass;          // --add-pass: each output frame a copy of its layered frame with this pass
     float exposure = 1.0f;        // of the PNG previews
     bool preview = true;          // animated OUTDIR/preview.mp4 through ffmpeg when it is on PATH
     bool quiet = false;           // no per-frame lines on stdout

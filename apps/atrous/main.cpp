@@ -32,6 +32,14 @@ int main(int argc, char** argv) {
     atrous::cli::addBenchCommand(app);
     atrous::cli::addViewCommand(app);
     atrous::cli::addInspectCommand(app);
+    // CLI11 reads an empty value as 0 ("--sigma-depth ''") or as if the flag were absent ("inspect
+    // --export ''") without a word (found by tests/fuzz): every option of every command that takes
+    // a value refuses an empty one.
+    static const CLI::Validator kNonEmpty(
+        [](std::string& v) { return v.empty() ? std::string("an empty value") : std::string(); }, "", "non-empty");
+    for (CLI::App* cmd : app.get_subcommands({}))
+        for (CLI::Option* opt : cmd->get_options())
+            if (opt->get_expected_min() > 0) opt->check(kNonEmpty);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

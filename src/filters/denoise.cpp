@@ -100,6 +100,15 @@ InputError negativeVarianceError(float value, size_t pixel, int width) {
                       std::to_string(pixel % size_t(width)) + ", " + std::to_string(pixel / size_t(width)) + ")");
 }
 
+void requireColorInRange(const Image& color) {
+    if (color.device() != Device::Cpu) return;
+    for (size_t i = 0; i < 3 * color.plane(); ++i) {
+        const float v = color.data()[i];
+        if (std::isfinite(v) && std::fabs(v) > kMaxInputColor)
+            throw outOfRangeError("color", v, kMaxInputColor, i % color.plane(), color.width());
+    }
+}
+
 PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, DenoiseReport& rep) {
     if (!in.color || in.color->empty()) throw InputError("no color buffer given");
     const Image& color = *in.color;
@@ -119,11 +128,7 @@ PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, D
     const bool colorOnHost = color.device() == Device::Cpu;
     rep.nonFinitePixels = 0;
     if (colorOnHost) {
-        for (size_t i = 0; i < 3 * color.plane(); ++i) {
-            const float v = color.data()[i];
-            if (std::isfinite(v) && std::fabs(v) > kMaxInputColor)
-                throw outOfRangeError("color", v, kMaxInputColor, i % color.plane(), color.width());
-        }
+        requireColorInRange(color);
         for (size_t i = 0; i < color.plane(); ++i) {
             if (!std::isfinite(color.data()[i]) || !std::isfinite(color.data()[i + color.plane()]) ||
                 !std::isfinite(color.data()[i + 2 * color.plane()]))

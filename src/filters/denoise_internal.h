@@ -25,6 +25,10 @@ struct DriverDebug {
 // colour pixels and estimates the noise when there is no variance buffer. For inputs on the GPU
 // the non-finite count and the negative-variance check are left to denoiseCuda (no download).
 PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, DenoiseReport& rep);
+// Every filter's colour rule (docs/reliability.md): a finite value beyond ±1e15 is not a
+// measurement. Throws InputError "color buffer has a value of magnitude ... at pixel (x, y)" for
+// a host image; a CUDA image is not scanned here.
+void requireColorInRange(const Image& color);
 // The InputError for a negative variance value at planar index `pixel` (of one plane).
 InputError negativeVarianceError(float value, size_t pixel, int width);
 // Without a variance buffer: the driver's local noise estimate (noise_estimate.h), floored at

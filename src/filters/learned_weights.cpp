@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <vector>
@@ -82,9 +83,22 @@ LearnedWeights LearnedWeights::parse(const void* data, size_t size, const std::s
 }
 
 LearnedWeights LearnedWeights::load(const std::string& path) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (!fs::exists(path, ec)) throw InputError(path + ": cannot open the learned-filter weight file (not found)");
+    if (fs::is_directory(path, ec)) throw InputError(path + ": is a directory, not a learned-filter weight file");
+    // A FIFO or a device (/dev/zero) would be read for ever: only regular files, and only as many
+    // bytes as a weight file can have (it is a few KB; parse() checks the exact size).
+    if (!fs::is_regular_file(path, ec)) throw InputError(path + ": not a regular file (a learned-filter weight file)");
+    const uintmax_t size = fs::file_size(path, ec);
+    constexpr uintmax_t kMaxBytes = 1u << 20;
+    if (ec || size > kMaxBytes)
+        throw InputError(path + ": over-long weight file (" + std::to_string(size) + " bytes; a weight file has a few KB)");
     std::ifstream f(path, std::ios::binary);
     if (!f) throw InputError(path + ": cannot open the learned-filter weight file");
-    const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    std::vector<std::uint8_t> bytes(static_cast<size_t>(size));
+    f.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(size));
+    if (size_t(f.gcount()) != bytes.size()) throw InputError(path + ": cannot read the learned-filter weight file");
     return parse(bytes.data(), bytes.size(), path);
 }
 

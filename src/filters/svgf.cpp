@@ -7,6 +7,7 @@
 #include "atrous/error.h"
 #include "atrous/params.h"
 #include "core/parallel.h"
+#include "filters/denoise_internal.h"
 #include "filters/svgf_pipeline.h"
 
 namespace atrous {
@@ -36,6 +37,8 @@ void checkFrame(const SvgfFrame& f) {
     check(f.ids, "ids", 1);
     check(f.motion, "motion", 2);
     check(f.emission, "emission", 3);
+    // The still filters' colour rule: beyond ±1e15 the history's squares overflow.
+    filters::requireColorInRange(*f.color);
 }
 
 }  // namespace svgf

@@ -1,6 +1,8 @@
 #include "io/buffer_set.h"
 
+#include <algorithm>
 #include <filesystem>
+#include <iterator>
 
 #include "atrous/error.h"
 #include "io/image_io.h"
@@ -71,25 +73,72 @@ SvgfFrame svgfFrame(const BufferRefs& r) {
     return SvgfFrame{in.color, in.albedo, in.normal, in.depth, in.ids, r.get(Buffer::Motion), in.emission};
 }
 
+namespace {
+
+// --layer names a view layer of every layered file it is applied to.
+void requireViewLayer(const ExrInfo& info, const std::string& viewLayer) {
+    if (viewLayer.empty()) return;
+    for (const ExrLayer& l : info.layers)
+        if (l.prefix() == viewLayer) return;
+    throw InputError(info.path + ": --layer '" + viewLayer + "': no pass under that view layer (layers: " + layerList(info) + ")");
+}
+
+}  // namespace
+
 Image readBufferFile(const std::string& path, Buffer b, const std::vector<PassRequest>& passes,
-                     const std::string& viewLayer, std::string* from) {
+                     const std::string& viewLayer, std::string* from, bool* layered) {
     if (from) *from = path;
+    if (layered) *layered = false;
     if (fs::is_regular_file(path) && isExrFile(path)) {
         const ExrInfo info = inspectExr(path);
         // Root R,G,B (atrous's own files, ids with mesh and material in R and G) are read whole.
         if (info.layers.size() > 1 || !info.layers[0].name.empty()) {
+            requireViewLayer(info, viewLayer);
             const PassChoice c = passForFile(info, b, passes, viewLayer);
             if (from && c.layer >= 0) *from = path + " (layer " + info.layers[size_t(c.layer)].name + ", " + c.rule + ")";
+            if (layered) *layered = true;
             return readPass(info, c, b);
         }
     }
-    Image img = readImage(path);
+    int channels = 3;
+    Image img = readImage(path, &channels);
+    requireComponents(b, channels, path);
     conformBuffer(b, img);
     return img;
 }
 
+std::vector<std::string> inputFiles(const BufferFiles& f) {
+    std::vector<std::string> files;
+    std::error_code ec;
+    if (!f.in.empty()) {
+        if (fs::is_directory(f.in, ec)) {
+            for (const char* name : kDirNames)
+                if (name[0]) files.push_back((fs::path(f.in) / name).string());
+        } else {
+            files.push_back(f.in);
+        }
+    }
+    for (const std::string& p : f.file)
+        if (!p.empty()) files.push_back(p);
+    return files;
+}
+
+std::string withSourceFile(const std::string& msg, const std::function<std::string(const std::string&)>& fileOf,
+                           const std::string& fallback) {
+    static const char* const kNames[] = {"color", "variance", "albedo", "normal", "position", "depth", "ids", "emission", "motion"};
+    for (const std::string prefix : {std::string(), std::string("SVGF frame: the ")})
+        for (const char* name : kNames)
+            if (msg.rfind(prefix + name + " buffer", 0) == 0) {
+                const std::string file = fileOf(name);
+                if (!file.empty()) return file + ": " + msg;
+            }
+    return fallback.empty() ? msg : fallback + ": " + msg;
+}
+
 BufferSet loadBuffers(const BufferFiles& f) {
+    requireDistinctPasses(f.passes);
     BufferSet s;
+    bool layered[kBufferCount] = {};  // read from a layered EXR (where --pass and --layer apply)
     std::string dir;
     if (!f.in.empty()) {
         std::error_code ec;
@@ -126,6 +175,7 @@ BufferSet loadBuffers(const BufferFiles& f) {
             s.from[b] = f.in + " (" + (label.empty() ? std::string("root R,G,B") : label) + ", " + c.rule + ")";
             Image& dst = Buffer(b) == Buffer::ObjectId ? object : Buffer(b) == Buffer::MaterialId ? material : s.image[b];
             dst = std::move(img);
+            layered[b] = true;
         }
         if (!object.empty() || !material.empty()) {
             const Image& any = object.empty() ? material : object;
@@ -142,7 +192,22 @@ BufferSet loadBuffers(const BufferFiles& f) {
         if (path.empty()) continue;
         // A layered file given for the ids (`--ids aovs.exr`) gives its object-index pass only;
         // atrous's own ids.exr (root R, G) is read whole: mesh and material ids.
-        s.image[b] = readBufferFile(path, Buffer(b), f.passes, f.viewLayer, &s.from[b]);
+        s.image[b] = readBufferFile(path, Buffer(b), f.passes, f.viewLayer, &s.from[b], &layered[b]);
+        if (Buffer(b) == Buffer::ObjectId) layered[int(Buffer::MaterialId)] = layered[b];
+    }
+    // --pass and --layer pick layers of layered EXRs: refused where no layered file is read for them.
+    const bool anyLayered = std::any_of(std::begin(layered), std::end(layered), [](bool v) { return v; });
+    if (!f.viewLayer.empty() && !anyLayered)
+        throw InputError("--layer '" + f.viewLayer + "': picks a view layer of a layered EXR, and none of the inputs is one");
+    for (const PassRequest& r : f.passes) {
+        const int b = int(r.buffer);
+        if (layered[b]) continue;
+        const std::string what = std::string("--pass ") + bufferName(r.buffer) + "=" + r.name;
+        if (!s.from[b].empty())
+            throw InputError(what + ": " + bufferName(r.buffer) + " is read from '" + s.from[b] +
+                             "', a plain image (--pass picks a layer of a layered EXR)");
+        throw InputError(what + ": no layered EXR among the inputs gives " + bufferName(r.buffer) +
+                         " (--pass picks a layer of a layered EXR)");
     }
     if (s.image[int(Buffer::Color)].empty()) {
         if (!dir.empty()) throw InputError("--in '" + dir + "': no color.exr in it");

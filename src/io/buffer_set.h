@@ -2,6 +2,7 @@
 // directory as atrous writes it (color.exr, albedo.exr, ...), a layered EXR (Blender's multilayer
 // file, Mitsuba's aov output), separate files per buffer, or a mix (explicit files win).
 #pragma once
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -58,14 +59,32 @@ BufferRefs refsOf(const SequenceFrame& f);  // all but the reference
 DenoiseInputs denoiseInputs(const BufferRefs& r);
 SvgfFrame svgfFrame(const BufferRefs& r);
 
+// Every file loadBuffers(files) reads or could read: the explicit files, `in` when it is a file,
+// and for a render directory each buffer's file name in it (color.exr, albedo.exr, ...: present
+// or not, since a file written there would be read as that buffer next time). Outputs are checked
+// against this list (io/paths.h) before anything runs.
+std::vector<std::string> inputFiles(const BufferFiles& files);
+
+// A denoiser's message about a buffer ("variance buffer has a value of ...", "SVGF frame: the
+// normal buffer is ...") with the file that buffer came from in front ("FILE: variance buffer has
+// ..."). fileOf(name) gives that file for a library buffer name (color, variance, albedo, normal,
+// position, depth, ids, emission, motion; "" when unknown); a message that names no buffer gets
+// `fallback` in front (when not empty).
+std::string withSourceFile(const std::string& msg, const std::function<std::string(const std::string&)>& fileOf,
+                           const std::string& fallback);
+
 // Reads every buffer that `files` names or that `files.in` holds. Throws InputError naming the
 // file (and part) for a missing colour, an unreadable file, an ambiguous or empty pass mapping, or
-// a buffer whose size differs from the colour's (naming both files).
+// a buffer whose size differs from the colour's (naming both files); and naming the flag for a
+// --pass whose buffer is not read from a layered EXR, a buffer given twice in --pass, or a --layer
+// when no input is a layered EXR (flags that cannot apply are refused, never ignored).
 BufferSet loadBuffers(const BufferFiles& files);
 
 // Reads one buffer from a file given for it alone: a layered EXR gives the pass of that buffer
-// (passForFile), any other image is read whole (readImage). Conventions applied (conformBuffer).
+// (passForFile; `viewLayer` must be one of its view layers), any other image is read whole
+// (readImage; the channel-count rule of pass_map.h applies). Conventions applied (conformBuffer).
+// `layered`, when given, says whether a layered EXR's pass was read.
 Image readBufferFile(const std::string& path, Buffer b, const std::vector<PassRequest>& passes,
-                     const std::string& viewLayer, std::string* from = nullptr);
+                     const std::string& viewLayer, std::string* from = nullptr, bool* layered = nullptr);
 
 }  // namespace atrous::io

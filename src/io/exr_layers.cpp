@@ -19,6 +19,7 @@
 #include <set>
 
 #include "atrous/error.h"
+#include "io/exr_limits.h"
 #include "io/image_io.h"
 
 namespace atrous::io {
@@ -71,18 +72,20 @@ ExrInfo inspectExr(const std::string& path) {
     try {
         Imf::MultiPartInputFile file(path.c_str());
         const int parts = file.parts();
+        std::vector<const Imf::Header*> headers;
+        std::vector<std::string> labels;
         for (int p = 0; p < parts; ++p) {
             const Imf::Header& hd = file.header(p);
             ExrPartInfo part;
             part.name = hd.hasName() ? hd.name() : std::string();
             part.type = hd.hasType() ? hd.type() : std::string(Imf::SCANLINEIMAGE);
+            headers.push_back(&hd);
+            labels.push_back(parts == 1 ? std::string() : "part " + std::to_string(p) + (part.name.empty() ? "" : " '" + part.name + "'"));
             const Imath::Box2i dw = hd.dataWindow();
-            const long w = long(dw.max.x) - dw.min.x + 1, h = long(dw.max.y) - dw.min.y + 1;
-            if (w <= 0 || h <= 0 || w > kMaxImageDim || h > kMaxImageDim)
-                throw InputError(path + ": part " + std::to_string(p) + (part.name.empty() ? "" : " '" + part.name + "'") +
-                                 ": unsupported image size " + std::to_string(w) + "x" + std::to_string(h));
-            part.width = int(w);
-            part.height = int(h);
+            part.x0 = dw.min.x;
+            part.y0 = dw.min.y;
+            part.width = int(std::min<long>(long(dw.max.x) - dw.min.x + 1, kMaxImageDim + 1L));
+            part.height = int(std::min<long>(long(dw.max.y) - dw.min.y + 1, kMaxImageDim + 1L));
             for (auto it = hd.channels().begin(); it != hd.channels().end(); ++it) {
                 ExrChannelInfo ch;
                 ch.part = p;
@@ -94,14 +97,21 @@ ExrInfo inspectExr(const std::string& path) {
             }
             info.parts.push_back(part);
         }
+        if (parts > 0) {
+            // Every part's size against what the file can hold, before anything is allocated.
+            requireExrFits(path, headers, labels);
+            const ExrWindow win = exrImageWindow(path, file.header(0));
+            info.x0 = win.x0;
+            info.y0 = win.y0;
+            info.width = win.width;
+            info.height = win.height;
+        }
     } catch (const InputError&) {
         throw;
     } catch (const std::exception& e) {
         throw InputError(path + ": cannot read EXR header (" + e.what() + ")");
     }
     if (info.parts.empty()) throw InputError(path + ": EXR file has no parts");
-    info.width = info.parts[0].width;
-    info.height = info.parts[0].height;
     std::map<std::string, size_t> layerIndex;
     for (size_t i = 0; i < info.channels.size(); ++i) {
         const std::string layerName = withoutLastComponent(info.channels[i].fullName);
@@ -152,57 +162,90 @@ std::vector<int> pickComponents(const ExrInfo& info, const ExrLayer& layer, int 
 std::vector<Image> readExrChannelSets(const ExrInfo& info, const std::vector<std::vector<int>>& sets,
                                       const std::vector<std::string>& whats) {
     const int w = info.width, h = info.height;
-    std::vector<Image> images;
+    const ExrWindow win{info.x0, info.y0, w, h};
+    // Every channel of every set is checked before anything is allocated or decoded.
     for (size_t k = 0; k < sets.size(); ++k) {
         if (sets[k].empty() || sets[k].size() > 3)
             throw InputError(info.path + ": " + whats[k] + ": no channels to read");
-        images.emplace_back(w, h, 3);
+        for (int c : sets[k]) {
+            const ExrChannelInfo& ch = info.channels.at(size_t(c));
+            const ExrPartInfo& part = info.parts[size_t(ch.part)];
+            const std::string label = part.name.empty() ? "part " + std::to_string(ch.part) : "part '" + part.name + "'";
+            if (part.type.rfind("deep", 0) == 0)
+                throw InputError(info.path + ": " + label + " (" + whats[k] + ") is a deep image, which atrous cannot read");
+            const Imath::Box2i dw(Imath::V2i(part.x0, part.y0), Imath::V2i(part.x0 + part.width - 1, part.y0 + part.height - 1));
+            if (!exrCovers(dw, win))
+                throw InputError(info.path + ": " + label + " (" + whats[k] + ") has the data window (" + std::to_string(part.x0) +
+                                 "," + std::to_string(part.y0) + ")-(" + std::to_string(dw.max.x) + "," + std::to_string(dw.max.y) +
+                                 "), which does not cover the image's (" + std::to_string(win.x0) + "," + std::to_string(win.y0) +
+                                 ")-(" + std::to_string(win.x0 + w - 1) + "," + std::to_string(win.y0 + h - 1) + ")");
+        }
     }
     // A channel taken by two sets is read once and copied: (source plane, destination plane).
-    std::vector<std::pair<const float*, float*>> copies;
-    std::map<int, const float*> readInto;
-    std::string what;
+    std::vector<std::pair<int, std::pair<size_t, int>>> copies;  // channel -> (set, component)
+    std::map<int, std::vector<std::pair<size_t, int>>> byPart;   // part -> the (set, component) it fills
+    std::map<int, std::pair<size_t, int>> firstUse;
+    for (size_t k = 0; k < sets.size(); ++k)
+        for (size_t j = 0; j < sets[k].size(); ++j) {
+            const int c = sets[k][j];
+            auto seen = firstUse.find(c);
+            if (seen != firstUse.end()) {
+                copies.push_back({c, {k, int(j)}});
+                continue;
+            }
+            firstUse.emplace(c, std::make_pair(k, int(j)));
+            byPart[info.channels[size_t(c)].part].push_back({k, int(j)});
+        }
+    std::string what = sets.size() == 1 ? whats[0] : "its passes";
+    std::vector<Image> images;
     try {
         Imf::MultiPartInputFile file(info.path.c_str());
-        // One frame buffer per part: each part is decoded once for all the sets.
-        std::map<int, Imf::FrameBuffer> buffers;
-        for (size_t k = 0; k < sets.size(); ++k) {
-            what = whats[k];
-            for (size_t j = 0; j < sets[k].size(); ++j) {
-                const ExrChannelInfo& ch = info.channels.at(size_t(sets[k][j]));
-                const ExrPartInfo& part = info.parts[size_t(ch.part)];
-                if (part.width != w || part.height != h)
-                    throw InputError(info.path + ": part '" + part.name + "' (" + what + ") is " +
-                                     describeSize(part.width, part.height) + " but the first part is " + describeSize(w, h));
-                if (part.type.rfind("deep", 0) == 0)
-                    throw InputError(info.path + ": part '" + part.name + "' (" + what + ") is a deep image, which atrous cannot read");
-                float* plane = images[k].view().channel(int(j));
-                auto seen = readInto.find(sets[k][j]);
-                if (seen != readInto.end()) {
-                    copies.emplace_back(seen->second, plane);
-                    continue;
-                }
-                readInto.emplace(sets[k][j], plane);
-                const Imath::Box2i dw = file.header(ch.part).dataWindow();
-                const size_t xs = sizeof(float), ys = sizeof(float) * size_t(w);
-                char* base = reinterpret_cast<char*>(plane) - dw.min.x * long(xs) - dw.min.y * long(ys);
-                buffers[ch.part].insert(ch.name.c_str(), Imf::Slice(Imf::FLOAT, base, xs, ys, 1, 1, 0.0));
+        for (const auto& [p, uses] : byPart) {
+            Imf::InputPart part(file, p);
+            for (const auto& use : uses) {
+                const ExrChannelInfo& ch = info.channels[size_t(sets[use.first][size_t(use.second)])];
+                const Imf::Channel* c = part.header().channels().findChannel(ch.name.c_str());
+                if (c && (c->xSampling != 1 || c->ySampling != 1))
+                    throw InputError(info.path + ": channel '" + ch.fullName + "' (" + whats[use.first] + ") is subsampled (" +
+                                     std::to_string(c->xSampling) + "x" + std::to_string(c->ySampling) +
+                                     "), which atrous cannot read");
             }
         }
-        what = sets.size() == 1 ? whats[0] : "its passes";
-        for (auto& [p, fb] : buffers) {
+        // Rule 3 of exr_limits.h: a header that claims more than its chunks hold fails here, at a
+        // row's cost, when the planes would be large against the file.
+        if (exrNeedsProof(uint64_t(sets.size()) * 12 * uint64_t(w) * uint64_t(h), exrFileBytes(info.path)))
+            for (const auto& [p, uses] : byPart) {
+                Imf::InputPart part(file, p);
+                std::vector<std::string> names;
+                for (const auto& use : uses) names.push_back(info.channels[size_t(sets[use.first][size_t(use.second)])].name);
+                proveExrRows(part, names, win.y0, win.y0 + h - 1);
+            }
+        for (size_t k = 0; k < sets.size(); ++k) images.emplace_back(w, h, 3);
+        for (const auto& [p, uses] : byPart) {
             Imf::InputPart part(file, p);
-            part.setFrameBuffer(fb);
-            const Imath::Box2i dw = part.header().dataWindow();
-            part.readPixels(dw.min.y, dw.max.y);
+            std::vector<std::string> names;
+            std::vector<float*> planes;
+            for (const auto& use : uses) {
+                names.push_back(info.channels[size_t(sets[use.first][size_t(use.second)])].name);
+                planes.push_back(images[use.first].view().channel(use.second));
+            }
+            readExrPlanes(part, names, planes, win);
         }
     } catch (const InputError&) {
         throw;
+    } catch (const RuntimeError& e) {
+        throw RuntimeError(info.path + ": " + e.what());
+    } catch (const std::bad_alloc&) {
+        throw RuntimeError(info.path + ": out of host memory reading " + what);
     } catch (const std::exception& e) {
         throw InputError(info.path + ": cannot read " + what + " (" + e.what() + ")");
     }
     const size_t plane = size_t(w) * size_t(h);
-    for (const auto& [from, to] : copies) std::copy(from, from + plane, to);
+    for (const auto& [c, to] : copies) {
+        const auto& from = firstUse.at(c);
+        const float* src = images[from.first].view().channel(from.second);
+        std::copy(src, src + plane, images[to.first].view().channel(to.second));
+    }
     for (size_t k = 0; k < sets.size(); ++k) {
         float* d = images[k].data();
         if (sets[k].size() == 1) {
@@ -240,22 +283,30 @@ std::vector<PartPixels> readAllParts(const ExrInfo& source) {
                 throw InputError(source.path + ": part " + std::to_string(p) + " is a deep image: cannot copy it");
             const Imath::Box2i dw = pp.header.dataWindow();
             const size_t w = size_t(dw.max.x - dw.min.x + 1), h = size_t(dw.max.y - dw.min.y + 1);
+            Imf::InputPart part(file, p);
             Imf::FrameBuffer fb;
+            std::vector<std::string> names;
+            uint64_t partBytes = 0;
             for (auto it = pp.header.channels().begin(); it != pp.header.channels().end(); ++it) {
                 const Imf::Channel& c = it.channel();
                 if (c.xSampling != 1 || c.ySampling != 1)
                     throw InputError(source.path + ": channel '" + std::string(it.name()) +
                                      "' is subsampled: atrous cannot copy it");
-                const size_t bytes = pixelBytes(c.type);
-                pp.channels.emplace_back(it.name(), c.type);
-                pp.data.emplace_back(w * h * bytes);
+                names.push_back(it.name());
+                partBytes += uint64_t(w) * h * pixelBytes(c.type);
+            }
+            // exr_limits.h, rule 3: the chunks are proven before the copy's planes are allocated.
+            if (!names.empty() && exrNeedsProof(partBytes, exrFileBytes(source.path)))
+                proveExrRows(part, names, dw.min.y, dw.max.y);
+            for (auto it = pp.header.channels().begin(); it != pp.header.channels().end(); ++it) {
+                pp.channels.emplace_back(it.name(), it.channel().type);
+                pp.data.emplace_back(w * h * pixelBytes(it.channel().type));
             }
             for (size_t i = 0; i < pp.channels.size(); ++i) {
                 const size_t bytes = pixelBytes(pp.channels[i].second);
                 char* base = pp.data[i].data() - dw.min.x * long(bytes) - dw.min.y * long(bytes * w);
                 fb.insert(pp.channels[i].first.c_str(), Imf::Slice(pp.channels[i].second, base, bytes, bytes * w));
             }
-            Imf::InputPart part(file, p);
             part.setFrameBuffer(fb);
             part.readPixels(dw.min.y, dw.max.y);
             // Tiled parts are written back as scanlines (the pixels are the same).
@@ -272,13 +323,18 @@ std::vector<PartPixels> readAllParts(const ExrInfo& source) {
     return parts;
 }
 
-// Adds the float planes of `layer` as channels "<prefix><component>" to a part.
-void addLayerChannels(PartPixels& pp, const ExrOutLayer& layer, const std::string& prefix, const std::string& path) {
+// Adds the float planes of `layer` as channels "<prefix><component>" to a part. The image's pixel
+// (0, 0) is the file's pixel `origin` (the image window of exr_limits.h), inside the part's data
+// window; the part's pixels outside the image are 0.
+void addLayerChannels(PartPixels& pp, const ExrOutLayer& layer, const std::string& prefix, const std::string& path,
+                      Imath::V2i origin) {
     const Imath::Box2i dw = pp.header.dataWindow();
     const int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;
-    if (!layer.image || layer.image->width() != w || layer.image->height() != h ||
-        layer.image->channels() < int(layer.components.size()))
+    const int ox = origin.x - dw.min.x, oy = origin.y - dw.min.y;
+    if (!layer.image || layer.image->channels() < int(layer.components.size()) || ox < 0 || oy < 0 ||
+        ox + layer.image->width() > w || oy + layer.image->height() > h)
         throw InputError(path + ": layer '" + layer.name + "' does not match the file's size " + describeSize(w, h));
+    const int iw = layer.image->width(), ih = layer.image->height();
     for (size_t c = 0; c < layer.components.size(); ++c) {
         const std::string name = prefix + layer.components[c];
         if (pp.header.channels().findChannel(name))
@@ -286,7 +342,13 @@ void addLayerChannels(PartPixels& pp, const ExrOutLayer& layer, const std::strin
         pp.header.channels().insert(name, Imf::Channel(Imf::FLOAT));
         const float* plane = layer.image->view().channel(int(c));
         std::vector<char> bytes(size_t(w) * size_t(h) * sizeof(float));
-        std::memcpy(bytes.data(), plane, bytes.size());
+        if (iw == w && ih == h) {
+            std::memcpy(bytes.data(), plane, bytes.size());
+        } else {
+            float* dst = reinterpret_cast<float*>(bytes.data());
+            for (int y = 0; y < ih; ++y)
+                std::memcpy(dst + size_t(y + oy) * size_t(w) + size_t(ox), plane + size_t(y) * size_t(iw), size_t(iw) * sizeof(float));
+        }
         pp.channels.emplace_back(name, Imf::FLOAT);
         pp.data.push_back(std::move(bytes));
     }
@@ -325,7 +387,8 @@ void writeParts(const std::string& path, std::vector<PartPixels>& parts) {
 void writeExrWithLayers(const std::string& outPath, const ExrInfo& source, const std::vector<ExrOutLayer>& added) {
     std::vector<PartPixels> parts = readAllParts(source);
     if (parts.size() == 1) {
-        for (const ExrOutLayer& l : added) addLayerChannels(parts[0], l, l.name.empty() ? "" : l.name + ".", outPath);
+        for (const ExrOutLayer& l : added)
+            addLayerChannels(parts[0], l, l.name.empty() ? "" : l.name + ".", outPath, Imath::V2i(source.x0, source.y0));
     } else {
         const std::string viewLayer = withoutLastComponent(source.parts[0].name);
         std::set<std::string> names;
@@ -335,13 +398,17 @@ void writeExrWithLayers(const std::string& outPath, const ExrInfo& source, const
             PartPixels pp;
             pp.header = parts[0].header;
             pp.header.channels() = Imf::ChannelList();
+            // The new part holds the image window alone (parts may have their own data windows).
+            if (l.image)
+                pp.header.dataWindow() = Imath::Box2i(Imath::V2i(source.x0, source.y0),
+                                                      Imath::V2i(source.x0 + l.image->width() - 1, source.y0 + l.image->height() - 1));
             pp.header.setName(viewLayer.empty() ? l.name : viewLayer + "." + l.name);
             if (!names.insert(pp.header.name()).second)
                 throw InputError(outPath + ": the file already has a part '" + pp.header.name() + "' (choose another pass name)");
             // Blender names the channels of a part "<part name>.<component>".
             const bool qualified = parts[0].channels.empty() ? false
                                    : parts[0].channels[0].first.rfind(source.parts[0].name + ".", 0) == 0;
-            addLayerChannels(pp, l, qualified ? pp.header.name() + "." : "", outPath);
+            addLayerChannels(pp, l, qualified ? pp.header.name() + "." : "", outPath, Imath::V2i(source.x0, source.y0));
             parts.push_back(std::move(pp));
         }
     }
@@ -363,7 +430,7 @@ void writeLayeredExr(const std::string& path, const std::vector<ExrOutLayer>& la
     if (!multipart) parts.push_back(newPart(""));
     for (const ExrOutLayer& l : layers) {
         if (multipart) parts.push_back(newPart(l.name));
-        addLayerChannels(parts.back(), l, l.name.empty() ? "" : l.name + ".", path);
+        addLayerChannels(parts.back(), l, l.name.empty() ? "" : l.name + ".", path, Imath::V2i(0, 0));
     }
     if (halfFloat) {
         for (auto& pp : parts) {

@@ -18,7 +18,7 @@ namespace atrous::io {
 struct ExrPartInfo {
     std::string name;  // the part's name attribute ("" when it has none)
     std::string type;  // "scanlineimage", "tiledimage", "deepscanline", ...
-    int width = 0, height = 0;
+    int x0 = 0, y0 = 0, width = 0, height = 0;  // its data window
 };
 
 struct ExrChannelInfo {
@@ -40,7 +40,10 @@ struct ExrLayer {
 
 struct ExrInfo {
     std::string path;
-    int width = 0, height = 0;  // of the first part; layers of parts of another size are not readable
+    // The image (exr_limits.h): the first part's data window clipped to its display window, in the
+    // file's pixel coordinates. A pass is read from its part placed by the part's data window,
+    // which must cover this window; pixels outside it are dropped.
+    int x0 = 0, y0 = 0, width = 0, height = 0;
     std::vector<ExrPartInfo> parts;
     std::vector<ExrChannelInfo> channels;
     std::vector<ExrLayer> layers;  // in order of first appearance
@@ -49,7 +52,8 @@ struct ExrInfo {
 // True when the file starts with the EXR magic number (whatever its extension).
 bool isExrFile(const std::string& path);
 
-// Reads the headers only. Throws InputError naming the file when it is not a readable EXR.
+// Reads the headers only. Throws InputError naming the file when it is not a readable EXR, or when
+// its parts claim more pixels than the file can hold (exr_limits.h, rules 1 and 2).
 ExrInfo inspectExr(const std::string& path);
 
 // Picks `count` (1, 2 or 3) components of a layer for a buffer: R,G,B / X,Y,Z / U,V,W (either
@@ -59,9 +63,10 @@ ExrInfo inspectExr(const std::string& path);
 // layer has no usable component (only A), or fewer than `count` but more than one.
 std::vector<int> pickComponents(const ExrInfo& info, const ExrLayer& layer, int count);
 
-// Reads the given channels (indices into info.channels, 1..3 of them, all in parts of the first
-// part's size) into a 3-channel host Image; one channel is repeated into all three, two fill R,G
-// (B = 0). Half and uint channels are converted to float. `what` names the buffer in messages.
+// Reads the given channels (indices into info.channels, 1..3 of them, in parts whose data windows
+// cover the image window) into a 3-channel host Image; one channel is repeated into all three, two
+// fill R,G (B = 0). Half and uint channels are converted to float. `what` names the buffer in
+// messages. A part that does not cover the image, a deep part or a subsampled channel is refused.
 Image readExrChannels(const ExrInfo& info, const std::vector<int>& channels, const std::string& what);
 // The same for several buffers at once: the file is opened and each part decoded once (a
 // single-part file such as Mitsuba's holds every pass in the same chunks). whats[k] names set k.

@@ -24,6 +24,7 @@
 #include "atrous/error.h"
 #include "core/srgb.h"
 #include "io/exr_layers.h"
+#include "io/exr_limits.h"
 #include "io/pass_map.h"
 
 namespace fs = std::filesystem;
@@ -60,48 +61,30 @@ static uintmax_t fileSize(const std::string& path) {
     return ec ? 0 : n;
 }
 
-// The most bytes of decoded pixels one byte of an EXR file can hold, by compression (a lying
-// header then costs memory in proportion to the file, not to its data window): deflate peaks near
-// 1032:1 (ZIP, ZIPS, PXR24), PIZ's Huffman run codes and DWA's zipped DC near a few thousand,
-// B44 stays below 16:1, RLE below 64:1.
-static double exrMaxExpansion(Imf::Compression c) {
-    switch (c) {
-    case Imf::NO_COMPRESSION: return 1.0;
-    case Imf::RLE_COMPRESSION: return 64.0;
-    case Imf::B44_COMPRESSION:
-    case Imf::B44A_COMPRESSION: return 16.0;
-    case Imf::ZIPS_COMPRESSION:
-    case Imf::ZIP_COMPRESSION:
-    case Imf::PXR24_COMPRESSION: return 1100.0;
-    default: return 8192.0;  // PIZ, DWAA, DWAB
+// Out of memory while reading a file names the file (the allocator's message names none).
+template <class F>
+static auto namingFile(const std::string& path, F&& f) -> decltype(f()) {
+    try {
+        return f();
+    } catch (const RuntimeError& e) {
+        if (std::string(e.what()).rfind(path + ":", 0) == 0) throw;
+        throw RuntimeError(path + ": " + e.what());
+    } catch (const std::bad_alloc&) {
+        throw RuntimeError(path + ": out of host memory");
     }
 }
 
-// Throws unless a file of `bytes` bytes can hold the header's data window (before any allocation).
-static void requireExrSizeFits(const std::string& path, const Imf::Header& header, long w, long h) {
-    double bytesPerPixel = 0.0;
-    for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
-        const Imf::Channel& ch = it.channel();
-        const double sampling = double(std::max(1, ch.xSampling)) * std::max(1, ch.ySampling);
-        bytesPerPixel += (ch.type == Imf::HALF ? 2.0 : 4.0) / sampling;
-    }
-    const double decoded = double(w) * double(h) * bytesPerPixel;
-    const double bytes = double(fileSize(path));
-    if (decoded > bytes * exrMaxExpansion(header.compression()) + 65536.0)
-        throw InputError(path + ": truncated or corrupt EXR (the header's " + std::to_string(w) + "x" + std::to_string(h) +
-                         " data window needs more pixel data than the file's " + std::to_string(uintmax_t(bytes)) +
-                         " bytes can hold)");
-}
-
-static Image readExr(const std::string& path) {
+// One EXR part's R,G,B (or Y, or its only channel) as a 3-channel image (exr_limits.h: the size rule
+// before anything is allocated, placed by the data window clipped to the display window).
+static Image readExr(const std::string& path, int* sourceChannels) {
     try {
         Imf::InputFile file(path.c_str());
-        const Imath::Box2i dw = file.header().dataWindow();
-        const long w = long(dw.max.x) - dw.min.x + 1, h = long(dw.max.y) - dw.min.y + 1;
-        if (w <= 0 || h <= 0 || w > kMaxImageDim || h > kMaxImageDim)
-            throw InputError(path + ": unsupported image size " + std::to_string(w) + "x" + std::to_string(h));
-        requireExrSizeFits(path, file.header(), w, h);
-        const Imf::ChannelList& channels = file.header().channels();
+        const Imf::Header& header = file.header();
+        requireExrFits(path, {&header}, {""});
+        const ExrWindow win = exrImageWindow(path, header);
+        const Imath::Box2i dw = header.dataWindow();
+        const long w = win.width, h = win.height;
+        const Imf::ChannelList& channels = header.channels();
         std::vector<std::string> names;
         for (auto it = channels.begin(); it != channels.end(); ++it) names.push_back(it.name());
         auto has = [&](const char* n) { return channels.findChannel(n) != nullptr; };
@@ -110,18 +93,22 @@ static Image readExr(const std::string& path) {
             src[0] = "R", src[1] = "G", src[2] = "B";
         } else if (has("Y") && (has("RY") || has("BY"))) {
             // Luminance/chroma (Y, RY, BY): OpenEXR's RGBA interface converts it to RGB.
+            const long dwW = long(dw.max.x) - dw.min.x + 1, dwH = long(dw.max.y) - dw.min.y + 1;
+            if (exrNeedsProof(uint64_t(dwW) * uint64_t(dwH) * 20, fileSize(path)))
+                proveExrRows(file, {"Y", has("RY") ? "RY" : "BY"}, dw.min.y, dw.max.y);
             Imf::RgbaInputFile rgba(path.c_str());
-            Imf::Array2D<Imf::Rgba> px(h, w);
-            rgba.setFrameBuffer(&px[0][0] - dw.min.x - dw.min.y * w, 1, size_t(w));
+            Imf::Array2D<Imf::Rgba> px(dwH, dwW);
+            rgba.setFrameBuffer(&px[0][0] - dw.min.x - dw.min.y * dwW, 1, size_t(dwW));
             rgba.readPixels(dw.min.y, dw.max.y);
             Image img(int(w), int(h), 3);
             for (long y = 0; y < h; ++y)
                 for (long x = 0; x < w; ++x) {
-                    const Imf::Rgba& p = px[y][x];
+                    const Imf::Rgba& p = px[y + win.y0 - dw.min.y][x + win.x0 - dw.min.x];
                     img(int(x), int(y), 0) = float(p.r);
                     img(int(x), int(y), 1) = float(p.g);
                     img(int(x), int(y), 2) = float(p.b);
                 }
+            if (sourceChannels) *sourceChannels = 3;
             return img;
         } else if (has("Y")) {
             src[0] = src[1] = src[2] = "Y";
@@ -131,33 +118,38 @@ static Image readExr(const std::string& path) {
             // A layered file (Blender's multilayer, Mitsuba's aov): its colour pass (pass_map.h).
             const ExrInfo info = inspectExr(path);
             const PassMap m = mapPasses(info, {}, "");
-            if (m[Buffer::Color].found()) return readPass(info, m[Buffer::Color], Buffer::Color);
+            if (m[Buffer::Color].found()) {
+                if (sourceChannels) *sourceChannels = int(m[Buffer::Color].channels.size());
+                return readPass(info, m[Buffer::Color], Buffer::Color);
+            }
             std::string list;
             for (auto& n : names) list += (list.empty() ? "" : ",") + n;
             throw InputError(path + ": expected R,G,B (or Y, or a single) channels or a colour pass, found " + list);
         } else {
-            std::string list;
-            for (auto& n : names) list += (list.empty() ? "" : ",") + n;
-            throw InputError(path + ": expected R,G,B (or Y, or a single) channels, found " +
-                             (list.empty() ? std::string("none") : list));
+            throw InputError(path + ": expected R,G,B (or Y, or a single) channels, found none");
         }
+        const bool grey = src[1] == src[0];
+        std::vector<std::string> read(src, src + (grey ? 1 : 3));
+        for (const std::string& n : read) {
+            const Imf::Channel& ch = *channels.findChannel(n.c_str());
+            if (ch.xSampling != 1 || ch.ySampling != 1)
+                throw InputError(path + ": channel '" + n + "' is subsampled (" + std::to_string(ch.xSampling) + "x" +
+                                 std::to_string(ch.ySampling) + "), which atrous cannot read");
+        }
+        if (exrNeedsProof(uint64_t(w) * uint64_t(h) * 12, fileSize(path))) proveExrRows(file, read, dw.min.y, dw.max.y);
         Image img(int(w), int(h), 3);
-        Imf::FrameBuffer fb;
-        const size_t xs = sizeof(float), ys = sizeof(float) * size_t(w);
-        for (int c = 0; c < 3; ++c) {
-            // Point the slice's origin so that data-window pixel (min.x, min.y) lands at (0, 0).
-            char* base = reinterpret_cast<char*>(img.view().channel(c)) - dw.min.x * long(xs) - dw.min.y * long(ys);
-            if (c > 0 && src[c] == src[0]) continue;  // grey: filled below
-            fb.insert(src[c].c_str(), Imf::Slice(Imf::FLOAT, base, xs, ys, 1, 1, 0.0));
-        }
-        file.setFrameBuffer(fb);
-        file.readPixels(dw.min.y, dw.max.y);
-        if (src[1] == src[0]) {
+        std::vector<float*> planes;
+        for (size_t c = 0; c < read.size(); ++c) planes.push_back(img.view().channel(int(c)));
+        readExrPlanes(file, read, planes, win);
+        if (grey) {
             std::copy(img.data(), img.data() + img.plane(), img.data() + img.plane());
             std::copy(img.data(), img.data() + img.plane(), img.data() + 2 * img.plane());
         }
+        if (sourceChannels) *sourceChannels = grey ? 1 : 3;
         return img;
     } catch (const InputError&) {
+        throw;
+    } catch (const RuntimeError&) {
         throw;
     } catch (const std::exception& e) {
         throw InputError(path + ": cannot read EXR (" + e.what() + ")");
@@ -191,7 +183,7 @@ void writeExr(const std::string& path, const Image& img) {
 
 // ---------------------------------------------------------------------------------------- PFM
 
-static Image readPfm(const std::string& path) {
+static Image readPfm(const std::string& path, int* sourceChannels) {
     std::ifstream in(path, std::ios::binary);
     std::string magic;
     long w = 0, h = 0;
@@ -204,6 +196,7 @@ static Image readPfm(const std::string& path) {
     if (scale == 0 || !std::isfinite(scale)) throw InputError(path + ": PFM scale must be a non-zero number");
     in.get();  // the single whitespace byte after the scale
     const int nc = magic == "PF" ? 3 : 1;
+    if (sourceChannels) *sourceChannels = nc;
     // Before allocating: a 20-byte file may declare 16384x16384 (3 GB).
     const uintmax_t need = uintmax_t(w) * uintmax_t(h) * uintmax_t(nc) * sizeof(float);
     const std::streamoff at = in.tellg();
@@ -336,9 +329,10 @@ static void requirePngComplete(const std::string& path) {
         throw InputError(path + ": truncated PNG (no complete IEND chunk at its end)");
 }
 
-static Image readStb(const std::string& path) {
+static Image readStb(const std::string& path, int* sourceChannels) {
     int w = 0, h = 0, n = 0;
     if (stbi_info(path.c_str(), &w, &h, &n)) {
+        if (sourceChannels) *sourceChannels = n <= 2 ? 1 : 3;  // grey (+ alpha) or colour (+ alpha)
         if (w <= 0 || h <= 0 || w > kMaxImageDim || h > kMaxImageDim)
             throw InputError(path + ": unsupported image size " + std::to_string(w) + "x" + std::to_string(h) + " (at most " +
                              std::to_string(kMaxImageDim) + " per side)");
@@ -384,13 +378,13 @@ static Image readStb(const std::string& path) {
     return img;
 }
 
-Image readImage(const std::string& path) {
+Image readImage(const std::string& path, int* sourceChannels) {
     requireFile(path);
     const std::string ext = extensionOf(path);
-    if (ext == ".exr") return readExr(path);
-    if (ext == ".pfm") return readPfm(path);
+    if (ext == ".exr") return namingFile(path, [&] { return readExr(path, sourceChannels); });
+    if (ext == ".pfm") return namingFile(path, [&] { return readPfm(path, sourceChannels); });
     if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".hdr" || ext == ".bmp" || ext == ".tga")
-        return readStb(path);
+        return namingFile(path, [&] { return readStb(path, sourceChannels); });
     throw InputError(path + ": unsupported image format '" + ext + "' (expected .exr, .pfm, .png, .jpg or .hdr)");
 }
 

@@ -12,8 +12,10 @@ namespace atrous::io {
 // Reads an image file as a 3-channel planar host Image (linear RGB). EXR needs R,G,B channels
 // (A is ignored), or Y, or exactly one channel (grey, repeated into R,G,B); PFM may be colour or
 // grey; 8-bit formats are converted from sRGB to linear. Throws InputError naming the file and the
-// problem for a missing, unreadable, truncated or oddly-shaped file.
-Image readImage(const std::string& path);
+// problem for a missing, unreadable, truncated or oddly-shaped file (exr_limits.h: the size rule
+// every EXR reader shares). `sourceChannels`, when given, receives how many distinct channels the
+// file held: 1 for grey (one EXR channel, Y, a grey PFM or PNG), else 3.
+Image readImage(const std::string& path, int* sourceChannels = nullptr);
 
 // Writes `img` (1 or 3 channels on the host) by the file's extension: .exr (32-bit float R,G,B,
 // ZIP compressed), .pfm, or .png (tonemapped preview: exposure, clamp, sRGB). Atomic.

@@ -74,6 +74,7 @@ std::vector<int> channelsFor(const ExrInfo& info, const ExrLayer& layer, Buffer 
     if (ch.empty())
         throw InputError(info.path + where(info, layer) + ": layer " + layerLabel(layer) + " has no usable channels for " +
                          kNames[int(b)] + " (it has " + std::to_string(layer.components.size()) + ")");
+    requireComponents(b, int(ch.size()), info.path + where(info, layer) + ": layer " + layerLabel(layer));
     return ch;
 }
 
@@ -129,6 +130,7 @@ PassChoice requested(const ExrInfo& info, const PassRequest& r) {
     }
     for (size_t i = 0; i < info.channels.size(); ++i)
         if (info.channels[i].fullName == r.name) {
+            requireComponents(r.buffer, 1, info.path + ": " + c.rule + " (one channel)");
             c.channels = {int(i)};
             return c;
         }
@@ -152,6 +154,31 @@ Buffer parseBufferName(const std::string& name) {
     std::string all;
     for (const char* n : kNames) all += (all.empty() ? "" : ", ") + std::string(n);
     throw InputError("unknown buffer '" + name + "' (expected one of " + all + ")");
+}
+
+bool bufferTakesGrey(Buffer b) { return b != Buffer::Normal && b != Buffer::Position && b != Buffer::Motion; }
+
+void requireComponents(Buffer b, int have, const std::string& source) {
+    if (have >= bufferChannels(b) || bufferTakesGrey(b)) return;
+    const char* what = b == Buffer::Motion ? "motion needs 2 (an x and a y offset)" : b == Buffer::Normal ? "normal needs 3 (x, y, z)"
+                                                                                               : "position needs 3 (x, y, z)";
+    throw InputError(source + " has " + std::to_string(have) + " channel" + (have == 1 ? "" : "s") + "; " + what +
+                     ", and one channel cannot stand for a direction or a point");
+}
+
+std::vector<PassRequest> parsePassRequests(const std::vector<std::string>& specs) {
+    std::vector<PassRequest> out;
+    for (const std::string& spec : specs) out.push_back(parsePassRequest(spec));
+    requireDistinctPasses(out);
+    return out;
+}
+
+void requireDistinctPasses(const std::vector<PassRequest>& requests) {
+    for (size_t i = 0; i < requests.size(); ++i)
+        for (size_t j = 0; j < i; ++j)
+            if (requests[i].buffer == requests[j].buffer)
+                throw InputError(std::string("--pass ") + kNames[int(requests[i].buffer)] + " given twice ('" + requests[j].name +
+                                 "' and '" + requests[i].name + "'): name each buffer once");
 }
 
 PassRequest parsePassRequest(const std::string& spec) {

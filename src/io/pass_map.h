@@ -29,6 +29,19 @@ struct PassRequest {
 
 // "BUFFER=NAME" (e.g. "albedo=ViewLayer.Denoising Albedo"); InputError otherwise.
 PassRequest parsePassRequest(const std::string& spec);
+// Every --pass of a command line, the same buffer at most once (requireDistinctPasses).
+std::vector<PassRequest> parsePassRequests(const std::vector<std::string>& specs);
+// InputError when two requests name the same buffer (whichever path reads them).
+void requireDistinctPasses(const std::vector<PassRequest>& requests);
+
+// The channel-count rule (docs/inputs.md, "Channels"): a buffer takes bufferChannels(b) components;
+// one channel is repeated into all three where a grey value means the same thing (colour,
+// variance, albedo, emission; depth and ids take one), and refused for the directions and points
+// (normal, position: 3; motion: 2), where (x, x, x) or (x, -x) would be a silent wrong answer.
+bool bufferTakesGrey(Buffer b);
+// Throws InputError "<source> has N channels; motion needs 2 ..." when `have` components cannot be
+// buffer b by that rule.
+void requireComponents(Buffer b, int have, const std::string& source);
 
 struct PassChoice {
     int layer = -1;             // index into ExrInfo::layers; -1: absent

@@ -13,6 +13,7 @@
 #include "atrous/error.h"
 #include "io/buffer_set.h"
 #include "io/exr_layers.h"
+#include "io/exr_limits.h"
 #include "io/image_io.h"
 
 namespace fs = std::filesystem;
@@ -40,16 +41,42 @@ std::string companion(const std::string& frame, const char* what) {
 
 std::string sizeText(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
 
-// Data-window size from the EXR header alone.
+// The image size from the EXR header alone, after the size rule of exr_limits.h.
 void exrSize(const std::string& path, int& w, int& h) {
     try {
         Imf::InputFile file(path.c_str());
-        const auto& dw = file.header().dataWindow();
-        w = dw.max.x - dw.min.x + 1;
-        h = dw.max.y - dw.min.y + 1;
+        requireExrFits(path, {&file.header()}, {""});
+        const ExrWindow win = exrImageWindow(path, file.header());
+        w = win.width;
+        h = win.height;
+    } catch (const InputError&) {
+        throw;
     } catch (const std::exception& e) {
         throw InputError(path + ": cannot read the EXR header (" + e.what() + ")");
     }
+}
+
+// The buffers (names of kSequenceBuffers) a layered frame gives: its passes as mapPasses finds
+// them, and motion from its companion too.
+std::vector<std::string> layeredBuffers(const std::string& frame, const ExrInfo& info, const SequenceOptions& o) {
+    const PassMap m = mapPasses(info, o.passes, o.viewLayer);
+    if (!m[Buffer::Color].found())
+        throw InputError(frame + ": no colour pass (layers: " + layerList(info) + "); name one with --pass color=LAYER");
+    std::vector<std::string> here;
+    for (int i = 0; i < 9; ++i) {
+        const Buffer b = kFileBuffer[i];
+        bool found = m[b].found();
+        if (b == Buffer::ObjectId) found = found || m[Buffer::MaterialId].found();
+        if (b == Buffer::Motion) found = found || !companion(frame, "motion").empty();
+        if (found) here.push_back(kSequenceBuffers[i]);
+    }
+    return here;
+}
+
+std::string joined(const std::vector<std::string>& v) {
+    std::string s;
+    for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+    return s.empty() ? "none" : s;
 }
 
 }  // namespace
@@ -156,7 +183,8 @@ std::vector<std::string> listSequenceFrames(const std::string& dir) {
     return out;
 }
 
-std::vector<std::string> validateSequence(const std::vector<std::string>& frames, int& width, int& height) {
+std::vector<std::string> validateSequence(const std::vector<std::string>& frames, int& width, int& height,
+                                         const SequenceOptions& options) {
     std::string firstFile;
     width = height = 0;
     auto checkSize = [&](const std::string& path, int w, int h) {
@@ -177,41 +205,57 @@ std::vector<std::string> validateSequence(const std::vector<std::string>& frames
     std::vector<std::string> present;
     for (size_t i = 0; i < frames.size(); ++i) {
         const std::string& frame = frames[i];
+        const bool layered = isLayeredFrame(frame);
         std::error_code ec;
-        if (isLayeredFrame(frame)) {
+        if (!layered && (!options.passes.empty() || !options.viewLayer.empty()))
+            throw InputError(std::string(options.passes.empty() ? "--layer" : "--pass") + ": picks a layer of a layered EXR, and " +
+                             frame + " is a frame_NNNN folder of plain EXRs");
+        std::vector<std::string> here;
+        if (layered) {
             const ExrInfo info = inspectExr(frame);
             checkSize(frame, info.width, info.height);
             const std::string motion = companion(frame, "motion");
             if (!motion.empty()) checkFile(motion);
-            continue;
-        }
-        std::vector<std::string> here;
-        for (const char* name : kSequenceBuffers) {
-            const std::string path = (fs::path(frame) / (std::string(name) + ".exr")).string();
-            if (fs::is_regular_file(path, ec)) {
-                checkFile(path);
-                here.push_back(name);
-            } else if (std::string(name) == "color") {
-                throw InputError(path + ": missing (every frame needs color.exr)");
+            here = layeredBuffers(frame, info, options);
+        } else {
+            for (const char* name : kSequenceBuffers) {
+                const std::string path = (fs::path(frame) / (std::string(name) + ".exr")).string();
+                if (fs::is_regular_file(path, ec)) {
+                    checkFile(path);
+                    here.push_back(name);
+                } else if (std::string(name) == "color") {
+                    throw InputError(path + ": missing (every frame needs color.exr)");
+                }
             }
         }
         if (i == 0) {
             present = here;
             continue;
         }
+        // A buffer in every frame or in none: the message names the frame's file (or folder).
+        auto missingIn = [&](const std::string& where, const std::string& name, const std::string& has) {
+            if (layered)
+                return InputError(where + ": has no " + name + " (its buffers: " + joined(where == frame ? here : present) +
+                                  "), but " + has + " has one (a buffer must be in every frame or in none)");
+            return InputError((fs::path(where) / (name + ".exr")).string() + ": missing, but " + has + " has " + name +
+                              ".exr (a buffer must be in every frame or in none)");
+        };
         for (const auto& name : present)
-            if (std::find(here.begin(), here.end(), name) == here.end())
-                throw InputError((fs::path(frame) / (name + ".exr")).string() + ": missing, but " + frames[0] + " has " + name +
-                                 ".exr (a buffer must be in every frame or in none)");
+            if (std::find(here.begin(), here.end(), name) == here.end()) throw missingIn(frame, name, frames[0]);
         for (const auto& name : here)
-            if (std::find(present.begin(), present.end(), name) == present.end())
-                throw InputError((fs::path(frames[0]) / (name + ".exr")).string() + ": missing, but " + frame + " has " + name +
-                                 ".exr (a buffer must be in every frame or in none)");
+            if (std::find(present.begin(), present.end(), name) == present.end()) throw missingIn(frames[0], name, frame);
     }
     return present;
 }
 
-SequenceFrame loadSequenceFrame(const std::string& frame, const std::vector<std::string>& expected) {
+std::string SequenceFrame::fileOf(const std::string& buffer) const {
+    for (int i = 0; i < 10; ++i)
+        if (buffer == kSequenceBuffers[i] && !files[i].empty()) return files[i];
+    return dir;
+}
+
+SequenceFrame loadSequenceFrame(const std::string& frame, const std::vector<std::string>& expected,
+                                const SequenceOptions& options) {
     SequenceFrame f;
     f.dir = frame;
     Image* slot[10] = {&f.color, &f.albedo, &f.normal, &f.position, &f.depth, &f.ids, &f.motion, &f.emission, &f.variance,
@@ -220,13 +264,25 @@ SequenceFrame loadSequenceFrame(const std::string& frame, const std::vector<std:
         f.index = parseLayeredFrameName(fs::path(frame).filename().string());
         BufferFiles files;
         files.in = frame;
+        files.passes = options.passes;
+        files.viewLayer = options.viewLayer;
         files.file[int(Buffer::Motion)] = companion(frame, "motion");
         BufferSet set = loadBuffers(files);
-        const Buffer from[9] = {Buffer::Color,    Buffer::Albedo, Buffer::Normal,   Buffer::Position, Buffer::Depth,
-                                Buffer::ObjectId, Buffer::Motion, Buffer::Emission, Buffer::Variance};
-        for (int i = 0; i < 9; ++i) *slot[i] = std::move(set.image[int(from[i])]);
+        f.layered = set.layered;
+        for (int i = 0; i < 9; ++i) {
+            *slot[i] = std::move(set.image[int(kFileBuffer[i])]);
+            if (!slot[i]->empty()) f.files[i] = kFileBuffer[i] == Buffer::Motion && !files.file[int(Buffer::Motion)].empty()
+                                                    ? files.file[int(Buffer::Motion)] : frame;
+        }
+        for (const std::string& name : expected)
+            for (int i = 0; i < 9; ++i)
+                if (name == kSequenceBuffers[i] && slot[i]->empty())
+                    throw InputError(frame + ": has no " + name + " (every frame of this sequence has one)");
         return f;
     }
+    if (!options.passes.empty() || !options.viewLayer.empty())
+        throw InputError(std::string(options.passes.empty() ? "--layer" : "--pass") + ": picks a layer of a layered EXR, and " +
+                         frame + " is a frame_NNNN folder of plain EXRs");
     f.index = parseSequenceFrameName(fs::path(frame).filename().string());
     std::string firstPath;
     for (int i = 0; i < 10; ++i) {
@@ -239,8 +295,11 @@ SequenceFrame loadSequenceFrame(const std::string& frame, const std::vector<std:
             continue;
         }
         Image& dst = *slot[i];
-        dst = readImage(path);
+        int channels = 3;
+        dst = readImage(path, &channels);
+        if (i != 9) requireComponents(kFileBuffer[i], channels, path);
         conformBuffer(kFileBuffer[i], dst);
+        f.files[i] = path;
         if (firstPath.empty()) {
             firstPath = path;
         } else if (dst.width() != f.color.width() || dst.height() != f.color.height()) {

@@ -14,21 +14,36 @@
 // A buffer must be in every frame or in none. Other entries are ignored.
 #pragma once
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "atrous/image.h"
+#include "io/exr_layers.h"
+#include "io/pass_map.h"
 
 namespace atrous::io {
 
 // The buffers of a frame directory, in the order they are checked (color first: required).
 extern const char* const kSequenceBuffers[10];
 
+// How layered frames are read: `--pass` and `--layer`, applied to every frame as `denoise --in
+// FILE.exr` applies them (a frame_NNNN-folder sequence refuses both: its files are plain EXRs).
+struct SequenceOptions {
+    std::vector<PassRequest> passes;
+    std::string viewLayer;
+};
+
 struct SequenceFrame {
     int index = 0;
     std::string dir;  // the frame directory or layered file
     // 3-channel host images; empty when the frame has no such buffer.
     Image color, albedo, normal, position, depth, ids, motion, reference, emission, variance;
+    // The file each buffer came from, by kSequenceBuffers' order ("" when absent), for messages.
+    std::string files[10];
+    std::shared_ptr<ExrInfo> layered;  // the frame's layered file (`--add-pass` copies it); else null
+    // The file `buffer` (a name of kSequenceBuffers, or the library's "ids") came from, else the frame.
+    std::string fileOf(const std::string& buffer) const;
 };
 
 // The frames of `dir` (frame directories or numbered layered files), sorted by number. Throws
@@ -37,15 +52,18 @@ struct SequenceFrame {
 std::vector<std::string> listSequenceFrames(const std::string& dir);
 
 // Checks every frame without decoding pixels: each has a colour, every buffer is in every frame or
-// in none, and every buffer of every frame has the first frame's size (read from the EXR headers).
-// Throws InputError naming the missing file, or both files whose sizes differ. Returns the size
-// and the buffers present (names of kSequenceBuffers).
-std::vector<std::string> validateSequence(const std::vector<std::string>& frames, int& width, int& height);
+// in none (a layered frame's passes as mapPasses finds them, its motion companion too), every
+// buffer of every frame has the first frame's size and fits its file (exr_limits.h, from the EXR
+// headers), and --pass/--layer apply. Throws InputError naming the frame's file and the problem (or
+// both files whose sizes differ). Returns the size and the buffers present (names of kSequenceBuffers).
+std::vector<std::string> validateSequence(const std::vector<std::string>& frames, int& width, int& height,
+                                         const SequenceOptions& options = {});
 
 // Loads one frame. Throws InputError naming the file when a buffer is unreadable, when one of
 // `expected` (validateSequence's list; empty: no check) is missing, or naming both files when two
 // buffers differ in size.
-SequenceFrame loadSequenceFrame(const std::string& frame, const std::vector<std::string>& expected = {});
+SequenceFrame loadSequenceFrame(const std::string& frame, const std::vector<std::string>& expected = {},
+                                const SequenceOptions& options = {});
 
 // "frame_0007" for 7 (at least four digits).
 std::string sequenceFrameName(int index);

@@ -383,6 +383,11 @@ Scene Scene::load(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     std::error_code ec;
     if (!in || std::filesystem::is_directory(path, ec)) throw InputError(path + ": cannot open scene file");
+    // A FIFO or a device (/dev/zero) would be read for ever; a scene file is text of a few KB.
+    if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path + ": not a regular file (a scene file)");
+    constexpr uintmax_t kMaxSceneBytes = 16u << 20;
+    if (std::filesystem::file_size(path, ec) > kMaxSceneBytes)
+        throw InputError(path + ": scene file larger than 16 MiB (meshes belong in OBJ files it references)");
     std::stringstream ss;
     ss << in.rdbuf();
     return parse(ss.str(), std::filesystem::path(path).parent_path().string(), path);

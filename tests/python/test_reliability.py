@@ -1,4 +1,4 @@
-"""Issue 14's Python findings (docs/reliability.md): a --threads ceiling (threads=100000 used to
+"""Issue 14's (and 29's) Python findings (docs/reliability.md): a --threads ceiling (threads=100000 used to
 abort the interpreter in tbb::task_arena's destructor), a NUL byte in a path (write_image wrote
 "a"), and filter parameters whose inverse squares overflowed (the whole output NaN)."""
 import os
@@ -33,3 +33,14 @@ def test_tiny_filter_parameters_are_rejected(name):
         atrous.denoise(b["color"], method="eaw", **kw, **{name: 1e-20})
     out = atrous.denoise(b["color"], method="eaw", **kw, **{name: 1e-6})
     assert np.isfinite(out).all()
+
+
+def test_a_directory_or_a_device_as_weights_is_a_value_error(tmp_path):
+    """Issue 29, case 9: a directory as the weight file raised RuntimeError ("basic_filebuf::underflow
+    error reading the file: Is a directory"); /dev/zero would have been read for ever."""
+    b = atrous.render("cornell", width=8, height=8, spp=1)
+    (tmp_path / "weights").mkdir()
+    with pytest.raises(ValueError, match="weights: is a directory"):
+        atrous.denoise(b["color"], method="learned", learned_weights=tmp_path / "weights")
+    with pytest.raises(ValueError, match="not a regular file"):
+        atrous.denoise(b["color"], method="learned", learned_weights="/dev/zero")
