@@ -35,6 +35,10 @@ public:
     // Allocates width*height*channels floats on `device`, zero-filled. Throws InputError for
     // non-positive or absurd sizes (more than 2^31 floats) and RuntimeError when memory runs out.
     Image(int width, int height, int channels, Device device = Device::Cpu);
+    // The same without the zero fill, for a caller that writes every pixel before anything reads
+    // it (a reader decoding a whole file into the planes, a copy): the pages are first touched by
+    // those writes, not by a fill that they then overwrite.
+    static Image uninitialized(int width, int height, int channels, Device device = Device::Cpu);
     ~Image();
     Image(Image&& o) noexcept;
     Image& operator=(Image&& o) noexcept;
@@ -63,6 +67,8 @@ public:
     float operator()(int x, int y, int c) const { return mData[size_t(c) * plane() + size_t(y) * mWidth + x]; }
 
 private:
+    struct NoFill {};
+    Image(int width, int height, int channels, Device device, NoFill);
     void release();
     float* mData = nullptr;
     int mWidth = 0, mHeight = 0, mChannels = 0;

@@ -62,7 +62,15 @@ void fillFloats(float* dst, Device device, float value, size_t count) {
 
 }  // namespace detail
 
-Image::Image(int width, int height, int channels, Device device)
+Image::Image(int width, int height, int channels, Device device) : Image(width, height, channels, device, NoFill{}) {
+    detail::fillFloats(mData, device, 0.0f, size());
+}
+
+Image Image::uninitialized(int width, int height, int channels, Device device) {
+    return Image(width, height, channels, device, NoFill{});
+}
+
+Image::Image(int width, int height, int channels, Device device, NoFill)
     : mWidth(width), mHeight(height), mChannels(channels), mDevice(device) {
     if (width <= 0 || height <= 0 || channels <= 0)
         throw InputError("image size " + std::to_string(width) + "x" + std::to_string(height) + "x" +
@@ -71,7 +79,6 @@ Image::Image(int width, int height, int channels, Device device)
         throw InputError("image size " + std::to_string(width) + "x" + std::to_string(height) +
                          " exceeds the limit of " + std::to_string(kMaxImageDim) + " pixels per side");
     mData = static_cast<float*>(detail::allocateBytes(size() * sizeof(float), device));
-    detail::fillFloats(mData, device, 0.0f, size());
 }
 
 Image::~Image() { release(); }
@@ -103,7 +110,7 @@ Image Image::clone() const { return to(mDevice); }
 
 Image Image::to(Device device) const {
     if (empty()) return Image();
-    Image out(mWidth, mHeight, mChannels, device);
+    Image out = uninitialized(mWidth, mHeight, mChannels, device);
     detail::copyBytes(out.mData, device, mData, mDevice, size() * sizeof(float));
     return out;
 }
