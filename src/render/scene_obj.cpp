@@ -4,6 +4,7 @@
 
 #include <tiny_obj_loader.h>
 
+#include <cctype>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +19,39 @@ namespace atrous::pt {
 namespace {
 
 namespace fs = std::filesystem;
+
+// tinyobjloader reads a number's exponent into an int, checking for overflow only before each
+// digit's multiply: "1e-2147483648" overflows it (undefined behaviour, found by the libFuzzer
+// target obj_mtl, tests/fuzz/libfuzzer). Where it wraps (Debian's build), numbers that strtod and
+// the checks below read as 0 come out as other values: "2e-21474836480" as 2, "3e-2147483649" as
+// inf. True when `tok` starts with a number whose exponent has 10 or more significant digits; the
+// prescans refuse such a token in any statement (v/vt/vn, t tags, MTL values and texture options).
+bool exponentOutOfRange(const std::string& tok) {
+    size_t i = 0;
+    if (i < tok.size() && (tok[i] == '+' || tok[i] == '-')) ++i;
+    while (i < tok.size() && std::isdigit(static_cast<unsigned char>(tok[i]))) ++i;
+    if (i < tok.size() && tok[i] == '.') ++i;
+    while (i < tok.size() && std::isdigit(static_cast<unsigned char>(tok[i]))) ++i;
+    if (i >= tok.size() || (tok[i] != 'e' && tok[i] != 'E')) return false;
+    ++i;
+    if (i < tok.size() && (tok[i] == '+' || tok[i] == '-')) ++i;
+    while (i < tok.size() && tok[i] == '0') ++i;
+    size_t digits = 0;
+    while (i < tok.size() && std::isdigit(static_cast<unsigned char>(tok[i]))) ++i, ++digits;
+    return digits >= 10;
+}
+
+// Throws for a token of `line` with an exponent out of range (exponentOutOfRange); comment lines
+// (a first token starting with '#', which tinyobjloader skips) are not looked at.
+void requireExponentsInRange(const std::string& line, const std::string& file, size_t lineNo) {
+    std::istringstream words(line);
+    std::string tok;
+    for (bool first = true; words >> tok; first = false) {
+        if (first && tok[0] == '#') return;
+        if (exponentOutOfRange(tok))
+            throw InputError(file + ": line " + std::to_string(lineNo) + ": \"" + tok + "\" has an exponent out of range");
+    }
+}
 
 // What tinyobjloader does not check, read from the OBJ text before it parses it: a face index
 // beyond int's range (atoi wraps 99999999999999999999 to -1, the last vertex), a face with more
@@ -36,6 +70,7 @@ std::vector<std::string> prescanObj(const std::string& path) {
         ++lineNo;
         size_t i = line.find_first_not_of(" \t");
         if (i == std::string::npos) continue;
+        requireExponentsInRange(line, path, lineNo);
         const bool face = line.compare(i, 2, "f ") == 0 || line.compare(i, 2, "f\t") == 0;
         const bool lib = line.compare(i, 7, "mtllib ") == 0 || line.compare(i, 7, "mtllib\t") == 0;
         // v, vt, vn: every value a finite number (tinyobjloader reads "nan" or "x" as 0 and 1e39 as Inf).
@@ -119,6 +154,7 @@ void prescanMtl(const std::string& mtl, const std::string& objPath) {
     size_t lineNo = 0;
     while (std::getline(in, line)) {
         ++lineNo;
+        requireExponentsInRange(line, mtl, lineNo);
         std::istringstream words(line);
         std::string key, tok;
         if (!(words >> key)) continue;
