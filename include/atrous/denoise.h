@@ -170,6 +170,14 @@ Image denoise(const DenoiseInputs& inputs, const DenoiseOptions& options);
 // parameter is out of range; the ranges are the rows of denoiseParams().
 void validateDenoiseOptions(const DenoiseOptions& options);
 
+// Which buffers a denoise() call with these options reads when they are given, for a resolved
+// method (Eaw, Sure or Learned): a reader need not decode the others (the CLI skips them and says
+// so). Colour is always read.
+struct DenoiseBufferUse {
+    bool variance = true, albedo = true, normal = true, position = true, depth = true, ids = true, emission = true;
+};
+DenoiseBufferUse denoiseBufferUse(const DenoiseOptions& options, DenoiseMethod resolved);
+
 // "eaw" | "sure" | "learned" | "auto"; InputError otherwise.
 DenoiseMethod parseDenoiseMethod(const std::string& name);
 const char* denoiseMethodName(DenoiseMethod m);

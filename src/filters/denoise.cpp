@@ -164,17 +164,32 @@ PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, D
             estimateNoiseSigmaCuda(color, o.demodulate ? in.albedo : nullptr, o.albedoEpsilon, o.albedoFloor, rep.noiseSigma);
         }
     }
-    if (in.albedo) used += o.demodulate ? ",albedo" : ",albedo(unused: demodulation off)";
-    if (in.normal) used += ",normal";
-    // The learned filter's network reads depth (and no position or ids); EAW/SURE the reverse by default.
+    const DenoiseBufferUse use = denoiseBufferUse(o, o.method);
     const bool learned = o.method == DenoiseMethod::Learned;
-    if (in.position) used += learned ? ",position(unused by learned)" : ",position";
-    if (in.depth) used += learned || o.eaw.sigmaDepth > 0 ? ",depth" : ",depth(unused: sigma-depth 0)";
-    if (in.ids) used += learned ? ",ids(unused by learned)" : o.eaw.useIds ? ",ids" : ",ids(unused)";
+    if (in.albedo) used += use.albedo ? ",albedo" : ",albedo(unused: demodulation off)";
+    if (in.normal) used += ",normal";
+    if (in.position) used += use.position ? ",position" : ",position(unused by learned)";
+    if (in.depth) used += use.depth ? ",depth" : ",depth(unused: sigma-depth 0)";
+    if (in.ids) used += use.ids ? ",ids" : learned ? ",ids(unused by learned)" : ",ids(unused)";
     if (in.emission) used += ",emission";
     rep.buffersUsed = used;
     return p;
 }
+
+}  // namespace filters
+
+// The learned filter's network reads depth (and no position or ids); EAW/SURE the reverse by default.
+DenoiseBufferUse denoiseBufferUse(const DenoiseOptions& o, DenoiseMethod resolved) {
+    const bool learned = resolved == DenoiseMethod::Learned;
+    DenoiseBufferUse u;
+    u.albedo = o.demodulate;
+    u.position = !learned;
+    u.depth = learned || o.eaw.sigmaDepth > 0;
+    u.ids = !learned && o.eaw.useIds;
+    return u;
+}
+
+namespace filters {
 
 void setNoiseEstimate(DriverConfig& cfg, const DenoiseReport& rep) {
     if (cfg.varianceGiven) return;
