@@ -1,0 +1,28 @@
+// libFuzzer target: a single EXR file through atrous::io::readImage (the reader of --color FILE.exr,
+// textures and environment maps). The input is the file's bytes.
+//
+// Contract (fuzz_common.h): readImage returns a 3-channel image or throws InputError. Its size is
+// one the file can hold: at most 8192 bytes of decoded pixels per file byte (PIZ/DWA's ratio, the
+// most the reader allows, docs/reliability.md) plus 64 KiB, at 2 bytes (one half channel) per
+// pixel. NaN/Inf pixels are allowed (colour: the filters repair them).
+#include "fuzz_common.h"
+#include "io/image_io.h"
+
+using namespace atrous_fuzz;
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+    targetName() = "exr_single";
+    return 0;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+    if (skipKnownImage(data, size)) return 0;
+    const std::string path = writeScratch("in.exr", data, size);
+    Image img;
+    if (!returnsOrInputError("readImage(.exr)", [&] { img = atrous::io::readImage(path); })) return 0;
+    checkShape("readImage(.exr)", img);
+    if (double(img.width()) * img.height() * 2.0 > double(size) * 8192.0 + 65536.0)
+        finding("readImage(.exr) returned a " + std::to_string(img.width()) + "x" + std::to_string(img.height()) +
+                " image from a file of " + std::to_string(size) + " bytes");
+    return 0;
+}
