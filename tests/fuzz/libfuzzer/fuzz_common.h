@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <filesystem>
 #include <set>
@@ -197,11 +198,29 @@ inline bool jpegDhtOverflow(const uint8_t* data, size_t size) {
     return false;
 }
 
+// Known (stb_image 2.27): the PNG reader grows its IDAT buffer to a chunk's claimed length before
+// reading it, so a 200-byte PNG whose IDAT claims 2^31 bytes makes it realloc 2 GB (found by png,
+// reproducer tests/fuzz/libfuzzer/findings/png-stb-idat-length-2gb.png). True when an IDAT chunk
+// claims more bytes than follow its header.
+inline bool pngIdatOverrun(const uint8_t* d, size_t n) {
+    static const uint8_t kSig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    if (n < 8 || std::memcmp(d, kSig, 8) != 0) return false;
+    for (size_t at = 8; at + 8 <= n;) {
+        const uint64_t len = uint64_t(d[at]) << 24 | uint64_t(d[at + 1]) << 16 | uint64_t(d[at + 2]) << 8 | d[at + 3];
+        if (std::memcmp(d + at + 4, "IDAT", 4) == 0 && len > n - (at + 8)) return true;
+        at += 12 + size_t(len);
+    }
+    return false;
+}
+
 // The known-problem skips of every target that hands bytes to an image reader.
 inline bool skipKnownImage(const uint8_t* d, size_t n) {
     std::string what;
     if (exrAttributeOverrun(d, n, &what) &&
         knownIssue("openexr-attribute-size", "OpenEXR allocates a header attribute's claimed size before reading it: " + what))
+        return true;
+    if (pngIdatOverrun(d, n) &&
+        knownIssue("stb-png-idat-length", "stb_image 2.27 allocates an IDAT chunk's claimed length before reading it"))
         return true;
     return jpegDhtOverflow(d, n) &&
            knownIssue("stb-jpeg-dht-overflow", "stb_image 2.27 writes past a Huffman table for a JPEG DHT with more than 256 codes");
