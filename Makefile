@@ -6,7 +6,7 @@ CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 # cmake --build runs make again: no "Entering/Leaving directory" lines from the nested makes.
 MAKEFLAGS += --no-print-directory
 
-.PHONY: setup setup-python configure build demo test quality python bench gpu-pack fuzz sanitize clean
+.PHONY: setup setup-python configure build demo test quality python bench gpu-pack fuzz libfuzz sanitize clean
 
 setup:
 	@./scripts/setup.sh
@@ -48,13 +48,21 @@ bench: build
 gpu-pack:
 	@JOBS=$(JOBS) ./scripts/gpu-pack.sh
 
-# The fuzz harness at full size (docs/reliability.md): FUZZ_CASES CLI cases plus a sixth as many
-# Python-binding cases, seeded (FUZZ_SEED) and reproducible. `make test` runs its CI subset.
+# The fuzz harnesses at full size (docs/reliability.md): the generator harness (FUZZ_CASES CLI cases
+# plus a sixth as many Python-binding cases, seeded (FUZZ_SEED) and reproducible; `make test` runs
+# its CI subset), then every libFuzzer target of the input readers for FUZZ_SECONDS each, JOBS at a
+# time (scripts/libfuzz.sh: clang build in build-fuzz/, findings kept in out/libfuzz/; .ci/run runs
+# each for 20 s). `make libfuzz` runs the libFuzzer targets alone.
 FUZZ_CASES ?= 2000
 FUZZ_SEED ?= 1
+FUZZ_SECONDS ?= 600
 fuzz: build setup-python
 	@JOBS=$(JOBS) ./scripts/python_install.sh
 	@python3 tests/fuzz/fuzz.py --cli $(BUILD)/atrous --cases $(FUZZ_CASES) --seed $(FUZZ_SEED) --jobs $(JOBS)
+	@./scripts/libfuzz.sh --seconds $(FUZZ_SECONDS) --jobs $(JOBS)
+
+libfuzz: setup
+	@./scripts/libfuzz.sh --seconds $(FUZZ_SECONDS) --jobs $(JOBS)
 
 # AddressSanitizer + UBSan build in build-asan/: the ctest suite and the fuzz CI subset (docs/reliability.md).
 sanitize: setup
