@@ -117,6 +117,8 @@ def _header(part, multipart, chunks, nparts):
                                       "deep": b"deepscanline"}[kind])
     if multipart:
         h += _attr("chunkCount", "int", struct.pack("<i", chunks))
+    for name, typ, data in part.get("attrs", ()):  # more attributes: (name, type, bytes)
+        h += _attr(name, typ, data)
     if kind == "deep":
         h += _attr("version", "int", struct.pack("<i", 1))
         h += _attr("maxSamplesPerPixel", "int", struct.pack("<i", 1))

@@ -114,6 +114,7 @@ def build_pass_flag(cid, rng, seeds, d, cli, klass, ordinal, seed):
                 p2, m2 = layered_file(rng, frame_buffers(seeds, k), style, passes=passes)
                 E.write(os.path.join(seq, "render%04d.exr" % k), p2, m2)
         out = os.path.join(d, "out")
+        names.append(seq)  # a message may name a frame's file instead of render.exr
         argv = [cli, "denoise", "--sequence", seq, "--method", rng.choice(["svgf", "sure"]), "--out", out]
         check = lambda case, out=out: _outputs_present(out)
         if flag == "--add-pass" and path == "seq-files":
@@ -162,7 +163,7 @@ def _added(out, name):
 # ------------------------------------------------------------------------- oidn
 
 OIDN = ["basic", "ldr", "ldr-srgb", "ldr-and-hdr", "srgb-alone", "filter", "quality", "clean-aux", "device",
-        "out", "alb-size", "layered-hdr"]
+        "out", "alb-size", "layered-hdr", "ldr-png"]
 
 
 def _ldr_check(out):
@@ -239,6 +240,16 @@ def build_oidn(cid, rng, seeds, d, cli, klass, ordinal, seed):
         write_pfm(small, 8, 6, [0.5] * (8 * 6 * 3))
         argv += ["--hdr", col, rng.choice(["--alb", "--nrm"]), small, "-o", out]
         must, names = True, ["small.pfm"]
+    elif variant == "ldr-png":  # an 8-bit LDR colour; its IDAT chunk may claim far more than the file holds
+        from fuzz_files import write_png
+        png = os.path.join(d, "ldr.png")
+        write_png(png, 16, 12, [int(255 * min(1.0, max(0.0, v))) for v in vals[:16 * 12 * 3]])
+        lie = rng.choice([None, 0x7FFFFFF0, 0x10000000, 5000000])
+        if lie:
+            data = open(png, "rb").read()
+            open(png, "wb").write(data[:33] + struct.pack(">I", lie) + data[37:])  # IDAT's length field
+        argv += ["--ldr", png] + aux + ["-o", out]
+        must, good, names = (True, False, ["ldr.png"]) if lie else (None, True, ["ldr.png"])
     else:
         f = os.path.join(d, "render.exr")
         parts, multi = layered_file(rng, bufs, rng.choice(["blender5", "blender4", "mitsuba"]))

@@ -246,7 +246,7 @@ def copy_check(parts, out, added):
 
 
 KINDS = ["valid", "damage", "huge", "offset", "othersize", "onechannel", "deep", "tiled", "twolayers", "specials",
-         "outisinput", "aovs"]
+         "outisinput", "aovs", "attrsize"]
 COMMANDS = ["denoise-in", "inspect", "export", "color-albedo", "add-pass"]
 ALBEDO_PASSES = {"Denoising Albedo", "DiffCol", "albedo"}
 NORMAL_PASSES = {"Normal", "Denoising Normal", "nn", "sh_normal"}
@@ -405,6 +405,9 @@ def build_layered(cid, rng, seeds, d, cli, klass, ordinal, seed):
                 p["pixels"][n][rng.randrange(len(p["pixels"][n]))] = rng.choice(
                     [float("nan"), float("inf"), float("-inf"), -1.0, 0.0, 1e4])
             note += " specials in " + n
+    if kind == "attrsize":
+        parts[0]["attrs"] = [("comments", "string", b"rendered by the fuzz harness"),
+                             ("owner", "string", b"atrous")]
     data = E.exr_bytes(parts, multi, override)
     if kind == "damage":
         info = E.read_headers(data)
@@ -413,6 +416,21 @@ def build_layered(cid, rng, seeds, d, cli, klass, ordinal, seed):
         if k == "truncate":
             must = True if len(data) < colour_end and cmd != "inspect" else None
         note += " " + k
+    if kind == "attrsize":  # a header attribute claiming a huge size (the reader must not allocate it)
+        info_attrs = []
+        pos = 8
+        while data[pos] != 0:
+            e1 = data.index(b"\0", pos)
+            e2 = data.index(b"\0", e1 + 1)
+            size = struct.unpack_from("<i", data, e2 + 1)[0]
+            info_attrs.append((data[pos:e1].decode(), e2 + 1))
+            pos = e2 + 5 + size
+        # variable-size types only: OpenEXR reads box2i, float, v2f, ... at their own size
+        name, at = rng.choice([a for a in info_attrs if a[0] in ("comments", "owner", "name", "type")])
+        claim = rng.choice([0x7FFFFFF0, 0x40000000, 100000000, 20000000])
+        data = data[:at] + struct.pack("<i", claim) + data[at + 4:]
+        must = True
+        note += " %s claims %d bytes" % (name, claim)
     open(f, "wb").write(data)
     out_exr = os.path.join(d, "out.exr")
     if kind == "outisinput":

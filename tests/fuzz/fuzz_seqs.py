@@ -148,8 +148,8 @@ def build_seq(cid, rng, seeds, d, cli, klass, ordinal, seed):
         note += " " + k2
     elif kind == "prefixes":
         if layout == "dirs":
-            os.rename(files[j], os.path.join(seq, "frame_%04d_x" % j))  # not a frame name: a gap (or too few)
-            must = True if j < 2 else None
+            os.rename(files[j], os.path.join(seq, "frame_%04d_x" % j))  # not a frame name
+            must = True if j == 1 else None  # a gap; without the first or last, frames 1-2 or 0-1 remain
         else:
             other = os.path.join(seq, "other%04d.exr" % (j + 5))
             shutil.copy(target, other)
