@@ -135,14 +135,16 @@ inline std::vector<std::string> splitSections(const uint8_t* data, size_t size, 
 // ------------------------------------------------------------------------------ known problems
 
 // Known (OpenEXR 3.1.5, Debian 12): Header::readFrom allocates an attribute's claimed size (a
-// string's, an unknown type's opaque data) before reading it, so a 1 KB file with a string
-// attribute of size 0x7fffffff costs 2 GB (found by exr_layered in its first minute; reproducer
-// tests/fuzz/libfuzzer/findings/exr-openexr-attribute-size-2gb.exr). True, with what, when an
-// attribute of the file's header(s) claims more bytes than follow it.
+// string's, an unknown type's opaque data, a string vector's strings, a preview's pixels) before
+// reading it, so a 1 KB file with a string attribute of size 0x7fffffff costs 2 GB (found by
+// exr_layered in its first minute; reproducer tests/fuzz/libfuzzer/findings/
+// exr-openexr-attribute-size-2gb.exr). True, with what, when an attribute of the file's header(s)
+// claims more bytes than follow it. The header is walked the way OpenEXR reads it: a channel list
+// up to its terminating null name and the fixed-size types by their size, whatever size the
+// attribute declares (OpenEXR does not compare the two); the others by their declared size.
 inline bool exrAttributeOverrun(const uint8_t* d, size_t n, std::string* what) {
     if (n < 8 || d[0] != 0x76 || d[1] != 0x2f || d[2] != 0x31 || d[3] != 0x01) return false;
     const bool multipart = (d[5] & 0x10) != 0;  // version flag 0x1000
-    size_t at = 8;
     auto cstr = [&](size_t& i, std::string& out) {
         const size_t start = i;
         while (i < n && d[i] != 0 && i - start < 256) ++i;
@@ -151,6 +153,24 @@ inline bool exrAttributeOverrun(const uint8_t* d, size_t n, std::string* what) {
         ++i;
         return true;
     };
+    auto i32 = [&](size_t i) {
+        return int64_t(int32_t(uint32_t(d[i]) | uint32_t(d[i + 1]) << 8 | uint32_t(d[i + 2]) << 16 | uint32_t(d[i + 3]) << 24));
+    };
+    auto fixedSize = [](const std::string& t) -> size_t {
+        static const std::pair<const char*, size_t> kFixed[] = {
+            {"box2i", 16}, {"box2f", 16}, {"compression", 1}, {"lineOrder", 1}, {"envmap", 1}, {"deepImageState", 1},
+            {"int", 4}, {"float", 4}, {"double", 8}, {"v2i", 8}, {"v2f", 8}, {"v2d", 16}, {"v3i", 12}, {"v3f", 12},
+            {"v3d", 24}, {"m33f", 36}, {"m33d", 72}, {"m44f", 64}, {"m44d", 128}, {"tiledesc", 9}, {"keycode", 28},
+            {"timecode", 8}, {"rational", 8}, {"chromaticities", 32}};
+        for (const auto& [name, bytes] : kFixed)
+            if (t == name) return bytes;
+        return 0;
+    };
+    auto overrun = [&](const std::string& name, const std::string& type, int64_t claim, size_t left) {
+        if (what) *what = "attribute '" + name + "' (" + type + ") claims " + std::to_string(claim) + " bytes, " + std::to_string(left) + " follow";
+        return true;
+    };
+    size_t at = 8;
     while (at < n) {
         if (d[at] == 0) {  // end of a header; in a multipart file an empty header ends the list
             ++at;
@@ -159,15 +179,37 @@ inline bool exrAttributeOverrun(const uint8_t* d, size_t n, std::string* what) {
         }
         std::string name, type;
         if (!cstr(at, name) || !cstr(at, type) || at + 4 > n) return false;
-        const int32_t size = int32_t(uint32_t(d[at]) | uint32_t(d[at + 1]) << 8 | uint32_t(d[at + 2]) << 16 | uint32_t(d[at + 3]) << 24);
+        const int64_t size = i32(at);
         at += 4;
         if (size < 0) return false;  // OpenEXR refuses it
-        if (size_t(size) > n - at) {
-            if (what) *what = "attribute '" + name + "' (" + type + ") claims " + std::to_string(size) + " bytes, " +
-                              std::to_string(n - at) + " follow";
-            return true;
+        const size_t left = n - at;
+        if (type == "chlist") {
+            for (std::string channel;;) {
+                if (!cstr(at, channel)) return false;
+                if (channel.empty()) break;
+                if ((at += 16) > n) return false;
+            }
+        } else if (const size_t fixed = fixedSize(type)) {
+            if (fixed > left) return false;
+            at += fixed;
+        } else if (type == "preview") {
+            if (left < 8 || i32(at) < 0 || i32(at + 4) < 0) return false;
+            const uint64_t pixels = uint64_t(i32(at)) * uint64_t(i32(at + 4));  // 4 bytes each
+            if (pixels > (left - 8) / 4) return overrun(name, type, int64_t(pixels * 4), left - 8);
+            at += 8 + size_t(pixels * 4);
+        } else if (type == "stringvector") {
+            for (int64_t read = 0; read < size;) {
+                if (at + 4 > n || i32(at) < 0) return false;
+                const int64_t len = i32(at);
+                at += 4;
+                if (uint64_t(len) > n - at) return overrun(name, type + " string", len, n - at);
+                at += size_t(len);
+                read += 4 + len;
+            }
+        } else {
+            if (uint64_t(size) > left) return overrun(name, type, size, left);
+            at += size_t(size);
         }
-        at += size_t(size);
     }
     return false;
 }
