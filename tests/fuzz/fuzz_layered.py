@@ -177,6 +177,8 @@ def export_check(parts, outdir):
         except (OSError, ValueError, KeyError, IndexError, struct.error, zlib.error) as e:
             return "wrong-output", "an exported file is unreadable: %s" % e
         fx0, fy0, fx1, fy1 = parts[0]["dw"]
+        dw_, dh_ = parts[0].get("display", (fx1 + 1, fy1 + 1))
+        fx0, fy0, fx1, fy1 = max(fx0, 0), max(fy0, 0), min(fx1, dw_ - 1), min(fy1, dh_ - 1)  # the image
         for buffer in ("color", "albedo", "position", "depth"):
             pi, names = pass_channels(parts, buffer)
             path = os.path.join(outdir, buffer + ".exr")
@@ -249,6 +251,7 @@ KINDS = ["valid", "damage", "huge", "offset", "othersize", "onechannel", "deep",
          "outisinput", "aovs", "attrsize"]
 COMMANDS = ["denoise-in", "inspect", "export", "color-albedo", "add-pass"]
 ALBEDO_PASSES = {"Denoising Albedo", "DiffCol", "albedo"}
+SURE_READS = ["albedo", "normal", "position", "emission", "object_id", "material_id"]
 NORMAL_PASSES = {"Normal", "Denoising Normal", "nn", "sh_normal"}
 
 
@@ -317,10 +320,13 @@ def build_layered(cid, rng, seeds, d, cli, klass, ordinal, seed):
                                 typ="float" if big_colour else None)
     ci, cnames = colour_of(parts)
     note = "%s %s %s" % (kind, cmd, style)
-    read = ["albedo", "normal"] if cmd == "color-albedo" else [b for b in TIERS if b != "color"]
-    if cmd == "inspect":
-        read = []
+    # The buffers the command surely reads (SURE by default: not depth, whose sigma is 0, nor motion;
+    # those two may be read or skipped), export all of them, inspect none.
+    read, maybe = {"denoise-in": (SURE_READS, ["depth", "motion"]), "add-pass": (SURE_READS, ["depth", "motion"]),
+                   "export": (list(TIERS), []), "color-albedo": (["albedo", "normal"], []),
+                   "inspect": ([], [])}[cmd]
     aux = sorted(taken(parts, read) - {ci}) if multi else []
+    maybe_aux = sorted(taken(parts, maybe) - set(aux) - {ci}) if multi else []
     spare = [i for i in range(len(parts)) if i != ci and i not in taken(parts, TIERS)]
     if kind in ("valid", "aovs"):
         good = True
@@ -336,9 +342,8 @@ def build_layered(cid, rng, seeds, d, cli, klass, ordinal, seed):
                 override[i] = huge_chunks(p, i, multi, big[0], big[1])
         for p in parts:
             p["display"] = big if which == "all" else (W, H)
-        # a part of another size than the first is an error only where it is read; its header lies
-        # about the file size either way (a reader may refuse the whole file)
-        must = True if cmd != "inspect" and (which == "all" or target in aux or cmd == "add-pass") else None
+        # what all parts claim must fit in the file, whether the part is read or not
+        must = True if cmd != "inspect" else None
         note += " %dx%d %s" % (big[0], big[1], which if which == "all" else "part %d" % target)
     elif kind == "offset":
         dx, dy = rng.choice([(5, 5), (-3, -2), (100, 0), (0, 7)])
@@ -349,33 +354,41 @@ def build_layered(cid, rng, seeds, d, cli, klass, ordinal, seed):
             if which == "all" or i == target:
                 p["dw"] = (dx, dy, dx + W - 1, dy + H - 1)
             p["display"] = (W, H)
-        good = which == "all"
+        # The image is the first part's window clipped to the display window; a pass placed elsewhere
+        # that does not cover it is refused where it is read
+        # (a window wholly outside the display window: refused, or taken as it is; no oracle)
+        empty = dx >= W or dy >= H
+        if which == "all":
+            good = not empty
+        else:
+            must = True if target in aux else None
         note += " (%d,%d) %s" % (dx, dy, which if which == "all" else "part %d" % target)
     elif kind == "othersize":
-        used = bool(aux) and rng.random() < 0.6
+        used = bool(aux + maybe_aux) and rng.random() < 0.6
         if not used:
             parts.append(make_part(bufs, "ViewLayer.Shadow2", "RGB", "albedo", "ViewLayer.Shadow2."))
-        i = rng.choice(aux) if used else len(parts) - 1
+        i = rng.choice(aux + maybe_aux) if used else len(parts) - 1
         w2, h2 = rng.choice([(8, 6), (17, 12), (16, 13), (1, 1)])
+        smaller = w2 < W or h2 < H  # a larger part from (0, 0) covers the image: read in place
         p = parts[i]
         parts[i] = make_part(bufs, p["name"], "".join(n[-1] for n, _ in p["channels"]), p["src"], p["name"] + ".",
                              p["channels"][0][1], p["compression"], w2, h2)
-        must = True if used and cmd != "inspect" else None
+        must = True if used and smaller and i in aux else None
         good = not used and cmd != "add-pass"
         note += " part %s %dx%d%s" % (p["name"], w2, h2, " (taken)" if used else "")
     elif kind == "onechannel":
-        must = True if cmd != "inspect" else None
+        must = True if one[2] in read else None  # one channel for a normal or motion, where it is read
         note += " " + parts[-1]["channels"][0][0] if multi else " " + parts[0]["channels"][-1][0]
     elif kind == "deep":
-        used = bool(aux) and rng.random() < 0.5
+        used = bool(aux + maybe_aux) and rng.random() < 0.5
         if used:
-            i = rng.choice(aux)
+            i = rng.choice(aux + maybe_aux)
         else:
             parts.append(make_part(bufs, "ViewLayer.Deep", "RGBZ", "albedo", "ViewLayer.Deep."))
             i = len(parts) - 1
         parts[i]["kind"] = "deep"
         parts[i]["compression"] = 0
-        must = True if (used and cmd != "inspect") or cmd == "add-pass" else None
+        must = True if (used and i in aux) or cmd == "add-pass" else None
         good = not used and cmd in ("denoise-in", "export")
         note += " part %s%s" % (parts[i]["name"], " (taken)" if used else "")
     elif kind == "tiled":
@@ -447,7 +460,7 @@ def build_layered(cid, rng, seeds, d, cli, klass, ordinal, seed):
         ex = os.path.join(d, "export")
         argv = [cli, "inspect", f, "--export", ex] + extra_argv
         outs = [os.path.join(ex, "color.exr")]
-        if kind in ("valid", "tiled", "offset"):
+        if kind in ("valid", "tiled") or (kind == "offset" and good):
             check = export_check(parts, ex)
     elif cmd == "color-albedo":
         out = os.path.join(d, "out.pfm")

@@ -56,7 +56,7 @@ def build_seq(cid, rng, seeds, d, cli, klass, ordinal, seed):
     must, good = None, False
     names = [seq]
     files = []  # each frame's file (layered) or directory
-    passes = None
+    passes, with_vector = None, False
     if layout != "dirs":
         style = layout
         base = [BLENDER[0], BLENDER[1], BLENDER[3], BLENDER[5]] if style != "mitsuba" else list(MITSUBA[:3])
@@ -128,12 +128,14 @@ def build_seq(cid, rng, seeds, d, cli, klass, ordinal, seed):
             have = [os.path.exists(c) for c in comps]
             sizes = [E.read_headers(open(c, "rb").read())["headers"][0]["dataWindow"] for c in comps if
                      os.path.exists(c)]
-            if not all(have) or len(set(sizes)) > 1:
-                must = True
+            if len(set(sizes)) > 1 or (not all(have) and not with_vector):
+                must = True  # motion in some frames only, or of another size than the frame
+            elif not all(have):
+                must = None  # every frame has its Vector pass; some also a companion (which wins there)
             elif rng.random() < 0.5:
                 data, k2, _ = mutate_bytes(rng, open(comps[j], "rb").read(), 200)
                 open(comps[j], "wb").write(data)
-                must = True if k2 == "truncate" else None
+                must = True if k2 == "truncate" and method == "svgf" else None  # still methods need no motion
                 note += " companion " + k2
             else:
                 good = True
