@@ -215,3 +215,27 @@ TEST(LayeredInput, AddPassPlacesThePassOnTheImage) {
         EXPECT_TRUE(std::equal(want.data(), want.data() + want.size(), added.data())) << (multipart ? "multipart" : "single part");
     }
 }
+
+// Rule 0 of exr_limits.h: OpenEXR 3.1's header parser allocates an attribute's claimed size before
+// reading it (2 GB and ~4 s from a 901-byte file, found by tests/fuzz/libfuzzer). An attribute that
+// claims more bytes than the file has is refused before OpenEXR sees the file, on every reader.
+TEST(LayeredInput, HeaderAttributeLargerThanTheFileIsRefusedFirst) {
+    TempDir dir;
+    writeExrParts(dir / "ok.exr", {simplePart("ViewLayer.Combined", 8, 6, kRgb, colourAt),
+                                   simplePart("ViewLayer.Denoising Albedo", 8, 6, kRgb, albedoAt)});
+    std::string bytes = fileBytes(dir / "ok.exr");
+    const std::string key = std::string("channels") + '\0' + "chlist" + '\0';
+    const size_t at = bytes.find(key);
+    ASSERT_NE(at, std::string::npos);
+    const uint32_t huge = 0x7ff00000u;  // ~2 GB
+    for (int i = 0; i < 4; ++i) bytes[at + key.size() + size_t(i)] = char((huge >> (8 * i)) & 0xff);
+    std::ofstream(dir / "lie.exr", std::ios::binary) << bytes;
+    for (const std::string& args : {"inspect " + (dir / "lie.exr"), "denoise --in " + (dir / "lie.exr") + " --out " + (dir / "o.exr"),
+                                    "compare --ref " + (dir / "lie.exr") + " " + (dir / "lie.exr")}) {
+        const CliRun r = runCliMeasured(args);
+        EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.output;
+        EXPECT_TRUE(oneLine(r.output)) << r.output;
+        EXPECT_NE(r.output.find("lie.exr: truncated or corrupt EXR header (attribute 'channels'"), std::string::npos) << r.output;
+        EXPECT_LT(r.peakMb, 150) << args;
+    }
+}

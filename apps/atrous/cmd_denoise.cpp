@@ -70,8 +70,10 @@ void noteIgnoredFlags(const CLI::App& cmd, const std::string& method, bool seque
         if (g == kGroupBuffers && sequence) ignoredSeq += (ignoredSeq.empty() ? "" : ", ") + opt->get_name();
     }
     if (!ignored.empty()) std::fprintf(stderr, "denoise: note: ignored with --method %s: %s\n", method.c_str(), ignored.c_str());
+    // A buffer file given beside --sequence would not be read: refused, not noted (issue 29).
     if (!ignoredSeq.empty())
-        std::fprintf(stderr, "denoise: note: ignored with --sequence (frames bring their own buffers): %s\n", ignoredSeq.c_str());
+        throw InputError(ignoredSeq + ": a sequence's frames bring their own buffers (--sequence DIR); drop " +
+                         (ignoredSeq.find(',') == std::string::npos ? "it" : "them"));
 }
 
 // --out FILE: its directory must exist and be a directory (checked before any work).
@@ -161,9 +163,18 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     if (a.inDir.empty() == a.color.empty())
         throw InputError("give exactly one of --in RENDER_DIR, --in LAYERED.exr or --color FILE (--hdr/--ldr)");
     checkOutputFile(a.out);
-    const io::BufferFiles files = bufferFiles(a);
+    io::BufferFiles files = bufferFiles(a);
     io::refuseOverwrite("--out", a.out, io::inputFiles(files));
+    // Only the buffers the method reads are decoded (auto: by the buffers present).
+    files.wanted = [&](io::Buffer b, const bool present[io::kBufferCount]) {
+        const DenoiseMethod m = o.method != DenoiseMethod::Auto ? o.method
+                                : present[int(io::Buffer::Albedo)] && present[int(io::Buffer::Normal)] ? DenoiseMethod::Learned
+                                                                                                      : DenoiseMethod::Sure;
+        return io::methodReads(denoiseBufferUse(o, m), b);
+    };
+    Timer readTimer;
     io::BufferSet set = io::loadBuffers(files);
+    const double readMs = readTimer.ms();
     if (!a.addPass.empty() && (!set.layered || ext != ".exr"))
         throw InputError("--add-pass '" + a.addPass + "' writes a copy of a layered EXR: give --in FILE.exr and --out COPY.exr");
     Image& color = set.image[int(io::Buffer::Color)];
@@ -190,10 +201,12 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     const double ms = t.ms();
     if (a.ldr) clampUnit(out);
     if (a.srgb) linearToSrgb(out);
+    Timer writeTimer;
     if (!a.addPass.empty())
         io::writeExrWithLayers(a.out, *set.layered, {io::ExrOutLayer{a.addPass, &out}});
     else
         io::writeImage(a.out, out);
+    const double writeMs = writeTimer.ms();
     const std::string method = o.method == DenoiseMethod::Auto
                                    ? std::string("auto -> ") + denoiseMethodName(rep.methodUsed) +
                                          (rep.methodUsed == DenoiseMethod::Learned ? " (albedo and normal given)"
@@ -209,7 +222,14 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     if (o.firefly.enabled)
         std::printf("denoise: fireflies clamped: %d pixels, mean luminance %.6g -> %.6g\n", rep.firefliesClamped,
                     rep.meanLuminanceIn, rep.meanLuminanceAfterFirefly);
-    std::printf("denoise: filter %.2f ms, total %.2f ms, wrote %s\n", rep.milliseconds, ms, a.out.c_str());
+    if (!set.skipped.empty()) {
+        std::string list;
+        for (io::Buffer b : set.skipped)
+            if (b != io::Buffer::MaterialId) list += (list.empty() ? "" : ", ") + std::string(io::bufferName(b));
+        std::printf("denoise: not read (unused by %s): %s\n", denoiseMethodName(rep.methodUsed), list.c_str());
+    }
+    std::printf("denoise: read %.2f ms, filter %.2f ms, total %.2f ms, write %.2f ms, wrote %s\n", readMs, rep.milliseconds, ms,
+                writeMs, a.out.c_str());
     if (!rep.stages.empty()) {  // the filter's own stages (DenoiseReport::stages)
         std::printf("denoise: stages ms:");
         for (size_t i = 0; i < rep.stages.size(); ++i)

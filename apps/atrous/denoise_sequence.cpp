@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <future>
 #include <memory>
 #include <sstream>
 #include <vector>
@@ -221,8 +222,17 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
     int firstIndex = -1;
     bool idsTrusted = true, warnedSign = false, notedMotion = false;
     io::SequenceFrame prev;
-    for (const auto& path : frames) {
-        io::SequenceFrame f = io::loadSequenceFrame(path, present, args.layers);
+    // Pipelined: frame N+1 is read and frame N-1 written (EXR and PNG) on other threads while
+    // frame N is filtered. An error in either reaches this thread through its future, in frame
+    // order; nothing reaches OUTDIR before every frame is done (StagedOutput).
+    auto load = [&](size_t i) { return io::loadSequenceFrame(frames[i], present, args.layers); };
+    std::future<io::SequenceFrame> next = std::async(std::launch::async, load, size_t(0));
+    std::future<void> writing;
+    Timer wall;
+    double filterMs = 0.0;
+    for (size_t i = 0; i < frames.size(); ++i) {
+        io::SequenceFrame f = next.get();
+        if (i + 1 < frames.size()) next = std::async(std::launch::async, load, i + 1);
         if (firstIndex < 0) firstIndex = f.index;
         std::string name = io::sequenceFrameName(f.index);
         // Other renderers' sequences: how much reprojects, with which sign, and whether ids hold.
@@ -262,25 +272,34 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
             throw InputError(io::withSourceFile(e.what(), [&](const std::string& b) { return f.fileOf(b); }, f.dir));
         }
         double ms = timer.ms();
-        const std::string exrOut = (fs::path(stage) / (name + ".exr")).string();
-        if (!args.addPass.empty())
-            io::writeExrWithLayers(exrOut, *f.layered, {io::ExrOutLayer{args.addPass, &out}});
-        else
-            io::writeImage(exrOut, out);
-        io::writePng((fs::path(stage) / (name + ".png")).string(), out, args.exposure);
+        filterMs += ms;
+        const double mseOut = f.reference.empty() ? 0.0 : meanSquaredError(out, f.reference);
+        if (writing.valid()) writing.get();  // frame N-1's files, and its errors, before frame N's
+        writing = std::async(std::launch::async, [&, name, layered = f.layered, img = std::make_shared<Image>(std::move(out))] {
+            const std::string exrOut = (fs::path(stage) / (name + ".exr")).string();
+            if (!args.addPass.empty())
+                io::writeExrWithLayers(exrOut, *layered, {io::ExrOutLayer{args.addPass, img.get()}});
+            else
+                io::writeImage(exrOut, *img);
+            io::writePng((fs::path(stage) / (name + ".png")).string(), *img, args.exposure);
+        });
         if (!args.quiet) {
             std::printf("%s: %s%s%s %.1f ms", name.c_str(), args.method.c_str(),
                         args.method == "auto" ? " -> " : (svgf && args.svgf.learnedSpatial ? " (learned spatial)" : ""),
                         args.method == "auto" ? denoiseMethodName(frameReport.methodUsed) : "", ms);
             if (check.tested > 0) std::printf(", %.0f%% reprojects onto the previous frame", 100 * check.kept);
             if (!f.reference.empty())
-                std::printf(", MSE vs reference %.6g (input %.6g)", meanSquaredError(out, f.reference),
-                            meanSquaredError(f.color, f.reference));
+                std::printf(", MSE vs reference %.6g (input %.6g)", mseOut, meanSquaredError(f.color, f.reference));
             std::printf("\n");
             std::fflush(stdout);
         }
         prev = std::move(f);
     }
+    if (writing.valid()) writing.get();
+    if (!args.quiet)
+        std::printf("sequence: %zu frames, filter %.1f ms per frame, %.1f ms per frame in all (reading and writing "
+                    "overlapped with filtering)\n",
+                    frames.size(), filterMs / double(frames.size()), wall.ms() / double(frames.size()));
     if (args.preview) writeAnimatedPreview(stage, firstIndex, args.quiet, args.outDir);
     staged.commit();
     return 0;

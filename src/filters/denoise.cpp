@@ -169,7 +169,9 @@ PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, D
     if (in.albedo) used += use.albedo ? ",albedo" : ",albedo(unused: demodulation off)";
     if (in.normal) used += ",normal";
     if (in.position) used += use.position ? ",position" : ",position(unused by learned)";
-    if (in.depth) used += use.depth ? ",depth" : ",depth(unused: sigma-depth 0)";
+    // Depth steers the depth stop (sigma-depth > 0), the learned network, and, without a usable
+    // variance, the noise estimate's geometric edges.
+    if (in.depth) used += learned || o.eaw.sigmaDepth > 0 || rep.noiseEstimated ? ",depth" : ",depth(unused: sigma-depth 0)";
     if (in.ids) used += use.ids ? ",ids" : learned ? ",ids(unused by learned)" : ",ids(unused)";
     if (in.emission) used += ",emission";
     rep.buffersUsed = used;
@@ -184,7 +186,9 @@ DenoiseBufferUse denoiseBufferUse(const DenoiseOptions& o, DenoiseMethod resolve
     DenoiseBufferUse u;
     u.albedo = o.demodulate;
     u.position = !learned;
-    u.depth = learned || o.eaw.sigmaDepth > 0;
+    // Depth is read by EAW/SURE too when the variance turns out unusable (the noise estimate's
+    // edges), which only reading the variance tells: always.
+    u.depth = true;
     u.ids = !learned && o.eaw.useIds;
     return u;
 }

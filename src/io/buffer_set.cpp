@@ -107,6 +107,22 @@ Image readBufferFile(const std::string& path, Buffer b, const std::vector<PassRe
     return img;
 }
 
+bool methodReads(const DenoiseBufferUse& use, Buffer b) {
+    switch (b) {
+        case Buffer::Color: return true;
+        case Buffer::Variance: return use.variance;
+        case Buffer::Albedo: return use.albedo;
+        case Buffer::Normal: return use.normal;
+        case Buffer::Position: return use.position;
+        case Buffer::Depth: return use.depth;
+        case Buffer::ObjectId:
+        case Buffer::MaterialId: return use.ids;
+        case Buffer::Emission: return use.emission;
+        case Buffer::Motion: return false;
+    }
+    return true;
+}
+
 std::vector<std::string> inputFiles(const BufferFiles& f) {
     std::vector<std::string> files;
     std::error_code ec;
@@ -126,9 +142,9 @@ std::vector<std::string> inputFiles(const BufferFiles& f) {
 std::string withSourceFile(const std::string& msg, const std::function<std::string(const std::string&)>& fileOf,
                            const std::string& fallback) {
     static const char* const kNames[] = {"color", "variance", "albedo", "normal", "position", "depth", "ids", "emission", "motion"};
-    for (const std::string prefix : {std::string(), std::string("SVGF frame: the ")})
+    for (const char* prefix : {"", "SVGF frame: the "})
         for (const char* name : kNames)
-            if (msg.rfind(prefix + name + " buffer", 0) == 0) {
+            if (msg.rfind(std::string(prefix) + name + " buffer", 0) == 0) {
                 const std::string file = fileOf(name);
                 if (!file.empty()) return file + ": " + msg;
             }
@@ -149,14 +165,40 @@ BufferSet loadBuffers(const BufferFiles& f) {
             s.layered = std::make_shared<ExrInfo>(inspectExr(f.in));
         }
     }
+    // Where each buffer comes from, before anything is decoded: an explicit file, the render
+    // directory's file, or the layered file's pass.
+    std::string pathOf[kBufferCount];
+    PassMap m;
+    bool present[kBufferCount] = {};
+    for (int b = 0; b < kBufferCount; ++b) {
+        pathOf[b] = f.file[b];
+        if (pathOf[b].empty() && !dir.empty() && kDirNames[b][0]) {
+            const std::string p = (fs::path(dir) / kDirNames[b]).string();
+            if (fs::exists(p)) pathOf[b] = p;
+        }
+        present[b] = !pathOf[b].empty();
+    }
+    if (s.layered) {
+        m = mapPasses(*s.layered, f.passes, f.viewLayer);
+        for (int b = 0; b < kBufferCount; ++b) present[b] = present[b] || m.pass[size_t(b)].found();
+    }
+    // The caller's choice of what to decode (the buffers its method reads); the rest are noted.
+    bool want[kBufferCount];
+    for (int b = 0; b < kBufferCount; ++b) {
+        want[b] = b == int(Buffer::Color) || !f.wanted || f.wanted(Buffer(b), present);
+        if (Buffer(b) == Buffer::MaterialId) want[b] = want[int(Buffer::ObjectId)];
+        if (present[b] && !want[b]) {
+            s.skipped.push_back(Buffer(b));
+            layered[b] = true;  // a --pass for it is not a flag that cannot apply: it is not needed
+        }
+    }
     if (s.layered) {
         const ExrInfo& info = *s.layered;
-        const PassMap m = mapPasses(info, f.passes, f.viewLayer);
         if (!m[Buffer::Color].found() && f.file[int(Buffer::Color)].empty())
             throw InputError(f.in + ": no colour pass (layers: " + layerList(info) + "); name one with --pass color=LAYER");
         std::vector<std::pair<Buffer, const PassChoice*>> wanted;
         for (int b = 0; b < kBufferCount; ++b)
-            if (m.pass[size_t(b)].found() && f.file[b].empty()) wanted.emplace_back(Buffer(b), &m.pass[size_t(b)]);
+            if (m.pass[size_t(b)].found() && f.file[b].empty() && want[b]) wanted.emplace_back(Buffer(b), &m.pass[size_t(b)]);
         std::vector<Image> images = readPasses(info, wanted);
         Image object, material;
         for (size_t k = 0; k < wanted.size(); ++k) {
@@ -184,12 +226,8 @@ BufferSet loadBuffers(const BufferFiles& f) {
         }
     }
     for (int b = 0; b < kBufferCount; ++b) {
-        std::string path = f.file[b];
-        if (path.empty() && !dir.empty() && kDirNames[b][0]) {
-            const std::string p = (fs::path(dir) / kDirNames[b]).string();
-            if (fs::exists(p)) path = p;
-        }
-        if (path.empty()) continue;
+        const std::string& path = pathOf[b];
+        if (path.empty() || !want[b]) continue;
         // A layered file given for the ids (`--ids aovs.exr`) gives its object-index pass only;
         // atrous's own ids.exr (root R, G) is read whole: mesh and material ids.
         s.image[b] = readBufferFile(path, Buffer(b), f.passes, f.viewLayer, &s.from[b], &layered[b]);

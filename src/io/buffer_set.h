@@ -24,6 +24,9 @@ struct BufferFiles {
     std::string file[kBufferCount];
     std::vector<PassRequest> passes;  // --pass BUFFER=NAME
     std::string viewLayer;            // --layer NAME
+    // Which buffers to decode, given which are present (by buffer; material_id follows object_id,
+    // colour is always decoded): empty = all. The others are listed in BufferSet::skipped.
+    std::function<bool(Buffer, const bool present[kBufferCount])> wanted;
 };
 
 struct BufferSet {
@@ -32,6 +35,7 @@ struct BufferSet {
     std::string from[kBufferCount];  // where each came from, for messages and `inspect`
     std::shared_ptr<ExrInfo> layered;  // the layered file given as `in`, if any
     std::vector<std::string> notes;    // conventions applied, passes not found, ...
+    std::vector<Buffer> skipped;       // present but not decoded (BufferFiles::wanted)
     const Image* get(Buffer b) const { return image[int(b)].empty() ? nullptr : &image[int(b)]; }
     DenoiseInputs inputs() const;  // denoiseInputs(refsOf(*this))
 };
@@ -58,6 +62,10 @@ BufferRefs refsOf(const SequenceFrame& f);  // all but the reference
 // albedo, normal, depth, ids, motion and emission (its variance is its own, from the history).
 DenoiseInputs denoiseInputs(const BufferRefs& r);
 SvgfFrame svgfFrame(const BufferRefs& r);
+
+// Whether a still denoiser that reads `use` (denoiseBufferUse) reads buffer b (colour always;
+// motion never: it is for sequences).
+bool methodReads(const DenoiseBufferUse& use, Buffer b);
 
 // Every file loadBuffers(files) reads or could read: the explicit files, `in` when it is a file,
 // and for a render directory each buffer's file name in it (color.exr, albedo.exr, ...: present

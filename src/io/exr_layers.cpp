@@ -16,9 +16,11 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <set>
 
 #include "atrous/error.h"
+#include "io/exr_core.h"
 #include "io/exr_limits.h"
 #include "io/image_io.h"
 
@@ -67,6 +69,7 @@ ExrInfo inspectExr(const std::string& path) {
     if (!std::filesystem::exists(path, ec)) throw InputError(path + ": file not found");
     if (std::filesystem::is_directory(path, ec)) throw InputError(path + ": is a directory, not an EXR file");
     if (!isExrFile(path)) throw InputError(path + ": not an OpenEXR file (no EXR magic number)");
+    requireExrHeadersFit(path);
     ExrInfo info;
     info.path = path;
     try {
@@ -91,6 +94,8 @@ ExrInfo inspectExr(const std::string& path) {
                 ch.part = p;
                 ch.name = it.name();
                 ch.type = typeName(it.channel().type);
+                ch.xSampling = it.channel().xSampling;
+                ch.ySampling = it.channel().ySampling;
                 const bool qualified = parts > 1 && !part.name.empty() && ch.name.rfind(part.name + ".", 0) != 0;
                 ch.fullName = qualified ? part.name + "." + ch.name : ch.name;
                 info.channels.push_back(ch);
@@ -196,39 +201,60 @@ std::vector<Image> readExrChannelSets(const ExrInfo& info, const std::vector<std
             firstUse.emplace(c, std::make_pair(k, int(j)));
             byPart[info.channels[size_t(c)].part].push_back({k, int(j)});
         }
+    for (const auto& [p, uses] : byPart)
+        for (const auto& use : uses) {
+            const ExrChannelInfo& ch = info.channels[size_t(sets[use.first][size_t(use.second)])];
+            if (ch.xSampling != 1 || ch.ySampling != 1)
+                throw InputError(info.path + ": channel '" + ch.fullName + "' (" + whats[use.first] + ") is subsampled (" +
+                                 std::to_string(ch.xSampling) + "x" + std::to_string(ch.ySampling) +
+                                 "), which atrous cannot read");
+        }
+    auto partLabel = [&](int p) {
+        return info.parts[size_t(p)].name.empty() ? "part " + std::to_string(p) : "part '" + info.parts[size_t(p)].name + "'";
+    };
+    auto requestsOf = [&](const std::vector<std::pair<size_t, int>>& uses, std::vector<Image>& images) {
+        std::vector<ExrPlaneRequest> r;
+        for (const auto& use : uses)
+            r.push_back({info.channels[size_t(sets[use.first][size_t(use.second)])].name, images[use.first].view().channel(use.second)});
+        return r;
+    };
     std::string what = sets.size() == 1 ? whats[0] : "its passes";
     std::vector<Image> images;
     try {
-        Imf::MultiPartInputFile file(info.path.c_str());
+        // Scanline parts (every renderer's output seen so far) through OpenEXR's Core API, chunks in
+        // parallel; their chunks are located and checked before anything is allocated (exr_core.h).
+        ExrCoreFile core(info.path);
+        std::vector<int> classic;
         for (const auto& [p, uses] : byPart) {
-            Imf::InputPart part(file, p);
-            for (const auto& use : uses) {
-                const ExrChannelInfo& ch = info.channels[size_t(sets[use.first][size_t(use.second)])];
-                const Imf::Channel* c = part.header().channels().findChannel(ch.name.c_str());
-                if (c && (c->xSampling != 1 || c->ySampling != 1))
-                    throw InputError(info.path + ": channel '" + ch.fullName + "' (" + whats[use.first] + ") is subsampled (" +
-                                     std::to_string(c->xSampling) + "x" + std::to_string(c->ySampling) +
-                                     "), which atrous cannot read");
-            }
+            if (core.decodes(p))
+                core.locate(p, win, partLabel(p));
+            else
+                classic.push_back(p);
         }
-        // Rule 3 of exr_limits.h: a header that claims more than its chunks hold fails here, at a
-        // row's cost, when the planes would be large against the file.
-        if (exrNeedsProof(uint64_t(sets.size()) * 12 * uint64_t(w) * uint64_t(h), exrFileBytes(info.path)))
-            for (const auto& [p, uses] : byPart) {
-                Imf::InputPart part(file, p);
-                std::vector<std::string> names;
-                for (const auto& use : uses) names.push_back(info.channels[size_t(sets[use.first][size_t(use.second)])].name);
-                proveExrRows(part, names, win.y0, win.y0 + h - 1);
-            }
-        for (size_t k = 0; k < sets.size(); ++k) images.emplace_back(w, h, 3);
+        std::unique_ptr<Imf::MultiPartInputFile> file;
+        if (!classic.empty()) {
+            file = std::make_unique<Imf::MultiPartInputFile>(info.path.c_str());
+            // Rule 3 of exr_limits.h for tiled parts: their rows decoded into one row first.
+            if (exrNeedsProof(uint64_t(sets.size()) * 12 * uint64_t(w) * uint64_t(h), exrFileBytes(info.path)))
+                for (int p : classic) {
+                    Imf::InputPart part(*file, p);
+                    std::vector<std::string> names;
+                    for (const auto& use : byPart[p]) names.push_back(info.channels[size_t(sets[use.first][size_t(use.second)])].name);
+                    proveExrRows(part, names, win.y0, win.y0 + h - 1);
+                }
+        }
+        // Every plane is written below (decoded, copied, or filled): no zero fill first.
+        for (size_t k = 0; k < sets.size(); ++k) images.push_back(Image::uninitialized(w, h, 3));
         for (const auto& [p, uses] : byPart) {
-            Imf::InputPart part(file, p);
+            const std::vector<ExrPlaneRequest> req = requestsOf(uses, images);
+            if (std::find(classic.begin(), classic.end(), p) == classic.end()) {
+                core.decode(p, req, win, partLabel(p));
+                continue;
+            }
+            Imf::InputPart part(*file, p);
             std::vector<std::string> names;
             std::vector<float*> planes;
-            for (const auto& use : uses) {
-                names.push_back(info.channels[size_t(sets[use.first][size_t(use.second)])].name);
-                planes.push_back(images[use.first].view().channel(use.second));
-            }
+            for (const auto& r : req) names.push_back(r.channel), planes.push_back(r.plane);
             readExrPlanes(part, names, planes, win);
         }
     } catch (const InputError&) {

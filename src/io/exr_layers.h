@@ -26,6 +26,7 @@ struct ExrChannelInfo {
     std::string name;      // the channel's name inside its part
     std::string fullName;  // part-qualified name (see above)
     std::string type;      // "half", "float" or "uint"
+    int xSampling = 1, ySampling = 1;
 };
 
 struct ExrLayer {

@@ -28,6 +28,13 @@ struct ExrWindow {
     int x0 = 0, y0 = 0, width = 0, height = 0;
 };
 
+// Rule 0, before OpenEXR reads a header (its 3.1 parser allocates an attribute's claimed size: 2 GB
+// from a 901-byte file, found by tests/fuzz/libfuzzer): walks every header's attributes (name,
+// type, size, value) and refuses one whose claimed size runs past the end of the file. Throws
+// InputError naming the file and the attribute; a file that is not an EXR passes (the caller's
+// magic-number check refuses it).
+void requireExrHeadersFit(const std::string& path);
+
 // The first part's data window clipped to its display window. Throws InputError naming the file
 // when that is empty or larger than kMaxImageDim per side.
 ExrWindow exrImageWindow(const std::string& path, const Imf::Header& first);

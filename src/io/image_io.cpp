@@ -4,15 +4,17 @@
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
-#include <ImfOutputFile.h>
 #include <ImfRgbaFile.h>
 #include <ImfArray.h>
+#include <libdeflate.h>
 #include <stb_image.h>
+#include <tbb/parallel_for.h>
 #include <stb_image_write.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdint>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -24,6 +26,7 @@
 #include "atrous/error.h"
 #include "core/srgb.h"
 #include "io/exr_layers.h"
+#include "io/exr_core.h"
 #include "io/exr_limits.h"
 #include "io/pass_map.h"
 
@@ -78,6 +81,7 @@ static auto namingFile(const std::string& path, F&& f) -> decltype(f()) {
 // before anything is allocated, placed by the data window clipped to the display window).
 static Image readExr(const std::string& path, int* sourceChannels) {
     try {
+        requireExrHeadersFit(path);
         Imf::InputFile file(path.c_str());
         const Imf::Header& header = file.header();
         requireExrFits(path, {&header}, {""});
@@ -136,11 +140,22 @@ static Image readExr(const std::string& path, int* sourceChannels) {
                 throw InputError(path + ": channel '" + n + "' is subsampled (" + std::to_string(ch.xSampling) + "x" +
                                  std::to_string(ch.ySampling) + "), which atrous cannot read");
         }
-        if (exrNeedsProof(uint64_t(w) * uint64_t(h) * 12, fileSize(path))) proveExrRows(file, read, dw.min.y, dw.max.y);
-        Image img(int(w), int(h), 3);
+        Image img;
         std::vector<float*> planes;
-        for (size_t c = 0; c < read.size(); ++c) planes.push_back(img.view().channel(int(c)));
-        readExrPlanes(file, read, planes, win);
+        ExrCoreFile core(path);
+        if (core.decodes(0)) {
+            // OpenEXR Core, chunks located and checked first, then decoded in parallel (exr_core.h).
+            core.locate(0, win, "the image");
+            img = Image::uninitialized(int(w), int(h), 3);
+            std::vector<ExrPlaneRequest> req;
+            for (size_t c = 0; c < read.size(); ++c) req.push_back({read[c], img.view().channel(int(c))});
+            core.decode(0, req, win, "the image");
+        } else {
+            if (exrNeedsProof(uint64_t(w) * uint64_t(h) * 12, fileSize(path))) proveExrRows(file, read, dw.min.y, dw.max.y);
+            img = Image::uninitialized(int(w), int(h), 3);
+            for (size_t c = 0; c < read.size(); ++c) planes.push_back(img.view().channel(int(c)));
+            readExrPlanes(file, read, planes, win);
+        }
         if (grey) {
             std::copy(img.data(), img.data() + img.plane(), img.data() + img.plane());
             std::copy(img.data(), img.data() + img.plane(), img.data() + 2 * img.plane());
@@ -161,23 +176,10 @@ void writeExr(const std::string& path, const Image& img) {
     if (img.channels() != 1 && img.channels() != 3)
         throw InputError(path + ": can only write 1- or 3-channel images, got " + std::to_string(img.channels()));
     writeFileAtomically(path, [&](const std::string& tmp) {
-        try {
-            Imf::Header header(img.width(), img.height());
-            header.compression() = Imf::ZIP_COMPRESSION;
-            const char* names[3] = {"R", "G", "B"};
-            for (auto n : names) header.channels().insert(n, Imf::Channel(Imf::FLOAT));
-            Imf::OutputFile file(tmp.c_str(), header);
-            Imf::FrameBuffer fb;
-            const size_t xs = sizeof(float), ys = sizeof(float) * size_t(img.width());
-            for (int c = 0; c < 3; ++c) {
-                const float* plane = img.view().channel(img.channels() == 3 ? c : 0);
-                fb.insert(names[c], Imf::Slice(Imf::FLOAT, (char*)plane, xs, ys));
-            }
-            file.setFrameBuffer(fb);
-            file.writePixels(img.height());
-        } catch (const std::exception& e) {
-            throw RuntimeError(path + ": cannot write EXR (" + e.what() + ")");
-        }
+        // 32-bit float R,G,B, ZIP: chunks packed and deflated in parallel (exr_core.h).
+        std::vector<const float*> planes;
+        for (int c = 0; c < 3; ++c) planes.push_back(img.view().channel(img.channels() == 3 ? c : 0));
+        writeExrCore(tmp, img.width(), img.height(), {"R", "G", "B"}, planes);
     });
 }
 
@@ -211,21 +213,26 @@ static Image readPfm(const std::string& path, int* sourceChannels) {
                          " bytes of pixels, found " + std::to_string(in.gcount()) + ")");
     const bool fileLittle = scale < 0;
     const uint16_t probe = 1;
-    const bool hostLittle = *reinterpret_cast<const uint8_t*>(&probe) == 1;
-    if (fileLittle != hostLittle) {
-        for (float& f : raw) {
-            uint32_t u;
-            std::memcpy(&u, &f, 4);
-            u = __builtin_bswap32(u);
-            std::memcpy(&f, &u, 4);
-        }
-    }
-    Image img(int(w), int(h), 3);
-    for (long y = 0; y < h; ++y) {
-        const long srcRow = h - 1 - y;  // PFM rows run bottom to top
+    const bool swap = fileLittle != (*reinterpret_cast<const uint8_t*>(&probe) == 1);
+    // Rows in parallel, each written once (no zero fill): de-interleaved, flipped (PFM rows run
+    // bottom to top), byte-swapped when the file's order is not the host's.
+    Image img = Image::uninitialized(int(w), int(h), 3);
+    const ImageView v = img.view();
+    tbb::parallel_for(0L, h, [&](long y) {
+        const float* src = raw.data() + size_t(h - 1 - y) * size_t(w) * size_t(nc);
+        float* dst[3] = {&v(0, int(y), 0), &v(0, int(y), 1), &v(0, int(y), 2)};
         for (long x = 0; x < w; ++x)
-            for (int c = 0; c < 3; ++c) img(int(x), int(y), c) = raw[(size_t(srcRow) * w + x) * nc + (nc == 3 ? c : 0)];
-    }
+            for (int c = 0; c < 3; ++c) {
+                float f = src[size_t(x) * size_t(nc) + size_t(nc == 3 ? c : 0)];
+                if (swap) {
+                    uint32_t u;
+                    std::memcpy(&u, &f, 4);
+                    u = __builtin_bswap32(u);
+                    std::memcpy(&f, &u, 4);
+                }
+                dst[c][x] = f;
+            }
+    });
     return img;
 }
 
@@ -236,12 +243,18 @@ void writePfm(const std::string& path, const Image& img) {
         if (!out) throw RuntimeError(tmp + ": cannot open for writing");
         const int w = img.width(), h = img.height();
         out << "PF\n" << w << " " << h << "\n-1.0\n";
-        std::vector<float> row(size_t(w) * 3);
-        for (int y = h - 1; y >= 0; --y) {
-            for (int x = 0; x < w; ++x)
-                for (int c = 0; c < 3; ++c) row[size_t(x) * 3 + c] = img(x, y, img.channels() == 3 ? c : 0);
-            out.write(reinterpret_cast<const char*>(row.data()), std::streamsize(row.size() * sizeof(float)));
-        }
+        // Interleaved and flipped in parallel, then written in one call.
+        std::vector<float> px(size_t(w) * size_t(h) * 3);
+        const ImageView v = img.view();
+        const int ch = img.channels();
+        tbb::parallel_for(0, h, [&](int y) {
+            float* row = px.data() + size_t(h - 1 - y) * size_t(w) * 3;
+            for (int c = 0; c < 3; ++c) {
+                const float* src = &v(0, y, ch == 3 ? c : 0);
+                for (int x = 0; x < w; ++x) row[size_t(x) * 3 + size_t(c)] = src[x];
+            }
+        });
+        out.write(reinterpret_cast<const char*>(px.data()), std::streamsize(px.size() * sizeof(float)));
         if (!out) throw RuntimeError(path + ": write failed");
     });
 }
@@ -310,36 +323,88 @@ static void requireHdrComplete(const std::string& path, int w, int h) {
 // 1032:1 holds ~8256): a lying header is refused before stb allocates for it.
 constexpr double kMaxPixelsPerByte = 8448.0;
 
-// A PNG must end with its IEND chunk (with its CRC): stb skips CRCs and decodes a file cut short
-// inside or after its last data chunk without a word (found by tests/fuzz, seed 90210). Data after
-// IEND (some tools append it) is allowed: the chunk is looked for in the last 4 KiB.
-static void requirePngComplete(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    unsigned char magic[8] = {0};
-    in.read(reinterpret_cast<char*>(magic), 8);
+static uint32_t bigEndian32(const unsigned char* p) { return uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | p[3]; }
+
+// A PNG's chunks, checked before stb sees them (stb skips CRCs, reallocates to an IDAT chunk's
+// claimed length before reading it: 2 GB from a 326-byte file, and memcpy's from a null pointer on
+// an empty IDAT; found by tests/fuzz/libfuzzer): every chunk's length fits in the file, its CRC is
+// right, and the file ends with IEND (a file cut short inside or after its last data chunk was
+// decoded without a word: tests/fuzz, seed 90210). Empty IDAT chunks (legal, and nothing to
+// decode) are dropped. Data after IEND (some tools append it) is ignored. Non-PNG bytes pass as
+// they are.
+static void checkPngChunks(const std::string& path, std::vector<unsigned char>& bytes) {
     static const unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-    if (in.gcount() != 8 || std::memcmp(magic, kPng, 8) != 0) return;
-    const uintmax_t bytes = fileSize(path);
-    const uintmax_t tail = std::min<uintmax_t>(bytes, 4096);
-    std::string data(size_t(tail), '\0');
-    in.seekg(std::streamoff(bytes - tail));
-    in.read(&data[0], std::streamsize(tail));
-    static const char kIend[8] = {'I', 'E', 'N', 'D', char(0xAE), char(0x42), char(0x60), char(0x82)};
-    if (data.find(std::string(kIend, 8)) == std::string::npos)
-        throw InputError(path + ": truncated PNG (no complete IEND chunk at its end)");
+    if (bytes.size() < 8 || std::memcmp(bytes.data(), kPng, 8) != 0) return;
+    std::vector<unsigned char> out(bytes.begin(), bytes.begin() + 8);
+    size_t at = 8;
+    for (;;) {
+        if (bytes.size() - at < 12) throw InputError(path + ": truncated PNG (no complete IEND chunk at its end)");
+        const uint32_t len = bigEndian32(&bytes[at]);
+        if (len > bytes.size() - at - 12)
+            throw InputError(path + ": truncated or corrupt PNG (a chunk of " + std::to_string(len) + " bytes at offset " +
+                             std::to_string(at) + " of a " + std::to_string(bytes.size()) + "-byte file)");
+        const unsigned char* type = &bytes[at + 4];
+        if (libdeflate_crc32(0, type, size_t(len) + 4) != bigEndian32(type + 4 + len))
+            throw InputError(path + ": corrupt PNG (chunk '" + std::string(reinterpret_cast<const char*>(type), 4) +
+                             "' at offset " + std::to_string(at) + " fails its CRC)");
+        const bool iend = std::memcmp(type, "IEND", 4) == 0;
+        if (!(len == 0 && std::memcmp(type, "IDAT", 4) == 0)) out.insert(out.end(), &bytes[at], &bytes[at] + len + 12);
+        at += size_t(len) + 12;
+        if (iend) break;
+    }
+    bytes.swap(out);
+}
+
+// A JPEG's Huffman tables, checked before stb builds them (stb_image 2.27 overruns its code table
+// when a DHT's 16 counts sum past 256: found by tests/fuzz/libfuzzer): each table's counts sum to
+// at most 256 and its values fit in the segment. Walks the segments up to the scan.
+static void checkJpegTables(const std::string& path, const std::vector<unsigned char>& b) {
+    if (b.size() < 4 || b[0] != 0xFF || b[1] != 0xD8) return;
+    size_t at = 2;
+    while (at + 4 <= b.size()) {
+        if (b[at] != 0xFF) return;  // not a marker where one should be: stb says so itself
+        const unsigned char marker = b[at + 1];
+        if (marker == 0xD8 || (marker >= 0xD0 && marker <= 0xD7) || marker == 0xFF) {
+            at += marker == 0xFF ? 1 : 2;
+            continue;
+        }
+        if (marker == 0xDA || marker == 0xD9) return;  // the scan (or the end): tables come before it
+        const size_t len = size_t(b[at + 2]) << 8 | b[at + 3];
+        if (len < 2 || at + 2 + len > b.size()) throw InputError(path + ": truncated or corrupt JPEG (a segment runs past the end)");
+        if (marker == 0xC4) {
+            for (size_t p = at + 4; p < at + 2 + len;) {
+                if (p + 17 > at + 2 + len) throw InputError(path + ": corrupt JPEG (a Huffman table is cut short)");
+                size_t count = 0;
+                for (int i = 0; i < 16; ++i) count += b[p + 1 + size_t(i)];
+                if (count > 256 || p + 17 + count > at + 2 + len)
+                    throw InputError(path + ": corrupt JPEG (a Huffman table of " + std::to_string(count) + " codes)");
+                p += 17 + count;
+            }
+        }
+        at += 2 + len;
+    }
 }
 
 static Image readStb(const std::string& path, int* sourceChannels) {
+    // The whole file in memory (its size is what it holds), checked, then decoded from there.
+    std::vector<unsigned char> bytes(static_cast<size_t>(fileSize(path)));
+    {
+        std::ifstream in(path, std::ios::binary);
+        if (!in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(bytes.size())))
+            throw InputError(path + ": cannot read the file");
+    }
+    checkPngChunks(path, bytes);
+    checkJpegTables(path, bytes);
+    const int len = bytes.size() > size_t(INT32_MAX) ? INT32_MAX : int(bytes.size());
     int w = 0, h = 0, n = 0;
-    if (stbi_info(path.c_str(), &w, &h, &n)) {
+    if (stbi_info_from_memory(bytes.data(), len, &w, &h, &n)) {
         if (sourceChannels) *sourceChannels = n <= 2 ? 1 : 3;  // grey (+ alpha) or colour (+ alpha)
         if (w <= 0 || h <= 0 || w > kMaxImageDim || h > kMaxImageDim)
             throw InputError(path + ": unsupported image size " + std::to_string(w) + "x" + std::to_string(h) + " (at most " +
                              std::to_string(kMaxImageDim) + " per side)");
-        const uintmax_t bytes = fileSize(path);
-        if (double(w) * double(h) > double(bytes) * kMaxPixelsPerByte + 65536.0)
+        if (double(w) * double(h) > double(bytes.size()) * kMaxPixelsPerByte + 65536.0)
             throw InputError(path + ": truncated or corrupt image (" + std::to_string(w) + "x" + std::to_string(h) +
-                             " pixels cannot fit in " + std::to_string(bytes) + " bytes)");
+                             " pixels cannot fit in " + std::to_string(bytes.size()) + " bytes)");
         if (extensionOf(path) == ".hdr") {
             requireHdrComplete(path, w, h);
             std::ifstream probe(path, std::ios::binary);
@@ -355,25 +420,29 @@ static Image readStb(const std::string& path, int* sourceChannels) {
             unsigned char first[2] = {0, 0};
             probe.read(reinterpret_cast<char*>(first), 2);
             const bool rle = w >= 8 && w < 32768 && first[0] == 2 && first[1] == 2;
-            if (!rle && bytes < headerBytes + uintmax_t(w) * uintmax_t(h) * 4)
-                throw InputError(path + ": truncated HDR (expected " + std::to_string(uintmax_t(w) * h * 4) +
-                                 " bytes of pixels, found " + std::to_string(bytes > headerBytes ? bytes - headerBytes : 0) + ")");
+            if (!rle && bytes.size() < headerBytes + uint64_t(w) * uint64_t(h) * 4)
+                throw InputError(path + ": truncated HDR (expected " + std::to_string(uint64_t(w) * h * 4) + " bytes of pixels, found " +
+                                 std::to_string(bytes.size() > headerBytes ? bytes.size() - headerBytes : 0) + ")");
         }
     }
-    requirePngComplete(path);
     // stbi_loadf converts 8-bit sRGB to linear (gamma 2.2) and reads Radiance .hdr as is.
-    float* data = stbi_loadf(path.c_str(), &w, &h, &n, 3);
+    float* data = stbi_loadf_from_memory(bytes.data(), len, &w, &h, &n, 3);
     if (!data) throw InputError(path + ": cannot read image (" + stbi_failure_reason() + ")");
     Image img;
     try {
-        img = Image(w, h, 3);
+        img = Image::uninitialized(w, h, 3);
     } catch (...) {
         stbi_image_free(data);
         throw;
     }
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x)
-            for (int c = 0; c < 3; ++c) img(x, y, c) = data[(size_t(y) * w + x) * 3 + c];
+    const ImageView v = img.view();
+    tbb::parallel_for(0, h, [&](int y) {
+        for (int c = 0; c < 3; ++c) {
+            float* dst = &v(0, y, c);
+            const float* src = data + size_t(y) * size_t(w) * 3 + size_t(c);
+            for (int x = 0; x < w; ++x) dst[x] = src[size_t(x) * 3];
+        }
+    });
     stbi_image_free(data);
     return img;
 }

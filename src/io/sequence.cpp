@@ -44,6 +44,7 @@ std::string sizeText(int w, int h) { return std::to_string(w) + "x" + std::to_st
 // The image size from the EXR header alone, after the size rule of exr_limits.h.
 void exrSize(const std::string& path, int& w, int& h) {
     try {
+        requireExrHeadersFit(path);
         Imf::InputFile file(path.c_str());
         requireExrFits(path, {&file.header()}, {""});
         const ExrWindow win = exrImageWindow(path, file.header());
