@@ -52,6 +52,7 @@ import time
 # cases). The names tests/python/test_fuzz.py uses are imported here too.
 from fuzz_cases import CLASSES, FAILURES, KLASSES, KNOWN, Case, build_case, run_case
 from fuzz_files import make_seeds, write_pfm, write_png  # noqa: F401
+import fuzz_proc
 from fuzz_proc import close_spawners
 from fuzz_python import python_cases, run_python_cases
 
@@ -74,6 +75,8 @@ def main():
     ap.add_argument("--show", type=int, default=40, help="failures printed in full")
     ap.add_argument("--json", default=None, help="write the summary here")
     ap.add_argument("--mem-cap", type=float, default=1024, help="MB: a case past this is killed (class memory)")
+    ap.add_argument("--mem-limit", type=float, default=None,
+                    help="MB a case with under 1 MB of input may peak at (default 300; 900 for a sanitizer build)")
     a = ap.parse_args()
     if a.ci:
         a.cases, a.seed = 40 * len(a.classes.split(",")), 14
@@ -82,6 +85,12 @@ def main():
     if a.python_cases is None:
         a.python_cases = a.cases // 6
     cli = os.path.abspath(a.cli)
+    if a.mem_limit is None:  # ASan's shadow memory and quarantine roughly triple a process's resident set
+        sanitized = os.path.isfile(cli) and b"__asan_init" in open(cli, "rb").read()
+        a.mem_limit = 900 if sanitized else 300
+        if sanitized:
+            print("fuzz: %s is a sanitizer build: memory limit %d MB" % (cli, a.mem_limit))
+    fuzz_proc.MEMORY_LIMIT_MB = a.mem_limit
     here = os.path.dirname(os.path.abspath(__file__))
     py = a.python or os.path.join(here, "..", "..", ".venv", "bin", "python")
     work = tempfile.mkdtemp(prefix="atrous_fuzz_")
@@ -104,7 +113,7 @@ def main():
             cases.append(build_case(i, crng, seeds, work, cli, k, i // len(klasses), a.seed))
         counts = {c: 0 for c in CLASSES}
         per_class = {}
-        peaks = {}
+        peaks, peaks_ok = {}, {}  # per class: the largest peak, and the largest of cases not in a failure class
         failures = []
         with cf.ThreadPoolExecutor(max_workers=a.jobs) as ex:
             futs = {ex.submit(run_case, c, a.timeout, env, a.mem_cap, logs): c for c in cases}
@@ -116,6 +125,8 @@ def main():
                 per_class[c.klass][cls] += 1
                 if peak > peaks.get(c.klass, (0, None))[0]:
                     peaks[c.klass] = (peak, c.id)
+                if cls not in FAILURES and peak > peaks_ok.get(c.klass, (0, None))[0]:
+                    peaks_ok[c.klass] = (peak, c.id)
                 if cls in FAILURES:
                     failures.append((c, cls, why))
         pcounts = {}
@@ -132,6 +143,8 @@ def main():
                     key = "python:" + c["kind"]
                     if peak > peaks.get(key, (0, None))[0]:
                         peaks[key] = (peak, "py%d" % c["id"])
+                    if s not in FAILURES and peak > peaks_ok.get(key, (0, None))[0]:
+                        peaks_ok[key] = (peak, "py%d" % c["id"])
                     if s in FAILURES:
                         failures.append((Case("py%d" % c["id"], "python", [c["kind"], repr(c["args"])[:300]], [], [],
                                               note=c.get("note", "")), s, why))
@@ -148,6 +161,9 @@ def main():
         if pcounts:
             print("  %-13s %s" % ("python", ", ".join("%s %d" % (c, n) for c, n in sorted(pcounts.items()))))
         print("  peak memory (MB, case): " + ", ".join("%s %.0f (%s)" % (k, v[0], v[1]) for k, v in sorted(peaks.items())))
+        if peaks_ok != peaks:
+            print("  of cases not failing:   " + ", ".join("%s %.0f (%s)" % (k, v[0], v[1]) for k, v in
+                                                          sorted(peaks_ok.items()) if peaks.get(k) != v))
         if counts.get("known"):
             print("  known (open, not failures): " + "; ".join(k[2] for k in KNOWN))
         failures.sort(key=lambda t: (t[1], t[0].klass, str(t[0].id)))
@@ -159,6 +175,7 @@ def main():
         if a.json:
             json.dump({"seed": a.seed, "cases": total, "counts": counts, "per_class": per_class, "python": pcounts,
                        "seconds": round(elapsed, 1), "peak_mb": {k: [round(v[0], 1), v[1]] for k, v in peaks.items()},
+                       "peak_mb_not_failing": {k: [round(v[0], 1), v[1]] for k, v in peaks_ok.items()},
                        "failures": [{"id": c.id, "class": cls, "klass": c.klass, "note": c.note, "why": why,
                                      "argv": c.argv} for c, cls, why in failures]},
                       open(a.json, "w"), indent=1)

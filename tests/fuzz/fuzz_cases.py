@@ -8,7 +8,8 @@ import struct
 import zlib
 
 from fuzz_files import outputs_finite, write_exr, write_pfm
-from fuzz_proc import MEMORY_LIMIT_MB, SMALL_INPUT_BYTES, entries, input_roots, modified, run_watched, snapshot
+import fuzz_proc
+from fuzz_proc import SMALL_INPUT_BYTES, entries, input_roots, modified, run_watched, snapshot
 from fuzz_mutate import (DENOISE_FLAGS, FLOAT_SPECIALS, NUM_VALUES, RENDER_FLAGS, SVGF_FLAGS, _isint, mutate_bytes,
                          mutate_json, mutate_mtl, mutate_obj, mutate_pfm)
 
@@ -251,7 +252,7 @@ def classify(case, r, before, new_entries, input_bytes):
         return "crash", (stderr.strip().splitlines() or ["signal %d" % -rc])[-1][:300]
     if changed:
         return "input-modified", changed + " (exit %d)" % rc
-    if r["peak_mb"] > MEMORY_LIMIT_MB and input_bytes < SMALL_INPUT_BYTES:
+    if r["peak_mb"] > fuzz_proc.MEMORY_LIMIT_MB and input_bytes < SMALL_INPUT_BYTES:
         return "memory", "peak %.0f MB with %d bytes of input" % (r["peak_mb"], input_bytes)
     if rc not in (0, 2):
         return "wrong-code", "exit %d: %s" % (rc, stderr.strip()[:300])
