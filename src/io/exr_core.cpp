@@ -3,6 +3,9 @@
 #include <libdeflate.h>
 #include <openexr.h>
 #include <tbb/parallel_for.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include <algorithm>
 #include <atomic>
@@ -52,6 +55,51 @@ struct Inflater {
 };
 thread_local Inflater tInflater;
 
+// t[i] = t[i - 1] + t[i] - 128 for i >= 1 (a running byte sum). SSE2: 16 bytes at a time, the sum
+// inside a vector in four shifted adds, carried from the last byte of the one before.
+void undoPredictor(uint8_t* t, uint64_t n) {
+    if (n == 0) return;
+    uint64_t i = 0;
+#if defined(__SSE2__)
+    t[0] = uint8_t(t[0] + 128);  // the first byte has no offset: pre-add what the loop takes away
+    const __m128i bias = _mm_set1_epi8(char(-128));
+    uint8_t prev = 0;
+    for (; i + 16 <= n; i += 16) {
+        __m128i d = _mm_add_epi8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(t + i)), bias);
+        d = _mm_add_epi8(d, _mm_slli_si128(d, 1));
+        d = _mm_add_epi8(d, _mm_slli_si128(d, 2));
+        d = _mm_add_epi8(d, _mm_slli_si128(d, 4));
+        d = _mm_add_epi8(d, _mm_slli_si128(d, 8));
+        d = _mm_add_epi8(d, _mm_set1_epi8(char(prev)));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(t + i), d);
+        prev = uint8_t(_mm_extract_epi16(d, 7) >> 8);
+    }
+    if (i == 0) t[0] = uint8_t(t[0] - 128);
+#endif
+    for (i = std::max<uint64_t>(i, 1); i < n; ++i) t[i] = uint8_t(int(t[i - 1]) + int(t[i]) - 128);
+}
+
+// out = the even half and the odd half of t, byte by byte: out[2k] = t[k], out[2k+1] = t[(n+1)/2 + k].
+void interleave(uint8_t* out, const uint8_t* t, uint64_t n) {
+    const uint8_t* even = t;
+    const uint8_t* odd = t + (n + 1) / 2;
+    const uint64_t pairs = n / 2;
+    uint64_t k = 0;
+#if defined(__SSE2__)
+    for (; k + 16 <= pairs; k += 16) {
+        const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i*>(even + k));
+        const __m128i b = _mm_loadu_si128(reinterpret_cast<const __m128i*>(odd + k));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(out + 2 * k), _mm_unpacklo_epi8(a, b));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(out + 2 * k + 16), _mm_unpackhi_epi8(a, b));
+    }
+#endif
+    for (; k < pairs; ++k) {
+        out[2 * k] = even[k];
+        out[2 * k + 1] = odd[k];
+    }
+    if (n & 1) out[n - 1] = even[pairs];
+}
+
 exr_result_t undoZip(exr_decode_pipeline_t* decode) {
     const uint64_t packed = decode->chunk.packed_size, unpacked = decode->chunk.unpacked_size;
     if (packed == 0) return EXR_ERR_SUCCESS;
@@ -69,17 +117,8 @@ exr_result_t undoZip(exr_decode_pipeline_t* decode) {
         tLastError = "a ZIP chunk does not inflate to its " + std::to_string(unpacked) + " bytes";
         return EXR_ERR_CORRUPT_CHUNK;
     }
-    uint8_t* t = inf.scratch.data();
-    for (uint64_t i = 1; i < unpacked; ++i) t[i] = uint8_t(int(t[i - 1]) + int(t[i]) - 128);
-    uint8_t* out = static_cast<uint8_t*>(decode->unpacked_buffer);
-    const uint8_t* even = t;
-    const uint8_t* odd = t + (unpacked + 1) / 2;
-    const uint64_t pairs = unpacked / 2;
-    for (uint64_t i = 0; i < pairs; ++i) {
-        out[2 * i] = even[i];
-        out[2 * i + 1] = odd[i];
-    }
-    if (unpacked & 1) out[unpacked - 1] = even[pairs];
+    undoPredictor(inf.scratch.data(), unpacked);
+    interleave(static_cast<uint8_t*>(decode->unpacked_buffer), inf.scratch.data(), unpacked);
     return EXR_ERR_SUCCESS;
 }
 
@@ -105,16 +144,17 @@ std::vector<uint8_t> zipChunk(const std::vector<uint8_t>& packed, int level) {
     }
     if (!d.c) throw std::bad_alloc();
     const size_t n = packed.size();
-    d.scratch.resize(n);
-    uint8_t* t = d.scratch.data();
-    uint8_t* even = t;
-    uint8_t* odd = t + (n + 1) / 2;
-    for (size_t i = 0; i + 1 < n; i += 2) {
-        *even++ = packed[i];
-        *odd++ = packed[i + 1];
+    d.scratch.resize(2 * n);
+    uint8_t* split = d.scratch.data();  // the even bytes, then the odd ones
+    uint8_t* t = split + n;             // each byte's difference from the one before, + 128
+    const size_t half = (n + 1) / 2;
+    for (size_t k = 0; k < n / 2; ++k) {
+        split[k] = packed[2 * k];
+        split[half + k] = packed[2 * k + 1];
     }
-    if (n & 1) *even = packed[n - 1];
-    for (size_t i = n; i-- > 1;) t[i] = uint8_t(int(t[i]) - int(t[i - 1]) + (128 + 256));
+    if (n & 1) split[n / 2] = packed[n - 1];
+    if (n) t[0] = split[0];
+    for (size_t i = 1; i < n; ++i) t[i] = uint8_t(int(split[i]) - int(split[i - 1]) + 128);
     std::vector<uint8_t> out(libdeflate_zlib_compress_bound(d.c, n));
     const size_t got = libdeflate_zlib_compress(d.c, t, n, out.data(), out.size());
     if (got == 0 || got >= n) return packed;
