@@ -97,7 +97,7 @@ def _chlist(channels):
     return b"".join(n.encode() + b"\0" + struct.pack("<iB3xii", TYPES[t], 0, 1, 1) for n, t in channels) + b"\0"
 
 
-def _header(part, multipart, chunks, nparts):
+def _header(part, multipart, chunks, nparts, deep_file=False):
     x0, y0, x1, y1 = part["dw"]
     w0, h0 = part.get("display", (x1 + 1, y1 + 1))
     kind = part.get("kind", "scanline")
@@ -119,8 +119,9 @@ def _header(part, multipart, chunks, nparts):
         h += _attr("chunkCount", "int", struct.pack("<i", chunks))
     for name, typ, data in part.get("attrs", ()):  # more attributes: (name, type, bytes)
         h += _attr(name, typ, data)
-    if kind == "deep":
+    if deep_file:  # OpenEXR Core wants it in every part of a file flagged as holding deep data
         h += _attr("version", "int", struct.pack("<i", 1))
+    if kind == "deep":
         h += _attr("maxSamplesPerPixel", "int", struct.pack("<i", 1))
     return h + b"\0"
 
@@ -180,7 +181,8 @@ def exr_bytes(parts, multipart=None, chunk_override=None):
         else:
             ch = _chunks(p, multipart, i)
             bodies.append((len(ch), ch))
-    heads = b"".join(_header(p, multipart, bodies[i][0], len(parts)) for i, p in enumerate(parts))
+    deep = any(p.get("kind") == "deep" for p in parts)
+    heads = b"".join(_header(p, multipart, bodies[i][0], len(parts), deep) for i, p in enumerate(parts))
     if multipart:
         heads += b"\0"
     names = [n for p in parts for n, _ in p["channels"]] + [p.get("name") or "" for p in parts]
