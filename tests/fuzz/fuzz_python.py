@@ -152,11 +152,14 @@ def _image_files(d, seeds):
     rng = random.Random(7)
     bufs = seed_buffers(seeds)
     out = {}
-    for style in ("blender5", "blender4", "mitsuba"):
-        parts, multi = layered_file(rng, bufs, style)
-        p = os.path.join(d, "layered_%s.exr" % style)
+    for style, typ in (("blender5", "float"), ("blender5", "half"), ("blender4", "float"), ("blender4", "half"),
+                       ("mitsuba", "half")):
+        parts, multi = layered_file(rng, bufs, style, typ=typ)
+        p = os.path.join(d, "layered_%s_%s.exr" % (style, typ))
         data = E.write(p, parts, multi)
-        out["layered-" + style] = (p, None)
+        out["layered-%s-%s" % (style, typ)] = (p, None)
+        if typ == "float" and style != "mitsuba":
+            continue
         t = os.path.join(d, "cut_%s.exr" % style)
         cut = len(data) * 2 // 3
         open(t, "wb").write(data[:cut])
