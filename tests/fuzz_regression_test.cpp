@@ -73,7 +73,21 @@ TEST(FuzzRegression, ObjAndMtlExponentsBeyondIntAreErrors) {
         const std::string msg = meshError(dir, c.obj, c.mtl);
         EXPECT_NE(msg.find(c.needle), std::string::npos) << c.needle << "\n" << msg;
     }
-    // Ordinary exponents (leading zeros included) and comments still load.
+    // Ordinary exponents (leading zeros included), comments and skin weights still load.
     EXPECT_EQ(meshError(dir, "# 1e-2147483648 in a comment\nv 0 0 1e-5\nv 1.5E+0 0 0\nv 1 1e-000000000001 0\nf 1 2 3\n", ""), "");
     EXPECT_EQ(meshError(dir, useMtl + tri, "newmtl a\nKd 5e-1 0.5 0.5\n"), "");
+}
+
+// obj_mtl: tinyobjloader's skin weights ("vw vid joint weight ...", its own extension, ignored by
+// atrous) cast each joint id from a float to int: undefined for 7.7e85 or 3e9 (UBSan: "inf is
+// outside the range of representable values of type 'int'"). A joint id is now a number below
+// 2^31; without the fix both cases below load without an error.
+TEST(FuzzRegression, ObjSkinWeightJointIdsBeyondIntAreErrors) {
+    ScratchDir dir;
+    const std::string tri = "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n";
+    std::string msg = meshError(dir, tri + "vw 1 " + std::string(90, '7') + " 0.5\n", "");
+    EXPECT_NE(msg.find("m.obj: line 5: skin weight joint id \"777"), std::string::npos) << msg;
+    msg = meshError(dir, tri + "vw 1 0 0.5 3e9 0.5\n", "");
+    EXPECT_NE(msg.find("m.obj: line 5: skin weight joint id \"3e9\" is not a number within int's range"), std::string::npos) << msg;
+    EXPECT_EQ(meshError(dir, tri + "vw 1 0 0.25 2 0.75\n", ""), "");
 }

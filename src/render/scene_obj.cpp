@@ -87,6 +87,22 @@ std::vector<std::string> prescanObj(const std::string& path) {
             }
             continue;
         }
+        // vw: skin weights, a tinyobjloader extension atrous ignores ("vw vid joint weight joint
+        // weight ..."); tinyobjloader casts each joint id from a float to int, undefined beyond int's
+        // range (found by the libFuzzer target obj_mtl: "vw 1 777...7"). Each joint id a number below 2^31.
+        if (line.compare(i, 3, "vw ") == 0 || line.compare(i, 3, "vw\t") == 0) {
+            std::istringstream vals(line.substr(i + 3));
+            std::string tok;
+            for (int k = 0; vals >> tok; ++k) {
+                if (k % 2 == 0) continue;  // the vertex id (read with atoi) and the weights
+                char* end = nullptr;
+                const double x = std::strtod(tok.c_str(), &end);
+                if (end == tok.c_str() || *end != '\0' || !(std::fabs(x) < 2147483520.0))  // float's largest below 2^31
+                    throw InputError(path + ": line " + std::to_string(lineNo) + ": skin weight joint id \"" + tok +
+                                     "\" is not a number within int's range");
+            }
+            continue;
+        }
         if (lib) {
             std::istringstream names(line.substr(i + 7));
             std::string n;
