@@ -99,14 +99,14 @@ run_one() {
 report() {
   local t=$1 dir="$OUT/$1" seed rc execs cov ft corp rss res known artifact
   read -r seed rc < "$dir/result"
-  execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$dir/log" | tail -1)
-  rss=$(sed -n 's/^stat::peak_rss_mb: *//p' "$dir/log" | tail -1)
-  local last; last=$(grep -E '^#[0-9]+.*cov: ' "$dir/log" | tail -1 || true)
+  execs=$(grep -a '^stat::number_of_executed_units:' "$dir/log" | tail -1 | tr -cd '0-9')
+  rss=$(grep -a '^stat::peak_rss_mb:' "$dir/log" | tail -1 | tr -cd '0-9')
+  local last; last=$(grep -aE '^#[0-9]+.*cov: ' "$dir/log" | tail -1 || true)
   cov=$(sed -n 's/.* cov: \([0-9]*\).*/\1/p' <<< "$last")
   ft=$(sed -n 's/.* ft: \([0-9]*\).*/\1/p' <<< "$last")
   corp=$(sed -n 's/.* corp: \([0-9]*\/[0-9]*[a-zA-Z]*\).*/\1/p' <<< "$last")
-  known=$(sed -n 's/^==atrous-fuzz== KNOWN \([^ ]*\).*/\1/p' "$dir/log" | sort -u | paste -sd, - || true)
-  artifact=$(sed -n 's/.*Test unit written to \(.*\)$/\1/p' "$dir/log" | tail -1)
+  known=$(grep -a '^==atrous-fuzz== KNOWN ' "$dir/log" | cut -d' ' -f3 | tr -cd '[:alnum:]-\n' | sort -u | paste -sd, - || true)
+  artifact=$(grep -a 'Test unit written to ' "$dir/log" | tail -1 | sed 's/.*Test unit written to //')
   if [ "$rc" = 0 ] && [ -z "$artifact" ]; then
     res="ok"
   else

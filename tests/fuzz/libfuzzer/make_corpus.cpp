@@ -391,10 +391,11 @@ void objSeeds() {
              "newmtl mirror\nillum 3\nKs 0.9 0.9 0.9\nnewmtl glass\nillum 7\nNi 1.45\nd 0.5\n"
              "newmtl metal\nPm 1\nPr 0.3\nKd 0.9 0.6 0.2\nmap_Kd -s 1 1 1 t.pfm\n" +
              sep + pfm("PF", 2, 2, "-1.0", std::vector<float>(12, 0.5f), false));
-    // The finding fixed in scene_obj.cpp (tests/fuzz_regression_test.cpp): exponents beyond int.
+    // The findings fixed in scene_obj.cpp (tests/fuzz_regression_test.cpp): exponents and skin weight joint ids beyond int.
     text("obj_mtl", "finding_exponent_overflow.obj",
          "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nt crease 0/1/0 1e-2147483648\nv 1e-2147483649 0 0\nusemtl a\nf 1 2 3\n" + sep +
              "newmtl a\nKd 1e-21474836480 1 1\nmap_Kd -s 1e-2147483648 1 1 t.png\n");
+    text("obj_mtl", "finding_vw_joint_overflow.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nvw 1 0 0.5 3e9 0.5\nvw 2 " + std::string(40, '7') + " 1\nf 1 2 3\n");
     text("obj_mtl", "polygon_no_mtl.obj", "# a pentagon, triangulated\nv 0 0 0\nv 2 0 0\nv 3 1 0\nv 1 3 0\nv -1 1 0\nvt 0.5 0.5\nf 1/1 2/1 3/1 4/1 5/1\n");
 }
 
