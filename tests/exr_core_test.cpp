@@ -194,3 +194,32 @@ TEST(ExrCore, DamagedFilesAreOneErrorNamingTheFile) {
         EXPECT_NE(std::string(e.what()).find("flipped.exr"), std::string::npos) << e.what();
     }
 }
+
+// A part with channels that are not read (Blender's Combined has an A) in half floats: OpenEXR 3.1
+// Core's 4-channel half-to-float routine wrote through the missing destination (found by
+// tests/fuzz: a segfault on a Blender-5 multipart file of half channels).
+TEST(ExrCore, HalfPartsWithChannelsNotReadDecode) {
+    TempDir dir;
+    Image rgba(19, 11, 4), alb(19, 11, 3);
+    for (int c = 0; c < 4; ++c)
+        for (int y = 0; y < 11; ++y)
+            for (int x = 0; x < 19; ++x) {
+                rgba(x, y, c) = float(half(pixelValue(x, y, c)));
+                if (c < 3) alb(x, y, c) = float(half(0.5f + 0.01f * float(x + y + c)));
+            }
+    for (const bool multipart : {true, false}) {
+        const std::string f = dir / (multipart ? "multi.exr" : "single.exr");
+        io::writeLayeredExr(f, {{"ViewLayer.Combined", &rgba, {"R", "G", "B", "A"}}, {"ViewLayer.Denoising Albedo", &alb}},
+                            multipart, /*halfFloat=*/true);
+        const io::ExrInfo info = io::inspectExr(f);
+        const io::PassMap m = io::mapPasses(info, {}, "");
+        const Image c = io::readPass(info, m[io::Buffer::Color], io::Buffer::Color);
+        const Image a = io::readPass(info, m[io::Buffer::Albedo], io::Buffer::Albedo);
+        for (int y = 0; y < 11; ++y)
+            for (int x = 0; x < 19; ++x)
+                for (int ch = 0; ch < 3; ++ch) {
+                    ASSERT_EQ(c(x, y, ch), rgba(x, y, ch)) << (multipart ? "multipart" : "single part");
+                    ASSERT_EQ(a(x, y, ch), std::min(alb(x, y, ch), 1.0f)) << (multipart ? "multipart" : "single part");
+                }
+    }
+}

@@ -39,12 +39,12 @@ void run(const CompareArgs& a) {
     }
     // PNG is an 8-bit, clamped, display-encoded preview: accepted (LDR images can be compared), but
     // the figures are then not of the HDR radiance the metrics are meant for.
-    auto notePng = [](const std::string& p) {
+    // Notes go to stderr once every image is read: bad input stays one line there.
+    std::vector<std::string> notes;
+    auto notePng = [&](const std::string& p) {
         std::string ext = std::filesystem::path(p).extension().string();
         for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-        if (ext == ".png")
-            std::fprintf(stderr, "note: %s is an 8-bit PNG preview, compared as its [0,1] values, not HDR radiance\n",
-                         p.c_str());
+        if (ext == ".png") notes.push_back("note: " + p + " is an 8-bit PNG preview, compared as its [0,1] values, not HDR radiance");
     };
     notePng(a.ref);
     Image ref = io::readImage(a.ref);
@@ -60,12 +60,12 @@ void run(const CompareArgs& a) {
         }
         const ImageMetrics& m = ms.back();
         if (m.nonFinitePixels > 0)
-            std::fprintf(stderr, "note: %s has %d non-finite (NaN/Inf) pixels, counted as 0\n", p.c_str(),
-                         m.nonFinitePixels);
+            notes.push_back("note: " + p + " has " + std::to_string(m.nonFinitePixels) + " non-finite (NaN/Inf) pixels, counted as 0");
     }
     if (!ms.empty() && ms.front().referenceNonFinitePixels > 0)
-        std::fprintf(stderr, "note: reference %s has %d non-finite (NaN/Inf) pixels, counted as 0\n", a.ref.c_str(),
-                     ms.front().referenceNonFinitePixels);
+        notes.push_back("note: reference " + a.ref + " has " + std::to_string(ms.front().referenceNonFinitePixels) +
+                        " non-finite (NaN/Inf) pixels, counted as 0");
+    for (const std::string& n : notes) std::fprintf(stderr, "%s\n", n.c_str());
     if (!a.errorMaps.empty()) {
         for (size_t i = 0; i < imgs.size(); ++i) {
             const std::string stem = std::filesystem::path(a.images[i]).stem().string();

@@ -69,7 +69,7 @@ void noteIgnoredFlags(const CLI::App& cmd, const std::string& method, bool seque
         if (unused) ignored += (ignored.empty() ? "" : ", ") + opt->get_name();
         if (g == kGroupBuffers && sequence) ignoredSeq += (ignoredSeq.empty() ? "" : ", ") + opt->get_name();
     }
-    if (!ignored.empty()) std::fprintf(stderr, "denoise: note: ignored with --method %s: %s\n", method.c_str(), ignored.c_str());
+    if (!ignored.empty()) std::printf("denoise: note: ignored with --method %s: %s\n", method.c_str(), ignored.c_str());
     // A buffer file given beside --sequence would not be read: refused, not noted (issue 29).
     if (!ignoredSeq.empty())
         throw InputError(ignoredSeq + ": a sequence's frames bring their own buffers (--sequence DIR); drop " +

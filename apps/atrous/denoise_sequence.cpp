@@ -240,19 +240,17 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
         if (firstIndex != f.index)
             check = checkReprojection(f.depth, f.normal, f.ids, f.motion, prev.depth, prev.normal, prev.ids);
         if (svgf && f.motion.empty() && !notedMotion) {
-            std::fprintf(stderr, "denoise: note: the frames have no motion vectors: SVGF assumes nothing moves on screen\n");
+            std::printf("denoise: note: the frames have no motion vectors: SVGF assumes nothing moves on screen\n");
             notedMotion = true;
         }
         if (check.tested >= 64 && !warnedSign && check.keptNegated > check.kept + 0.2 && check.keptNegated > 0.5) {
-            std::fprintf(stderr,
-                         "denoise: warning: %s: the motion vectors look like the opposite sign convention (%.0f%% of the "
+            std::printf("denoise: warning: %s: the motion vectors look like the opposite sign convention (%.0f%% of the "
                          "frame reprojects as given, %.0f%% negated); atrous wants previous - current, in pixels, y down\n",
                          name.c_str(), 100 * check.kept, 100 * check.keptNegated);
             warnedSign = true;
         }
         if (idsTrusted && !f.ids.empty() && check.tested >= 64 && check.kept > 0.2 && check.idsAgree < 0.9) {
-            std::fprintf(stderr,
-                         "denoise: note: %s: the ids change between frames (%.0f%% agree after reprojection): not used "
+            std::printf("denoise: note: %s: the ids change between frames (%.0f%% agree after reprojection): not used "
                          "from here on (Mitsuba renumbers shapes when a scene is loaded)\n",
                          name.c_str(), 100 * check.idsAgree);
             idsTrusted = false;

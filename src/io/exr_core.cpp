@@ -323,6 +323,22 @@ void ExrCoreFile::decode(int part, const std::vector<ExrPlaneRequest>& requests,
             }
         }
         if (matched != requests.size()) return stop(EXR_ERR_NO_ATTR_BY_NAME, "find every channel in");
+        // OpenEXR 3.1 Core picks its 3- and 4-channel half-to-float routines without looking at which
+        // channels have a destination, and writes through the null pointer of one that has none
+        // (a Blender part's A: found by tests/fuzz, a segfault). Those channels get a sink.
+        std::vector<float> sink;
+        if (matched < size_t(dec.channel_count) && dec.channel_count <= 4) {
+            sink.resize(size_t(c.width) * size_t(c.height));
+            for (int k = 0; k < dec.channel_count; ++k) {
+                exr_coding_channel_info_t& ch = dec.channels[k];
+                if (ch.decode_to_ptr) continue;
+                ch.user_data_type = EXR_PIXEL_FLOAT;
+                ch.user_bytes_per_element = 4;
+                ch.user_pixel_stride = 4;
+                ch.user_line_stride = c.width * 4;
+                ch.decode_to_ptr = reinterpret_cast<uint8_t*>(sink.data());
+            }
+        }
         rv = exr_decoding_choose_default_routines(m.ctx, part, &dec);
         if (rv != EXR_ERR_SUCCESS) return stop(rv, "decode");
         if (c.compression == EXR_COMPRESSION_ZIP || c.compression == EXR_COMPRESSION_ZIPS) dec.decompress_fn = undoZip;
