@@ -22,7 +22,8 @@ namespace atrous {
 // (DenoiseReport::methodUsed says which).
 enum class DenoiseMethod { Eaw, Sure, Learned, Auto };
 
-// Per-pixel buffers, each a 3-channel planar Image of the colour's size (see docs/rendering.md, "The buffers").
+// Per-pixel buffers, planar Images of the colour's size (see docs/rendering.md, "The buffers"):
+// 3 channels each (more are ignored), but depth (1: channel 0 is read) and ids (2: R and G).
 // Only `color` is required; a missing feature simply removes its edge stop.
 struct DenoiseInputs {
     const Image* color = nullptr;     // mean radiance, linear HDR
@@ -30,8 +31,8 @@ struct DenoiseInputs {
     const Image* albedo = nullptr;
     const Image* normal = nullptr;    // world-space unit normals (0 for background)
     const Image* position = nullptr;  // world-space hit points
-    const Image* depth = nullptr;     // view depth repeated in R,G,B
-    const Image* ids = nullptr;       // R = mesh id, G = material id, -1 for background
+    const Image* depth = nullptr;     // view depth in channel 0 (1 channel or more)
+    const Image* ids = nullptr;       // R = mesh id, G = material id, -1 for background (2 channels or more)
     // Emitted radiance of the primary hit (mean over the pixel's samples). When given, the filters
     // work on color - emission and add it back, through an edge-avoiding filter of its own
     // (EawParams::emissionLevels) that averages a visible light's partly covered edge pixels
@@ -152,9 +153,10 @@ struct DenoiseReport {
     double meanLuminanceAfterFirefly = 0;  // ... after firefly suppression
     std::string buffersUsed;           // e.g. "color,variance,normal,position"
     double milliseconds = 0;           // filter time (excluding validation)
-    // Per-stage times of the filter, in order: sanitize (NaN/Inf repair, the emission split and,
-    // with an emission buffer, the emission filter), fireflies, demodulate (without a variance buffer
-    // also the per-pixel noise estimate, docs/algorithms.md), sigma scales, then
+    // Per-stage times of the filter, in order: (without a variance buffer) noise sigma (the global
+    // MAD estimate), sanitize (NaN/Inf repair, the emission split and, with an emission buffer, the
+    // emission filter), fireflies, demodulate, (without a variance buffer) noise estimate (the
+    // per-pixel estimate, docs/algorithms.md), sigma scales, then
     // "level i" (and for SURE "sure i": the window sums and the choice of s_i) per level (the
     // learned method: one stage "learned" instead of sigma scales and the levels), then
     // "safety net" (when on) and remodulate. CPU: wall clock; CUDA: cudaEvents on the stream (GPU time, no extra syncs).
@@ -165,6 +167,27 @@ struct DenoiseReport {
 // options.device == Cuda and a colour already on the GPU, when the result stays there. Throws
 // InputError for mismatched sizes, missing colour, negative variance or parameters out of range.
 Image denoise(const DenoiseInputs& inputs, const DenoiseOptions& options);
+
+// The inputs of a denoise() call whose caller hands its colour, variance and emission images over
+// to the filter, as a one-shot caller does that read them from files only to denoise them (the
+// CLI). On the CPU the filter then works in their storage instead of copying them (c_0 and its
+// variance are sanitised in place, the variance's storage becomes a cascade buffer, the emission's
+// the emission filter's) and returns its result in one of them: a call costs about 24 bytes per
+// pixel beyond its inputs for EAW (docs/architecture.md, "Memory"). After the call each of the
+// three is empty or holds intermediate values: the caller must not read them. Images the filter
+// cannot use (on the GPU, not 3 channels) are copied as by the const overload, whose results
+// this one's equal bit for bit. The other buffers are read only, as in DenoiseInputs.
+struct DenoiseBuffers {
+    Image* color = nullptr;           // required
+    Image* variance = nullptr;
+    Image* emission = nullptr;
+    const Image* albedo = nullptr;
+    const Image* normal = nullptr;
+    const Image* position = nullptr;
+    const Image* depth = nullptr;     // 1 channel or more
+    const Image* ids = nullptr;       // 2 channels or more
+};
+Image denoise(DenoiseBuffers& buffers, const DenoiseOptions& options);
 
 // Throws ParamError (atrous/params.h: an InputError naming the field, `sigma_normal`) when a
 // parameter is out of range; the ranges are the rows of denoiseParams().

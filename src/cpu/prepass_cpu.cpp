@@ -12,6 +12,9 @@
 #endif
 
 #include <atomic>
+#include <cmath>
+#include <cstring>
+#include <mutex>
 #include <vector>
 
 #include "core/parallel.h"
@@ -20,12 +23,34 @@
 
 namespace atrous::filters {
 
-void runFireflyClamp(const CpuExec& exec, const FireflyClamp& f) {
+void runFireflyClamp(const CpuExec& exec, const FireflyClamp& f, int* clamped) {
     const int w = f.cIn.width, h = f.cIn.height;
     if (w < 3) {
         exec.forEachPixel(w, h, f);
+        if (clamped) {
+            // The decisions again, for the count (tiny images only).
+            int n = 0;
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x) {
+                    float l[8], lv[8];
+                    int k = 0;
+                    for (int dy = -1; dy <= 1; ++dy)
+                        for (int dx = -1; dx <= 1; ++dx) {
+                            if (dx == 0 && dy == 0) continue;
+                            const int xx = clampIdx(x + dx, w - 1), yy = clampIdx(y + dy, h - 1);
+                            l[k] = lum(f.cIn(xx, yy, 0), f.cIn(xx, yy, 1), f.cIn(xx, yy, 2));
+                            lv[k] = lumVarianceIndependent(f.vIn(xx, yy, 0), f.vIn(xx, yy, 1), f.vIn(xx, yy, 2));
+                            ++k;
+                        }
+                    bool c;
+                    f.scaleOf(x, y, l, lv, c);
+                    n += c;
+                }
+            *clamped = n;
+        }
         return;
     }
+    std::vector<int> rowCount(size_t(h), 0);
     cpu::parallelForIsa(cpu::activeIsa(), 0, h, 8, [&](int r0, int r1) {
         const FireflyClamp g = f;  // a local copy: its views cannot alias the stores
         std::vector<float> rowsL(size_t(3) * w), rowsV(size_t(3) * w);
@@ -63,8 +88,31 @@ void runFireflyClamp(const CpuExec& exec, const FireflyClamp& f) {
                 flag[x] = g.apply(x, y, l, lv);
             }
             g(w - 1, y);
+            if (clamped) {
+                int n = 0;
+                for (int x = 1; x < w - 1; ++x) n += flag[x] > 0.5f;
+                // The border pixels' decisions (the functor wrote them to the flag view, if any).
+                for (int x : {0, w - 1}) {
+                    if (g.flag.valid()) {
+                        n += g.flag(x, y, 0) > 0.5f;
+                        continue;
+                    }
+                    const int xm = clampIdx(x - 1, w - 1), xp = clampIdx(x + 1, w - 1);
+                    const float l[8] = {L0[xm], L0[x], L0[xp], L1[xm], L1[xp], L2[xm], L2[x], L2[xp]};
+                    const float lv[8] = {V0[xm], V0[x], V0[xp], V1[xm], V1[xp], V2[xm], V2[x], V2[xp]};
+                    bool c;
+                    g.scaleOf(x, y, l, lv, c);
+                    n += c;
+                }
+                rowCount[size_t(y)] = n;
+            }
         }
     });
+    if (clamped) {
+        int n = 0;
+        for (int c : rowCount) n += c;
+        *clamped = n;
+    }
 }
 
 }  // namespace atrous::filters
@@ -73,26 +121,61 @@ namespace atrous::filters {
 
 void runSanitizeColor(const CpuExec&, const SanitizeColor& f) {
     const int w = f.colorIn.width, h = f.colorIn.height;
+    // Rows of an in-place plane (out = in) that hold a non-finite value: repaired after the scan,
+    // from the values as given (a repair reads its 5x5 neighbours, which may be repaired too).
+    struct Bad {
+        int k, c, y;
+    };
+    std::vector<Bad> bad;
+    std::mutex badMutex;
     cpu::parallelForIsa(cpu::activeIsa(), 0, h, 8, [&](int r0, int r1) {
         const SanitizeColor g = f;
         for (int y = r0; y < r1; ++y)
             for (int c = 0; c < 3; ++c)
-                for (int k = 0; k < 2; ++k) {
+                for (int k = 0; k < (g.varIn.valid() ? 2 : 1); ++k) {
                     const ImageView& in = k == 0 ? g.colorIn : g.varIn;
                     const ImageView& out = k == 0 ? g.colorOut : g.varOut;
-                    const float* ATROUS_RESTRICT a = in.channel(c) + size_t(y) * w;
-                    float* ATROUS_RESTRICT o = out.channel(c) + size_t(y) * w;
-                    int bad = 0;
-#pragma omp simd reduction(| : bad)
-                    for (int x = 0; x < w; ++x) {
-                        o[x] = a[x];
-                        bad |= finite(a[x]) ? 0 : 1;
+                    const float* a = in.channel(c) + size_t(y) * w;
+                    float* o = out.channel(c) + size_t(y) * w;
+                    int nonFinite = 0;
+                    if (a == o) {
+#pragma omp simd reduction(| : nonFinite)
+                        for (int x = 0; x < w; ++x) nonFinite |= finite(a[x]) ? 0 : 1;
+                        if (nonFinite) {
+                            std::lock_guard<std::mutex> lock(badMutex);
+                            bad.push_back({k, c, y});
+                        }
+                        continue;
                     }
-                    if (!bad) continue;
+                    const float* ATROUS_RESTRICT ar = a;
+                    float* ATROUS_RESTRICT orow = o;
+#pragma omp simd reduction(| : nonFinite)
+                    for (int x = 0; x < w; ++x) {
+                        orow[x] = ar[x];
+                        nonFinite |= finite(ar[x]) ? 0 : 1;
+                    }
+                    if (!nonFinite) continue;
                     // Rare: the functor's repair (mean of the finite 5×5 neighbours).
                     for (int x = 0; x < w; ++x)
                         if (!finite(a[x])) o[x] = SanitizeColor::fix(in, x, y, c);
                 }
+    });
+    if (bad.empty()) return;
+    std::vector<std::pair<float*, float>> repairs;
+    for (const Bad& b : bad) {
+        const ImageView& in = b.k == 0 ? f.colorIn : f.varIn;
+        float* row = in.channel(b.c) + size_t(b.y) * w;
+        for (int x = 0; x < w; ++x)
+            if (!finite(row[x])) repairs.emplace_back(row + x, SanitizeColor::fix(in, x, b.y, b.c));
+    }
+    for (const auto& r : repairs) *r.first = r.second;
+}
+
+void runCopy3(const CpuExec&, const ImageView& in, const ImageView& out) {
+    const int w = in.width, h = in.height;
+    cpu::parallelForIsa(cpu::activeIsa(), 0, h, 32, [&](int r0, int r1) {
+        for (int c = 0; c < 3; ++c)
+            std::memcpy(out.channel(c) + size_t(r0) * w, in.channel(c) + size_t(r0) * w, size_t(r1 - r0) * w * sizeof(float));
     });
 }
 
@@ -187,9 +270,7 @@ void runFootprint(const CpuExec& exec, const Footprint& f) {
             const float* ATROUS_RESTRICT px = g.position.channel(0);
             const float* ATROUS_RESTRICT py = g.position.channel(1);
             const float* ATROUS_RESTRICT pz = g.position.channel(2);
-            const float* ATROUS_RESTRICT z = g.depth.channel(0) + o;
             float* ATROUS_RESTRICT invX = g.invX.channel(0) + o;
-            float* ATROUS_RESTRICT invZ = g.invZ.channel(0) + o;
             g(0, y);
 #pragma omp simd
             for (int x = 1; x < w - 1; ++x) {
@@ -199,7 +280,12 @@ void runFootprint(const CpuExec& exec, const Footprint& f) {
                 const float dD = sq(cx - px[oDown + x]) + sq(cy - py[oDown + x]) + sq(cz - pz[oDown + x]);
                 const float dU = sq(cx - px[oUp + x]) + sq(cy - py[oUp + x]) + sq(cz - pz[oUp + x]);
                 invX[x] = g.invXOf(dR, dL, hasDown ? dD : kFootprintBorder, hasUp ? dU : kFootprintBorder);
-                invZ[x] = 1.0f / maxSel(fabsf(z[x]), 1e-6f);
+            }
+            if (g.invZ.valid()) {
+                const float* ATROUS_RESTRICT z = g.depth.channel(0) + o;
+                float* ATROUS_RESTRICT invZ = g.invZ.channel(0) + o;
+#pragma omp simd
+                for (int x = 1; x < w - 1; ++x) invZ[x] = 1.0f / maxSel(fabsf(z[x]), 1e-6f);
             }
             g(w - 1, y);
         }

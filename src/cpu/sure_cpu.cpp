@@ -15,10 +15,15 @@
 
 #include "core/parallel.h"
 #include "cpu/isa_dispatch.h"
+#include "cpu/row_sums.h"
 #include "filters/safety_net.h"
 #include "filters/sure.h"
 
 namespace atrous::filters {
+
+namespace {
+constexpr int kMaxWindowRadius = 10;  // SureParams / SafetyNetParams windowRadius and kGiveBackRadius
+}
 
 void runSureBoxH(const CpuExec& exec, const SureBoxH& f) {
     const int w = f.in.width, h = f.in.height, r = f.radius;
@@ -28,6 +33,7 @@ void runSureBoxH(const CpuExec& exec, const SureBoxH& f) {
     }
     cpu::parallelForIsa(cpu::activeIsa(), 0, h, 16, [&](int range0, int range1) {
         const SureBoxH g = f;
+        std::vector<const float*> shiftedD(static_cast<size_t>(2 * r + 1)), shiftedV(static_cast<size_t>(2 * r + 1));
         for (int y = range0; y < range1; ++y) {
             const size_t o = size_t(y) * w;
             const float* ATROUS_RESTRICT d = g.in.channel(0) + o;
@@ -35,16 +41,12 @@ void runSureBoxH(const CpuExec& exec, const SureBoxH& f) {
             float* ATROUS_RESTRICT od = g.out.channel(0) + o;
             float* ATROUS_RESTRICT ov = g.out.channel(1) + o;
             for (int x = 0; x < r; ++x) g(x, y);
-            // One tap offset at a time over the row (the same order of additions per pixel as
-            // the functor's loop over dx), so each loop is a plain vectorised x loop.
-            for (int x = r; x < w - r; ++x) od[x] = ov[x] = 0.0f;
-            for (int dx = -r; dx <= r; ++dx) {
-#pragma omp simd
-                for (int x = r; x < w - r; ++x) {
-                    od[x] += d[x + dx];
-                    ov[x] += v[x + dx];
-                }
-            }
+            // The window's taps added in the functor's order (dx = -r..r, from 0), the interior
+            // columns as sums of shifted rows (cpu::sumRows).
+            const int n = w - 2 * r;
+            for (int k = 0; k <= 2 * r; ++k) shiftedD[size_t(k)] = d + k, shiftedV[size_t(k)] = v + k;
+            cpu::sumRows(shiftedD.data(), 2 * r + 1, od + r, size_t(n));
+            cpu::sumRows(shiftedV.data(), 2 * r + 1, ov + r, size_t(n));
             for (int x = w - r; x < w; ++x) g(x, y);
         }
     });
@@ -57,22 +59,20 @@ void chooseRows(const SureChoose& f, int y0, int y1) {
     const int w = f.boxH.width, h = f.boxH.height, r = f.p.radius;
     SureChoiceParams p = f.p;
     p.jamesStein = kJamesStein;  // a constant: no branch left in the x loop
-    std::vector<float> sumDRow(w), sumVRow(w), sScratch(w);
+    std::vector<float> sScratch(w), sumDRow(w), sumVRow(w);
+    std::vector<const float*> rowsD(2 * r + 1), rowsV(2 * r + 1);
     const size_t plane = size_t(w) * h;
     for (int y = y0; y < y1; ++y) {
-        float* ATROUS_RESTRICT sumD = sumDRow.data();
-        float* ATROUS_RESTRICT sumV = sumVRow.data();
-        for (int x = 0; x < w; ++x) sumD[x] = sumV[x] = 0.0f;
+        // The window's rows (clamped), added in order dy = -r..r from 0 in registers.
         for (int dy = -r; dy <= r; ++dy) {
             const int yy = clampIdx(y + dy, h - 1);
-            const float* ATROUS_RESTRICT bd = f.boxH.channel(0) + size_t(yy) * w;
-            const float* ATROUS_RESTRICT bv = f.boxH.channel(1) + size_t(yy) * w;
-#pragma omp simd
-            for (int x = 0; x < w; ++x) {
-                sumD[x] += bd[x];
-                sumV[x] += bv[x];
-            }
+            rowsD[dy + r] = f.boxH.channel(0) + size_t(yy) * w;
+            rowsV[dy + r] = f.boxH.channel(1) + size_t(yy) * w;
         }
+        float* ATROUS_RESTRICT sumD = sumDRow.data();
+        float* ATROUS_RESTRICT sumV = sumVRow.data();
+        cpu::sumRows(rowsD.data(), 2 * r + 1, sumD, size_t(w));
+        cpu::sumRows(rowsV.data(), 2 * r + 1, sumV, size_t(w));
         const size_t o = size_t(y) * w;
         const float* ATROUS_RESTRICT ci = f.cI.data + o;
         const float* ATROUS_RESTRICT cn = f.cNext.data + o;
@@ -113,10 +113,12 @@ void rowWindowSums(const float* ATROUS_RESTRICT in, float* ATROUS_RESTRICT out, 
         out[x] = s;
     };
     for (int x = 0; x < r; ++x) border(x);
-    for (int x = r; x < w - r; ++x) out[x] = 0.0f;
-    for (int dx = -r; dx <= r; ++dx) {
-#pragma omp simd
-        for (int x = r; x < w - r; ++x) out[x] += in[x + dx];
+    if (r <= kMaxWindowRadius) {
+        const float* shifted[2 * kMaxWindowRadius + 1];
+        for (int k = 0; k <= 2 * r; ++k) shifted[k] = in + k;
+        cpu::sumRows(shifted, 2 * r + 1, out + r, size_t(w - 2 * r));  // taps in order from 0 (as BoxSum)
+    } else {
+        for (int x = r; x < w - r; ++x) border(x);
     }
     for (int x = w - r; x < w; ++x) border(x);
 }
@@ -130,17 +132,14 @@ void bandColumnSums(int y0, int y1, int h, int w, int r, int channels, RowFn row
     const int slots = 2 * r + 1;
     const size_t rowSize = size_t(channels) * w;
     std::vector<float> ring(rowSize * slots), sums(rowSize);
+    std::vector<const float*> rows(slots);
     int next = y0 - r < 0 ? 0 : y0 - r;  // the first row not computed yet
     for (int y = y0; y < y1; ++y) {
         const int lo = y - r < 0 ? 0 : y - r, hi = y + r > h - 1 ? h - 1 : y + r;
         for (; next <= hi; ++next) rowFn(next, ring.data() + rowSize * size_t(next % slots));
-        float* ATROUS_RESTRICT out = sums.data();
-        for (size_t i = 0; i < rowSize; ++i) out[i] = 0.0f;
-        for (int j = lo; j <= hi; ++j) {
-            const float* ATROUS_RESTRICT in = ring.data() + rowSize * size_t(j % slots);
-#pragma omp simd
-            for (size_t i = 0; i < rowSize; ++i) out[i] += in[i];
-        }
+        // Rows lo..hi added in order from 0 (cpu::sumRows).
+        for (int j = lo; j <= hi; ++j) rows[j - lo] = ring.data() + rowSize * size_t(j % slots);
+        cpu::sumRows(rows.data(), hi - lo + 1, sums.data(), rowSize);
         use(y, sums.data());
     }
 }
@@ -153,7 +152,7 @@ void bandColumnSums(int y0, int y1, int h, int w, int r, int channels, RowFn row
 // giveBackTerm. The same per-pixel arithmetic and order of additions as the functors
 // (tests/albedo_giveback_test.cpp compares the two), with no image-sized window sums stored.
 void runAlbedoGiveBack(const CpuExec& exec, const ImageView& input, const ImageView& cN, const ImageView& detailSum,
-                       const ImageView& albedo, int radius, float significance) {
+                       const ImageView& albedo, int radius, float significance, const GiveBackScratch* scratch) {
     const int w = input.width, h = input.height, r = radius;
     if (w <= 2 * r) {
         runAlbedoGiveBack<CpuExec>(exec, input, cN, detailSum, albedo, radius, significance);
@@ -161,8 +160,16 @@ void runAlbedoGiveBack(const CpuExec& exec, const ImageView& input, const ImageV
     }
     constexpr int K = kGiveBackMoments;
     constexpr int kBand = 64;  // rows per task: the ring's 2r rows recomputed per band are ~12% more
-    Image coefStore(w, h, 6);
-    const ImageView C = coefStore.view();
+    // The coefficients A (rgb) and b (rgb): the caller's spare planes, or new (every pixel is
+    // written by the fit).
+    Image coefStore;
+    float* coef[6];
+    if (scratch && scratch->count >= 6) {
+        for (int k = 0; k < 6; ++k) coef[k] = scratch->plane[k];
+    } else {
+        coefStore = Image::uninitialized(w, h, 6);
+        for (int k = 0; k < 6; ++k) coef[k] = coefStore.view().channel(k);
+    }
     const bool sure = detailSum.valid();
     cpu::parallelForIsa(cpu::activeIsa(), 0, h, kBand, [&](int y0, int y1) {
         std::vector<float> m(size_t(K) * w);
@@ -192,8 +199,8 @@ void runAlbedoGiveBack(const CpuExec& exec, const ImageView& input, const ImageV
             const size_t o = size_t(y) * w;
             for (int c = 0; c < 3; ++c) {
                 const float* ATROUS_RESTRICT q = s + size_t(5 * c) * w;
-                float* ATROUS_RESTRICT A = C.channel(c) + o;
-                float* ATROUS_RESTRICT b = C.channel(3 + c) + o;
+                float* ATROUS_RESTRICT A = coef[c] + o;
+                float* ATROUS_RESTRICT b = coef[3 + c] + o;
 #pragma omp simd
                 for (int x = 0; x < w; ++x)
                     giveBackSlope(significance, boxTaps(r, x, y, w, h), q[x], q[w + x], q[2 * w + x], q[3 * w + x],
@@ -204,7 +211,7 @@ void runAlbedoGiveBack(const CpuExec& exec, const ImageView& input, const ImageV
     });
     cpu::parallelForIsa(cpu::activeIsa(), 0, h, kBand, [&](int y0, int y1) {
         auto coefRow = [&](int j, float* dst) {
-            for (int k = 0; k < 6; ++k) rowWindowSums(C.channel(k) + size_t(j) * w, dst + size_t(k) * w, w, r);
+            for (int k = 0; k < 6; ++k) rowWindowSums(coef[k] + size_t(j) * w, dst + size_t(k) * w, w, r);
         };
         auto apply = [&](int y, const float* s) {
             const size_t o = size_t(y) * w;

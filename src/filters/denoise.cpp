@@ -3,8 +3,13 @@
 // src/cuda/cuda_denoise.cu, on the GPU.
 #include "atrous/denoise.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -14,6 +19,7 @@
 #include "atrous/params.h"
 #include "core/parallel.h"
 #include "core/timer.h"
+#include "cpu/isa_dispatch.h"
 #include "filters/denoise_driver.h"
 #include "filters/denoise_internal.h"
 #include "filters/noise_estimate.h"
@@ -61,24 +67,16 @@ void estimateNoiseSigma(const Image& color, const Image* albedo, float eps, floa
     globalNoiseSigma(CpuExec{}, color.view(), albedo ? albedo->view() : ImageView{}, eps, floor, sigma);
 }
 
-float medianFinite(const CpuExec&, const ImageView& v, float none) {
-    float* d = v.data;
-    const size_t n = size_t(v.width) * size_t(v.height);
-    float* end = std::partition(d, d + n, [](float a) { return a < INFINITY && a == a; });
-    const size_t m = size_t(end - d);
-    if (!m) return none;
-    std::nth_element(d, d + m / 2, end);
-    return d[m / 2];
-}
-
-static void checkBuffer(const Image* img, const Image& color, const char* name) {
+static void checkBuffer(const Image* img, const Image& color, const char* name, int minChannels = 3) {
     if (!img) return;
     if (img->empty()) throw InputError(std::string(name) + " buffer is empty");
     if (img->width() != color.width() || img->height() != color.height())
         throw InputError(std::string(name) + " buffer is " + std::to_string(img->width()) + "x" +
                          std::to_string(img->height()) + " but the color is " + std::to_string(color.width()) + "x" +
                          std::to_string(color.height()));
-    if (img->channels() < 3) throw InputError(std::string(name) + " buffer needs 3 channels");
+    if (img->channels() < minChannels)
+        throw InputError(std::string(name) + " buffer needs " + std::to_string(minChannels) +
+                         (minChannels == 1 ? " channel" : " channels"));
 }
 
 // The largest finite colour magnitude and variance the filters take (docs/reliability.md): squares
@@ -109,7 +107,125 @@ void requireColorInRange(const Image& color) {
     }
 }
 
-PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, DenoiseReport& rep) {
+namespace {
+
+// One parallel pass over the host colour, variance and emission for what prepareInputs checks and
+// the report counts: per band of rows, then the bands in order (the luminance sums are per row,
+// rows added in order: deterministic, not the old sequential sum's last bits).
+struct InputScan {
+    size_t colorBad = SIZE_MAX;     // first planar index of a finite colour value beyond kMaxInputColor
+    int nonFinite = 0;              // pixels with a non-finite colour channel
+    double lumSum = 0, lumCount = 0;  // finite luminances of the colour
+    bool varianceInformative = false;  // a finite nonzero variance value (varianceIsEmpty's test)
+    size_t varianceBad = SIZE_MAX;  // first planar index of a negative or out-of-range variance
+    double emissionLumSum = 0, emissionLumCount = 0;
+};
+
+InputScan scanInputs(const Image& color, const Image* variance, const Image* emission) {
+    const int w = color.width(), h = color.height();
+    const size_t plane = color.plane();
+    constexpr int kBand = 16;
+    const int bands = (h + kBand - 1) / kBand;
+    std::vector<InputScan> part(static_cast<size_t>(bands));
+    const ImageView c = color.view();
+    const ImageView v = variance ? variance->view() : ImageView{};
+    const ImageView e = emission ? emission->view() : ImageView{};
+    cpu::parallelForIsa(cpu::activeIsa(), 0, bands, 1, [&](int b0, int b1) {
+        for (int b = b0; b < b1; ++b) {
+            InputScan& r = part[size_t(b)];
+            const int y0 = b * kBand, y1 = std::min(h, y0 + kBand);
+            for (int y = y0; y < y1; ++y) {
+                const size_t o = size_t(y) * w;
+                const float* ATROUS_RESTRICT cr = c.channel(0) + o;
+                const float* ATROUS_RESTRICT cg = c.channel(1) + o;
+                const float* ATROUS_RESTRICT cb = c.channel(2) + o;
+                for (int ch = 0; ch < 3; ++ch) {
+                    const float* ATROUS_RESTRICT a = c.channel(ch) + o;
+                    int bad = 0;
+#pragma omp simd reduction(| : bad)
+                    for (int x = 0; x < w; ++x) bad |= (finite(a[x]) & (fabsf(a[x]) > kMaxInputColor)) ? 1 : 0;
+                    if (bad)
+                        for (int x = 0; x < w; ++x)
+                            if (finite(a[x]) && fabsf(a[x]) > kMaxInputColor) {
+                                r.colorBad = std::min(r.colorBad, size_t(ch) * plane + o + size_t(x));
+                                break;
+                            }
+                }
+                int nf = 0;
+                double ls = 0, ln = 0;
+                for (int x = 0; x < w; ++x) {
+                    nf += (finite(cr[x]) & finite(cg[x]) & finite(cb[x])) ? 0 : 1;
+                    const float l = lum(cr[x], cg[x], cb[x]);
+                    if (finite(l)) ls += l, ln += 1;
+                }
+                r.nonFinite += nf;
+                r.lumSum += ls, r.lumCount += ln;
+                if (v.valid())
+                    for (int ch = 0; ch < 3; ++ch) {
+                        const float* ATROUS_RESTRICT a = v.channel(ch) + o;
+                        int info = 0, bad = 0;
+#pragma omp simd reduction(| : info, bad)
+                        for (int x = 0; x < w; ++x) {
+                            info |= (a[x] != 0.0f) & finite(a[x]) ? 1 : 0;
+                            bad |= (a[x] < 0.0f) | (finite(a[x]) & (a[x] > kMaxInputVariance)) ? 1 : 0;
+                        }
+                        r.varianceInformative = r.varianceInformative || info;
+                        if (bad)
+                            for (int x = 0; x < w; ++x)
+                                if (a[x] < 0.0f || (finite(a[x]) && a[x] > kMaxInputVariance)) {
+                                    r.varianceBad = std::min(r.varianceBad, size_t(ch) * plane + o + size_t(x));
+                                    break;
+                                }
+                    }
+                if (e.valid()) {
+                    const float* ATROUS_RESTRICT er = e.channel(0) + o;
+                    const float* ATROUS_RESTRICT eg = e.channel(1) + o;
+                    const float* ATROUS_RESTRICT eb = e.channel(2) + o;
+                    double es = 0, en = 0;
+                    for (int x = 0; x < w; ++x) {
+                        const float l = lum(er[x], eg[x], eb[x]);
+                        if (finite(l)) es += l, en += 1;
+                    }
+                    r.emissionLumSum += es, r.emissionLumCount += en;
+                }
+            }
+        }
+    });
+    InputScan all;
+    for (const InputScan& r : part) {
+        all.colorBad = std::min(all.colorBad, r.colorBad);
+        all.nonFinite += r.nonFinite;
+        all.lumSum += r.lumSum, all.lumCount += r.lumCount;
+        all.varianceInformative = all.varianceInformative || r.varianceInformative;
+        all.varianceBad = std::min(all.varianceBad, r.varianceBad);
+        all.emissionLumSum += r.emissionLumSum, all.emissionLumCount += r.emissionLumCount;
+    }
+    return all;
+}
+
+}  // namespace
+
+// True when a host variance buffer holds no information: every value is 0 (or non-finite, which the
+// filters treat as missing). A renderer at 1 sample per pixel writes exactly that (a one-sample
+// mean has no variance estimate), and taken at face value it tells the filters the image is
+// noise-free, so they would return it unchanged. A converged image still has tiny nonzero values.
+bool varianceIsEmpty(const Image& v) {
+    if (v.device() != Device::Cpu) return false;  // GPU buffers are taken as given
+    std::atomic<bool> informative{false};
+    const size_t n = v.plane() * size_t(std::min(v.channels(), 3));
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
+        if (informative.load(std::memory_order_relaxed)) return;
+        const float* d = v.data();
+        for (size_t i = r.begin(); i < r.end(); ++i)
+            if (d[i] != 0.0f && std::isfinite(d[i])) {
+                informative.store(true, std::memory_order_relaxed);
+                return;
+            }
+    });
+    return !informative.load();
+}
+
+PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, DenoiseReport& rep, bool deferNoiseSigma) {
     if (!in.color || in.color->empty()) throw InputError("no color buffer given");
     const Image& color = *in.color;
     if (color.channels() < 3) throw InputError("color buffer needs 3 channels");
@@ -117,8 +233,8 @@ PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, D
     checkBuffer(in.albedo, color, "albedo");
     checkBuffer(in.normal, color, "normal");
     checkBuffer(in.position, color, "position");
-    checkBuffer(in.depth, color, "depth");
-    checkBuffer(in.ids, color, "ids");
+    checkBuffer(in.depth, color, "depth", 1);  // channel 0 is read
+    checkBuffer(in.ids, color, "ids", 2);      // R mesh, G material
     checkBuffer(in.emission, color, "emission");
     validateDenoiseOptions(o);
     PreparedInputs p;
@@ -128,40 +244,57 @@ PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, D
     const bool colorOnHost = color.device() == Device::Cpu;
     rep.nonFinitePixels = 0;
     if (colorOnHost) {
-        requireColorInRange(color);
-        for (size_t i = 0; i < color.plane(); ++i) {
-            if (!std::isfinite(color.data()[i]) || !std::isfinite(color.data()[i + color.plane()]) ||
-                !std::isfinite(color.data()[i + 2 * color.plane()]))
-                ++rep.nonFinitePixels;
+        const Image* hostVariance = in.variance && in.variance->device() == Device::Cpu ? in.variance : nullptr;
+        const Image* hostEmission = in.emission && in.emission->device() == Device::Cpu ? in.emission : nullptr;
+        const InputScan scan = scanInputs(color, hostVariance, hostEmission);
+        if (scan.colorBad != SIZE_MAX) {
+            const float v = color.data()[scan.colorBad];
+            throw outOfRangeError("color", v, kMaxInputColor, scan.colorBad % color.plane(), color.width());
+        }
+        rep.nonFinitePixels = scan.nonFinite;
+        p.meanLuminanceIn = scan.lumCount > 0 ? scan.lumSum / scan.lumCount : 0.0;
+        p.meanLuminanceEmission = scan.emissionLumCount > 0 ? scan.emissionLumSum / scan.emissionLumCount : 0.0;
+        if (hostVariance && scan.varianceBad != SIZE_MAX) {
+            const Image& vh = *hostVariance;
+            const float v = vh.data()[scan.varianceBad];
+            if (v < 0) throw negativeVarianceError(v, scan.varianceBad % vh.plane(), vh.width());
+            throw outOfRangeError("variance", v, kMaxInputVariance, scan.varianceBad % vh.plane(), vh.width());
+        }
+    } else if (in.variance && in.variance->device() == Device::Cpu) {
+        const Image& vh = *in.variance;
+        for (size_t i = 0; i < 3 * vh.plane(); ++i) {
+            if (vh.data()[i] < 0) throw negativeVarianceError(vh.data()[i], i % vh.plane(), vh.width());
+            if (std::isfinite(vh.data()[i]) && vh.data()[i] > kMaxInputVariance)
+                throw outOfRangeError("variance", vh.data()[i], kMaxInputVariance, i % vh.plane(), vh.width());
         }
     }
     std::string used = "color";
     if (in.variance) {
-        if (in.variance->device() == Device::Cpu) {
-            const Image& vh = *in.variance;
-            for (size_t i = 0; i < 3 * vh.plane(); ++i) {
-                if (vh.data()[i] < 0) throw negativeVarianceError(vh.data()[i], i % vh.plane(), vh.width());
-                if (std::isfinite(vh.data()[i]) && vh.data()[i] > kMaxInputVariance)
-                    throw outOfRangeError("variance", vh.data()[i], kMaxInputVariance, i % vh.plane(), vh.width());
-            }
-        }
         used += ",variance";
         rep.noiseEstimated = false;
     } else {
-        // No variance: Donoho's MAD estimate, constant over the image. A GPU colour is estimated
-        // on the GPU, and denoiseCuda fills the constant variance there (estimatedVariance empty).
+        // No variance: Donoho's MAD estimate, the per-pixel estimate's floor. A GPU colour is
+        // estimated on the GPU, and denoiseCuda fills the constant variance there (estimatedVariance
+        // empty); a host colour on the host (by denoiseCpu when deferred), and the GPU path uploads
+        // the constant it is given.
         rep.noiseEstimated = true;
         if (colorOnHost) {
-            const Image* albedo = o.demodulate && in.albedo && in.albedo->device() == Device::Cpu ? in.albedo : nullptr;
-            estimateNoiseSigma(color, albedo, o.albedoEpsilon, o.albedoFloor, rep.noiseSigma);
-            p.estimatedVariance = Image(color.width(), color.height(), 3, Device::Cpu);
-            for (int c = 0; c < 3; ++c) {
-                const float v = rep.noiseSigma[c] * rep.noiseSigma[c];
-                std::fill(p.estimatedVariance.data() + c * p.estimatedVariance.plane(),
-                          p.estimatedVariance.data() + (c + 1) * p.estimatedVariance.plane(), v);
+            if (!deferNoiseSigma || o.device == Device::Cuda) {
+                const Image* albedo = o.demodulate && in.albedo && in.albedo->device() == Device::Cpu ? in.albedo : nullptr;
+                estimateNoiseSigma(color, albedo, o.albedoEpsilon, o.albedoFloor, rep.noiseSigma);
+                p.sigmaEstimated = true;
+            }
+            if (o.device == Device::Cuda) {
+                p.estimatedVariance = Image::uninitialized(color.width(), color.height(), 3, Device::Cpu);
+                for (int c = 0; c < 3; ++c) {
+                    const float v = rep.noiseSigma[c] * rep.noiseSigma[c];
+                    std::fill(p.estimatedVariance.data() + c * p.estimatedVariance.plane(),
+                              p.estimatedVariance.data() + (c + 1) * p.estimatedVariance.plane(), v);
+                }
             }
         } else {
             estimateNoiseSigmaCuda(color, o.demodulate ? in.albedo : nullptr, o.albedoEpsilon, o.albedoFloor, rep.noiseSigma);
+            p.sigmaEstimated = true;
         }
     }
     const DenoiseBufferUse use = denoiseBufferUse(o, o.method);
@@ -203,22 +336,11 @@ void setNoiseEstimate(DriverConfig& cfg, const DenoiseReport& rep) {
 
 static ImageView viewOf(const Image* img) { return img ? img->view() : ImageView{}; }
 
-static double meanLuminance(const Image& img) {
-    double s = 0;
-    size_t n = 0;
-    for (size_t i = 0; i < img.plane(); ++i) {
-        const float l = lum(img.data()[i], img.data()[i + img.plane()], img.data()[i + 2 * img.plane()]);
-        if (std::isfinite(l)) {
-            s += l;
-            ++n;
-        }
-    }
-    return n ? s / double(n) : 0.0;
-}
-
 static DriverInputs driverInputsOf(const DenoiseInputs& in, const PreparedInputs& prep) {
     DriverInputs di;
     di.color = in.color->view();
+    // Without a variance buffer the CPU driver makes its own from the estimate (GlobalVariance);
+    // the GPU path is given the constant estimate.
     di.variance = in.variance ? in.variance->view() : prep.estimatedVariance.view();
     di.albedo = viewOf(in.albedo);
     di.normal = viewOf(in.normal);
@@ -230,14 +352,14 @@ static DriverInputs driverInputsOf(const DenoiseInputs& in, const PreparedInputs
 }
 
 Image denoiseCpu(const DenoiseInputs& in, const DenoiseOptions& o, const PreparedInputs& prep, DenoiseReport& rep,
-                 DriverDebug* debug) {
-    const int w = in.color->width(), h = in.color->height();
-    const DriverInputs di = driverInputsOf(in, prep);
-    Image out(w, h, 3, Device::Cpu), after(w, h, 3, Device::Cpu), flag(w, h, 1, Device::Cpu);
+                 DriverDebug* debug, const HandedOver* stores) {
+    DriverInputs di = driverInputsOf(in, prep);
+    if (stores) di.colorStore = stores->color, di.varianceStore = stores->variance, di.emissionStore = stores->emission;
+    Image out;
+    DriverReport dr;
     DriverOutputs dout;
-    dout.out = out.view();
-    dout.afterFirefly = after.view();
-    dout.fireflyFlag = flag.view();
+    dout.result = &out;  // remodulated in the driver's own planes
+    dout.report = &dr;
     if (debug && !debug->sureS.empty()) dout.sureS = debug->sureS.view();
     // A steady-clock read per stage (stages take >= 0.1 ms): always on, it costs nothing measurable.
     std::unique_ptr<StageClock> clock = makeStageClock(Device::Cpu);
@@ -246,18 +368,23 @@ Image denoiseCpu(const DenoiseInputs& in, const DenoiseOptions& o, const Prepare
     DriverConfig cfg{o};
     cfg.learned = prep.learned;
     cfg.varianceGiven = in.variance != nullptr;
-    setNoiseEstimate(cfg, rep);
     clock->start();
+    if (!in.variance && !prep.sigmaEstimated) {
+        // The global estimate (Donoho's MAD), timed as a stage of its own.
+        const Image* albedo = o.demodulate && in.albedo ? in.albedo : nullptr;
+        estimateNoiseSigma(*in.color, albedo, o.albedoEpsilon, o.albedoFloor, rep.noiseSigma);
+        markStage(dout.clock, "noise sigma");
+    }
+    setNoiseEstimate(cfg, rep);
     runDenoise(CpuExec{}, di, cfg, dout);
     rep.milliseconds = t.ms();
     clock->collect(rep.stages);
-    rep.meanLuminanceIn = meanLuminance(*in.color);
-    // `after` is c_0 = colour − emission after the pass: add the emission back so that both
+    rep.meanLuminanceIn = prep.meanLuminanceIn;
+    // c_0 after the pass is colour − emission: the emission's mean is added back so that both
     // figures are of the whole image (with the sky as emission, they differed by the sky).
-    rep.meanLuminanceAfterFirefly = meanLuminance(after) + (in.emission ? meanLuminance(*in.emission) : 0.0);
-    int clamped = 0;
-    for (size_t i = 0; i < flag.plane(); ++i) clamped += flag.data()[i] > 0.5f;
-    rep.firefliesClamped = clamped;
+    rep.meanLuminanceAfterFirefly =
+        (dr.lumAfterCount > 0 ? dr.lumAfterSum / dr.lumAfterCount : 0.0) + (in.emission ? prep.meanLuminanceEmission : 0.0);
+    rep.firefliesClamped = dr.firefliesClamped;
     return out;
 }
 
@@ -265,27 +392,17 @@ Image denoiseCpu(const DenoiseInputs& in, const DenoiseOptions& o, const Prepare
 
 namespace {
 
-// True when a host variance buffer holds no information: every value is 0 (or non-finite, which the
-// filters treat as missing). A renderer at 1 sample per pixel writes exactly that (a one-sample
-// mean has no variance estimate), and taken at face value it tells the filters the image is
-// noise-free, so they would return it unchanged. A converged image still has tiny nonzero values.
-bool varianceIsEmpty(const Image& v) {
-    if (v.device() != Device::Cpu) return false;  // GPU buffers are taken as given
-    const float* d = v.data();
-    for (size_t i = 0, n = v.plane() * size_t(std::min(v.channels(), 3)); i < n; ++i)
-        if (d[i] != 0.0f && std::isfinite(d[i])) return false;
-    return true;
-}
-
 // What denoise() and learnedPlanes() do before the driver: an all-zero variance dropped, the
-// inputs validated and the noise estimated (prepareInputs).
-filters::PreparedInputs prepareCall(DenoiseInputs& inputs, const DenoiseOptions& options, DenoiseReport& rep) {
+// inputs validated and the noise estimated (prepareInputs; on the CPU denoise() leaves the global
+// estimate to denoiseCpu, which times it).
+filters::PreparedInputs prepareCall(DenoiseInputs& inputs, const DenoiseOptions& options, DenoiseReport& rep,
+                                    bool deferNoiseSigma = false) {
     rep = DenoiseReport{};
     const bool varianceIgnored = inputs.variance && inputs.color && !inputs.color->empty() &&
                                  inputs.variance->view().sameSize(inputs.color->view()) &&
-                                 varianceIsEmpty(*inputs.variance);
+                                 filters::varianceIsEmpty(*inputs.variance);
     if (varianceIgnored) inputs.variance = nullptr;  // estimate the noise from the image instead
-    filters::PreparedInputs prep = filters::prepareInputs(inputs, options, rep);
+    filters::PreparedInputs prep = filters::prepareInputs(inputs, options, rep, deferNoiseSigma);
     if (varianceIgnored) {
         rep.varianceIgnored = true;
         rep.buffersUsed += ",variance(ignored: all zero, e.g. a 1-spp render; noise estimated)";
@@ -302,9 +419,8 @@ void requireHostInputs(const DenoiseInputs& inputs) {
         }
 }
 
-}  // namespace
-
-Image denoise(const DenoiseInputs& given, const DenoiseOptions& options) {
+// denoise() with, optionally, the caller's images handed over (used on the CPU only).
+Image denoiseWith(const DenoiseInputs& given, const DenoiseOptions& options, const filters::HandedOver* stores) {
     DenoiseReport local;
     DenoiseReport& rep = options.report ? *options.report : local;
     DenoiseInputs inputs = given;
@@ -314,7 +430,7 @@ Image denoise(const DenoiseInputs& given, const DenoiseOptions& options) {
     LearnedWeights weights;
     if (o.method == DenoiseMethod::Learned)
         weights = o.learnedWeights.empty() ? LearnedWeights::builtin() : LearnedWeights::load(o.learnedWeights);
-    filters::PreparedInputs prep = prepareCall(inputs, o, rep);
+    filters::PreparedInputs prep = prepareCall(inputs, o, rep, true);
     prep.learned = weights;
     rep.methodUsed = o.method;
     if (o.device == Device::Cuda) {
@@ -322,7 +438,19 @@ Image denoise(const DenoiseInputs& given, const DenoiseOptions& options) {
         return filters::denoiseCuda(inputs, o, prep, rep);
     }
     requireHostInputs(inputs);
-    return filters::denoiseCpu(inputs, o, prep, rep, nullptr);
+    return filters::denoiseCpu(inputs, o, prep, rep, nullptr, stores);
+}
+
+}  // namespace
+
+Image denoise(const DenoiseInputs& given, const DenoiseOptions& options) { return denoiseWith(given, options, nullptr); }
+
+Image denoise(DenoiseBuffers& buffers, const DenoiseOptions& options) {
+    const DenoiseInputs in{buffers.color, buffers.variance, buffers.albedo, buffers.normal, buffers.position,
+                           buffers.depth, buffers.ids, buffers.emission};
+    filters::HandedOver stores;
+    stores.color = buffers.color, stores.variance = buffers.variance, stores.emission = buffers.emission;
+    return denoiseWith(in, options, &stores);
 }
 
 namespace filters {

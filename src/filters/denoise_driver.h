@@ -3,6 +3,7 @@
 // the executor's device; temporaries are allocated there.
 #pragma once
 #include <cmath>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -27,8 +28,26 @@ constexpr int kMaxLevels = 10;
 constexpr float kIdPenalty = 1e4f;
 
 struct DriverInputs {
-    ImageView color, variance;  // variance always valid (a constant estimate when none was given)
+    // variance: invalid when estimated (no variance buffer): the driver then fills its own from the
+    // global estimate (GlobalVariance, cfg.noiseFloorVar); the GPU path passes a constant estimate.
+    ImageView color, variance;
     ImageView albedo, normal, position, depth, ids, emission;  // invalid when absent
+    // Optional, host only (denoise() on DenoiseBuffers): the caller's Images behind color, variance
+    // and emission, handed over. The driver then works in their storage (c_0 and var(c_0) are
+    // sanitised in place, the emission filter ping-pongs through the emission's image) and may
+    // keep any of them as its result; a handed-over image is left empty or holding intermediate
+    // values. Null, or not the image the view is of: copies, as before.
+    Image* colorStore = nullptr;
+    Image* varianceStore = nullptr;
+    Image* emissionStore = nullptr;
+};
+
+// What the CPU driver measures for the report while it runs (denoiseCpu; the GPU path reduces its
+// afterFirefly and fireflyFlag planes instead).
+struct DriverReport {
+    int firefliesClamped = 0;
+    double lumAfterSum = 0;  // Σ of the finite luminances of c_0 after the firefly pass
+    double lumAfterCount = 0;
 };
 
 // The learned filter's prepared planes (docs/learned.md), copied out after step 3 for training
@@ -55,12 +74,16 @@ struct ModulationOf {
 };
 
 struct DriverOutputs {
-    ImageView out;           // 3 channels, required (not written when `planes` is set)
+    // 3 channels, not written when `planes` is set. Invalid: the result is remodulated in place in
+    // the driver's own planes and moved into *result.
+    ImageView out;
+    Image* result = nullptr;
     ImageView afterFirefly;  // optional: c_0 after sanitising and firefly suppression (3 ch)
     ImageView fireflyFlag;   // optional: 1 where a firefly was clamped (1 ch)
     ImageView sureS;         // optional: s_i per level (levels channels)
     StageClock* clock = nullptr;  // optional: started by the caller, marked after each stage
     const DriverPlanes* planes = nullptr;  // optional: copy the prepared planes out and stop after step 3
+    DriverReport* report = nullptr;        // optional (CPU): the firefly count and the luminance after it
 };
 
 // The caller's options held whole (as SvgfPipeline holds its SvgfParams), plus what the driver
@@ -124,6 +147,29 @@ inline void sureDetailVarianceFactors(int levels, float* alpha) {
     }
 }
 
+// The report's luminance after the firefly pass (DriverReport): nothing on a device executor (its
+// caller reduces the afterFirefly plane); the CpuExec overload (src/cpu/driver_cpu.cpp) sums the
+// finite luminances of `c` per row in double, the rows in order.
+template <class Exec>
+void reportLuminance(const Exec&, const ImageView&, DriverReport&) {}
+void reportLuminance(const CpuExec& exec, const ImageView& c, DriverReport& report);
+
+// The caller's image behind `v` when it was handed over (3 channels, on `dev`, the view's very
+// storage), moved out of *store; else an empty image.
+inline Image takeStore(Image* store, const ImageView& v, Device dev) {
+    if (!store || store->empty() || store->device() != dev || store->channels() != 3 || store->data() != v.data ||
+        store->width() != v.width || store->height() != v.height)
+        return Image();
+    return std::move(*store);
+}
+
+// Memory (docs/architecture.md, "Memory"): every temporary is allocated without a zero fill
+// (each is written whole before it is read), once per call (the cascade's planes live through it:
+// nothing is allocated per level), and dead planes are reused: the variance's buffer becomes EAW's
+// second cascade buffer once the colour scale is taken from it, the emission filter ping-pongs
+// through the emission's own copy, and the albedo give-back's window sums live in the cascade's
+// spare buffer and the σ planes. On the CPU the sanitise and firefly passes work in place, and
+// with DriverInputs' stores (denoise() on DenoiseBuffers) in the caller's images.
 template <class Exec>
 void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cfg, const DriverOutputs& out) {
     const int w = in.color.width, h = in.color.height;
@@ -132,100 +178,128 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     const bool sure = o.method == DenoiseMethod::Sure;
     const bool learned = o.method == DenoiseMethod::Learned;
     const int levels = o.eaw.levels;
+    constexpr bool kHost = std::is_same<Exec, CpuExec>::value;
+    // The CPU row engine compiles the depth and id terms out when they are off: their planes are
+    // then never read (the functor path, CUDA's and the tests' reference, reads them whatever).
+    bool rowEngine = false;
+    if constexpr (kHost) rowEngine = atrousCpuFastPath();
+    auto planes = [&](int channels) { return Image::uninitialized(w, h, channels, dev); };
+    const bool noise = !cfg.varianceGiven && cfg.noiseRadius > 0;
 
-    // 1. Non-finite samples and features.
-    Image c0(w, h, 3, dev), v0(w, h, 3, dev);
-    runSanitizeColor(exec, SanitizeColor{in.color, in.variance, c0.view(), v0.view()});
+    // 1. Non-finite samples and features. c_0 and var(c_0): the caller's images when handed over
+    // (then only scanned, and repaired in place where not finite), else copies.
+    Image c0 = takeStore(in.colorStore, in.color, dev);
+    if (c0.empty()) c0 = planes(3);
+    // (A handed-over variance that denoise() dropped, all zero, still serves as var(c_0)'s storage.)
+    Image v0 = in.varianceStore ? takeStore(in.varianceStore, in.variance.valid() ? in.variance : in.varianceStore->view(), dev)
+                                : Image();
+    if (v0.empty()) v0 = planes(3);
+    runSanitizeColor(exec, SanitizeColor{in.color, in.variance, c0.view(), in.variance.valid() ? v0.view() : ImageView{}});
     // The albedo the demodulation divides by, sanitised once (the noise estimate reads it too).
     ImageView albedo = o.demodulate ? in.albedo : ImageView{};
     Image albedoStore;
     if (albedo.valid()) albedo = sanitizedFeature(exec, albedo, w, h, 3, albedoStore);
-    if (!cfg.varianceGiven && cfg.noiseRadius > 0 && albedo.valid()) {
-        // The global estimate is of the demodulated colour: in the colour's units it scales with
-        // the albedo (noise_estimate.h). Without an albedo the constant given is that already.
+    if (!in.variance.valid() || (noise && albedo.valid())) {
+        // The global estimate in the colour's units, σ_c² a'_c² (noise_estimate.h): without an albedo
+        // the constant σ_c², which the GPU path passes in as the variance.
         GlobalVariance gv;
         for (int c = 0; c < 3; ++c) gv.floorVar[c] = cfg.noiseFloorVar[c];
         gv.eps = o.albedoEpsilon;
         gv.floor = o.albedoFloor;
         gv.albedo = albedo;
         gv.var = v0.view();
-        exec.forEachPixel(w, h, gv);
+        runGlobalVariance(exec, gv);
     }
     // Features: sanitised copies (on the CPU the buffers themselves when already clean), zeros
-    // when absent.
-    Image emissionStore, normalStore, positionStore, depthStore, idsStore, emissionA, emissionB;
+    // when absent (the level reads normal and position whatever).
+    Image emissionStore, emissionA, emissionB;
     ImageView emission;
     if (in.emission.valid()) {
         // Filter the reflected part only: c_0 = color - emission (emission added back at the end).
         emission = sanitizedFeature(exec, in.emission, w, h, 3, emissionStore);
         exec.forEachPixel(w, h, SubtractEmission{emission, c0.view()});
-        // The emission added back is filtered along emitter edges (filters/emission_filter.h).
+        // The emission added back is filtered along emitter edges (filters/emission_filter.h),
+        // between a new buffer and the emission's copy (or the caller's image, handed over): its
+        // input is read by the first level only.
         if (o.eaw.emissionLevels > 0) {
-            emissionA = Image(w, h, 3, dev);
-            emissionB = Image(w, h, 3, dev);
+            emissionA = planes(3);
+            ImageView b;
+            if (!emissionStore.empty()) {
+                b = emissionStore.view();
+            } else {
+                emissionB = takeStore(in.emissionStore, in.emission, dev);
+                if (emissionB.empty()) emissionB = planes(3);
+                b = emissionB.view();
+            }
             emission = runEmissionFilter(exec, o.eaw.emissionLevels, o.eaw.emissionScale, v0.view(), emission,
-                                         emissionA.view(), emissionB.view());
+                                         emissionA.view(), b);
+            if (emission.data != emissionA.data()) emissionA = Image();  // the other buffer holds it
+            else emissionStore = Image(), emissionB = Image();
         }
     }
+    Image normalStore, positionStore, depthStore, idsStore;
     const ImageView normal = sanitizedFeature(exec, in.normal, w, h, 3, normalStore);
     const ImageView position = sanitizedFeature(exec, in.position, w, h, 3, positionStore);
-    const ImageView depth = sanitizedFeature(exec, in.depth, w, h, 1, depthStore);
-    const ImageView ids = sanitizedFeature(exec, in.ids, w, h, 2, idsStore);
+    // Depth: for the learned network, the depth stop, and the noise estimate's edge test.
+    const bool depthStop = !learned && o.eaw.sigmaDepth > 0 && in.depth.valid();
+    const bool needDepth = learned || depthStop || noise || out.planes;
+    ImageView depth;
+    if (needDepth && in.depth.valid()) depth = sanitizedFeature(exec, in.depth, w, h, 1, depthStore);
+    else if (!rowEngine && !learned) depth = sanitizedFeature(exec, ImageView{}, w, h, 1, depthStore);  // zeros
+    const bool idStop = !learned && o.eaw.useIds && in.ids.valid();
+    ImageView ids;
+    if (idStop) ids = sanitizedFeature(exec, in.ids, w, h, 2, idsStore);
+    else if (!rowEngine && !learned) ids = sanitizedFeature(exec, ImageView{}, w, h, 2, idsStore);  // zeros
     markStage(out.clock, "sanitize");
 
-    // 2. Fireflies (before demodulation: the outlier is in radiance).
-    // c0/v0 are dead after this step: without the firefly pass they become cA/vA (no copy), with
-    // it they are reused below as the cascade's second buffers (fewer image-sized temporaries).
-    Image cA, vA;
+    // 2. Fireflies (before demodulation: the outlier is in radiance), into new planes: c_0 and
+    // var(c_0) are free afterwards, and hold y (the give-back's and safety net's input) and the
+    // σ planes.
+    Image cA, vA, spareC, spareV;
     if (o.firefly.enabled) {
-        cA = Image(w, h, 3, dev);
-        vA = Image(w, h, 3, dev);
+        cA = planes(3), vA = planes(3);
+        int* count = out.report ? &out.report->firefliesClamped : nullptr;
         runFireflyClamp(exec, FireflyClamp{o.firefly.k, cfg.varianceGiven ? 1 : 0, c0.view(), v0.view(), cA.view(),
-                                           vA.view(), out.fireflyFlag});
+                                           vA.view(), out.fireflyFlag},
+                        count);
+        spareC = std::move(c0), spareV = std::move(v0);
     } else {
-        cA = std::move(c0);
-        vA = std::move(v0);
+        cA = std::move(c0), vA = std::move(v0);
     }
-    if (out.afterFirefly.valid()) {
-        exec.forEachPixel(w, h, Copy3{cA.view(), out.afterFirefly});
-    }
+    if (out.afterFirefly.valid()) exec.forEachPixel(w, h, Copy3{cA.view(), out.afterFirefly});
+    if (out.report) reportLuminance(exec, cA.view(), *out.report);
     markStage(out.clock, "fireflies");
-    if (!cfg.varianceGiven && cfg.noiseRadius > 0) {
-        // The variance from the colour itself (after the emission is taken out and the fireflies
-        // clamped with the constant estimate, so that they do not raise it): noise_estimate.h.
-        Image demod(w, h, 3, dev), energy(w, h, 3, dev);
-        Demodulate d;
-        d.rule = stillAlbedoRule(o);
-        d.albedo = albedo, d.in = cA.view(), d.out = demod.view();
-        exec.forEachPixel(w, h, d);
-        DetailEnergy de;
-        de.color = demod.view(), de.energy = energy.view(), de.normal = normal, de.depth = depth;  // albedo fit off
-        for (int c = 0; c < 3; ++c) de.maxDiff2[c] = kNoiseEdgeSigmas2 * kNoiseCapMul * cfg.noiseFloorVar[c];
-        exec.forEachPixel(w, h, de);
-        Image rows(w, h, 8, dev);
-        exec.forEachPixel(w, h, QuadrantRows{cfg.noiseRadius, energy.view(), rows.view()});
-        LocalVariance lv;
-        lv.radius = cfg.noiseRadius;
-        lv.capMul = kNoiseCapMul;
-        for (int c = 0; c < 3; ++c) lv.floorVar[c] = cfg.noiseFloorVar[c];
-        lv.eps = o.albedoEpsilon;
-        lv.floor = o.albedoFloor;
-        lv.rows = rows.view();
-        lv.albedo = albedo;
-        lv.var = vA.view();
-        lv.normal = in.normal.valid() ? normal : ImageView{};
-        exec.forEachPixel(w, h, lv);
-    }
 
-    // 3. Albedo demodulation.
+    // 3. Albedo demodulation, then (without a variance buffer) the variance from the colour
+    // itself, after the emission is taken out and the fireflies clamped with the global estimate
+    // so that they do not raise it (noise_estimate.h): of the demodulated colour, and demodulated.
     if (albedo.valid()) {
         Demodulate d;
         d.rule = stillAlbedoRule(o);
         d.albedo = albedo;
         d.in = d.out = cA.view();
-        d.var = vA.view();
-        exec.forEachPixel(w, h, d);
+        if (!noise) d.var = vA.view();
+        runDemodulate(exec, d);
     }
+    if (noise) {
+        markStage(out.clock, "demodulate");
+        LocalNoise ln;
+        ln.radius = cfg.noiseRadius;
+        for (int c = 0; c < 3; ++c) {
+            ln.floorVar[c] = cfg.noiseFloorVar[c];
+            ln.maxDiff2[c] = kNoiseEdgeSigmas2 * kNoiseCapMul * cfg.noiseFloorVar[c];
+        }
+        ln.capMul = kNoiseCapMul;
+        ln.eps = o.albedoEpsilon;
+        ln.floor = o.albedoFloor;
+        ln.color = cA.view();
+        ln.normal = in.normal.valid() ? normal : ImageView{};
+        ln.depth = in.depth.valid() ? depth : ImageView{};
+        ln.albedo = albedo;
+        ln.var = vA.view();
+        runLocalNoise(exec, ln);
+    }
+    const char* const demodStage = noise ? "noise estimate" : "demodulate";
     if (out.planes) {
         const DriverPlanes& P = *out.planes;
         if (P.d.valid()) exec.forEachPixel(w, h, Copy3{cA.view(), P.d});
@@ -235,7 +309,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         if (P.depth.valid() && in.depth.valid()) exec.forEachPixel(w, h, CopyChannels<1>{depth, P.depth});
         if (P.mod.valid()) exec.forEachPixel(w, h, ModulationOf{stillAlbedoRule(o), albedo, P.mod});
         if (P.emission.valid() && emission.valid()) exec.forEachPixel(w, h, Copy3{emission, P.emission});
-        markStage(out.clock, "demodulate");
+        markStage(out.clock, demodStage);
         exec.synchronize();
         return;
     }
@@ -244,55 +318,58 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     const bool giveBack = cfg.albedoGiveBack && !learned && albedo.valid();
     Image safetyIn, safetyVar;
     if (o.safety.enabled || giveBack) {
-        safetyIn = Image(w, h, 3, dev);
-        exec.forEachPixel(w, h, Copy3{cA.view(), safetyIn.view()});
+        safetyIn = spareC.empty() ? planes(3) : std::move(spareC);
+        runCopy3(exec, cA.view(), safetyIn.view());
     }
     if (o.safety.enabled) {
-        safetyVar = Image(w, h, 1, dev);
+        safetyVar = planes(1);
         exec.forEachPixel(w, h, SafetyVariance{vA.view(), safetyVar.view()});
     }
-    markStage(out.clock, "demodulate");
+    markStage(out.clock, demodStage);
 
     // 4-5. The learned method: its cascade (filters/learned.h) on the prepared planes, d_out in
     // `learnedOut`; a feature that was not given is an invalid plane (the network reads it as absent).
     Image* cur = &cA;
-    Image cB, vB, detail, boxH, acc, learnedOut;
+    Image cB, vB, detail, boxH, acc, learnedOut, sigmas, invZ;
     if (learned) {
-        learnedOut = Image(w, h, 3, dev);
+        learnedOut = spareC.empty() ? planes(3) : std::move(spareC);
         const LearnedPlanes P{cA.view(), vA.view(), albedo, in.normal.valid() ? normal : ImageView{},
                               in.depth.valid() ? depth : ImageView{}};
         runLearned(exec, cfg.learned, P, learnedOut.view());
         cur = &learnedOut;
         markStage(out.clock, "learned");
     } else {
-        // 4. Per-pixel scales of the automatic σ_c and σ_x.
-        Image S(w, h, 1, dev), invX(w, h, 1, dev), invZ(w, h, 1, dev);
-        runColorScale(exec, ColorScale{o.eaw.sigmaColor, o.eaw.colorScale * o.eaw.colorScale, vA.view(), S.view()});
+        // 4. Per-pixel scales of the automatic σ_c and σ_x (1/σ_z only for the depth stop). The
+        // colour scale S, 1/σ_x² and each level's 1/σ_c² factors (EawLevel::rS) are the three planes
+        // of `sigmas`, var(c_0)'s buffer when the firefly pass freed it.
+        sigmas = spareV.empty() ? planes(3) : std::move(spareV);
+        const ImageView S{sigmas.view().channel(0), w, h, 1}, invX{sigmas.view().channel(1), w, h, 1},
+            rS{sigmas.view().channel(2), w, h, 1};
+        if (depthStop || !rowEngine) invZ = planes(1);
+        runColorScale(exec, ColorScale{o.eaw.sigmaColor, o.eaw.colorScale * o.eaw.colorScale, vA.view(), S});
         runFootprint(exec, Footprint{in.position.valid() ? 1 : 0, o.eaw.sigmaPosition,
-                                     o.eaw.positionScale * o.eaw.positionScale, position, depth, invX.view(),
-                                     invZ.view()});
+                                     o.eaw.positionScale * o.eaw.positionScale, position, depth, invX,
+                                     invZ.empty() ? ImageView{} : invZ.view()});
         markStage(out.clock, "sigma scales");
 
-        // 5. The cascade. SURE also propagates the variance and keeps Σ s_i d_i in `acc`.
-        cB = c0.empty() ? Image(w, h, 3, dev) : std::move(c0);  // fully overwritten by level 0
+        // 5. The cascade. SURE also propagates the variance and keeps Σ s_i d_i in `acc`. EAW's
+        // second buffer is the variance's, dead once S is taken from it.
         float alpha[kMaxLevels];
         for (int i = 0; i < kMaxLevels; ++i) alpha[i] = 1.0f;
         SureChoiceParams choice;
         if (sure) {
-            vB = v0.empty() ? Image(w, h, 3, dev) : std::move(v0);  // fully overwritten by level 0
-            detail = Image(w, h, 2, dev);
-            boxH = Image(w, h, 2, dev);
-            acc = Image(w, h, 3, dev);
+            cB = planes(3), vB = planes(3);  // fully overwritten by level 0
+            detail = planes(2);
+            boxH = planes(2);
+            acc = Image(w, h, 3, dev);  // zeros: Σ s_i d_i
             if (o.sure.correlatedVariance) sureDetailVarianceFactors(levels, alpha);
             choice.radius = o.sure.windowRadius;
             choice.jamesStein = o.sure.mode == SureMode::JamesStein ? 1 : 0;
             choice.count = int(o.sure.candidates.size());
             for (int k = 0; k < choice.count && k < kMaxSureCandidates; ++k) choice.candidates[k] = o.sure.candidates[k];
+        } else {
+            cB = std::move(vA);
         }
-        // Each level's 1/σ_c² factors (EawLevel::rS). The CPU level takes its plane from the scalable
-        // allocator per level instead, as it did before the shared cascade (docs/benchmarks.md, "One
-        // cascade": holding an image through the cascade was a suspect of a slower sanitise stage).
-        Image rS = dev == Device::Cpu ? Image() : Image(w, h, 1, dev);
         cur = &cA;
         Image* nxt = &cB;
         Image* vcur = &vA;
@@ -304,8 +381,8 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
             lp.colorMul = std::pow(o.eaw.colorLevelFactor, 2.0f * float(i));
             lp.invNormal = o.eaw.normalStepScale ? invSigmaN2 / float(lp.step * lp.step) : invSigmaN2;
             lp.autoPosition = o.eaw.sigmaPosition > 0 ? 0 : 1;
-            lp.invDepth = o.eaw.sigmaDepth > 0 && in.depth.valid() ? 1.0f / (o.eaw.sigmaDepth * o.eaw.sigmaDepth) : 0.0f;
-            lp.idPenalty = o.eaw.useIds && in.ids.valid() ? kIdPenalty : 0.0f;
+            lp.invDepth = depthStop ? 1.0f / (o.eaw.sigmaDepth * o.eaw.sigmaDepth) : 0.0f;
+            lp.idPenalty = idStop ? kIdPenalty : 0.0f;
             lp.propagate = sure ? 1 : 0;
             lp.detailVarScale = alpha[i];
             EawLevel f;
@@ -317,13 +394,13 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
                 f.vOut = vnxt->view();
                 f.detail = detail.view();
             }
-            f.S = S.view();
-            f.rS = rS.empty() ? ImageView{} : rS.view();
+            f.S = S;
+            f.rS = rS;
             f.normal = normal;
             f.position = position;
-            f.invX = invX.view();
+            f.invX = invX;
             f.depth = depth;
-            f.invZ = invZ.view();
+            f.invZ = invZ.empty() ? ImageView{} : invZ.view();
             f.ids = ids;
             runEawLevel(exec, f);
             markStage(out.clock, "level", i);
@@ -358,13 +435,22 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     // residual (safety_net.h).
     ImageView detailSum = sure ? acc.view() : ImageView{};
     if (giveBack) {
-        runAlbedoGiveBack(exec, safetyIn.view(), cur->view(), detailSum, albedo);
+        // Its window sums in planes the cascade is done with: the spare cascade buffer and the σ
+        // planes (6 planes).
+        Image* spare = cur == &cA ? &cB : &cA;
+        GiveBackScratch scratch;
+        int n = 0;
+        for (Image* p : {spare, &sigmas})
+            for (int c = 0; c < 3 && !p->empty(); ++c) scratch.plane[n++] = p->view().channel(c);
+        scratch.count = n;
+        runAlbedoGiveBack(exec, safetyIn.view(), cur->view(), detailSum, albedo, kGiveBackRadius, kGiveBackSignificance,
+                          n == 6 ? &scratch : nullptr);
         detailSum = ImageView{};
     }
     if (o.safety.enabled) {
         if (!sure) {
-            detail = Image(w, h, 2, dev);
-            boxH = Image(w, h, 2, dev);
+            detail = planes(2);
+            boxH = planes(2);
         }
         SureChoiceParams sp;
         sp.radius = o.safety.windowRadius;
@@ -377,7 +463,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         // acts where the residual is out of line with the rest. A given variance is trusted (κ = 1).
         float kappa = 1.0f;
         if (!cfg.varianceGiven) {
-            Image ratio(w, h, 1, dev);
+            Image ratio = planes(1);
             exec.forEachPixel(w, h, SafetyRatio{sp.radius, boxH.view(), ratio.view()});
             kappa = std::fmax(1.0f, medianFinite(exec, ratio.view(), 1.0f));
         }
@@ -386,13 +472,15 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         markStage(out.clock, "safety net");
     }
 
-    // 7. out = (c_N + Σ s_i d_i) · albedo.
+    // 7. out = (c_N + Σ s_i d_i) · albedo + the filtered emission: into out.out, or in place.
     Remodulate r;
     r.rule = stillAlbedoRule(o);
-    r.base = cur->view(), r.detail = detailSum, r.albedo = albedo, r.emission = emission, r.out = out.out;
-    exec.forEachPixel(w, h, r);
+    r.base = cur->view(), r.detail = detailSum, r.albedo = albedo, r.emission = emission;
+    r.out = out.out.valid() ? out.out : cur->view();
+    runRemodulate(exec, r);
     markStage(out.clock, "remodulate");
     exec.synchronize();
+    if (!out.out.valid() && out.result) *out.result = std::move(*cur);
 }
 
 }  // namespace atrous::filters

@@ -10,10 +10,16 @@
 namespace atrous::filters {
 
 struct PreparedInputs {
-    // Constant σ² per channel when no variance buffer was given and the colour is on the host
-    // (for a GPU colour denoiseCuda fills it on the GPU from DenoiseReport::noiseSigma).
+    // Constant σ² per channel when no variance buffer was given, the colour is on the host and the
+    // filter runs on the GPU (for a GPU colour denoiseCuda fills it there from DenoiseReport::noiseSigma;
+    // the CPU driver makes its own from the estimate).
     Image estimatedVariance;
     LearnedWeights learned;  // the learned method's weights (empty for the other methods)
+    // Without a variance buffer: whether DenoiseReport::noiseSigma holds the global estimate yet
+    // (denoise() leaves it to denoiseCpu, which times it as the stage "noise sigma").
+    bool sigmaEstimated = false;
+    // The report's figures of a host colour and emission, from prepareInputs' one scan.
+    double meanLuminanceIn = 0, meanLuminanceEmission = 0;
 };
 
 // Optional extra outputs for tests.
@@ -24,7 +30,9 @@ struct DriverDebug {
 // Validates sizes, channels, negative variance and parameters (InputError), counts non-finite
 // colour pixels and estimates the noise when there is no variance buffer. For inputs on the GPU
 // the non-finite count and the negative-variance check are left to denoiseCuda (no download).
-PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, DenoiseReport& rep);
+// deferNoiseSigma: leave the global noise estimate of a host colour to denoiseCpu.
+PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, DenoiseReport& rep,
+                             bool deferNoiseSigma = false);
 // Every filter's colour rule (docs/reliability.md): a finite value beyond ±1e15 is not a
 // measurement. Throws InputError "color buffer has a value of magnitude ... at pixel (x, y)" for
 // a host image; a CUDA image is not scanned here.
@@ -53,8 +61,16 @@ struct PreparedPlanes {
     Image d, var, albedo, normal, depth, mod, emission;
 };
 PreparedPlanes learnedPlanes(const DenoiseInputs& in, const DenoiseOptions& o);
+// stores (optional): the caller's colour, variance and emission images, handed over (denoise() on
+// DenoiseBuffers, DriverInputs::colorStore): the filter works in them and returns its result in
+// one of them.
+struct HandedOver {
+    Image* color = nullptr;
+    Image* variance = nullptr;
+    Image* emission = nullptr;
+};
 Image denoiseCpu(const DenoiseInputs& in, const DenoiseOptions& o, const PreparedInputs& prep, DenoiseReport& rep,
-                 DriverDebug* debug);
+                 DriverDebug* debug, const HandedOver* stores = nullptr);
 Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const PreparedInputs& prep, DenoiseReport& rep);
 
 }  // namespace atrous::filters

@@ -110,8 +110,10 @@ struct EawStop {
         R.rS = f.rS.channel(0) + o;
         R.nx = f.normal.channel(0) + o, R.ny = f.normal.channel(1) + o, R.nz = f.normal.channel(2) + o;
         R.px = f.position.channel(0) + o, R.py = f.position.channel(1) + o, R.pz = f.position.channel(2) + o;
-        R.ix = f.invX.channel(0) + o, R.z = f.depth.channel(0) + o, R.iz = f.invZ.channel(0) + o;
-        R.m0 = f.ids.channel(0) + o, R.m1 = f.ids.channel(1) + o;
+        R.ix = f.invX.channel(0) + o;
+        // The depth and id planes are not read (may be absent) when their terms are compiled out.
+        R.z = kDepth ? f.depth.channel(0) + o : nullptr, R.iz = kDepth ? f.invZ.channel(0) + o : nullptr;
+        R.m0 = kIds ? f.ids.channel(0) + o : nullptr, R.m1 = kIds ? f.ids.channel(1) + o : nullptr;
         R.vr = R.vg = R.vb = nullptr;
         if (kPropagate) R.vr = f.vIn.channel(0) + o, R.vg = f.vIn.channel(1) + o, R.vb = f.vIn.channel(2) + o;
         return R;

@@ -7,6 +7,10 @@
 #include "atrous/platform.h"
 #include "filters/filter_math.h"
 
+namespace atrous {
+struct CpuExec;
+}
+
 namespace atrous::filters {
 
 // How an albedo pixel becomes the divisors a'_c (pixelModulationAlbedo, filter_math.h).
@@ -89,5 +93,20 @@ struct RemodulateT {
 
 using Remodulate = RemodulateT<false>;       // the still filters
 using RemodulateGuarded = RemodulateT<true>;  // SVGF
+
+// The still filters' pair on `exec`. The CpuExec overloads (src/cpu/modulation_cpu.cpp) run row
+// loops: a' of a whole row at once (cpu::modulationRow, the rim rule's 3x3 scan as row minima),
+// then a vectorised x loop with the same arithmetic (bit-equal, tests/modulation_test.cpp).
+// Demodulate's `out` may be its `in`, Remodulate's `out` its `base` (both work pixel by pixel).
+template <class Exec>
+void runDemodulate(const Exec& exec, const Demodulate& f) {
+    exec.forEachPixel(f.in.width, f.in.height, f);
+}
+template <class Exec>
+void runRemodulate(const Exec& exec, const Remodulate& f) {
+    exec.forEachPixel(f.base.width, f.base.height, f);
+}
+void runDemodulate(const CpuExec& exec, const Demodulate& f);
+void runRemodulate(const CpuExec& exec, const Remodulate& f);
 
 }  // namespace atrous::filters

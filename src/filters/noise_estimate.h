@@ -90,6 +90,9 @@ struct MadDetail {
 // Donoho's global estimate on `exec`, per channel: σ_c = median |d_0,c| / 0.6745 /
 // sqrt(kDetailVarFactor) over the pixels whose 5×5 window is finite (0 when none is), of `color`
 // divided by a' when `albedo` is valid. estimateNoiseSigma (CPU) and estimateNoiseSigmaCuda.
+// The CpuExec overload (src/cpu/noise_cpu.cpp): the demodulation and the 25 double taps in row
+// loops (the same sums in the same order), the median by a radix histogram and a selection within
+// one bin, not a partition of the whole plane: the same σ, several times faster.
 template <class Exec>
 void globalNoiseSigma(const Exec& exec, const ImageView& color, const ImageView& albedo, float eps, float floor,
                       float sigma[3]) {
@@ -109,6 +112,8 @@ void globalNoiseSigma(const Exec& exec, const ImageView& color, const ImageView&
         sigma[c] = float(double(mid) / 0.6745 / std::sqrt(double(kDetailVarFactor)));
     }
 }
+void globalNoiseSigma(const CpuExec& exec, const ImageView& color, const ImageView& albedo, float eps, float floor,
+                      float sigma[3]);
 
 // e_c(p) = d_0,c(p)² / kDetailVarFactor: an unbiased per-pixel estimate of σ_c² on white noise.
 // The B3 taps across a geometric edge (normals further apart than kNoiseNormalDist, or depths
@@ -121,7 +126,7 @@ constexpr float kNoiseDepthRel = 0.05f;
 constexpr float kNoiseFitMinVar = 1e-5f;
 struct DetailEnergy {
     ImageView color, energy;  // color: c_0 demodulated (Demodulate into a copy), energy: out (3 ch)
-    ImageView normal, depth;  // sanitised (zeros when absent)
+    ImageView normal, depth;  // sanitised; invalid when absent (read as 0: no geometric edge)
     // A tap further from p than this (squared, per channel) is across an edge in the colour itself
     // (a visible light in a wall of the same normal and depth), left out as a geometric edge is.
     float maxDiff2[3] = {3.0e38f, 3.0e38f, 3.0e38f};
@@ -143,7 +148,9 @@ struct DetailEnergy {
     ImageView albedo;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         const int w = color.width, h = color.height;
-        const float nx = normal(x, y, 0), ny = normal(x, y, 1), nz = normal(x, y, 2), zp = depth(x, y, 0);
+        const bool hasN = normal.valid(), hasZ = depth.valid();
+        const float nx = hasN ? normal(x, y, 0) : 0.0f, ny = hasN ? normal(x, y, 1) : 0.0f,
+                    nz = hasN ? normal(x, y, 2) : 0.0f, zp = hasZ ? depth(x, y, 0) : 0.0f;
         const float cp[3] = {color(x, y, 0), color(x, y, 1), color(x, y, 2)};
         float s[3] = {0, 0, 0}, ws = 0, w2 = 0;
         float sa[3] = {0, 0, 0}, saa[3] = {0, 0, 0}, sac[3] = {0, 0, 0};
@@ -151,8 +158,9 @@ struct DetailEnergy {
         for (int qy = -2; qy <= 2; ++qy)
             for (int qx = -2; qx <= 2; ++qx) {
                 const int xx = clampIdx(x + qx, w - 1), yy = clampIdx(y + qy, h - 1);
-                const float dn = sq(nx - normal(xx, yy, 0)) + sq(ny - normal(xx, yy, 1)) + sq(nz - normal(xx, yy, 2));
-                const float dz = fabsf(zp - depth(xx, yy, 0));
+                const float dn = hasN ? sq(nx - normal(xx, yy, 0)) + sq(ny - normal(xx, yy, 1)) + sq(nz - normal(xx, yy, 2))
+                                      : 0.0f;
+                const float dz = hasZ ? fabsf(zp - depth(xx, yy, 0)) : 0.0f;
                 const bool near = (sq(color(xx, yy, 0) - cp[0]) <= maxDiff2[0]) & (sq(color(xx, yy, 1) - cp[1]) <= maxDiff2[1]) &
                                   (sq(color(xx, yy, 2) - cp[2]) <= maxDiff2[2]);
                 const bool same = (dn <= kNoiseNormalDist2) & (dz <= kNoiseDepthRel * fabsf(zp)) & near;
@@ -202,6 +210,13 @@ struct GlobalVariance {
     }
 };
 
+// Runs GlobalVariance on `exec`; the CpuExec overload (src/cpu/modulation_cpu.cpp) is a row loop.
+template <class Exec>
+void runGlobalVariance(const Exec& exec, const GlobalVariance& f) {
+    exec.forEachPixel(f.var.width, f.var.height, f);
+}
+void runGlobalVariance(const CpuExec& exec, const GlobalVariance& f);
+
 // Row half-sums of the energy: left(p) = Σ_{i=0..r} e(x - i, y), right(p) = Σ_{i=0..r} e(x + i, y)
 // (inside the image), per channel, and their tap counts: the first pass of the quadrant sums.
 // rows: 8 channels (left rgb, right rgb, left count, right count).
@@ -242,6 +257,9 @@ struct LocalVariance {
     // variance is kNoiseBackgroundFloor times the global estimate. Invalid (no normal buffer): no
     // pixel is background.
     ImageView normal;
+    // Also demodulate the estimate: var_c /= a'_c² (as Demodulate's var *= (1/a')², after it), for
+    // a driver that demodulated the colour first.
+    int divide = 0;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         const int h = rows.height;
         const bool bg = normal.valid() && normal(x, y, 0) == 0.0f && normal(x, y, 1) == 0.0f && normal(x, y, 2) == 0.0f;
@@ -270,9 +288,61 @@ struct LocalVariance {
             const float a = m[c];
             const float local = bg ? 0.0f : q[best][c] / q[best][3];
             const float v = minSel(maxSel(local, fm * floorVar[c]), capMul * floorVar[c]) * a * a;
-            var(x, y, c) = finite(v) ? v : floorVar[c] * a * a;
+            const float out = finite(v) ? v : floorVar[c] * a * a;
+            if (divide) {
+                const float ia = 1.0f / a;
+                var(x, y, c) = out * (ia * ia);
+            } else {
+                var(x, y, c) = out;
+            }
         }
     }
 };
+
+// The local estimate of the driver (step 2, without a variance buffer): `var` ← the per-pixel
+// variance of `color`, the firefly-clamped colour already demodulated (Demodulate, the still
+// rule), in the demodulated colour's units: DetailEnergy, QuadrantRows and LocalVariance (divide
+// on), the colour-edge threshold maxDiff2 = kNoiseEdgeSigmas2 · kNoiseCapMul · floorVar.
+struct LocalNoise {
+    int radius = 5;
+    float floorVar[3] = {0, 0, 0};
+    float maxDiff2[3] = {3.0e38f, 3.0e38f, 3.0e38f};
+    float capMul = kNoiseCapMul;
+    float eps = 1e-3f, floor = 0.0f;
+    ImageView color;           // 3 ch, demodulated
+    ImageView normal, depth;   // sanitised, invalid when not given (normal: also the background test)
+    ImageView albedo;          // sanitised, invalid without demodulation
+    ImageView var;             // out, 3 ch
+};
+
+// On `exec`: the three functors through image-sized temporaries (energy 3 planes, row sums 8). The
+// CpuExec overload (src/cpu/noise_cpu.cpp) runs the energy as a vectorised row loop into one
+// 3-plane temporary, and the row sums and the quadrant choice per band of rows from a ring of row
+// sums (no 8-plane temporary); the same sums in the same order, so the same values.
+template <class Exec>
+void runLocalNoise(const Exec& exec, const LocalNoise& f) {
+    const int w = f.color.width, h = f.color.height;
+    const Device dev = exec.device();
+    Image energy = Image::uninitialized(w, h, 3, dev), rows = Image::uninitialized(w, h, 8, dev);
+    DetailEnergy de;
+    de.color = f.color, de.energy = energy.view(), de.normal = f.normal, de.depth = f.depth;  // albedo fit off
+    for (int c = 0; c < 3; ++c) de.maxDiff2[c] = f.maxDiff2[c];
+    exec.forEachPixel(w, h, de);
+    exec.forEachPixel(w, h, QuadrantRows{f.radius, energy.view(), rows.view()});
+    LocalVariance lv;
+    lv.radius = f.radius;
+    lv.capMul = f.capMul;
+    for (int c = 0; c < 3; ++c) lv.floorVar[c] = f.floorVar[c];
+    lv.eps = f.eps;
+    lv.floor = f.floor;
+    lv.rows = rows.view();
+    lv.albedo = f.albedo;
+    lv.var = f.var;
+    lv.normal = f.normal;
+    lv.divide = 1;
+    exec.forEachPixel(w, h, lv);
+    exec.synchronize();  // before the temporaries die
+}
+void runLocalNoise(const CpuExec& exec, const LocalNoise& f);
 
 }  // namespace atrous::filters

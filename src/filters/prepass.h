@@ -17,12 +17,12 @@ constexpr float kFeatureClamp = 1e18f;
 // NaN/Inf colour or variance samples are missing data: replaced by the mean of the finite values
 // of the same channel in the 5×5 neighbourhood (0 when there are none), so they never spread.
 struct SanitizeColor {
-    ImageView colorIn, varIn;    // user buffers (varIn may be a constant estimate)
-    ImageView colorOut, varOut;  // c_0, var(c_0)
+    ImageView colorIn, varIn;    // user buffers (varIn may be a constant estimate, or invalid: none)
+    ImageView colorOut, varOut;  // c_0, var(c_0) (varOut invalid with varIn)
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         for (int c = 0; c < 3; ++c) {
             colorOut(x, y, c) = fix(colorIn, x, y, c);
-            varOut(x, y, c) = fix(varIn, x, y, c);
+            if (varIn.valid()) varOut(x, y, c) = fix(varIn, x, y, c);
         }
     }
     ATROUS_HOST_DEVICE static float fix(const ImageView& v, int x, int y, int c) {
@@ -45,7 +45,9 @@ struct SanitizeColor {
 };
 
 // Runs SanitizeColor on `exec`; the CpuExec overload (src/cpu/prepass_cpu.cpp) copies whole rows
-// with a vectorised finiteness test and calls fix() only where a value is not finite.
+// with a vectorised finiteness test and calls fix() only where a value is not finite. There an
+// output may be its input (colorOut = colorIn, varOut = varIn): the image is then only scanned, and
+// the few repairs are computed from the unrepaired values before any is written.
 template <class Exec>
 void runSanitizeColor(const Exec& exec, const SanitizeColor& f) {
     exec.forEachPixel(f.colorIn.width, f.colorIn.height, f);
@@ -89,6 +91,13 @@ struct CopyChannels {
     }
 };
 using Copy3 = CopyChannels<3>;
+
+// out = in, 3 channels; the CpuExec overload copies rows with memcpy.
+template <class Exec>
+void runCopy3(const Exec& exec, const ImageView& in, const ImageView& out) {
+    exec.forEachPixel(in.width, in.height, Copy3{in, out});
+}
+void runCopy3(const CpuExec& exec, const ImageView& in, const ImageView& out);
 
 // Firefly suppression: L(p) above m + k·sqrt(s² + v̄) is scaled down to that bound, where m and s²
 // are the mean and variance of the 3×3 neighbours' luminance without the brightest neighbour (so
@@ -144,6 +153,18 @@ struct FireflyClamp {
     // variance in row order (dy = -1: dx = -1, 0, 1; dy = 0: -1, 1; dy = 1: -1, 0, 1). Shared
     // with the CPU row loop (src/cpu/prepass_cpu.cpp). Returns 1 where the pixel was clamped, else 0.
     ATROUS_FORCE_INLINE ATROUS_HOST_DEVICE float apply(int x, int y, const float (&l)[8], const float (&lv)[8]) const {
+        bool clamp;
+        const float scale = scaleOf(x, y, l, lv, clamp);
+        for (int c = 0; c < 3; ++c) {
+            cOut(x, y, c) = cIn(x, y, c) * scale;
+            vOut(x, y, c) = vIn(x, y, c) * scale * scale;
+        }
+        return clamp ? 1.0f : 0.0f;
+    }
+    // The decision alone: the factor the pixel's colour is multiplied by (1 where it is kept) and
+    // whether it was clamped.
+    ATROUS_FORCE_INLINE ATROUS_HOST_DEVICE float scaleOf(int x, int y, const float (&l)[8], const float (&lv)[8],
+                                                          bool& clampOut) const {
         // The brightest neighbour (the first one on ties) and the others' sums, with selects
         // rather than branches so the x loop vectorises; same order of summation as before.
         int imax = 0;
@@ -171,22 +192,22 @@ struct FireflyClamp {
         const bool noisy = (ownVariance == 0) | (ownStd > kFireflyOwnStd * (L - m));
         const bool clamp = (L > bound) & (L > 0.0f) & noisy;
         const float ratio = bound / L;  // unused (maybe inf) where not clamped
-        const float scale = clamp ? ratio : 1.0f;
-        for (int c = 0; c < 3; ++c) {
-            cOut(x, y, c) = cIn(x, y, c) * scale;
-            vOut(x, y, c) = vIn(x, y, c) * scale * scale;
-        }
-        return clamp ? 1.0f : 0.0f;
+        clampOut = clamp;
+        return clamp ? ratio : 1.0f;
     }
 };
 
 // Runs the firefly pass on `exec`; the CpuExec overload (src/cpu/prepass_cpu.cpp) computes the
-// neighbours' luminances once per row and runs a vectorised x loop with the same math.
+// neighbours' luminances once per row and runs a vectorised x loop with the same math (its values
+// agree with the functor's to a few ulps: GCC contracts the bound's multiply-adds differently in
+// the two; the decisions are the same). There `clamped`, when given, receives the number of pixels
+// clamped (the report's count, without a flag plane).
 template <class Exec>
-void runFireflyClamp(const Exec& exec, const FireflyClamp& f) {
+void runFireflyClamp(const Exec& exec, const FireflyClamp& f, int* clamped = nullptr) {
+    (void)clamped;  // the GPU driver counts its flag plane
     exec.forEachPixel(f.cIn.width, f.cIn.height, f);
 }
-void runFireflyClamp(const CpuExec& exec, const FireflyClamp& f);
+void runFireflyClamp(const CpuExec& exec, const FireflyClamp& f, int* clamped = nullptr);
 
 // Per-pixel colour scale S of the automatic σ_c: k_c² · (3×3 [1 2 1]² / 16 prefilter of the
 // channel-summed variance, without its largest neighbour, renormalised) — prefiltered because a
@@ -245,9 +266,9 @@ struct Footprint {
     int hasPosition = 0;
     float rawSigma = 0;  // > 0: constant σ_x
     float k2 = 1;
-    ImageView position, depth, invX, invZ;
+    ImageView position, depth, invX, invZ;  // invZ (and depth) invalid: no depth stop, not written
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        invZ(x, y, 0) = 1.0f / maxSel(fabsf(depth(x, y, 0)), 1e-6f);
+        if (invZ.valid()) invZ(x, y, 0) = 1.0f / maxSel(fabsf(depth(x, y, 0)), 1e-6f);
         if (!hasPosition) {
             invX(x, y, 0) = 0.0f;
             return;

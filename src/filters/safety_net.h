@@ -198,12 +198,21 @@ struct GiveBackApply {
     }
 };
 
+// Six image planes (w x h floats each) a caller has no more use for, which the CPU give-back may
+// take for its coefficients instead of allocating them (the driver's spare cascade buffer and σ
+// planes).
+struct GiveBackScratch {
+    float* plane[6] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
+    int count = 0;
+};
+
 // The passes on `exec`: cN ← F + the albedo-explained residual of y (input) against F. The CpuExec
 // overload (src/cpu/sure_cpu.cpp) fuses them into row loops with the same arithmetic.
 template <class Exec>
 void runAlbedoGiveBack(const Exec& exec, const ImageView& input, const ImageView& cN, const ImageView& detailSum,
                        const ImageView& albedo, int radius = kGiveBackRadius,
-                       float significance = kGiveBackSignificance) {
+                       float significance = kGiveBackSignificance, const GiveBackScratch* scratch = nullptr) {
+    (void)scratch;
     const int w = input.width, h = input.height;
     const Device dev = exec.device();
     Image m(w, h, kGiveBackMoments, dev), t(w, h, kGiveBackMoments, dev);
@@ -220,6 +229,6 @@ void runAlbedoGiveBack(const Exec& exec, const ImageView& input, const ImageView
 }
 void runAlbedoGiveBack(const CpuExec& exec, const ImageView& input, const ImageView& cN, const ImageView& detailSum,
                        const ImageView& albedo, int radius = kGiveBackRadius,
-                       float significance = kGiveBackSignificance);
+                       float significance = kGiveBackSignificance, const GiveBackScratch* scratch = nullptr);
 
 }  // namespace atrous::filters

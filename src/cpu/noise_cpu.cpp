@@ -1,0 +1,378 @@
+// CPU path of the noise estimate without a variance buffer (filters/noise_estimate.h,
+// docs/algorithms.md "Noise without a variance buffer"): the global MAD σ and the local
+// per-pixel estimate, as row loops with the functors' arithmetic in the functors' order.
+//
+// Global σ (globalNoiseSigma): per band of rows, the demodulated colour rows (Demodulate's
+// (c - 0)·(1/a')) in a ring of five rows padded by two replicated pixels either side, so the
+// 25-tap double sum of MadDetail runs branch-free over every column; the detail plane's median per
+// channel by a radix histogram of its bits and a selection within the one bin holding the median
+// (the median is an element, so it is the element nth_element finds). Through the functors: a
+// demodulated copy, MadDetail's clamped scalar taps and a partition + nth_element of each plane.
+//
+// Local estimate (runLocalNoise): DetailEnergy's 25 taps as a vectorised x loop over the interior
+// columns (the two border columns either side through the functor), into one 3-plane temporary;
+// then per band of rows the row half-sums of QuadrantRows into a ring of 2r+1 rows and
+// LocalVariance's quadrant sums, choice and clamp over them (the 8-plane temporary of the functor
+// path is never stored). Same sums in the same order: bit-equal (tests/noise_fit_test.cpp).
+// FP exceptions are never unmasked or tested here; without -ftrapping-math GCC if-converts the
+// selects (results unchanged: no reassociation or contraction is allowed by this).
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC optimize("no-trapping-math")
+#endif
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <vector>
+
+#include "core/parallel.h"
+#include "cpu/isa_dispatch.h"
+#include "cpu/modulation_rows.h"
+#include "filters/noise_estimate.h"
+
+namespace atrous::filters {
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// The median of the finite values (NaN and +Inf left out, as medianFinite's partition does) of n
+// floats, without reordering them: a histogram of the top 12 bits of an order-preserving key,
+// then nth_element over the values of the bin that holds rank m/2.
+
+inline uint32_t orderKey(float v) {
+    uint32_t b;
+    std::memcpy(&b, &v, sizeof b);
+    return (b & 0x80000000u) ? ~b : (b | 0x80000000u);
+}
+inline bool counted(float v) { return v == v && v != INFINITY; }
+
+constexpr int kBinBits = 12;
+constexpr int kBins = 1 << kBinBits;
+
+float radixMedian(const float* d, size_t n, float none) {
+    const size_t chunk = 1 << 16;
+    const size_t chunks = (n + chunk - 1) / chunk;
+    std::vector<uint32_t> hist(chunks * kBins, 0);
+    tbb::parallel_for(size_t(0), chunks, [&](size_t k) {
+        uint32_t* H = hist.data() + k * kBins;
+        const size_t i1 = std::min(n, (k + 1) * chunk);
+        for (size_t i = k * chunk; i < i1; ++i)
+            if (counted(d[i])) ++H[orderKey(d[i]) >> (32 - kBinBits)];
+    });
+    std::vector<size_t> total(kBins, 0);
+    size_t m = 0;
+    for (size_t k = 0; k < chunks; ++k)
+        for (int b = 0; b < kBins; ++b) total[b] += hist[k * kBins + size_t(b)];
+    for (int b = 0; b < kBins; ++b) m += total[b];
+    if (!m) return none;
+    const size_t rank = m / 2;
+    size_t before = 0;
+    int bin = 0;
+    for (; bin < kBins; ++bin) {
+        if (rank < before + total[bin]) break;
+        before += total[bin];
+    }
+    std::vector<std::vector<float>> found(chunks);
+    tbb::parallel_for(size_t(0), chunks, [&](size_t k) {
+        const size_t i1 = std::min(n, (k + 1) * chunk);
+        for (size_t i = k * chunk; i < i1; ++i)
+            if (counted(d[i]) && int(orderKey(d[i]) >> (32 - kBinBits)) == bin) found[k].push_back(d[i]);
+    });
+    std::vector<float> cand;
+    cand.reserve(total[bin]);
+    for (auto& f : found) cand.insert(cand.end(), f.begin(), f.end());
+    std::nth_element(cand.begin(), cand.begin() + long(rank - before), cand.end());
+    return cand[rank - before];
+}
+
+// ---------------------------------------------------------------------------------------------
+// Global σ.
+
+// The double-precision finite test of the 25-tap sum (a non-finite tap makes it Inf or NaN).
+ATROUS_FORCE_INLINE inline bool finiteD(double s) { return s - s == 0.0; }
+
+struct MadBand {
+    ImageView color, albedo, detail;
+    AlbedoRule rule;
+    ATROUS_FORCE_INLINE void operator()(int y0, int y1) const {
+        const int w = color.width, h = color.height;
+        const size_t pw = size_t(w) + 4;
+        std::vector<float> ring(5 * 3 * pw), abuf(3 * size_t(w) + cpu::modulationRowScratch(w));
+        int have[5] = {-1, -1, -1, -1, -1};
+        float* const a[3] = {abuf.data(), abuf.data() + w, abuf.data() + 2 * size_t(w)};
+        auto slot = [&](int j, int c) { return ring.data() + (size_t(j % 5) * 3 + size_t(c)) * pw; };
+        auto fill = [&](int j) {
+            const bool demod = albedo.valid();
+            if (demod) cpu::modulationRow(rule, albedo, j, a, abuf.data() + 3 * size_t(w));
+            for (int c = 0; c < 3; ++c) {
+                const float* ATROUS_RESTRICT src = color.channel(c) + size_t(j) * w;
+                float* ATROUS_RESTRICT dst = slot(j, c) + 2;
+                const float* ATROUS_RESTRICT ac = a[c];
+                if (demod) {
+                    // Demodulate without emission or variance: (c - 0) · (1/a').
+#pragma omp simd
+                    for (int x = 0; x < w; ++x) dst[x] = (src[x] - 0.0f) * (1.0f / ac[x]);
+                } else {
+                    for (int x = 0; x < w; ++x) dst[x] = src[x];
+                }
+                dst[-2] = dst[-1] = dst[0];
+                dst[w] = dst[w + 1] = dst[w - 1];
+            }
+            have[j % 5] = j;
+        };
+        for (int y = y0; y < y1; ++y) {
+            for (int j = std::max(0, y - 2); j <= std::min(h - 1, y + 2); ++j)
+                if (have[j % 5] != j) fill(j);
+            for (int c = 0; c < 3; ++c) {
+                const float* r[5];
+                for (int k = 0; k < 5; ++k) r[k] = slot(clampIdx(y + k - 2, h - 1), c) + 2;
+                const float *ATROUS_RESTRICT r0 = r[0], *ATROUS_RESTRICT r1 = r[1], *ATROUS_RESTRICT r2 = r[2],
+                            *ATROUS_RESTRICT r3 = r[3], *ATROUS_RESTRICT r4 = r[4];
+                float* ATROUS_RESTRICT out = detail.channel(c) + size_t(y) * w;
+#pragma omp simd
+                for (int x = 0; x < w; ++x) {
+                    // MadDetail's sum: rows qy = -2..2, columns qx = -2..2, weights b3·b3 in
+                    // float times the value in double (exact products), ws = 1 exactly.
+                    double s = 0;
+                    const float* rows[5] = {r0, r1, r2, r3, r4};
+                    for (int qy = -2; qy <= 2; ++qy)
+                        for (int qx = -2; qx <= 2; ++qx) s += double(b3(qx) * b3(qy)) * rows[qy + 2][x + qx];
+                    const float v = r2[x];
+                    out[x] = finite(v) & finiteD(s) ? fabsf(float(v - s / 1.0)) : INFINITY;
+                }
+            }
+        }
+    }
+};
+
+// ---------------------------------------------------------------------------------------------
+// Local estimate.
+
+// DetailEnergy at interior pixel x of a row (taps x-2..x+2 inside the row): the functor's
+// arithmetic without the index clamps. c/n: per channel the five rows (qy = -2..2); z: five rows.
+template <bool kN, bool kZ>
+ATROUS_FORCE_INLINE inline void energyAt(const float* const (&c)[3][5], const float* const (&n)[3][5],
+                                         const float* const (&z)[5], const float (&maxDiff2)[3], int x, float& e0,
+                                         float& e1, float& e2) {
+    const float nx = kN ? n[0][2][x] : 0.0f, ny = kN ? n[1][2][x] : 0.0f, nz = kN ? n[2][2][x] : 0.0f;
+    const float zp = kZ ? z[2][x] : 0.0f;
+    const float cp[3] = {c[0][2][x], c[1][2][x], c[2][2][x]};
+    float s[3] = {0, 0, 0}, ws = 0, w2 = 0;
+    for (int qy = -2; qy <= 2; ++qy)
+        for (int qx = -2; qx <= 2; ++qx) {
+            const int xx = x + qx, k = qy + 2;
+            const float dn = kN ? sq(nx - n[0][k][xx]) + sq(ny - n[1][k][xx]) + sq(nz - n[2][k][xx]) : 0.0f;
+            const float dz = kZ ? fabsf(zp - z[k][xx]) : 0.0f;
+            const bool near = (sq(c[0][k][xx] - cp[0]) <= maxDiff2[0]) & (sq(c[1][k][xx] - cp[1]) <= maxDiff2[1]) &
+                              (sq(c[2][k][xx] - cp[2]) <= maxDiff2[2]);
+            const bool same = (dn <= kNoiseNormalDist2) & (dz <= kNoiseDepthRel * fabsf(zp)) & near;
+            const float wt = same ? b3(qx) * b3(qy) : 0.0f;
+            ws += wt;
+            w2 += wt * wt;
+            for (int ch = 0; ch < 3; ++ch) s[ch] += wt * c[ch][k][xx];
+        }
+    const float wp = b3(0) * b3(0);
+    const float factor = 1.0f - 2.0f * wp / ws + w2 / (ws * ws);
+    float e[3];
+    for (int ch = 0; ch < 3; ++ch) {
+        const float d = c[ch][2][x] - s[ch] / ws;
+        e[ch] = factor > 1e-3f ? d * d / factor : 0.0f;
+    }
+    e0 = e[0], e1 = e[1], e2 = e[2];
+}
+
+template <bool kN, bool kZ>
+struct EnergyRows {
+    LocalNoise f;
+    DetailEnergy de;  // the border columns
+    ImageView energy;
+    ATROUS_FORCE_INLINE void operator()(int y0, int y1) const {
+        const int w = f.color.width, h = f.color.height;
+        for (int y = y0; y < y1; ++y) {
+            const float* c[3][5];
+            const float* n[3][5];
+            const float* z[5];
+            for (int k = 0; k < 5; ++k) {
+                const size_t o = size_t(clampIdx(y + k - 2, h - 1)) * size_t(w);
+                for (int ch = 0; ch < 3; ++ch) {
+                    c[ch][k] = f.color.channel(ch) + o;
+                    n[ch][k] = kN ? f.normal.channel(ch) + o : nullptr;
+                }
+                z[k] = kZ ? f.depth.channel(0) + o : nullptr;
+            }
+            const size_t o = size_t(y) * size_t(w);
+            float* ATROUS_RESTRICT e0 = energy.channel(0) + o;
+            float* ATROUS_RESTRICT e1 = energy.channel(1) + o;
+            float* ATROUS_RESTRICT e2 = energy.channel(2) + o;
+            const int x0 = std::min(2, w), x1 = std::max(x0, w - 2);
+            for (int x = 0; x < x0; ++x) de(x, y);
+            float maxDiff2[3] = {f.maxDiff2[0], f.maxDiff2[1], f.maxDiff2[2]};
+#pragma omp simd
+            for (int x = x0; x < x1; ++x) energyAt<kN, kZ>(c, n, z, maxDiff2, x, e0[x], e1[x], e2[x]);
+            for (int x = x1; x < w; ++x) de(x, y);
+        }
+    }
+};
+
+struct VarianceBands {
+    LocalNoise f;
+    ImageView energy;
+    AlbedoRule rule;
+    ATROUS_FORCE_INLINE void operator()(int y0, int y1) const {
+        const int w = f.color.width, h = f.color.height, r = f.radius;
+        const int slots = 2 * r + 1;
+        const size_t rowSize = 6 * size_t(w);
+        std::vector<float> ring(rowSize * size_t(slots));
+        std::vector<float> abuf(3 * size_t(w) + cpu::modulationRowScratch(w));
+        float* const a[3] = {abuf.data(), abuf.data() + w, abuf.data() + 2 * size_t(w)};
+        // QuadrantRows of row j into its slot: left (x - i, i = 0..r) and right (x + i) sums per
+        // channel, inside the row, in order i = 0..r.
+        auto quadRow = [&](int j) {
+            float* dst = ring.data() + rowSize * size_t(j % slots);
+            for (int ch = 0; ch < 3; ++ch) {
+                const float* ATROUS_RESTRICT e = energy.channel(ch) + size_t(j) * w;
+                float* ATROUS_RESTRICT L = dst + size_t(ch) * w;
+                float* ATROUS_RESTRICT R = dst + size_t(3 + ch) * w;
+                auto border = [&](int x) {
+                    float l = 0, rr = 0;
+                    for (int i = 0; i <= r; ++i) {
+                        if (x - i >= 0) l += e[x - i];
+                        if (x + i < w) rr += e[x + i];
+                    }
+                    L[x] = l, R[x] = rr;
+                };
+                const int xa = std::min(r, w), xb = std::max(xa, w - r);
+                for (int x = 0; x < xa; ++x) border(x);
+#pragma omp simd
+                for (int x = xa; x < xb; ++x) {
+                    float l = 0, rr = 0;
+                    for (int i = 0; i <= r; ++i) {
+                        l += e[x - i];
+                        rr += e[x + i];
+                    }
+                    L[x] = l, R[x] = rr;
+                }
+                for (int x = xb; x < w; ++x) border(x);
+            }
+        };
+        int next = std::max(0, y0 - r);
+        std::vector<const float*> up(size_t(r) + 1), down(size_t(r) + 1);
+        const bool bgTest = f.normal.valid();
+        for (int y = y0; y < y1; ++y) {
+            for (; next <= std::min(h - 1, y + r); ++next) quadRow(next);
+            // The rows of the up (y, y-1, ..) and down (y, y+1, ..) halves, in LocalVariance's order.
+            int nUp = 0, nDown = 0;
+            for (int j = 0; j <= r; ++j) {
+                if (y - j >= 0) up[size_t(nUp++)] = ring.data() + rowSize * size_t((y - j) % slots);
+                if (y + j < h) down[size_t(nDown++)] = ring.data() + rowSize * size_t((y + j) % slots);
+            }
+            cpu::modulationRowOrOne(rule, f.albedo, y, w, a, abuf.data() + 3 * size_t(w));
+            const size_t o = size_t(y) * size_t(w);
+            const float* const* ATROUS_RESTRICT U = up.data();
+            const float* const* ATROUS_RESTRICT D = down.data();
+            const float* ATROUS_RESTRICT nx = bgTest ? f.normal.channel(0) + o : nullptr;
+            const float* ATROUS_RESTRICT ny = bgTest ? f.normal.channel(1) + o : nullptr;
+            const float* ATROUS_RESTRICT nz = bgTest ? f.normal.channel(2) + o : nullptr;
+            float* ATROUS_RESTRICT v0 = f.var.channel(0) + o;
+            float* ATROUS_RESTRICT v1 = f.var.channel(1) + o;
+            float* ATROUS_RESTRICT v2 = f.var.channel(2) + o;
+            const float* ATROUS_RESTRICT a0 = a[0];
+            const float* ATROUS_RESTRICT a1 = a[1];
+            const float* ATROUS_RESTRICT a2 = a[2];
+            const float fUp = float(nUp), fDown = float(nDown);
+            const float floorVar[3] = {f.floorVar[0], f.floorVar[1], f.floorVar[2]};
+            const float capMul = f.capMul;
+#pragma omp simd
+            for (int x = 0; x < w; ++x) {
+                // q[k]: up-left, up-right, down-left, down-right (LocalVariance's order), rgb.
+                float q[4][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+                for (int j = 0; j < nUp; ++j)
+                    for (int ch = 0; ch < 3; ++ch) {
+                        q[0][ch] += U[j][size_t(ch) * w + x];
+                        q[1][ch] += U[j][size_t(3 + ch) * w + x];
+                    }
+                for (int j = 0; j < nDown; ++j)
+                    for (int ch = 0; ch < 3; ++ch) {
+                        q[2][ch] += D[j][size_t(ch) * w + x];
+                        q[3][ch] += D[j][size_t(3 + ch) * w + x];
+                    }
+                // The tap counts (sums of small integers, exact): rows × columns of each quadrant.
+                const float nl = float((x < r ? x : r) + 1), nr = float((w - 1 - x < r ? w - 1 - x : r) + 1);
+                const float cnt[4] = {fUp * nl, fUp * nr, fDown * nl, fDown * nr};
+                int best = 0;
+                float bestMean = 3.0e38f;
+                for (int k = 0; k < 4; ++k) {
+                    const float m = (q[k][0] + q[k][1] + q[k][2]) / cnt[k];
+                    const bool better = m < bestMean;
+                    bestMean = better ? m : bestMean;
+                    best = better ? k : best;
+                }
+                float qb[3], nb = cnt[0];
+                for (int ch = 0; ch < 3; ++ch) qb[ch] = q[0][ch];
+                for (int k = 1; k < 4; ++k) {
+                    const bool pick = best == k;
+                    for (int ch = 0; ch < 3; ++ch) qb[ch] = pick ? q[k][ch] : qb[ch];
+                    nb = pick ? cnt[k] : nb;
+                }
+                const bool bg = bgTest ? (nx[x] == 0.0f) & (ny[x] == 0.0f) & (nz[x] == 0.0f) : false;
+                const float fm = bg ? kNoiseBackgroundFloor : 1.0f;
+                const float av[3] = {a0[x], a1[x], a2[x]};
+                float out[3];
+                for (int ch = 0; ch < 3; ++ch) {
+                    const float aa = av[ch];
+                    const float local = bg ? 0.0f : qb[ch] / nb;
+                    const float v = minSel(maxSel(local, fm * floorVar[ch]), capMul * floorVar[ch]) * aa * aa;
+                    const float res = finite(v) ? v : floorVar[ch] * aa * aa;
+                    const float ia = 1.0f / aa;
+                    out[ch] = res * (ia * ia);
+                }
+                v0[x] = out[0], v1[x] = out[1], v2[x] = out[2];
+            }
+        }
+    }
+};
+
+}  // namespace
+
+void globalNoiseSigma(const CpuExec&, const ImageView& color, const ImageView& albedo, float eps, float floor,
+                      float sigma[3]) {
+    const int w = color.width, h = color.height;
+    Image detail = Image::uninitialized(w, h, 3);
+    MadBand band;
+    band.color = color, band.albedo = albedo, band.detail = detail.view();
+    band.rule.eps = eps, band.rule.floor = floor;  // the still rule (rim on, non-finite 0)
+    cpu::parallelForIsa(cpu::activeIsa(), 0, h, 16, band);
+    for (int c = 0; c < 3; ++c) {
+        const float mid = radixMedian(detail.view().channel(c), detail.plane(), 0.0f);
+        sigma[c] = float(double(mid) / 0.6745 / std::sqrt(double(kDetailVarFactor)));
+    }
+}
+
+float medianFinite(const CpuExec&, const ImageView& v, float none) {
+    return radixMedian(v.data, v.plane(), none);
+}
+
+void runLocalNoise(const CpuExec& exec, const LocalNoise& f) {
+    const int w = f.color.width, h = f.color.height;
+    Image energy = Image::uninitialized(w, h, 3);
+    DetailEnergy de;
+    de.color = f.color, de.energy = energy.view(), de.normal = f.normal, de.depth = f.depth;
+    for (int c = 0; c < 3; ++c) de.maxDiff2[c] = f.maxDiff2[c];
+    const bool n = f.normal.valid(), z = f.depth.valid();
+    const cpu::Isa isa = cpu::activeIsa();
+    if (n && z) cpu::parallelForIsa(isa, 0, h, 4, EnergyRows<true, true>{f, de, energy.view()});
+    else if (n) cpu::parallelForIsa(isa, 0, h, 4, EnergyRows<true, false>{f, de, energy.view()});
+    else if (z) cpu::parallelForIsa(isa, 0, h, 4, EnergyRows<false, true>{f, de, energy.view()});
+    else cpu::parallelForIsa(isa, 0, h, 4, EnergyRows<false, false>{f, de, energy.view()});
+    VarianceBands vb;
+    vb.f = f, vb.energy = energy.view();
+    vb.rule.eps = f.eps, vb.rule.floor = f.floor;  // LocalVariance's pixelModulationAlbedo defaults
+    // Bands of 32 rows: the ring recomputes 2r row sums per band (cheap next to the energy).
+    cpu::parallelForIsa(isa, 0, h, 32, vb);
+    (void)exec;
+}
+
+}  // namespace atrous::filters

@@ -1,0 +1,277 @@
+// The CPU row loops of the still driver's passes against the shared per-pixel functors they stand
+// for (the CUDA backend's code, and what the CPU ran before them): bit for bit. Demodulate,
+// Remodulate and the global variance (src/cpu/modulation_cpu.cpp: a' of a row at once, the rim
+// rule's 3x3 scan as row minima), the noise estimate without a variance buffer
+// (src/cpu/noise_cpu.cpp: the global MAD σ, its median, the local per-pixel estimate), the
+// in-place form of the sanitise pass and the firefly pass's count (src/cpu/prepass_cpu.cpp).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "core/parallel.h"
+#include "filters/denoise_driver.h"
+#include "filters/modulation.h"
+#include "filters/noise_estimate.h"
+#include "filters/prepass.h"
+
+using namespace atrous;
+using namespace atrous::filters;
+
+namespace {
+
+constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// Sizes with an interior for every row loop, and degenerate ones (the border paths alone).
+const int kSizes[][2] = {{37, 23}, {64, 19}, {5, 7}, {3, 5}, {2, 4}, {1, 1}, {1, 9}, {40, 1}};
+
+// The index of the first float that differs bit for bit (-1: none). NaNs compare by their bits.
+long firstBitDifference(const Image& a, const Image& b) {
+    if (a.size() != b.size()) return 0;
+    for (size_t i = 0; i < a.size(); ++i)
+        if (std::memcmp(a.data() + i, b.data() + i, sizeof(float)) != 0) return long(i);
+    return -1;
+}
+
+Image randomImage(int w, int h, int c, unsigned seed, float lo, float hi) {
+    Image img(w, h, c);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(lo, hi);
+    for (size_t i = 0; i < img.size(); ++i) img.data()[i] = u(rng);
+    return img;
+}
+
+// An albedo with every case of the modulation rule: black, below a tenth of the floor, between
+// the floor and twice it (the rim test), ordinary, above 1, NaN and Inf, in patches so that rims
+// form.
+Image ruleAlbedo(int w, int h, unsigned seed) {
+    const float vals[] = {0.0f, 0.004f, 0.03f, 0.06f, 0.09f, 0.3f, 0.8f, 1.4f, kNan, kInf, 1e-4f};
+    Image a(w, h, 3);
+    std::mt19937 rng(seed);
+    std::uniform_int_distribution<int> pick(0, 10);
+    std::uniform_real_distribution<float> jitter(0.9f, 1.1f);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const int base = pick(rng);
+            for (int c = 0; c < 3; ++c) {
+                const float v = vals[(base + (c == 2 && x % 3 == 0 ? 1 : 0)) % 11];
+                a(x, y, c) = std::isfinite(v) ? v * jitter(rng) : v;
+            }
+        }
+    return a;
+}
+
+AlbedoRule rules(int k) {
+    AlbedoRule r;
+    if (k == 0) r.eps = 1e-3f, r.floor = 0.05f;                   // the still filters'
+    if (k == 1) r.eps = 1e-3f, r.floor = 0.0f;                    // floor off
+    if (k == 2) r.eps = 1e-2f, r.floor = 0.2f, r.rim = false;     // no rim rule
+    if (k == 3) r.eps = 1e-3f, r.floor = 0.1f, r.nonFinite = 1.0f;
+    return r;
+}
+
+}  // namespace
+
+TEST(FilterRows, DemodulateRemodulateAndGlobalVarianceEqualTheFunctors) {
+    for (auto& sz : kSizes) {
+        const int w = sz[0], h = sz[1];
+        const Image albedo = ruleAlbedo(w, h, unsigned(w * 31 + h));
+        const Image color = randomImage(w, h, 3, 2, -0.5f, 4.0f), var = randomImage(w, h, 3, 3, 0.0f, 0.2f);
+        const Image emission = randomImage(w, h, 3, 4, 0.0f, 1.0f), detail = randomImage(w, h, 3, 5, -0.3f, 0.3f);
+        for (int k = 0; k < 4; ++k)
+            for (int withE = 0; withE < 2; ++withE)
+                for (int withAlbedo = 0; withAlbedo < 2; ++withAlbedo) {
+                    const std::string what = std::to_string(w) + "x" + std::to_string(h) + " rule " + std::to_string(k) +
+                                             " emission " + std::to_string(withE) + " albedo " + std::to_string(withAlbedo);
+                    Demodulate d;
+                    d.rule = rules(k);
+                    d.albedo = withAlbedo ? albedo.view() : ImageView{};
+                    if (withE) d.emission = emission.view();
+                    // Into other planes (and the variance in place), and in place.
+                    Image o1(w, h, 3), o2(w, h, 3), v1 = var.clone(), v2 = var.clone();
+                    d.in = color.view(), d.out = o1.view(), d.var = v1.view();
+                    runDemodulate(CpuExec{}, d);
+                    d.out = o2.view(), d.var = v2.view();
+                    CpuExec{}.forEachPixel(w, h, d);
+                    EXPECT_EQ(firstBitDifference(o1, o2), -1) << what;
+                    EXPECT_EQ(firstBitDifference(v1, v2), -1) << what;
+                    Image inPlace = color.clone();
+                    d.in = d.out = inPlace.view(), d.var = ImageView{};
+                    runDemodulate(CpuExec{}, d);
+                    EXPECT_EQ(firstBitDifference(inPlace, o2), -1) << what << " in place";
+
+                    Remodulate r;
+                    r.rule = rules(k);
+                    r.albedo = d.albedo;
+                    if (withE) r.emission = emission.view();
+                    for (int withDetail = 0; withDetail < 2; ++withDetail) {
+                        r.detail = withDetail ? detail.view() : ImageView{};
+                        Image p1(w, h, 3), p2(w, h, 3);
+                        r.base = o2.view(), r.out = p1.view();
+                        runRemodulate(CpuExec{}, r);
+                        r.out = p2.view();
+                        CpuExec{}.forEachPixel(w, h, r);
+                        EXPECT_EQ(firstBitDifference(p1, p2), -1) << what << " detail " << withDetail;
+                        Image p3 = o2.clone();
+                        r.base = r.out = p3.view();
+                        runRemodulate(CpuExec{}, r);
+                        EXPECT_EQ(firstBitDifference(p3, p2), -1) << what << " in place";
+                    }
+                }
+        for (int withAlbedo = 0; withAlbedo < 2; ++withAlbedo) {
+            GlobalVariance g;
+            g.floorVar[0] = 0.01f, g.floorVar[1] = 0.3f, g.floorVar[2] = 2e-5f;
+            g.eps = 1e-3f, g.floor = 0.05f;
+            g.albedo = withAlbedo ? albedo.view() : ImageView{};
+            Image a(w, h, 3), b(w, h, 3);
+            g.var = a.view();
+            runGlobalVariance(CpuExec{}, g);
+            g.var = b.view();
+            CpuExec{}.forEachPixel(w, h, g);
+            EXPECT_EQ(firstBitDifference(a, b), -1) << w << "x" << h << " albedo " << withAlbedo;
+        }
+    }
+}
+
+namespace {
+
+// A noisy scene for the noise estimate: planes of different normals and depths, a bright square
+// (a colour edge), a dense-noise patch, background (normal 0) in one corner, a few non-finite values.
+struct NoiseScene {
+    Image color, normal, depth, albedo;
+    NoiseScene(int w, int h, unsigned seed)
+        : color(w, h, 3), normal(w, h, 3), depth(w, h, 1), albedo(ruleAlbedo(w, h, seed + 1)) {
+        std::mt19937 rng(seed);
+        std::normal_distribution<float> g(0.0f, 1.0f);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const bool left = x < w / 2, bg = x > 3 * w / 4 && y < h / 4;
+                const bool bright = x > w / 4 && x < w / 3 && y > h / 3 && y < h / 2;
+                const float sigma = (x > w / 2 && y > h / 2) ? 0.4f : 0.05f;
+                for (int c = 0; c < 3; ++c) {
+                    color(x, y, c) = (bright ? 20.0f : 0.5f + 0.1f * c) + sigma * g(rng);
+                    normal(x, y, c) = bg ? 0.0f : (left ? (c == 2 ? 1.0f : 0.0f) : (c == 0 ? 1.0f : 0.0f));
+                }
+                depth(x, y, 0) = bg ? 1e18f : (left ? 2.0f : 3.0f + 0.01f * float(y));
+            }
+        if (w > 4 && h > 4) {
+            color(w / 2, h / 2, 1) = kNan;
+            color(1, h - 2, 0) = kInf;
+        }
+    }
+};
+
+}  // namespace
+
+TEST(FilterRows, NoiseEstimateEqualsTheFunctors) {
+    for (auto& sz : kSizes) {
+        const int w = sz[0], h = sz[1];
+        const NoiseScene s(w, h, unsigned(7 * w + h));
+        // The global σ: row loops and the radix median against the functor path.
+        for (int withAlbedo = 0; withAlbedo < 2; ++withAlbedo) {
+            const ImageView a = withAlbedo ? s.albedo.view() : ImageView{};
+            float s1[3], s2[3];
+            globalNoiseSigma(CpuExec{}, s.color.view(), a, 1e-3f, 0.05f, s1);
+            globalNoiseSigma<CpuExec>(CpuExec{}, s.color.view(), a, 1e-3f, 0.05f, s2);
+            for (int c = 0; c < 3; ++c) EXPECT_EQ(s1[c], s2[c]) << w << "x" << h << " channel " << c;
+        }
+        // The local estimate, with and without each feature, on the colour without non-finite
+        // values (the driver's input is sanitised).
+        Image clean = s.color.clone();
+        for (size_t i = 0; i < clean.size(); ++i)
+            if (!std::isfinite(clean.data()[i])) clean.data()[i] = 0.5f;
+        for (int mask = 0; mask < 8; ++mask) {
+            LocalNoise f;
+            for (int c = 0; c < 3; ++c) {
+                f.floorVar[c] = 0.0025f * float(c + 1);
+                f.maxDiff2[c] = kNoiseEdgeSigmas2 * kNoiseCapMul * f.floorVar[c];
+            }
+            f.eps = 1e-3f, f.floor = 0.05f;
+            f.color = clean.view();
+            if (mask & 1) f.normal = s.normal.view();
+            if (mask & 2) f.depth = s.depth.view();
+            if (mask & 4) f.albedo = s.albedo.view();
+            Image v1(w, h, 3), v2(w, h, 3);
+            f.var = v1.view();
+            runLocalNoise(CpuExec{}, f);
+            f.var = v2.view();
+            runLocalNoise<CpuExec>(CpuExec{}, f);
+            EXPECT_EQ(firstBitDifference(v1, v2), -1) << w << "x" << h << " features " << mask;
+        }
+    }
+}
+
+TEST(FilterRows, MedianIsTheElementNthElementFinds) {
+    std::mt19937 rng(3);
+    std::normal_distribution<float> g(0.0f, 1.0f);
+    for (size_t n : {size_t(1), size_t(2), size_t(7), size_t(1000), size_t(300001)}) {
+        std::vector<float> v(n);
+        for (float& x : v) x = std::fabs(g(rng)) * (rng() % 3 == 0 ? 1e-20f : 1.0f);
+        if (n > 10) v[3] = kNan, v[5] = kInf, v[7] = -kInf, v[9] = -0.0f, v[8] = -2.5f;
+        std::vector<float> ref(v);
+        auto end = std::partition(ref.begin(), ref.end(), [](float a) { return a < INFINITY && a == a; });
+        const size_t m = size_t(end - ref.begin());
+        std::nth_element(ref.begin(), ref.begin() + long(m / 2), end);
+        const float got = medianFinite(CpuExec{}, ImageView{v.data(), int(n), 1, 1}, 42.0f);
+        EXPECT_EQ(got, ref[m / 2]) << n;
+    }
+    std::vector<float> none = {kNan, kInf};
+    EXPECT_EQ(medianFinite(CpuExec{}, ImageView{none.data(), 2, 1, 1}, 42.0f), 42.0f);
+}
+
+TEST(FilterRows, InPlaceSanitiseAndTheFireflyCountEqualTheFunctors) {
+    for (auto& sz : kSizes) {
+        const int w = sz[0], h = sz[1];
+        Image c = randomImage(w, h, 3, 11, 0.0f, 1.0f), v = randomImage(w, h, 3, 12, 0.0f, 0.05f);
+        // Fireflies (clamped and kept), and non-finite values next to each other.
+        std::mt19937 rng(5);
+        for (int k = 0; k < (w * h) / 20 + 1; ++k) {
+            const int x = int(rng() % unsigned(w)), y = int(rng() % unsigned(h));
+            for (int ch = 0; ch < 3; ++ch) c(x, y, ch) = 40.0f;
+            if (k % 2) v(x, y, 0) = 400.0f;
+        }
+        c(0, 0, 1) = kNan;
+        c(w - 1, h - 1, 0) = kInf;
+        if (w > 1) c(1, 0, 1) = kNan;
+        v(w / 2, h / 2, 2) = -kInf;
+        // Sanitise into other planes (the functor) and in place.
+        Image c1(w, h, 3), v1(w, h, 3);
+        CpuExec{}.forEachPixel(w, h, SanitizeColor{c.view(), v.view(), c1.view(), v1.view()});
+        Image c2 = c.clone(), v2 = v.clone();
+        runSanitizeColor(CpuExec{}, SanitizeColor{c2.view(), v2.view(), c2.view(), v2.view()});
+        EXPECT_EQ(firstBitDifference(c1, c2), -1) << w << "x" << h;
+        EXPECT_EQ(firstBitDifference(v1, v2), -1) << w << "x" << h;
+        // Without a variance: the colour alone.
+        Image c3 = c.clone();
+        runSanitizeColor(CpuExec{}, SanitizeColor{c3.view(), ImageView{}, c3.view(), ImageView{}});
+        EXPECT_EQ(firstBitDifference(c1, c3), -1) << w << "x" << h;
+        // The firefly pass, given and estimated variance: the CPU row loop into other planes with a
+        // flag plane (what the driver ran before), against the same loop in place with its count.
+        // (The row loop and the functor agree to a few ulps, not bit for bit, since the CPU loop
+        // came in: GCC contracts the bound's multiply-adds differently in the two; same decisions.)
+        for (int own = 0; own < 2; ++own) {
+            Image fc1(w, h, 3), fv1(w, h, 3), flag1(w, h, 1);
+            runFireflyClamp(CpuExec{}, FireflyClamp{4.0f, own, c1.view(), v1.view(), fc1.view(), fv1.view(), flag1.view()});
+            int want = 0;
+            for (size_t i = 0; i < flag1.size(); ++i) want += flag1.data()[i] > 0.5f;
+            Image fr(w, h, 3), fvr(w, h, 3), flagr(w, h, 1);
+            CpuExec{}.forEachPixel(w, h, FireflyClamp{4.0f, own, c1.view(), v1.view(), fr.view(), fvr.view(), flagr.view()});
+            EXPECT_EQ(firstBitDifference(flag1, flagr), -1) << w << "x" << h << " own " << own;
+            for (size_t i = 0; i < fr.size(); ++i)
+                ASSERT_NEAR(fc1.data()[i], fr.data()[i], 1e-6f * std::fabs(fr.data()[i])) << w << "x" << h << " " << i;
+            if (w * h > 100 && own == 0) EXPECT_GT(want, 0) << w << "x" << h;
+            // Without a flag plane: the count alone.
+            Image fc4(w, h, 3), fv4(w, h, 3);
+            int count = -1;
+            runFireflyClamp(CpuExec{}, FireflyClamp{4.0f, own, c1.view(), v1.view(), fc4.view(), fv4.view(), ImageView{}}, &count);
+            EXPECT_EQ(firstBitDifference(fc1, fc4), -1) << w << "x" << h << " own " << own;
+            EXPECT_EQ(firstBitDifference(fv1, fv4), -1) << w << "x" << h << " own " << own;
+            EXPECT_EQ(count, want) << w << "x" << h << " own " << own;
+        }
+    }
+}
