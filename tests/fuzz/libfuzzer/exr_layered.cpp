@@ -11,7 +11,7 @@
 // Known (skipped unless ATROUS_FUZZ_STRICT=1): at 81cfc0d the layered reader does not check the
 // first part's data window against the file's size (a 16384x16384 claim allocates GBs); the input
 // is skipped when that window, at 2 bytes per pixel, needs more than the file can hold at PIZ's
-// 8192:1. And OpenEXR's attribute sizes (fuzz_common.h, skipKnownImage).
+// 8192:1. readBufferFile on a file without channels (below). And fuzz_common.h's skipKnownImage.
 #include "fuzz_common.h"
 #include "io/buffer_set.h"
 #include "io/exr_layers.h"
@@ -83,6 +83,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             if (!set.image[b].empty()) checkImage(Buffer(b), set.image[b], info, std::string("loadBuffers: ") + bufferName(Buffer(b)));
     }
 
+    // Known (src/io/buffer_set.cpp at 46195f1, found by this target's 10-minute run): readBufferFile
+    // reads info.layers[0] of a file without channels (an empty vector): `atrous denoise --color
+    // FILE.exr` SIGSEGVs. Reproducer findings/exr-no-channels-readbufferfile-segv.exr.
+    if (info.layers.empty() && knownIssue("readbufferfile-no-channels", "readBufferFile indexes the layers of a file without channels"))
+        return 0;
     const Buffer one = Buffer(size % kBufferCount);
     Image img;
     if (returnsOrInputError("readBufferFile", [&] { img = readBufferFile(path, one, {}, ""); }))
