@@ -239,3 +239,20 @@ TEST(LayeredInput, HeaderAttributeLargerThanTheFileIsRefusedFirst) {
         EXPECT_LT(r.peakMb, 150) << args;
     }
 }
+
+// An EXR without channels, given for one buffer: read info.layers[0] of an empty list (SIGSEGV,
+// found by tests/fuzz/libfuzzer's exr_layered target).
+TEST(LayeredInput, FileWithoutChannelsIsRefused) {
+    TempDir dir;
+    // OpenEXR will not write such a file: the libFuzzer target's reproducer (1386 bytes).
+    fs::copy_file(std::string(ATROUS_SOURCE_DIR) + "/tests/fuzz/libfuzzer/findings/exr-no-channels-readbufferfile-segv.exr",
+                  dir / "empty.exr");
+    io::writeImage(dir / "c.exr", Image(8, 6, 3));
+    for (const std::string& args : {"denoise --color " + (dir / "empty.exr") + " --out " + (dir / "o.exr"),
+                                    "denoise --color " + (dir / "c.exr") + " --albedo " + (dir / "empty.exr") + " --out " + (dir / "o.exr")}) {
+        const auto r = runCli(args);
+        EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.output;
+        EXPECT_NE(r.output.find("empty.exr"), std::string::npos) << r.output;
+    }
+    EXPECT_FALSE(fs::exists(dir / "o.exr"));
+}

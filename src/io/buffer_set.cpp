@@ -92,7 +92,8 @@ Image readBufferFile(const std::string& path, Buffer b, const std::vector<PassRe
     if (fs::is_regular_file(path) && isExrFile(path)) {
         const ExrInfo info = inspectExr(path);
         // Root R,G,B (atrous's own files, ids with mesh and material in R and G) are read whole.
-        if (info.layers.size() > 1 || !info.layers[0].name.empty()) {
+        // (A file without channels has no layers: readImage refuses it below.)
+        if (info.layers.size() > 1 || (info.layers.size() == 1 && !info.layers[0].name.empty())) {
             requireViewLayer(info, viewLayer);
             const PassChoice c = passForFile(info, b, passes, viewLayer);
             if (from && c.layer >= 0) *from = path + " (layer " + info.layers[size_t(c.layer)].name + ", " + c.rule + ")";
