@@ -79,15 +79,16 @@ TEST(FuzzRegression, ObjAndMtlExponentsBeyondIntAreErrors) {
 }
 
 // obj_mtl: tinyobjloader's skin weights ("vw vid joint weight ...", its own extension, ignored by
-// atrous) cast each joint id from a float to int: undefined for 7.7e85 or 3e9 (UBSan: "inf is
-// outside the range of representable values of type 'int'"). A joint id is now a number below
-// 2^31; without the fix both cases below load without an error.
+// atrous) cast each joint id from a float to int: undefined for 7.7e85, 3e9, or the NaN its parser
+// makes of 7...7e-2000 (UBSan: "inf/-nan is outside the range of representable values of type
+// 'int'"). A joint id is now an integer of at most 9 digits; without the fix every case loads.
 TEST(FuzzRegression, ObjSkinWeightJointIdsBeyondIntAreErrors) {
     ScratchDir dir;
     const std::string tri = "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n";
-    std::string msg = meshError(dir, tri + "vw 1 " + std::string(90, '7') + " 0.5\n", "");
-    EXPECT_NE(msg.find("m.obj: line 5: skin weight joint id \"777"), std::string::npos) << msg;
-    msg = meshError(dir, tri + "vw 1 0 0.5 3e9 0.5\n", "");
-    EXPECT_NE(msg.find("m.obj: line 5: skin weight joint id \"3e9\" is not a number within int's range"), std::string::npos) << msg;
-    EXPECT_EQ(meshError(dir, tri + "vw 1 0 0.25 2 0.75\n", ""), "");
+    for (const std::string& id : {std::string(90, '7'), std::string("3e9"), std::string(400, '7') + "e-2000", std::string("1234567890")}) {
+        const std::string msg = meshError(dir, tri + "vw 1 0 0.5 " + id + " 0.5\n", "");
+        EXPECT_NE(msg.find("m.obj: line 5: skin weight joint id \"" + id + "\" is not an integer of at most 9 digits"),
+                  std::string::npos) << msg;
+    }
+    EXPECT_EQ(meshError(dir, tri + "vw 1 0 0.25 2 0.75 3.0 0\n", ""), "");
 }

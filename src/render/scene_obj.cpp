@@ -89,17 +89,22 @@ std::vector<std::string> prescanObj(const std::string& path) {
         }
         // vw: skin weights, a tinyobjloader extension atrous ignores ("vw vid joint weight joint
         // weight ..."); tinyobjloader casts each joint id from a float to int, undefined beyond int's
-        // range (found by the libFuzzer target obj_mtl: "vw 1 777...7"). Each joint id a number below 2^31.
+        // range and for NaN, which its own number parser makes of "7...7e-2000" (inf * 0) where
+        // strtod reads 0 (found by the libFuzzer target obj_mtl: "vw 1 777...7"). Each joint id is
+        // an integer of at most 9 digits (a fraction allowed): what a joint index looks like.
         if (line.compare(i, 3, "vw ") == 0 || line.compare(i, 3, "vw\t") == 0) {
             std::istringstream vals(line.substr(i + 3));
             std::string tok;
             for (int k = 0; vals >> tok; ++k) {
                 if (k % 2 == 0) continue;  // the vertex id (read with atoi) and the weights
-                char* end = nullptr;
-                const double x = std::strtod(tok.c_str(), &end);
-                if (end == tok.c_str() || *end != '\0' || !(std::fabs(x) < 2147483520.0))  // float's largest below 2^31
+                size_t p = tok[0] == '+' || tok[0] == '-' ? 1 : 0;
+                const size_t digits = tok.find_first_not_of("0123456789", p);
+                const size_t intDigits = (digits == std::string::npos ? tok.size() : digits) - p;
+                const bool fraction = digits != std::string::npos && tok[digits] == '.' &&
+                                      tok.find_first_not_of("0123456789", digits + 1) == std::string::npos;
+                if (intDigits == 0 || intDigits > 9 || (digits != std::string::npos && !fraction))
                     throw InputError(path + ": line " + std::to_string(lineNo) + ": skin weight joint id \"" + tok +
-                                     "\" is not a number within int's range");
+                                     "\" is not an integer of at most 9 digits");
             }
             continue;
         }
