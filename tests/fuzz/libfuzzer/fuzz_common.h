@@ -236,9 +236,9 @@ inline bool exrAttributeOverrun(const uint8_t* d, size_t n, std::string* what,
 // target in its first minute; reproducer tests/fuzz/libfuzzer/findings/png-stb-jpeg-dht-overflow.
 // True for an input holding such a table anywhere (DHT segments are looked for as stb reads them).
 inline bool jpegDhtOverflow(const uint8_t* data, size_t size) {
-    if (size < 2 || data[0] != 0xFF || data[1] != 0xD8) return false;
+    // Wherever they are: stb takes fill bytes before the SOI marker (FF FF D8) and sniffs JPEG in any file.
     auto get8 = [&](size_t i) -> unsigned { return i < size ? data[i] : 0u; };  // stb reads 0 past the end
-    for (size_t at = 2; at + 1 < size; ++at) {
+    for (size_t at = 0; at + 1 < size; ++at) {
         if (data[at] != 0xFF || data[at + 1] != 0xC4) continue;
         size_t i = at + 2;
         long left = long(get8(i) << 8 | get8(i + 1)) - 2;

@@ -395,7 +395,7 @@ void objSeeds() {
     text("obj_mtl", "finding_exponent_overflow.obj",
          "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nt crease 0/1/0 1e-2147483648\nv 1e-2147483649 0 0\nusemtl a\nf 1 2 3\n" + sep +
              "newmtl a\nKd 1e-21474836480 1 1\nmap_Kd -s 1e-2147483648 1 1 t.png\n");
-    text("obj_mtl", "finding_vw_joint_overflow.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nvw 1 0 0.5 3e9 0.5\nvw 2 " + std::string(40, '7') + " 1\nf 1 2 3\n");
+    text("obj_mtl", "finding_vw_joint_overflow.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nvw 1 0 0.5 3e9 0.5\nvw 2 " + std::string(40, '7') + " 1\nvw 3 " + std::string(400, '7') + "e-2000 1\nf 1 2 3\n");
     text("obj_mtl", "polygon_no_mtl.obj", "# a pentagon, triangulated\nv 0 0 0\nv 2 0 0\nv 3 1 0\nv 1 3 0\nv -1 1 0\nvt 0.5 0.5\nf 1/1 2/1 3/1 4/1 5/1\n");
 }
 
