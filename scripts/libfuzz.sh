@@ -13,6 +13,7 @@
 # --seed S      libFuzzer's -seed for every target (default: a fresh one per target, printed)
 # --strict      ATROUS_FUZZ_STRICT=1: the known problems the targets skip are findings too
 # --no-build    use build-fuzz/ as it is
+# --report      print the table of the last run (out/libfuzz/) again, running nothing
 # Reproduce a finding: build-fuzz/fuzz_<target> out/libfuzz/<target>/crash-<sha1>
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -24,9 +25,10 @@ JOBS=$(nproc)
 SEED=""
 STRICT=0
 BUILD=1
+REPORT_ONLY=0
 BUILD_DIR=${FUZZ_BUILD_DIR:-build-fuzz}
 OUT=${FUZZ_OUT:-out/libfuzz}
-usage() { sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; }
 while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) SECS="$2"; shift 2 ;;
@@ -35,6 +37,7 @@ while [ $# -gt 0 ]; do
     --seed) SEED="$2"; shift 2 ;;
     --strict) STRICT=1; shift ;;
     --no-build) BUILD=0; shift ;;
+    --report) REPORT_ONLY=1; BUILD=0; shift ;;
     -h|--help) usage; exit 0 ;;
     *) echo "libfuzz: unknown argument '$1'" >&2; usage >&2; exit 2 ;;
   esac
@@ -92,21 +95,21 @@ run_one() {
   rc=$?
   set -e
   rm -rf "$tmp"
-  echo "$seed $rc" > "$dir/result"
+  echo "$seed $rc $SECS" > "$dir/result"
 }
 
 # Lines of the summary table from a target's log and result.
 report() {
-  local t=$1 dir="$OUT/$1" seed rc execs cov ft corp rss res known artifact
-  read -r seed rc < "$dir/result"
-  execs=$(grep -a '^stat::number_of_executed_units:' "$dir/log" | tail -1 | tr -cd '0-9')
-  rss=$(grep -a '^stat::peak_rss_mb:' "$dir/log" | tail -1 | tr -cd '0-9')
+  local t=$1 dir="$OUT/$1" seed rc secs execs cov ft corp rss res known artifact
+  read -r seed rc secs < "$dir/result"
+  execs=$(grep -a '^stat::number_of_executed_units:' "$dir/log" | tail -1 | tr -cd '0-9' || true)
+  rss=$(grep -a '^stat::peak_rss_mb:' "$dir/log" | tail -1 | tr -cd '0-9' || true)
   local last; last=$(grep -aE '^#[0-9]+.*cov: ' "$dir/log" | tail -1 || true)
-  cov=$(sed -n 's/.* cov: \([0-9]*\).*/\1/p' <<< "$last")
+  cov=$(sed -n 's/.* cov: \([0-9]*\).*/\1/p' <<< "$last" || true)
   ft=$(sed -n 's/.* ft: \([0-9]*\).*/\1/p' <<< "$last")
   corp=$(sed -n 's/.* corp: \([0-9]*\/[0-9]*[a-zA-Z]*\).*/\1/p' <<< "$last")
   known=$(grep -a '^==atrous-fuzz== KNOWN ' "$dir/log" | cut -d' ' -f3 | tr -cd '[:alnum:]-\n' | sort -u | paste -sd, - || true)
-  artifact=$(grep -a 'Test unit written to ' "$dir/log" | tail -1 | sed 's/.*Test unit written to //')
+  artifact=$(grep -a 'Test unit written to ' "$dir/log" | tail -1 | sed 's/.*Test unit written to //' || true)
   if [ "$rc" = 0 ] && [ -z "$artifact" ]; then
     res="ok"
   else
@@ -114,17 +117,23 @@ report() {
     FAILED=1
   fi
   [ -z "$known" ] || res="$res; known skipped: $known"
-  printf '%-14s %10s %5s %9s %6s %7s %12s %6s  %s\n' "$t" "$seed" "$SECS" "${execs:-?}" "${cov:-?}" "${ft:-?}" \
+  printf '%-14s %10s %5s %9s %6s %7s %12s %6s  %s\n' "$t" "$seed" "${secs:-$SECS}" "${execs:-?}" "${cov:-?}" "${ft:-?}" \
     "${corp:-?}" "${rss:-?}" "$res"
 }
 
-echo "libfuzz: ${#LIST[@]} target(s), ${SECS} s each, ${JOBS} at a time, $(date -u '+%Y-%m-%d %H:%M UTC'), $(git rev-parse --short HEAD 2>/dev/null || echo '?')"
-for t in "${LIST[@]}"; do
-  rm -f "$OUT/$t/result"
-  run_one "$t" &
-  while [ "$(jobs -rp | wc -l)" -ge "$JOBS" ]; do wait -n || true; done
-done
-wait
+if [ "$REPORT_ONLY" = 0 ]; then
+  echo "libfuzz: ${#LIST[@]} target(s), ${SECS} s each, ${JOBS} at a time, $(date -u '+%Y-%m-%d %H:%M UTC'), $(git rev-parse --short HEAD 2>/dev/null || echo '?')"
+  for t in "${LIST[@]}"; do
+    rm -f "$OUT/$t/result"
+    run_one "$t" &
+    while [ "$(jobs -rp | wc -l)" -ge "$JOBS" ]; do wait -n || true; done
+  done
+  wait
+else
+  for t in "${LIST[@]}"; do
+    [ -f "$OUT/$t/result" ] || { echo "libfuzz: no result for $t in $OUT" >&2; exit 2; }
+  done
+fi
 FAILED=0
 printf '%-14s %10s %5s %9s %6s %7s %12s %6s  %s\n' target seed secs runs cov ft corpus rss_mb result
 for t in "${LIST[@]}"; do report "$t"; done
