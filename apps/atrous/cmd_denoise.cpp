@@ -179,7 +179,19 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
         throw InputError("--add-pass '" + a.addPass + "' writes a copy of a layered EXR: give --in FILE.exr and --out COPY.exr");
     Image& color = set.image[int(io::Buffer::Color)];
     if (a.srgb) srgbToLinear(color);
-    DenoiseInputs in = set.inputs();
+    const int width = color.width(), height = color.height();
+    const bool albedoGiven = set.get(io::Buffer::Albedo) != nullptr;
+    // The colour, variance and emission were read to be denoised: the filter works in their
+    // storage (DenoiseBuffers) and they are not read afterwards.
+    DenoiseBuffers in;
+    in.color = &color;
+    if (!set.image[int(io::Buffer::Variance)].empty()) in.variance = &set.image[int(io::Buffer::Variance)];
+    if (!set.image[int(io::Buffer::Emission)].empty()) in.emission = &set.image[int(io::Buffer::Emission)];
+    in.albedo = set.get(io::Buffer::Albedo);
+    in.normal = set.get(io::Buffer::Normal);
+    in.position = set.get(io::Buffer::Position);
+    in.depth = set.get(io::Buffer::Depth);
+    in.ids = set.get(io::Buffer::ObjectId);
     static constexpr io::Buffer kLabelled[] = {io::Buffer::Color,    io::Buffer::Variance, io::Buffer::Albedo,
                                               io::Buffer::Normal,   io::Buffer::Position, io::Buffer::Depth,
                                               io::Buffer::ObjectId, io::Buffer::Emission};
@@ -212,11 +224,12 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
                                          (rep.methodUsed == DenoiseMethod::Learned ? " (albedo and normal given)"
                                                                                   : " (learned needs an albedo and a normal)")
                                    : std::string(denoiseMethodName(o.method));
-    std::printf("denoise: method %s on %s, %dx%d, buffers used: %s\n", method.c_str(), deviceToString(o.device), color.width(), color.height(), rep.buffersUsed.c_str());
+    std::printf("denoise: method %s on %s, %dx%d, buffers used: %s\n", method.c_str(), deviceToString(o.device), width, height,
+                rep.buffersUsed.c_str());
     if (rep.noiseEstimated)
         std::printf("denoise: no variance buffer: noise estimated from the image, per pixel (docs/algorithms.md), at least "
                     "the global MAD sigma = %.4g %.4g %.4g%s\n",
-                    rep.noiseSigma[0], rep.noiseSigma[1], rep.noiseSigma[2], in.albedo && o.demodulate ? " (of the demodulated colour)" : "");
+                    rep.noiseSigma[0], rep.noiseSigma[1], rep.noiseSigma[2], albedoGiven && o.demodulate ? " (of the demodulated colour)" : "");
     if (rep.nonFinitePixels > 0)
         std::printf("denoise: %d pixels had NaN/Inf colour, treated as missing\n", rep.nonFinitePixels);
     if (o.firefly.enabled)

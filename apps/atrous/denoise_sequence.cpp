@@ -260,11 +260,22 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
         // Every buffer the frame has (emission included), through the one input assembly.
         io::BufferRefs refs = io::refsOf(f);
         if (!idsTrusted) refs.set(io::Buffer::ObjectId, nullptr);
+        const double mseIn = f.reference.empty() ? 0.0 : meanSquaredError(f.color, f.reference);
         try {
-            if (svgf)
+            if (svgf) {
                 out = svgfDenoiser->denoiseFrame(io::svgfFrame(refs));
-            else
-                out = denoise(io::denoiseInputs(refs), options);
+            } else {
+                // The frame's colour, variance and emission are not read after this: the filter works
+                // in their storage.
+                const DenoiseInputs in = io::denoiseInputs(refs);
+                DenoiseBuffers bufs;
+                bufs.color = &f.color;
+                bufs.variance = f.variance.empty() ? nullptr : &f.variance;
+                bufs.emission = f.emission.empty() ? nullptr : &f.emission;
+                bufs.albedo = in.albedo, bufs.normal = in.normal, bufs.position = in.position;
+                bufs.depth = in.depth, bufs.ids = in.ids;
+                out = denoise(bufs, options);
+            }
         } catch (const InputError& e) {
             // The library names the buffer; the message names the frame's file too.
             throw InputError(io::withSourceFile(e.what(), [&](const std::string& b) { return f.fileOf(b); }, f.dir));
@@ -287,7 +298,7 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
                         args.method == "auto" ? denoiseMethodName(frameReport.methodUsed) : "", ms);
             if (check.tested > 0) std::printf(", %.0f%% reprojects onto the previous frame", 100 * check.kept);
             if (!f.reference.empty())
-                std::printf(", MSE vs reference %.6g (input %.6g)", mseOut, meanSquaredError(f.color, f.reference));
+                std::printf(", MSE vs reference %.6g (input %.6g)", mseOut, mseIn);
             std::printf("\n");
             std::fflush(stdout);
         }

@@ -21,9 +21,8 @@ std::string sizeOf(const Image& i) { return std::to_string(i.width()) + "x" + st
 
 // Object and material index passes (1 channel each) as atrous's ids buffer: R object, G material.
 Image composeIds(const Image* object, const Image* material, int w, int h) {
-    Image ids(w, h, 3);
+    Image ids(w, h, 2);
     const size_t n = ids.plane();
-    std::fill(ids.data(), ids.data() + 3 * n, 0.0f);
     if (object) std::copy(object->data(), object->data() + n, ids.data());
     if (material) std::copy(material->data(), material->data() + n, ids.data() + n);
     return ids;
@@ -101,8 +100,10 @@ Image readBufferFile(const std::string& path, Buffer b, const std::vector<PassRe
             return readPass(info, c, b);
         }
     }
+    // Held as the filters read them: depth 1 plane, ids 2 (atrous's ids.exr: R mesh, G material),
+    // motion 2, the rest 3.
     int channels = 3;
-    Image img = readImage(path, &channels);
+    Image img = readImage(path, &channels, b == Buffer::ObjectId ? 2 : bufferChannels(b));
     requireComponents(b, channels, path);
     conformBuffer(b, img);
     return img;

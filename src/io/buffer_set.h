@@ -30,7 +30,8 @@ struct BufferFiles {
 };
 
 struct BufferSet {
-    // By buffer; ids in the object_id slot (R = object, G = material id, B = 0). Empty when absent.
+    // By buffer, as the filters read them: 3 planes, but depth 1, motion 2 and the ids 2 (in the
+    // object_id slot: R = object, G = material id). Empty when absent.
     Image image[kBufferCount];
     std::string from[kBufferCount];  // where each came from, for messages and `inspect`
     std::shared_ptr<ExrInfo> layered;  // the layered file given as `in`, if any

@@ -165,7 +165,8 @@ std::vector<int> pickComponents(const ExrInfo& info, const ExrLayer& layer, int 
 }
 
 std::vector<Image> readExrChannelSets(const ExrInfo& info, const std::vector<std::vector<int>>& sets,
-                                      const std::vector<std::string>& whats) {
+                                      const std::vector<std::string>& whats, const std::vector<int>& outChannels) {
+    auto outOf = [&](size_t k) { return k < outChannels.size() ? std::max(outChannels[k], int(sets[k].size())) : 3; };
     const int w = info.width, h = info.height;
     const ExrWindow win{info.x0, info.y0, w, h};
     // Every channel of every set is checked before anything is allocated or decoded.
@@ -244,7 +245,7 @@ std::vector<Image> readExrChannelSets(const ExrInfo& info, const std::vector<std
                 }
         }
         // Every plane is written below (decoded, copied, or filled): no zero fill first.
-        for (size_t k = 0; k < sets.size(); ++k) images.push_back(Image::uninitialized(w, h, 3));
+        for (size_t k = 0; k < sets.size(); ++k) images.push_back(Image::uninitialized(w, h, outOf(k)));
         for (const auto& [p, uses] : byPart) {
             const std::vector<ExrPlaneRequest> req = requestsOf(uses, images);
             if (std::find(classic.begin(), classic.end(), p) == classic.end()) {
@@ -274,18 +275,18 @@ std::vector<Image> readExrChannelSets(const ExrInfo& info, const std::vector<std
     }
     for (size_t k = 0; k < sets.size(); ++k) {
         float* d = images[k].data();
-        if (sets[k].size() == 1) {
-            std::copy(d, d + plane, d + plane);
-            std::copy(d, d + plane, d + 2 * plane);
-        } else if (sets[k].size() == 2) {
-            std::fill(d + 2 * plane, d + 3 * plane, 0.0f);
+        for (int c = int(sets[k].size()); c < images[k].channels(); ++c) {
+            if (sets[k].size() == 1)
+                std::copy(d, d + plane, d + size_t(c) * plane);  // one channel: repeated
+            else
+                std::fill(d + size_t(c) * plane, d + size_t(c + 1) * plane, 0.0f);  // two: B = 0
         }
     }
     return images;
 }
 
 Image readExrChannels(const ExrInfo& info, const std::vector<int>& channels, const std::string& what) {
-    return std::move(readExrChannelSets(info, {channels}, {what})[0]);
+    return std::move(readExrChannelSets(info, {channels}, {what}, {})[0]);
 }
 
 namespace {

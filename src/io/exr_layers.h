@@ -70,9 +70,11 @@ std::vector<int> pickComponents(const ExrInfo& info, const ExrLayer& layer, int 
 // messages. A part that does not cover the image, a deep part or a subsampled channel is refused.
 Image readExrChannels(const ExrInfo& info, const std::vector<int>& channels, const std::string& what);
 // The same for several buffers at once: the file is opened and each part decoded once (a
-// single-part file such as Mitsuba's holds every pass in the same chunks). whats[k] names set k.
+// single-part file such as Mitsuba's holds every pass in the same chunks). whats[k] names set k;
+// outChannels[k] (when given) is the channel count of image k (at least the set's: 1 for a
+// depth, 2 for motion; 3 when absent).
 std::vector<Image> readExrChannelSets(const ExrInfo& info, const std::vector<std::vector<int>>& sets,
-                                      const std::vector<std::string>& whats);
+                                      const std::vector<std::string>& whats, const std::vector<int>& outChannels = {});
 
 // A layer to write: a full layer name ("" for the root) and a host image with at least as many
 // channels as `components` names (channel i is written as component i).

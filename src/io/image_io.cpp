@@ -64,6 +64,14 @@ static uintmax_t fileSize(const std::string& path) {
     return ec ? 0 : n;
 }
 
+// The first n channels of img (all of them when it has no more).
+static Image firstChannels(Image img, int n) {
+    if (n >= img.channels()) return img;
+    Image out = Image::uninitialized(img.width(), img.height(), n);
+    std::copy(img.data(), img.data() + out.size(), out.data());
+    return out;
+}
+
 // Out of memory while reading a file names the file (the allocator's message names none).
 template <class F>
 static auto namingFile(const std::string& path, F&& f) -> decltype(f()) {
@@ -79,7 +87,7 @@ static auto namingFile(const std::string& path, F&& f) -> decltype(f()) {
 
 // One EXR part's R,G,B (or Y, or its only channel) as a 3-channel image (exr_limits.h: the size rule
 // before anything is allocated, placed by the data window clipped to the display window).
-static Image readExr(const std::string& path, int* sourceChannels) {
+static Image readExr(const std::string& path, int* sourceChannels, int outChannels) {
     try {
         requireExrHeadersFit(path);
         Imf::InputFile file(path.c_str());
@@ -113,7 +121,7 @@ static Image readExr(const std::string& path, int* sourceChannels) {
                     img(int(x), int(y), 2) = float(p.b);
                 }
             if (sourceChannels) *sourceChannels = 3;
-            return img;
+            return firstChannels(std::move(img), outChannels);
         } else if (has("Y")) {
             src[0] = src[1] = src[2] = "Y";
         } else if (names.size() == 1) {
@@ -124,7 +132,7 @@ static Image readExr(const std::string& path, int* sourceChannels) {
             const PassMap m = mapPasses(info, {}, "");
             if (m[Buffer::Color].found()) {
                 if (sourceChannels) *sourceChannels = int(m[Buffer::Color].channels.size());
-                return readPass(info, m[Buffer::Color], Buffer::Color);
+                return firstChannels(readPass(info, m[Buffer::Color], Buffer::Color), outChannels);
             }
             std::string list;
             for (auto& n : names) list += (list.empty() ? "" : ",") + n;
@@ -133,7 +141,8 @@ static Image readExr(const std::string& path, int* sourceChannels) {
             throw InputError(path + ": expected R,G,B (or Y, or a single) channels, found none");
         }
         const bool grey = src[1] == src[0];
-        std::vector<std::string> read(src, src + (grey ? 1 : 3));
+        // Only the channels asked for are decoded (a depth file's R alone, an ids file's R and G).
+        std::vector<std::string> read(src, src + (grey ? 1 : outChannels));
         for (const std::string& n : read) {
             const Imf::Channel& ch = *channels.findChannel(n.c_str());
             if (ch.xSampling != 1 || ch.ySampling != 1)
@@ -146,20 +155,17 @@ static Image readExr(const std::string& path, int* sourceChannels) {
         if (core.decodes(0)) {
             // OpenEXR Core, chunks located and checked first, then decoded in parallel (exr_core.h).
             core.locate(0, win, "the image");
-            img = Image::uninitialized(int(w), int(h), 3);
+            img = Image::uninitialized(int(w), int(h), outChannels);
             std::vector<ExrPlaneRequest> req;
             for (size_t c = 0; c < read.size(); ++c) req.push_back({read[c], img.view().channel(int(c))});
             core.decode(0, req, win, "the image");
         } else {
             if (exrNeedsProof(uint64_t(w) * uint64_t(h) * 12, fileSize(path))) proveExrRows(file, read, dw.min.y, dw.max.y);
-            img = Image::uninitialized(int(w), int(h), 3);
+            img = Image::uninitialized(int(w), int(h), outChannels);
             for (size_t c = 0; c < read.size(); ++c) planes.push_back(img.view().channel(int(c)));
             readExrPlanes(file, read, planes, win);
         }
-        if (grey) {
-            std::copy(img.data(), img.data() + img.plane(), img.data() + img.plane());
-            std::copy(img.data(), img.data() + img.plane(), img.data() + 2 * img.plane());
-        }
+        for (int c = 1; grey && c < outChannels; ++c) std::copy(img.data(), img.data() + img.plane(), img.data() + c * img.plane());
         if (sourceChannels) *sourceChannels = grey ? 1 : 3;
         return img;
     } catch (const InputError&) {
@@ -447,13 +453,14 @@ static Image readStb(const std::string& path, int* sourceChannels) {
     return img;
 }
 
-Image readImage(const std::string& path, int* sourceChannels) {
+Image readImage(const std::string& path, int* sourceChannels, int channels) {
     requireFile(path);
+    if (channels < 1 || channels > 3) throw InputError(path + ": readImage takes 1 to 3 channels");
     const std::string ext = extensionOf(path);
-    if (ext == ".exr") return namingFile(path, [&] { return readExr(path, sourceChannels); });
-    if (ext == ".pfm") return namingFile(path, [&] { return readPfm(path, sourceChannels); });
+    if (ext == ".exr") return namingFile(path, [&] { return readExr(path, sourceChannels, channels); });
+    if (ext == ".pfm") return namingFile(path, [&] { return firstChannels(readPfm(path, sourceChannels), channels); });
     if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".hdr" || ext == ".bmp" || ext == ".tga")
-        return namingFile(path, [&] { return readStb(path, sourceChannels); });
+        return namingFile(path, [&] { return firstChannels(readStb(path, sourceChannels), channels); });
     throw InputError(path + ": unsupported image format '" + ext + "' (expected .exr, .pfm, .png, .jpg or .hdr)");
 }
 

@@ -241,12 +241,14 @@ PassChoice passForFile(const ExrInfo& info, Buffer b, const std::vector<PassRequ
 std::vector<Image> readPasses(const ExrInfo& info, const std::vector<std::pair<Buffer, const PassChoice*>>& passes) {
     std::vector<std::vector<int>> sets;
     std::vector<std::string> whats;
+    std::vector<int> outs;  // planes as the buffer takes them: depth and ids 1, motion 2, the rest 3
     for (const auto& [b, pass] : passes) {
         sets.push_back(pass->channels);
+        outs.push_back(bufferChannels(b));
         whats.push_back(std::string(bufferName(b)) + " pass" +
                         (pass->layer >= 0 ? " " + layerLabel(info.layers[size_t(pass->layer)]) : std::string()));
     }
-    std::vector<Image> images = readExrChannelSets(info, sets, whats);
+    std::vector<Image> images = readExrChannelSets(info, sets, whats, outs);
     for (size_t k = 0; k < images.size(); ++k) conformBuffer(passes[k].first, images[k]);
     return images;
 }

@@ -66,7 +66,8 @@ PassMap mapPasses(const ExrInfo& info, const std::vector<PassRequest>& requests,
 PassChoice passForFile(const ExrInfo& info, Buffer b, const std::vector<PassRequest>& requests,
                        const std::string& viewLayer);
 
-// Reads a pass as a 3-channel image and brings it to atrous's conventions (conformBuffer).
+// Reads a pass as an image of bufferChannels(b) planes (3 for a grey pass of a 3-component buffer:
+// repeated) and brings it to atrous's conventions (conformBuffer).
 Image readPass(const ExrInfo& info, const PassChoice& pass, Buffer b);
 // The same for several passes, decoding the file once (readExrChannelSets).
 std::vector<Image> readPasses(const ExrInfo& info, const std::vector<std::pair<Buffer, const PassChoice*>>& passes);

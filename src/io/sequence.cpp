@@ -297,7 +297,8 @@ SequenceFrame loadSequenceFrame(const std::string& frame, const std::vector<std:
         }
         Image& dst = *slot[i];
         int channels = 3;
-        dst = readImage(path, &channels);
+        const Buffer b = kFileBuffer[i];
+        dst = readImage(path, &channels, i == 9 ? 3 : b == Buffer::ObjectId ? 2 : bufferChannels(b));
         if (i != 9) requireComponents(kFileBuffer[i], channels, path);
         conformBuffer(kFileBuffer[i], dst);
         f.files[i] = path;

@@ -37,7 +37,8 @@ struct SequenceOptions {
 struct SequenceFrame {
     int index = 0;
     std::string dir;  // the frame directory or layered file
-    // 3-channel host images; empty when the frame has no such buffer.
+    // Host images as the filters read them (depth 1 plane, ids and motion 2, the rest 3); empty
+    // when the frame has no such buffer.
     Image color, albedo, normal, position, depth, ids, motion, reference, emission, variance;
     // The file each buffer came from, by kSequenceBuffers' order ("" when absent), for messages.
     std::string files[10];
