@@ -286,6 +286,18 @@ inline bool pngIdatOverrun(const uint8_t* d, size_t n) {
 // allocates its line buffers for the window's width: a 565-byte file with a data window from
 // x = -234881024 to 1792 costs 1.9 GB (reproducer findings/exr-huge-data-window-1.9gb.exr).
 // True when a header's data window is wider or taller than atrous accepts (kMaxImageDim).
+// Known (stb_image 2.27, fixed in 2.28): the PNM reader (P5/P6, which stb sniffs in any file)
+// reads the header's numbers into an int without an overflow check (UBSan: "666666666 * 10
+// cannot be represented in type 'int'", stbi__pnm_getinteger; found by the 10-minute png run;
+// reproducer findings/png-stb-pnm-integer-overflow.pnm). True for a P5/P6 file with a run of 10
+// or more digits in its first 1 KB.
+inline bool pnmLongNumber(const uint8_t* d, size_t n) {
+    if (n < 2 || d[0] != 'P' || (d[1] != '5' && d[1] != '6')) return false;
+    for (size_t i = 2, run = 0; i < std::min<size_t>(n, 1024); ++i)
+        if ((run = d[i] >= '0' && d[i] <= '9' ? run + 1 : 0) >= 10) return true;
+    return false;
+}
+
 inline bool exrWindowBeyondLimit(const std::vector<std::array<int64_t, 4>>& windows) {
     for (const auto& w : windows)
         if (w[2] - w[0] + 1 > atrous::kMaxImageDim || w[3] - w[1] + 1 > atrous::kMaxImageDim) return true;
@@ -300,6 +312,8 @@ inline bool skipKnownImage(const uint8_t* d, size_t n) {
         return true;
     if (exrWindowBeyondLimit(windows) &&
         knownIssue("exr-window-line-buffers", "an EXR data window beyond 16384 per side: OpenEXR allocates its line buffers first"))
+        return true;
+    if (pnmLongNumber(d, n) && knownIssue("stb-pnm-integer-overflow", "stb_image 2.27 overflows an int reading a PNM header's number"))
         return true;
     if (pngIdatOverrun(d, n) &&
         knownIssue("stb-png-idat-length", "stb_image 2.27 allocates an IDAT chunk's claimed length before reading it"))
