@@ -13,6 +13,7 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <random>
 #include <vector>
 
 #include "atrous/error.h"
@@ -294,4 +295,38 @@ TEST(Learned, BadPlanesAreClearErrors) {
     EXPECT_NE(msg(fx.planes(), small.view()).find("learned filter: out: size"), std::string::npos);
     EXPECT_NE(msg(fx.planes(), out.view()).find("no error"), std::string::npos);
     EXPECT_THROW(runLearned(CpuExec{}, LearnedWeights{}, fx.planes(), out.view()), InputError);
+}
+
+// Bands of rows (the CPU's way at large sizes, learnedCpuBandRows): every band's rows are computed
+// from its halo of 63 rows, so the output equals the whole image's bit for bit; bands shorter and
+// longer than the halo, and a last band of a few rows.
+TEST(Learned, BandsOfRowsEqualTheWholeImage) {
+    const int w = 45, h = 301;
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    Image d(w, h, 3), var(w, h, 3), albedo(w, h, 3), normal(w, h, 3), depth(w, h, 1);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const bool edge = (x + y / 3) % 17 < 8;
+            for (int c = 0; c < 3; ++c) {
+                d(x, y, c) = (edge ? 0.8f : 0.2f) + 0.3f * u(rng);
+                var(x, y, c) = 0.01f * u(rng);
+                albedo(x, y, c) = edge ? 0.7f : 0.3f;
+                normal(x, y, c) = c == 2 ? 1.0f : 0.0f;
+            }
+            depth(x, y, 0) = edge ? 2.0f : 5.0f;
+        }
+    const LearnedPlanes p{d.view(), var.view(), albedo.view(), normal.view(), depth.view()};
+    const LearnedWeights wts = LearnedWeights::builtin();
+    const int saved = learnedCpuBandRows();
+    learnedCpuBandRows() = -1;
+    const Image whole = run(p, wts, true);
+    for (int rows : {5, 40, 64, 120, 200, 296}) {
+        learnedCpuBandRows() = rows;
+        const Image banded = run(p, wts, true);
+        size_t differ = 0;
+        for (size_t i = 0; i < whole.size(); ++i) differ += std::memcmp(whole.data() + i, banded.data() + i, 4) != 0;
+        EXPECT_EQ(differ, 0u) << "bands of " << rows << " rows";
+    }
+    learnedCpuBandRows() = saved;
 }

@@ -142,5 +142,10 @@ template <class Stop>
 void runAtrousRows(const Stop& stop, bool avx512) {
     runAtrousRows(stop, isaFromAvx512Switch(avx512));
 }
+// Rows [y0, y1) of the level only (the others are not written).
+template <class Stop>
+void runAtrousRows(const Stop& stop, bool avx512, int y0, int y1) {
+    parallelForIsa(isaFromAvx512Switch(avx512), y0, y1, 8, AtrousRows<Stop>{stop});
+}
 
 }  // namespace atrous::cpu

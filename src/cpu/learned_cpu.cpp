@@ -8,7 +8,9 @@
 #include <tbb/scalable_allocator.h>
 
 #include <chrono>
+#include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <ctime>
 #include <memory>
 #include <vector>
@@ -45,15 +47,17 @@ struct LogRange {
     }
 };
 
-// Pass B over rows [y0, y1).
+// Pass B over rows [y0, y1) of T and acc (h rows); P's rows start pOffset values further on (a
+// band of rows: the band's first row in the image).
 struct NetRows {
     const LearnedNet* net;
     LearnedPlanes P;
     LearnedTemps T;
     ImageView acc;
+    size_t pOffset = 0;
 
     ATROUS_FORCE_INLINE void operator()(int y0, int y1) const {
-        const int w = P.d.width, h = P.d.height;
+        const int w = T.lg.width, h = T.lg.height;
         const size_t stride = size_t(w) + 2;
         std::vector<float> buf(kLearnedBoxQ * stride + size_t(w));
         float* V[kLearnedBoxQ];
@@ -89,11 +93,11 @@ struct NetRows {
             for (int x0 = 0; x0 < w; x0 += kLanes) {
                 const int n = w - x0 < kLanes ? w - x0 : kLanes;
                 float in[kLearnedIn][kLanes], out[kLearnedOut][kLanes];
-                learnedPointInputs<kLanes>(P, T.lg, o + size_t(x0), n, in);
+                learnedPointInputs<kLanes>(P, T.lg, o + size_t(x0), n, in, pOffset + o + size_t(x0));
                 const float* const Vx[kLearnedBoxQ] = {V[0] + x0, V[1] + x0, V[2] + x0, V[3] + x0, V[4] + x0};
                 learnedBoxInputs<kLanes>(Vx, inv + x0, n, in);
                 learnedMlp<kLanes>(*net, in, out);
-                learnedWriteOutputs<kLanes>(out, P.d, T, acc, o + size_t(x0), n);
+                learnedWriteOutputs<kLanes>(out, P.d, T, acc, o + size_t(x0), n, pOffset + o + size_t(x0));
             }
         }
     }
@@ -125,12 +129,33 @@ struct StageClock {
 
 }  // namespace
 
+// The learned filter's temporaries are 42 planes (168 bytes a pixel): at 3840x2160 1.4 GB. Above
+// kBandPixels pixels, a call without a cache (the still driver's) runs in bands of rows, each with
+// the rows within kBandHalo of it (the five levels reach 62 rows, the network's 3x3 box one more):
+// the temporaries are those of a band, ~40% of the image's at 4K. A band's rows get the same
+// values as the whole image's (every value's inputs lie within its band's rows), so the output
+// is bit-equal; the network runs again on the halo rows (at 4K, three bands: +17% of the network's
+// work), the levels on the rows the next level reads only.
+constexpr size_t kBandPixels = size_t(4) << 20;
+constexpr size_t kBandCorePixels = size_t(2800) << 10;
+constexpr int kBandHalo = 2 * ((1 << kLearnedLevels) - 1) + 1;
+
+int& learnedCpuBandRows() {
+    static int rows = 0;
+    return rows;
+}
+
 void runLearned(const CpuExec& exec, const LearnedWeights& weights, const LearnedPlanes& in, const ImageView& out,
                 LearnedStageTimes* times, LearnedCache* cache) {
     checkLearnedPlanes(weights, in, out);
     const int w = in.d.width, h = in.d.height;
     StageClock clock;
     double unused = 0;
+    const int forced = learnedCpuBandRows();
+    const bool banded = !cache && atrousCpuFastPath() &&
+                        (forced > 0 ? forced < h : forced == 0 && size_t(w) * size_t(h) > kBandPixels);
+    const int core = !banded ? h : forced > 0 ? forced : std::max(64, int(kBandCorePixels / size_t(w)));
+    const int regionRows = banded ? std::min(h, core + 2 * kBandHalo) : h;
     // The temporaries from the scalable allocator (not Images: no zero fill), one allocation per
     // view: at 512x512 each is at most 8 MiB, which the allocator's cache hands back on the next
     // call (one 36 MiB block was new memory, first touched, every call). With a cache they are
@@ -138,22 +163,24 @@ void runLearned(const CpuExec& exec, const LearnedWeights& weights, const Learne
     using Stores = std::vector<std::unique_ptr<float, void (*)(void*)>>;
     LearnedTemps T;
     std::shared_ptr<Stores> stores;
+    ImageView bandAcc;
     if (cache && cache->holds(weights, w, h)) {
         T = cache->temps;
     } else {
         stores = std::make_shared<Stores>();
-        const size_t plane = size_t(w) * size_t(h);
+        const size_t plane = size_t(w) * size_t(regionRows);
         auto alloc = [&](int channels) {
             const size_t bytes = size_t(channels) * plane * sizeof(float);
             stores->emplace_back(static_cast<float*>(scalable_aligned_malloc(bytes, 64)), scalable_aligned_free);
             float* p = stores->back().get();
             if (!p) throw RuntimeError("out of host memory for the learned filter's planes");
             adviseHugePages(p, bytes);
-            return ImageView{p, w, h, channels};
+            return ImageView{p, w, regionRows, channels};
         };
         T.lg = alloc(4), T.feat = alloc(kLearnedFeat), T.a = alloc(kLearnedLevels), T.m = alloc(kLearnedLevels);
         T.bk = alloc(kLearnedLevels), T.c = alloc(kLearnedLevels), T.beta = alloc(kLearnedLevels + 1), T.buf = alloc(3);
         T.v = alloc(1);
+        if (banded) bandAcc = alloc(3);
         if (cache) *cache = LearnedCache{w, h, weights.impl, stores, T, &weights.impl->net};
     }
     const LearnedNet* net = &weights.impl->net;
@@ -164,17 +191,60 @@ void runLearned(const CpuExec& exec, const LearnedWeights& weights, const Learne
         runLearnedFunctors(exec, net, in, T, out);
         return;
     }
-    cpu::parallelForIsa(cpu::activeIsa(), size_t(0), in.d.plane(), size_t(16384),
-                        LogRange{in.d.channel(0), in.d.channel(1), in.d.channel(2), in.var.channel(0),
-                                 in.var.channel(1), in.var.channel(2), T.lg.channel(0), T.lg.channel(1),
-                                 T.lg.channel(2), T.lg.channel(3), T.v.channel(0)});
-    clock.mark(t.logs, t.cpuLogs);
-    cpu::parallelForIsa(cpu::activeIsa(), 0, h, 2, NetRows{net, in, T, out});
-    clock.mark(t.network, t.cpuNetwork);
     const bool avx512 = atrousCpuAvx512();
-    for (int i = 0; i + 1 < kLearnedLevels; ++i) cpu::runAtrousRows(learnedStop<false>(in, T, out, i), avx512);
-    cpu::runAtrousRows(learnedStop<true>(in, T, out, kLearnedLevels - 1), avx512);
-    clock.mark(t.levels, t.cpuLevels);
+    double logs = 0, network = 0, levels = 0, cpuLogs = 0, cpuNetwork = 0, cpuLevels = 0;
+    LearnedStageTimes sum;  // over the bands
+    for (int y0 = 0; y0 < h; y0 += core) {
+        const int y1 = std::min(h, y0 + core);
+        const int r0 = banded ? std::max(0, y0 - kBandHalo) : 0, r1 = banded ? std::min(h, y1 + kBandHalo) : h;
+        const int rows = r1 - r0;
+        // The band's views: the temporaries from their first row (each view's planes contiguous
+        // for `rows` rows), P from the image's row r0.
+        auto view = [&](const ImageView& v) { return ImageView{v.data, w, rows, v.channels}; };
+        LearnedTemps B = T;
+        B.lg = view(T.lg), B.feat = view(T.feat), B.a = view(T.a), B.m = view(T.m), B.bk = view(T.bk), B.c = view(T.c);
+        B.beta = view(T.beta), B.buf = view(T.buf), B.v = view(T.v);
+        const ImageView acc = banded ? view(bandAcc) : out;
+        const size_t pOffset = size_t(r0) * size_t(w);
+        cpu::parallelForIsa(cpu::activeIsa(), size_t(0), size_t(rows) * size_t(w), size_t(16384),
+                            LogRange{in.d.channel(0) + pOffset, in.d.channel(1) + pOffset, in.d.channel(2) + pOffset,
+                                     in.var.channel(0) + pOffset, in.var.channel(1) + pOffset,
+                                     in.var.channel(2) + pOffset, B.lg.channel(0), B.lg.channel(1), B.lg.channel(2),
+                                     B.lg.channel(3), B.v.channel(0)});
+        clock.mark(logs, cpuLogs);
+        sum.logs += logs, sum.cpuLogs += cpuLogs;
+        cpu::parallelForIsa(cpu::activeIsa(), 0, rows, 2, NetRows{net, in, B, acc, pOffset});
+        clock.mark(network, cpuNetwork);
+        sum.network += network, sum.cpuNetwork += cpuNetwork;
+        // Level i over the rows the levels after it read: within H_i = 2 (2^5 - 2^(i+1)) of the band.
+        for (int i = 0; i < kLearnedLevels; ++i) {
+            const int reach = banded ? 2 * ((1 << kLearnedLevels) - (2 << i)) : 0;
+            const int a = std::max(r0, y0 - reach) - r0, b = std::min(r1, y1 + reach) - r0;
+            if (i + 1 < kLearnedLevels) {
+                LearnedStop<false> s = learnedStop<false>(in, B, acc, i);
+                s.height_ = rows;
+                if (i == 0) s.dInShift = ptrdiff_t(pOffset);
+                cpu::runAtrousRows(s, avx512, a, b);
+            } else {
+                LearnedStop<true> s = learnedStop<true>(in, B, acc, i);
+                s.height_ = rows;
+                if (i == 0) s.dInShift = ptrdiff_t(pOffset);
+                cpu::runAtrousRows(s, avx512, a, b);
+            }
+        }
+        if (banded) {
+            // The band's own rows of acc into the output.
+            cpu::parallelForIsa(cpu::activeIsa(), y0, y1, 16, [&](int q0, int q1) {
+                for (int c = 0; c < 3; ++c)
+                    std::memcpy(out.channel(c) + size_t(q0) * w, acc.channel(c) + size_t(q0 - r0) * w,
+                                size_t(q1 - q0) * w * sizeof(float));
+            });
+        }
+        clock.mark(levels, cpuLevels);
+        sum.levels += levels, sum.cpuLevels += cpuLevels;
+    }
+    t.logs = sum.logs, t.cpuLogs = sum.cpuLogs, t.network = sum.network, t.cpuNetwork = sum.cpuNetwork;
+    t.levels = sum.levels, t.cpuLevels = sum.cpuLevels;
 }
 
 }  // namespace atrous::filters

@@ -57,6 +57,9 @@ void runLearned(const CpuExec& exec, const LearnedWeights& w, const LearnedPlane
                 LearnedStageTimes* times = nullptr, LearnedCache* cache = nullptr);
 void runLearned(const CudaExec& exec, const LearnedWeights& w, const LearnedPlanes& in, const ImageView& out,
                 LearnedStageTimes* times = nullptr, LearnedCache* cache = nullptr);
+// The CPU entry point's bands of rows (src/cpu/learned_cpu.cpp): 0 (default) = by size (above 4 Mpixels,
+// without a cache), > 0 = bands of that many rows whenever the image is taller (tests), < 0 = never.
+int& learnedCpuBandRows();
 // The checks both entry points make (src/filters/learned_weights.cpp).
 void checkLearnedPlanes(const LearnedWeights& w, const LearnedPlanes& in, const ImageView& out);
 
@@ -115,10 +118,11 @@ struct LearnedLogPass {
 };
 
 // Inputs 0-10 of the pixels i0 .. i0 + n - 1 (flat index within a row), into lanes 0 .. n - 1;
-// lanes n .. N - 1 are zeroed.
+// lanes n .. N - 1 are zeroed. iP: the same pixels' index in P's planes (the CPU's bands of rows
+// index the temporaries from the band's first row, P from the image's).
 template <int N>
 ATROUS_FORCE_INLINE ATROUS_INLINE void learnedPointInputs(const LearnedPlanes& P, const ImageView& lg, size_t i0,
-                                                               int n, float (&x)[kLearnedIn][N]) {
+                                                               int n, float (&x)[kLearnedIn][N], size_t iP) {
     if (n < N)
         for (int k = 0; k < kLearnedIn; ++k)
             for (int l = 0; l < N; ++l) x[k][l] = 0.0f;
@@ -128,25 +132,25 @@ ATROUS_FORCE_INLINE ATROUS_INLINE void learnedPointInputs(const LearnedPlanes& P
     }
     for (int c = 0; c < 3; ++c) {
         if (P.albedo.valid()) {
-            const float* s = P.albedo.channel(c) + i0;
+            const float* s = P.albedo.channel(c) + iP;
             for (int l = 0; l < n; ++l) x[3 + c][l] = learnedAlbedoIn(s[l]);
         } else {
             for (int l = 0; l < n; ++l) x[3 + c][l] = 1.0f;
         }
         if (P.normal.valid()) {
-            const float* s = P.normal.channel(c) + i0;
+            const float* s = P.normal.channel(c) + iP;
             for (int l = 0; l < n; ++l) x[6 + c][l] = learnedFinite(s[l]);
         } else {
             for (int l = 0; l < n; ++l) x[6 + c][l] = 0.0f;
         }
     }
     if (P.depth.valid()) {
-        const float* s = P.depth.channel(0) + i0;
+        const float* s = P.depth.channel(0) + iP;
         for (int l = 0; l < n; ++l) x[9][l] = learnedDepthIn(s[l]);
     } else {
         for (int l = 0; l < n; ++l) x[9][l] = 0.0f;  // log 1
     }
-    const float *vr = P.var.channel(0) + i0, *vg = P.var.channel(1) + i0, *vb = P.var.channel(2) + i0;
+    const float *vr = P.var.channel(0) + iP, *vg = P.var.channel(1) + iP, *vb = P.var.channel(2) + iP;
     for (int l = 0; l < n; ++l) x[10][l] = learnedNoiseIn(vr[l], vg[l], vb[l]);
 }
 
@@ -174,12 +178,12 @@ ATROUS_FORCE_INLINE ATROUS_INLINE void learnedBoxInputs(const float* const (&V)[
 template <int N>
 ATROUS_FORCE_INLINE ATROUS_INLINE void learnedWriteOutputs(const float (&y)[kLearnedOut][N], const ImageView& d,
                                                                 const LearnedTemps& T, const ImageView& acc,
-                                                                size_t i0, int n) {
+                                                                size_t i0, int n, size_t iD) {
     for (int k = 0; k < kLearnedFeat; ++k) {
         float* o = T.feat.channel(k) + i0;
         for (int l = 0; l < n; ++l) o[l] = learnedFinite(y[k][l]);
     }
-    const float *dr = d.channel(0) + i0, *dg = d.channel(1) + i0, *db = d.channel(2) + i0;
+    const float *dr = d.channel(0) + iD, *dg = d.channel(1) + iD, *db = d.channel(2) + iD;  // d's own index
     for (int i = 0; i < kLearnedLevels; ++i) {
         float *oa = T.a.channel(i) + i0, *om = T.m.channel(i) + i0, *ob = T.bk.channel(i) + i0,
               *oc = T.c.channel(i) + i0;
@@ -228,7 +232,7 @@ struct LearnedNetPixel {
         const int w = P.d.width, h = P.d.height;
         const size_t i = P.d.index(x, y);
         float in[kLearnedIn][1];
-        learnedPointInputs<1>(P, T.lg, i, 1, in);
+        learnedPointInputs<1>(P, T.lg, i, 1, in, i);
         // Column sums of the 3x3 box, in the row loop's order (rows y - 1, y, y + 1 from 0).
         float cs[kLearnedBoxQ][3];
         for (int dx = -1; dx <= 1; ++dx) {
@@ -250,7 +254,7 @@ struct LearnedNetPixel {
         learnedBoxInputs<1>(V, &inv, 1, in);
         float out[kLearnedOut][1];
         learnedMlp<1>(*net, in, out);
-        learnedWriteOutputs<1>(out, P.d, T, acc, i, 1);
+        learnedWriteOutputs<1>(out, P.d, T, acc, i, 1, i);
     }
 };
 
@@ -260,6 +264,10 @@ template <bool kLast>
 struct LearnedStop {
     int step_ = 1;
     ImageView dIn, dOut, feat, acc;
+    // The CPU's bands of rows (src/cpu/learned_cpu.cpp): the level's height when not dIn's (0), and
+    // where dIn's rows start relative to the band's (level 0 reads d from the image's planes).
+    int height_ = 0;
+    ptrdiff_t dInShift = 0;
     // The level's planes; beta_{i+1}; v, the noise plane (every level's).
     const float *a = nullptr, *m = nullptr, *bk = nullptr, *c = nullptr, *beta = nullptr, *v = nullptr;
     float* bkNext = nullptr;  // b_{i+1}, scaled in place by kappa of d_{i+1} (not when kLast)
@@ -278,12 +286,12 @@ struct LearnedStop {
     struct TapRow {};
 
     ATROUS_HOST_DEVICE int width() const { return dIn.width; }
-    ATROUS_HOST_DEVICE int height() const { return dIn.height; }
+    ATROUS_HOST_DEVICE int height() const { return height_ ? height_ : dIn.height; }
     ATROUS_HOST_DEVICE int step() const { return step_; }
     ATROUS_HOST_DEVICE Row row(int y) const {
         const size_t o = size_t(y) * size_t(dIn.width);
         Row R;
-        R.r = dIn.channel(0) + o, R.g = dIn.channel(1) + o, R.b = dIn.channel(2) + o;
+        R.r = dIn.channel(0) + dInShift + o, R.g = dIn.channel(1) + dInShift + o, R.b = dIn.channel(2) + dInShift + o;
         R.a = a + o, R.m = m + o, R.bk = bk + o, R.c = c + o, R.beta = beta + o, R.v = v + o;
         for (int k = 0; k < kLearnedFeat; ++k) R.f[k] = feat.channel(k) + o;
         R.accR = acc.channel(0) + o, R.accG = acc.channel(1) + o, R.accB = acc.channel(2) + o;
