@@ -15,9 +15,11 @@
 
 #include "core/parallel.h"
 #include "filters/denoise_driver.h"
+#include "filters/emission_filter.h"
 #include "filters/modulation.h"
 #include "filters/noise_estimate.h"
 #include "filters/prepass.h"
+#include "filters/sure.h"
 
 using namespace atrous;
 using namespace atrous::filters;
@@ -273,5 +275,102 @@ TEST(FilterRows, InPlaceSanitiseAndTheFireflyCountEqualTheFunctors) {
             EXPECT_EQ(firstBitDifference(fv1, fv4), -1) << w << "x" << h << " own " << own;
             EXPECT_EQ(count, want) << w << "x" << h << " own " << own;
         }
+    }
+}
+
+TEST(FilterRows, EmissionLevelEqualsTheFunctor) {
+    // Emission: zeros, quiet lights (tiny variance), partly covered pixels (variance near and above
+    // the copy threshold), tiny values; every level's step.
+    for (auto& sz : kSizes) {
+        const int w = sz[0], h = sz[1];
+        Image e(w, h, 3), v(w, h, 3);
+        std::mt19937 rng(unsigned(w * 7 + h));
+        std::uniform_real_distribution<float> u(0.0f, 1.0f);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const int kind = int(rng() % 5);
+                for (int c = 0; c < 3; ++c) {
+                    const float val = kind == 0 ? 0.0f : (kind == 4 ? 1e-20f * u(rng) : 5.0f * u(rng));
+                    e(x, y, c) = val;
+                    // variance relative to the energy: below, at and above 1e-4 of it
+                    const float rel = kind == 1 ? 1e-6f : (kind == 2 ? 1.0e-4f / 3.0f : 0.5f);
+                    v(x, y, c) = rel * val * val * (0.9f + 0.2f * u(rng));
+                }
+            }
+        for (int step : {1, 2, 4, 8}) {
+            EmissionLevel f;
+            f.step = step;
+            f.sigmaMul = 2.0f / float(step * step);
+            f.eIn = e.view(), f.variance = v.view();
+            Image a(w, h, 3), b(w, h, 3);
+            f.eOut = a.view();
+            runEmissionLevel(CpuExec{}, f);
+            // The functor pixel by pixel in the dispatched row loop (what the CPU level was).
+            f.eOut = b.view();
+            parallelForRowsCpu(h, [&](int y) {
+                for (int x = 0; x < w; ++x) f(x, y);
+            });
+            EXPECT_EQ(firstBitDifference(a, b), -1) << w << "x" << h << " step " << step;
+        }
+    }
+}
+
+TEST(FilterRows, EmissionFilterEqualsTheFunctorLevels) {
+    // The whole filter (1 to 5 levels): the CPU's listed pixels against every pixel through the
+    // functor level by level; with the second buffer separate and being the input itself (as the
+    // driver passes the emission's own copy).
+    for (auto& sz : kSizes) {
+        const int w = sz[0], h = sz[1];
+        Image e(w, h, 3), v(w, h, 3);
+        std::mt19937 rng(unsigned(w * 5 + h));
+        std::uniform_real_distribution<float> u(0.0f, 1.0f);
+        for (size_t i = 0; i < e.plane(); ++i) {
+            const int kind = int(rng() % 4);
+            for (int c = 0; c < 3; ++c) {
+                const float val = kind == 0 ? 0.0f : 3.0f * u(rng);
+                e.data()[i + c * e.plane()] = val;
+                v.data()[i + c * e.plane()] = (kind == 1 ? 1e-6f : 0.3f) * val * val;
+            }
+        }
+        for (int levels = 1; levels <= 5; ++levels)
+            for (int alias = 0; alias < 2; ++alias) {
+                Image in1 = e.clone(), a1(w, h, 3), b1(w, h, 3), in2 = e.clone(), a2(w, h, 3), b2(w, h, 3);
+                const ImageView r1 = runEmissionFilter(CpuExec{}, levels, 1.0f, v.view(), in1.view(), a1.view(),
+                                                       alias ? in1.view() : b1.view());
+                const ImageView r2 = runEmissionFilter<CpuExec>(CpuExec{}, levels, 1.0f, v.view(), in2.view(), a2.view(),
+                                                                alias ? in2.view() : b2.view());
+                Image x1(w, h, 3), x2(w, h, 3);
+                std::memcpy(x1.data(), r1.data, x1.size() * sizeof(float));
+                std::memcpy(x2.data(), r2.data, x2.size() * sizeof(float));
+                EXPECT_EQ(firstBitDifference(x1, x2), -1) << w << "x" << h << " levels " << levels << " alias " << alias;
+            }
+    }
+}
+
+TEST(FilterRows, SureWindowEqualsItsTwoPasses) {
+    // The fused window passes (a ring of horizontal sums) against SureBoxH into a plane, then
+    // SureChoose from it: discrete and James-Stein, radii 1 to 5, s_i map or not.
+    for (auto& sz : kSizes) {
+        const int w = sz[0], h = sz[1];
+        const Image detail = randomImage(w, h, 2, 21, 0.0f, 1.0f);
+        const Image ci = randomImage(w, h, 3, 22, 0.0f, 2.0f), cn = randomImage(w, h, 3, 23, 0.0f, 2.0f);
+        const Image acc0 = randomImage(w, h, 3, 24, -0.1f, 0.1f);
+        for (int js = 0; js < 2; ++js)
+            for (int r = 1; r <= 5; r += 2)
+                for (int withS = 0; withS < 2; ++withS) {
+                    SureChoiceParams p;
+                    p.radius = r;
+                    p.jamesStein = js;
+                    Image boxH(w, h, 2), acc1 = acc0.clone(), acc2 = acc0.clone(), s1(w, h, 1), s2(w, h, 1);
+                    runSureBoxH(CpuExec{}, SureBoxH{r, detail.view(), boxH.view()});
+                    runSureChoose(CpuExec{}, SureChoose{p, boxH.view(), ci.view(), cn.view(), acc1.view(),
+                                                      withS ? s1.view() : ImageView{}});
+                    runSureWindow(CpuExec{}, SureBoxH{r, detail.view(), ImageView{}},
+                                  SureChoose{p, ImageView{}, ci.view(), cn.view(), acc2.view(), withS ? s2.view() : ImageView{}});
+                    const std::string what = std::to_string(w) + "x" + std::to_string(h) + " r " + std::to_string(r) +
+                                             " js " + std::to_string(js);
+                    EXPECT_EQ(firstBitDifference(acc1, acc2), -1) << what;
+                    if (withS) EXPECT_EQ(firstBitDifference(s1, s2), -1) << what;
+                }
     }
 }

@@ -30,8 +30,8 @@ static DenoiseReport stillReport(DenoiseMethod method, int levels, unsigned seed
 
 TEST(StageTimes, EawReportListsEveryStageInOrder) {
     const DenoiseReport rep = stillReport(DenoiseMethod::Eaw, 3, 7);
-    const std::vector<std::string> expected = {"sanitize", "fireflies",  "demodulate", "sigma scales", "level 0",
-                                               "level 1",  "level 2", "remodulate"};
+    const std::vector<std::string> expected = {"sanitize", "fireflies", "demodulate", "sigma scales", "level 0",
+                                               "level 1",  "level 2",   "give-back",  "remodulate"};
     EXPECT_EQ(test::stageNames(rep.stages), expected);
     // The stages are timed inside the window of rep.milliseconds with the same steady clock, so
     // their sum cannot exceed it (1e-6 ms: rounding of the two subtractions).
@@ -42,7 +42,27 @@ TEST(StageTimes, EawReportListsEveryStageInOrder) {
 TEST(StageTimes, SureReportHasTheChoiceAfterEachLevel) {
     const DenoiseReport rep = stillReport(DenoiseMethod::Sure, 2, 8);
     const std::vector<std::string> expected = {"sanitize", "fireflies", "demodulate", "sigma scales", "level 0",
-                                               "sure 0",   "level 1",   "sure 1",     "remodulate"};
+                                               "sure 0",   "level 1",   "sure 1",     "give-back",    "remodulate"};
+    EXPECT_EQ(test::stageNames(rep.stages), expected);
+    EXPECT_LE(test::stageSum(rep.stages), rep.milliseconds + 1e-6);
+}
+
+// Without a variance buffer the noise estimate's two stages come in under their own names (the
+// global MAD before the sanitise pass, the per-pixel estimate after the demodulation); without an
+// albedo there is no give-back.
+TEST(StageTimes, NoiseEstimateStagesWithoutAVariance) {
+    const test::SyntheticScene scene = test::makeScene(48, 40, 0.3f, 7);
+    DenoiseOptions o;
+    o.method = DenoiseMethod::Eaw;
+    o.eaw.levels = 2;
+    DenoiseReport rep;
+    o.report = &rep;
+    DenoiseInputs in = scene.inputs();
+    in.variance = nullptr;
+    in.albedo = nullptr;
+    denoise(in, o);
+    const std::vector<std::string> expected = {"noise sigma", "sanitize", "fireflies", "demodulate", "noise estimate",
+                                               "sigma scales", "level 0", "level 1", "remodulate"};
     EXPECT_EQ(test::stageNames(rep.stages), expected);
     EXPECT_LE(test::stageSum(rep.stages), rep.milliseconds + 1e-6);
 }

@@ -159,7 +159,8 @@ struct DenoiseReport {
     // per-pixel estimate, docs/algorithms.md), sigma scales, then
     // "level i" (and for SURE "sure i": the window sums and the choice of s_i) per level (the
     // learned method: one stage "learned" instead of sigma scales and the levels), then
-    // "safety net" (when on) and remodulate. CPU: wall clock; CUDA: cudaEvents on the stream (GPU time, no extra syncs).
+    // "give-back" (EAW and SURE with an albedo: the albedo give-back, docs/algorithms.md), "safety
+    // net" (when on) and remodulate. CPU: wall clock; CUDA: cudaEvents on the stream (GPU time, no extra syncs).
     std::vector<StageTime> stages;
 };
 

@@ -18,9 +18,12 @@ void reportLuminance(const CpuExec&, const ImageView& c, DriverReport& report) {
             const float* g = c.channel(1) + o;
             const float* b = c.channel(2) + o;
             double s = 0, n = 0;
+#pragma omp simd reduction(+ : s, n)
             for (int x = 0; x < w; ++x) {
                 const float l = lum(r[x], g[x], b[x]);
-                if (finite(l)) s += l, n += 1;
+                const bool ok = finite(l);
+                s += ok ? double(l) : 0.0;
+                n += ok ? 1.0 : 0.0;
             }
             sum[size_t(y)] = s, count[size_t(y)] = n;
         }

@@ -31,6 +31,7 @@
 #include "core/parallel.h"
 #include "cpu/isa_dispatch.h"
 #include "cpu/modulation_rows.h"
+#include "cpu/row_sums.h"
 #include "filters/noise_estimate.h"
 
 namespace atrous::filters {
@@ -55,17 +56,17 @@ constexpr int kBins = 1 << kBinBits;
 float radixMedian(const float* d, size_t n, float none) {
     const size_t chunk = 1 << 16;
     const size_t chunks = (n + chunk - 1) / chunk;
-    std::vector<uint32_t> hist(chunks * kBins, 0);
+    // One histogram per chunk, with a last bin for the values left out (no branch per value).
+    std::vector<uint32_t> hist(chunks * (kBins + 1), 0);
     tbb::parallel_for(size_t(0), chunks, [&](size_t k) {
-        uint32_t* H = hist.data() + k * kBins;
+        uint32_t* H = hist.data() + k * (kBins + 1);
         const size_t i1 = std::min(n, (k + 1) * chunk);
-        for (size_t i = k * chunk; i < i1; ++i)
-            if (counted(d[i])) ++H[orderKey(d[i]) >> (32 - kBinBits)];
+        for (size_t i = k * chunk; i < i1; ++i) ++H[counted(d[i]) ? orderKey(d[i]) >> (32 - kBinBits) : kBins];
     });
     std::vector<size_t> total(kBins, 0);
     size_t m = 0;
     for (size_t k = 0; k < chunks; ++k)
-        for (int b = 0; b < kBins; ++b) total[b] += hist[k * kBins + size_t(b)];
+        for (int b = 0; b < kBins; ++b) total[b] += hist[k * (kBins + 1) + size_t(b)];
     for (int b = 0; b < kBins; ++b) m += total[b];
     if (!m) return none;
     const size_t rank = m / 2;
@@ -138,10 +139,12 @@ struct MadBand {
                     // float times the value in double (exact products), ws = 1 exactly.
                     double s = 0;
                     const float* rows[5] = {r0, r1, r2, r3, r4};
+#pragma GCC unroll 5
                     for (int qy = -2; qy <= 2; ++qy)
+#pragma GCC unroll 5
                         for (int qx = -2; qx <= 2; ++qx) s += double(b3(qx) * b3(qy)) * rows[qy + 2][x + qx];
                     const float v = r2[x];
-                    out[x] = finite(v) & finiteD(s) ? fabsf(float(v - s / 1.0)) : INFINITY;
+                    out[x] = selectF(finite(v) & finiteD(s), fabsf(float(v - s / 1.0)), INFINITY);
                 }
             }
         }
@@ -159,29 +162,35 @@ ATROUS_FORCE_INLINE inline void energyAt(const float* const (&c)[3][5], const fl
                                          float& e1, float& e2) {
     const float nx = kN ? n[0][2][x] : 0.0f, ny = kN ? n[1][2][x] : 0.0f, nz = kN ? n[2][2][x] : 0.0f;
     const float zp = kZ ? z[2][x] : 0.0f;
-    const float cp[3] = {c[0][2][x], c[1][2][x], c[2][2][x]};
-    float s[3] = {0, 0, 0}, ws = 0, w2 = 0;
-    for (int qy = -2; qy <= 2; ++qy)
+    const float cp0 = c[0][2][x], cp1 = c[1][2][x], cp2 = c[2][2][x];
+    float s0 = 0, s1 = 0, s2 = 0, ws = 0, w2 = 0;
+    // The taps unrolled (GCC vectorises the x loop only around straight-line code), selects for
+    // the functor's conditionals: the same values.
+#pragma GCC unroll 5
+    for (int qy = -2; qy <= 2; ++qy) {
+#pragma GCC unroll 5
         for (int qx = -2; qx <= 2; ++qx) {
             const int xx = x + qx, k = qy + 2;
             const float dn = kN ? sq(nx - n[0][k][xx]) + sq(ny - n[1][k][xx]) + sq(nz - n[2][k][xx]) : 0.0f;
             const float dz = kZ ? fabsf(zp - z[k][xx]) : 0.0f;
-            const bool near = (sq(c[0][k][xx] - cp[0]) <= maxDiff2[0]) & (sq(c[1][k][xx] - cp[1]) <= maxDiff2[1]) &
-                              (sq(c[2][k][xx] - cp[2]) <= maxDiff2[2]);
+            const float q0 = c[0][k][xx], q1 = c[1][k][xx], q2 = c[2][k][xx];
+            const bool near = (sq(q0 - cp0) <= maxDiff2[0]) & (sq(q1 - cp1) <= maxDiff2[1]) & (sq(q2 - cp2) <= maxDiff2[2]);
             const bool same = (dn <= kNoiseNormalDist2) & (dz <= kNoiseDepthRel * fabsf(zp)) & near;
-            const float wt = same ? b3(qx) * b3(qy) : 0.0f;
+            const float wt = selectF(same, b3(qx) * b3(qy), 0.0f);
             ws += wt;
             w2 += wt * wt;
-            for (int ch = 0; ch < 3; ++ch) s[ch] += wt * c[ch][k][xx];
+            s0 += wt * q0;
+            s1 += wt * q1;
+            s2 += wt * q2;
         }
+    }
     const float wp = b3(0) * b3(0);
     const float factor = 1.0f - 2.0f * wp / ws + w2 / (ws * ws);
-    float e[3];
-    for (int ch = 0; ch < 3; ++ch) {
-        const float d = c[ch][2][x] - s[ch] / ws;
-        e[ch] = factor > 1e-3f ? d * d / factor : 0.0f;
-    }
-    e0 = e[0], e1 = e[1], e2 = e[2];
+    const bool use = factor > 1e-3f;
+    const float d0 = cp0 - s0 / ws, d1 = cp1 - s1 / ws, d2 = cp2 - s2 / ws;
+    e0 = selectF(use, d0 * d0 / factor, 0.0f);
+    e1 = selectF(use, d1 * d1 / factor, 0.0f);
+    e2 = selectF(use, d2 * d2 / factor, 0.0f);
 }
 
 template <bool kN, bool kZ>
@@ -229,37 +238,24 @@ struct VarianceBands {
         std::vector<float> abuf(3 * size_t(w) + cpu::modulationRowScratch(w));
         float* const a[3] = {abuf.data(), abuf.data() + w, abuf.data() + 2 * size_t(w)};
         // QuadrantRows of row j into its slot: left (x - i, i = 0..r) and right (x + i) sums per
-        // channel, inside the row, in order i = 0..r.
+        // channel, inside the row, in order i = 0..r. The energy row is copied between r zeros
+        // either side, so every column takes the same branch-free sums: a tap outside the row
+        // adds +0 to a sum of energies (>= +0), which leaves it as it is, bit for bit.
+        std::vector<float> padded(size_t(w) + 2 * size_t(r), 0.0f);
+        std::vector<const float*> left(size_t(r) + 1), right(size_t(r) + 1);
         auto quadRow = [&](int j) {
             float* dst = ring.data() + rowSize * size_t(j % slots);
             for (int ch = 0; ch < 3; ++ch) {
-                const float* ATROUS_RESTRICT e = energy.channel(ch) + size_t(j) * w;
-                float* ATROUS_RESTRICT L = dst + size_t(ch) * w;
-                float* ATROUS_RESTRICT R = dst + size_t(3 + ch) * w;
-                auto border = [&](int x) {
-                    float l = 0, rr = 0;
-                    for (int i = 0; i <= r; ++i) {
-                        if (x - i >= 0) l += e[x - i];
-                        if (x + i < w) rr += e[x + i];
-                    }
-                    L[x] = l, R[x] = rr;
-                };
-                const int xa = std::min(r, w), xb = std::max(xa, w - r);
-                for (int x = 0; x < xa; ++x) border(x);
-#pragma omp simd
-                for (int x = xa; x < xb; ++x) {
-                    float l = 0, rr = 0;
-                    for (int i = 0; i <= r; ++i) {
-                        l += e[x - i];
-                        rr += e[x + i];
-                    }
-                    L[x] = l, R[x] = rr;
-                }
-                for (int x = xb; x < w; ++x) border(x);
+                std::memcpy(padded.data() + r, energy.channel(ch) + size_t(j) * w, size_t(w) * sizeof(float));
+                const float* e = padded.data() + r;
+                for (int i = 0; i <= r; ++i) left[size_t(i)] = e - i, right[size_t(i)] = e + i;
+                cpu::sumRows(left.data(), r + 1, dst + size_t(ch) * w, size_t(w));
+                cpu::sumRows(right.data(), r + 1, dst + size_t(3 + ch) * w, size_t(w));
             }
         };
         int next = std::max(0, y0 - r);
-        std::vector<const float*> up(size_t(r) + 1), down(size_t(r) + 1);
+        std::vector<const float*> up(size_t(r) + 1), down(size_t(r) + 1), rowPtrs(size_t(r) + 1);
+        std::vector<float> qsum(12 * size_t(w));
         const bool bgTest = f.normal.valid();
         for (int y = y0; y < y1; ++y) {
             for (; next <= std::min(h - 1, y + r); ++next) quadRow(next);
@@ -270,9 +266,18 @@ struct VarianceBands {
                 if (y + j < h) down[size_t(nDown++)] = ring.data() + rowSize * size_t((y + j) % slots);
             }
             cpu::modulationRowOrOne(rule, f.albedo, y, w, a, abuf.data() + 3 * size_t(w));
+            // The quadrant sums q[k][ch] (up-left, up-right, down-left, down-right) of each pixel:
+            // the half rows added in LocalVariance's order (up: y, y-1, ..; down: y, y+1, ..).
+            for (int k = 0; k < 4; ++k)
+                for (int ch = 0; ch < 3; ++ch) {
+                    const int half = k / 2, side = k % 2;
+                    const std::vector<const float*>& src = half == 0 ? up : down;
+                    for (int j = 0; j < (half == 0 ? nUp : nDown); ++j)
+                        rowPtrs[size_t(j)] = src[size_t(j)] + size_t(3 * side + ch) * w;
+                    cpu::sumRows(rowPtrs.data(), half == 0 ? nUp : nDown, qsum.data() + size_t(3 * k + ch) * w, size_t(w));
+                }
             const size_t o = size_t(y) * size_t(w);
-            const float* const* ATROUS_RESTRICT U = up.data();
-            const float* const* ATROUS_RESTRICT D = down.data();
+            const float* ATROUS_RESTRICT Q = qsum.data();
             const float* ATROUS_RESTRICT nx = bgTest ? f.normal.channel(0) + o : nullptr;
             const float* ATROUS_RESTRICT ny = bgTest ? f.normal.channel(1) + o : nullptr;
             const float* ATROUS_RESTRICT nz = bgTest ? f.normal.channel(2) + o : nullptr;
@@ -287,45 +292,41 @@ struct VarianceBands {
             const float capMul = f.capMul;
 #pragma omp simd
             for (int x = 0; x < w; ++x) {
-                // q[k]: up-left, up-right, down-left, down-right (LocalVariance's order), rgb.
-                float q[4][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
-                for (int j = 0; j < nUp; ++j)
-                    for (int ch = 0; ch < 3; ++ch) {
-                        q[0][ch] += U[j][size_t(ch) * w + x];
-                        q[1][ch] += U[j][size_t(3 + ch) * w + x];
-                    }
-                for (int j = 0; j < nDown; ++j)
-                    for (int ch = 0; ch < 3; ++ch) {
-                        q[2][ch] += D[j][size_t(ch) * w + x];
-                        q[3][ch] += D[j][size_t(3 + ch) * w + x];
-                    }
+                float q[4][3];
+#pragma GCC unroll 4
+                for (int k = 0; k < 4; ++k)
+#pragma GCC unroll 3
+                    for (int ch = 0; ch < 3; ++ch) q[k][ch] = Q[size_t(3 * k + ch) * w + x];
                 // The tap counts (sums of small integers, exact): rows × columns of each quadrant.
                 const float nl = float((x < r ? x : r) + 1), nr = float((w - 1 - x < r ? w - 1 - x : r) + 1);
                 const float cnt[4] = {fUp * nl, fUp * nr, fDown * nl, fDown * nr};
                 int best = 0;
                 float bestMean = 3.0e38f;
+#pragma GCC unroll 4
                 for (int k = 0; k < 4; ++k) {
                     const float m = (q[k][0] + q[k][1] + q[k][2]) / cnt[k];
                     const bool better = m < bestMean;
-                    bestMean = better ? m : bestMean;
+                    bestMean = selectF(better, m, bestMean);
                     best = better ? k : best;
                 }
-                float qb[3], nb = cnt[0];
-                for (int ch = 0; ch < 3; ++ch) qb[ch] = q[0][ch];
+                float qb0 = q[0][0], qb1 = q[0][1], qb2 = q[0][2], nb = cnt[0];
+#pragma GCC unroll 3
                 for (int k = 1; k < 4; ++k) {
                     const bool pick = best == k;
-                    for (int ch = 0; ch < 3; ++ch) qb[ch] = pick ? q[k][ch] : qb[ch];
-                    nb = pick ? cnt[k] : nb;
+                    qb0 = selectF(pick, q[k][0], qb0), qb1 = selectF(pick, q[k][1], qb1), qb2 = selectF(pick, q[k][2], qb2);
+                    nb = selectF(pick, cnt[k], nb);
                 }
                 const bool bg = bgTest ? (nx[x] == 0.0f) & (ny[x] == 0.0f) & (nz[x] == 0.0f) : false;
-                const float fm = bg ? kNoiseBackgroundFloor : 1.0f;
+                const float fm = selectF(bg, kNoiseBackgroundFloor, 1.0f);
                 const float av[3] = {a0[x], a1[x], a2[x]};
+                const float qb[3] = {qb0, qb1, qb2};
                 float out[3];
+#pragma GCC unroll 3
                 for (int ch = 0; ch < 3; ++ch) {
                     const float aa = av[ch];
-                    const float local = bg ? 0.0f : qb[ch] / nb;
+                    const float local = selectF(bg, 0.0f, qb[ch] / nb);
                     const float v = minSel(maxSel(local, fm * floorVar[ch]), capMul * floorVar[ch]) * aa * aa;
-                    const float res = finite(v) ? v : floorVar[ch] * aa * aa;
+                    const float res = selectF(finite(v), v, floorVar[ch] * aa * aa);
                     const float ia = 1.0f / aa;
                     out[ch] = res * (ia * ia);
                 }

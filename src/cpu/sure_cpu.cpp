@@ -11,6 +11,7 @@
 #pragma GCC optimize("no-trapping-math")
 #endif
 
+#include <algorithm>
 #include <vector>
 
 #include "core/parallel.h"
@@ -25,6 +26,34 @@ namespace {
 constexpr int kMaxWindowRadius = 10;  // SureParams / SafetyNetParams windowRadius and kGiveBackRadius
 }
 
+namespace {
+
+// SureBoxH of row y into od/ov (w values each), for w > 2r: the border columns through the functor
+// (g's out views are not used: its sums are taken here), the interior as sums of shifted rows.
+void boxRow(const SureBoxH& g, int y, float* ATROUS_RESTRICT od, float* ATROUS_RESTRICT ov,
+            std::vector<const float*>& shiftedD, std::vector<const float*>& shiftedV) {
+    const int w = g.in.width, r = g.radius;
+    const size_t o = size_t(y) * w;
+    const float* d = g.in.channel(0) + o;
+    const float* v = g.in.channel(1) + o;
+    auto border = [&](int x) {
+        float a = 0, b = 0;
+        for (int dx = -r; dx <= r; ++dx) {
+            const int xx = clampIdx(x + dx, w - 1);
+            a += d[xx];
+            b += v[xx];
+        }
+        od[x] = a, ov[x] = b;
+    };
+    for (int x = 0; x < r; ++x) border(x);
+    for (int k = 0; k <= 2 * r; ++k) shiftedD[size_t(k)] = d + k, shiftedV[size_t(k)] = v + k;
+    cpu::sumRows(shiftedD.data(), 2 * r + 1, od + r, size_t(w - 2 * r));
+    cpu::sumRows(shiftedV.data(), 2 * r + 1, ov + r, size_t(w - 2 * r));
+    for (int x = w - r; x < w; ++x) border(x);
+}
+
+}  // namespace
+
 void runSureBoxH(const CpuExec& exec, const SureBoxH& f) {
     const int w = f.in.width, h = f.in.height, r = f.radius;
     if (w <= 2 * r) {
@@ -34,58 +63,78 @@ void runSureBoxH(const CpuExec& exec, const SureBoxH& f) {
     cpu::parallelForIsa(cpu::activeIsa(), 0, h, 16, [&](int range0, int range1) {
         const SureBoxH g = f;
         std::vector<const float*> shiftedD(static_cast<size_t>(2 * r + 1)), shiftedV(static_cast<size_t>(2 * r + 1));
-        for (int y = range0; y < range1; ++y) {
-            const size_t o = size_t(y) * w;
-            const float* ATROUS_RESTRICT d = g.in.channel(0) + o;
-            const float* ATROUS_RESTRICT v = g.in.channel(1) + o;
-            float* ATROUS_RESTRICT od = g.out.channel(0) + o;
-            float* ATROUS_RESTRICT ov = g.out.channel(1) + o;
-            for (int x = 0; x < r; ++x) g(x, y);
-            // The window's taps added in the functor's order (dx = -r..r, from 0), the interior
-            // columns as sums of shifted rows (cpu::sumRows).
-            const int n = w - 2 * r;
-            for (int k = 0; k <= 2 * r; ++k) shiftedD[size_t(k)] = d + k, shiftedV[size_t(k)] = v + k;
-            cpu::sumRows(shiftedD.data(), 2 * r + 1, od + r, size_t(n));
-            cpu::sumRows(shiftedV.data(), 2 * r + 1, ov + r, size_t(n));
-            for (int x = w - r; x < w; ++x) g(x, y);
-        }
+        for (int y = range0; y < range1; ++y)
+            boxRow(g, y, g.out.channel(0) + size_t(y) * w, g.out.channel(1) + size_t(y) * w, shiftedD, shiftedV);
     });
 }
 
 namespace {
 
+// SureChoose's choice and accumulation for row y, from the window's rows of horizontal sums
+// (clamped: rows y - r..y + r) added in order dy = -r..r.
+template <int kJamesStein>
+ATROUS_FORCE_INLINE inline void chooseRow(const SureChoose& f, int y, const float* const* rowsD, const float* const* rowsV,
+                                          float* sumD, float* sumV, float* sScratch) {
+    const int w = f.cI.width, h = f.cI.height, r = f.p.radius;
+    SureChoiceParams p = f.p;
+    p.jamesStein = kJamesStein;  // a constant: no branch left in the x loop
+    const size_t plane = size_t(w) * h;
+    cpu::sumRows(rowsD, 2 * r + 1, sumD, size_t(w));
+    cpu::sumRows(rowsV, 2 * r + 1, sumV, size_t(w));
+    const size_t o = size_t(y) * w;
+    const float* ATROUS_RESTRICT ci = f.cI.data + o;
+    const float* ATROUS_RESTRICT cn = f.cNext.data + o;
+    float* ATROUS_RESTRICT acc = f.acc.data + o;
+    float* ATROUS_RESTRICT sOut = f.sOut.valid() ? f.sOut.data + o : sScratch;
+    const float* ATROUS_RESTRICT sd = sumD;
+    const float* ATROUS_RESTRICT sv = sumV;
+#pragma omp simd
+    for (int x = 0; x < w; ++x) {
+        const float s = sureChoose(p, sd[x], sv[x]);
+        acc[x] += s * (ci[x] - cn[x]);
+        acc[x + plane] += s * (ci[x + plane] - cn[x + plane]);
+        acc[x + 2 * plane] += s * (ci[x + 2 * plane] - cn[x + 2 * plane]);
+        sOut[x] = s;
+    }
+}
+
 template <int kJamesStein>
 void chooseRows(const SureChoose& f, int y0, int y1) {
     const int w = f.boxH.width, h = f.boxH.height, r = f.p.radius;
-    SureChoiceParams p = f.p;
-    p.jamesStein = kJamesStein;  // a constant: no branch left in the x loop
     std::vector<float> sScratch(w), sumDRow(w), sumVRow(w);
     std::vector<const float*> rowsD(2 * r + 1), rowsV(2 * r + 1);
-    const size_t plane = size_t(w) * h;
     for (int y = y0; y < y1; ++y) {
-        // The window's rows (clamped), added in order dy = -r..r from 0 in registers.
         for (int dy = -r; dy <= r; ++dy) {
             const int yy = clampIdx(y + dy, h - 1);
             rowsD[dy + r] = f.boxH.channel(0) + size_t(yy) * w;
             rowsV[dy + r] = f.boxH.channel(1) + size_t(yy) * w;
         }
-        float* ATROUS_RESTRICT sumD = sumDRow.data();
-        float* ATROUS_RESTRICT sumV = sumVRow.data();
-        cpu::sumRows(rowsD.data(), 2 * r + 1, sumD, size_t(w));
-        cpu::sumRows(rowsV.data(), 2 * r + 1, sumV, size_t(w));
-        const size_t o = size_t(y) * w;
-        const float* ATROUS_RESTRICT ci = f.cI.data + o;
-        const float* ATROUS_RESTRICT cn = f.cNext.data + o;
-        float* ATROUS_RESTRICT acc = f.acc.data + o;
-        float* ATROUS_RESTRICT sOut = f.sOut.valid() ? f.sOut.data + o : sScratch.data();
-#pragma omp simd
-        for (int x = 0; x < w; ++x) {
-            const float s = sureChoose(p, sumD[x], sumV[x]);
-            acc[x] += s * (ci[x] - cn[x]);
-            acc[x + plane] += s * (ci[x + plane] - cn[x + plane]);
-            acc[x + 2 * plane] += s * (ci[x + 2 * plane] - cn[x + 2 * plane]);
-            sOut[x] = s;
+        chooseRow<kJamesStein>(f, y, rowsD.data(), rowsV.data(), sumDRow.data(), sumVRow.data(), sScratch.data());
+    }
+}
+
+// Both passes per band of rows: the horizontal sums of the band's rows and the r rows either side
+// (clamped) into a ring of 2r + 1 rows, the choice of each row from its window's ring rows.
+template <int kJamesStein>
+void windowRows(const SureBoxH& box, const SureChoose& f, int y0, int y1) {
+    const int w = box.in.width, h = box.in.height, r = box.radius;
+    const int slots = 2 * r + 1;
+    std::vector<float> ring(size_t(slots) * 2 * size_t(w)), sScratch(w), sumDRow(w), sumVRow(w);
+    const size_t n = static_cast<size_t>(slots);
+    std::vector<const float*> rowsD(n), rowsV(n), shiftedD(n), shiftedV(n);
+    std::vector<int> have(size_t(slots), -1);
+    for (int y = y0; y < y1; ++y) {
+        for (int dy = -r; dy <= r; ++dy) {
+            const int yy = clampIdx(y + dy, h - 1);
+            float* slot = ring.data() + size_t(yy % slots) * 2 * size_t(w);
+            if (have[size_t(yy % slots)] != yy) {
+                boxRow(box, yy, slot, slot + w, shiftedD, shiftedV);
+                have[size_t(yy % slots)] = yy;
+            }
+            rowsD[size_t(dy + r)] = slot;
+            rowsV[size_t(dy + r)] = slot + w;
         }
+        chooseRow<kJamesStein>(f, y, rowsD.data(), rowsV.data(), sumDRow.data(), sumVRow.data(), sScratch.data());
     }
 }
 
@@ -98,6 +147,28 @@ void runSureChoose(const CpuExec&, const SureChoose& f) {
             chooseRows<1>(f, range0, range1);
         else
             chooseRows<0>(f, range0, range1);
+    });
+}
+
+void runSureWindow(const CpuExec& exec, const SureBoxH& box, const SureChoose& choose) {
+    const int w = box.in.width, h = box.in.height;
+    if (w <= 2 * box.radius) {
+        // Narrow images (the horizontal pass through its functor): the two passes.
+        Image store;
+        SureBoxH b = box;
+        SureChoose c = choose;
+        if (!b.out.valid()) store = Image::uninitialized(w, h, 2), b.out = store.view();
+        c.boxH = b.out;
+        runSureBoxH(exec, b);
+        runSureChoose(exec, c);
+        return;
+    }
+    // Bands of 32 rows: the ring recomputes the 2r rows either side (cheap horizontal sums).
+    cpu::parallelForIsa(cpu::activeIsa(), 0, h, 32, [&](int y0, int y1) {
+        if (choose.p.jamesStein)
+            windowRows<1>(box, choose, y0, y1);
+        else
+            windowRows<0>(box, choose, y0, y1);
     });
 }
 
@@ -145,6 +216,14 @@ void bandColumnSums(int y0, int y1, int h, int w, int r, int channels, RowFn row
 }
 
 }  // namespace
+
+// 1 / boxTaps(r, x, y) for the pixels of row y: the interior's count is one value, so one division
+// (and one per border column) instead of one per pixel and channel.
+void tapReciprocals(int r, int y, int w, int h, float* ATROUS_RESTRICT inv) {
+    const float interior = 1.0f / boxTaps(r, std::min(r, w - 1), y, w, h);
+    for (int x = 0; x < w; ++x)
+        inv[x] = (x >= r && x < w - r) ? interior : 1.0f / boxTaps(r, x, y, w, h);
+}
 
 // The give-back's passes fused into row loops over bands of rows: (1) each row's moments
 // (GiveBackMoments) summed along x, their column sums and the fit (giveBackSlope) per pixel into
@@ -195,16 +274,19 @@ void runAlbedoGiveBack(const CpuExec& exec, const ImageView& input, const ImageV
             }
             for (int k = 0; k < K; ++k) rowWindowSums(m.data() + size_t(k) * w, dst + size_t(k) * w, w, r);
         };
+        std::vector<float> invNRow(static_cast<size_t>(w));
         auto fit = [&](int y, const float* s) {
             const size_t o = size_t(y) * w;
+            float* ATROUS_RESTRICT invN = invNRow.data();
+            tapReciprocals(r, y, w, h, invN);
             for (int c = 0; c < 3; ++c) {
                 const float* ATROUS_RESTRICT q = s + size_t(5 * c) * w;
                 float* ATROUS_RESTRICT A = coef[c] + o;
                 float* ATROUS_RESTRICT b = coef[3 + c] + o;
 #pragma omp simd
                 for (int x = 0; x < w; ++x)
-                    giveBackSlope(significance, boxTaps(r, x, y, w, h), q[x], q[w + x], q[2 * w + x], q[3 * w + x],
-                                  q[4 * w + x], A[x], b[x]);
+                    giveBackSlopeInv(significance, boxTaps(r, x, y, w, h), invN[x], q[x], q[w + x], q[2 * w + x],
+                                     q[3 * w + x], q[4 * w + x], A[x], b[x]);
             }
         };
         bandColumnSums(y0, y1, h, w, r, K, moments, fit);
@@ -213,8 +295,11 @@ void runAlbedoGiveBack(const CpuExec& exec, const ImageView& input, const ImageV
         auto coefRow = [&](int j, float* dst) {
             for (int k = 0; k < 6; ++k) rowWindowSums(coef[k] + size_t(j) * w, dst + size_t(k) * w, w, r);
         };
+        std::vector<float> invNRow(static_cast<size_t>(w));
         auto apply = [&](int y, const float* s) {
             const size_t o = size_t(y) * w;
+            float* ATROUS_RESTRICT invN = invNRow.data();
+            tapReciprocals(r, y, w, h, invN);
             for (int c = 0; c < 3; ++c) {
                 float* ATROUS_RESTRICT fc = cN.channel(c) + o;
                 const float* ATROUS_RESTRICT ds = sure ? detailSum.channel(c) + o : fc;
@@ -225,7 +310,7 @@ void runAlbedoGiveBack(const CpuExec& exec, const ImageView& input, const ImageV
                 for (int x = 0; x < w; ++x) {
                     float f = fc[x];
                     if (sure) f += ds[x];
-                    fc[x] = f + giveBackTerm(sA[x], sB[x], boxTaps(r, x, y, w, h), al[x]);
+                    fc[x] = f + giveBackTermInv(sA[x], sB[x], invN[x], al[x]);
                 }
             }
         };

@@ -153,10 +153,14 @@ InputScan scanInputs(const Image& color, const Image* variance, const Image* emi
                 }
                 int nf = 0;
                 double ls = 0, ln = 0;
+                // (Vector lanes of partial sums: the report's means, deterministic for an ISA.)
+#pragma omp simd reduction(+ : nf, ls, ln)
                 for (int x = 0; x < w; ++x) {
                     nf += (finite(cr[x]) & finite(cg[x]) & finite(cb[x])) ? 0 : 1;
                     const float l = lum(cr[x], cg[x], cb[x]);
-                    if (finite(l)) ls += l, ln += 1;
+                    const bool ok = finite(l);
+                    ls += ok ? double(l) : 0.0;
+                    ln += ok ? 1.0 : 0.0;
                 }
                 r.nonFinite += nf;
                 r.lumSum += ls, r.lumCount += ln;
@@ -182,9 +186,12 @@ InputScan scanInputs(const Image& color, const Image* variance, const Image* emi
                     const float* ATROUS_RESTRICT eg = e.channel(1) + o;
                     const float* ATROUS_RESTRICT eb = e.channel(2) + o;
                     double es = 0, en = 0;
+#pragma omp simd reduction(+ : es, en)
                     for (int x = 0; x < w; ++x) {
                         const float l = lum(er[x], eg[x], eb[x]);
-                        if (finite(l)) es += l, en += 1;
+                        const bool ok = finite(l);
+                        es += ok ? double(l) : 0.0;
+                        en += ok ? 1.0 : 0.0;
                     }
                     r.emissionLumSum += es, r.emissionLumCount += en;
                 }

@@ -360,7 +360,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         if (sure) {
             cB = planes(3), vB = planes(3);  // fully overwritten by level 0
             detail = planes(2);
-            boxH = planes(2);
+            if (!kHost) boxH = planes(2);  // the CPU's window passes keep a ring of rows instead
             acc = Image(w, h, 3, dev);  // zeros: Σ s_i d_i
             if (o.sure.correlatedVariance) sureDetailVarianceFactors(levels, alpha);
             choice.radius = o.sure.windowRadius;
@@ -412,7 +412,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
                 // level runs no window passes unless its s_i map is asked for (it is then all 0).
                 const bool dropped = i < o.sure.firstLevel;
                 if (!dropped || out.sureS.valid()) {
-                    runSureBoxH(exec, SureBoxH{choice.radius, detail.view(), boxH.view()});
+                    const ImageView bh = boxH.empty() ? ImageView{} : boxH.view();  // none on the CPU
                     ImageView sOut;
                     if (out.sureS.valid()) sOut = ImageView{out.sureS.channel(i), w, h, 1};
                     SureChoiceParams levelChoice = choice;
@@ -421,7 +421,8 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
                         levelChoice.count = 1;
                         levelChoice.candidates[0] = 0.0f;
                     }
-                    runSureChoose(exec, SureChoose{levelChoice, boxH.view(), cur->view(), nxt->view(), acc.view(), sOut});
+                    runSureWindow(exec, SureBoxH{choice.radius, detail.view(), bh},
+                                  SureChoose{levelChoice, bh, cur->view(), nxt->view(), acc.view(), sOut});
                 }
                 markStage(out.clock, "sure", i);
                 std::swap(vcur, vnxt);
@@ -430,9 +431,9 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         }
     }
 
-    // 6. The albedo give-back, F' = F + the part of y - F that the albedo explains (its time is
-    // counted in the next stage), then the safety net: F' = F + s (y - F), s chosen by SURE on the
-    // residual (safety_net.h).
+    // 6. The albedo give-back, F' = F + the part of y - F that the albedo explains (stage
+    // "give-back"), then the safety net: F' = F + s (y - F), s chosen by SURE on the residual
+    // (safety_net.h).
     ImageView detailSum = sure ? acc.view() : ImageView{};
     if (giveBack) {
         // Its window sums in planes the cascade is done with: the spare cascade buffer and the σ
@@ -446,12 +447,11 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         runAlbedoGiveBack(exec, safetyIn.view(), cur->view(), detailSum, albedo, kGiveBackRadius, kGiveBackSignificance,
                           n == 6 ? &scratch : nullptr);
         detailSum = ImageView{};
+        markStage(out.clock, "give-back");
     }
     if (o.safety.enabled) {
-        if (!sure) {
-            detail = planes(2);
-            boxH = planes(2);
-        }
+        if (detail.empty()) detail = planes(2);
+        if (boxH.empty()) boxH = planes(2);
         SureChoiceParams sp;
         sp.radius = o.safety.windowRadius;
         exec.forEachPixel(w, h, SafetyDetail{safetyIn.view(), cur->view(), detailSum, safetyVar.view(), detail.view()});

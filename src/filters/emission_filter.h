@@ -77,9 +77,10 @@ struct EmissionLevel {
     }
 };
 
-// One level on `exec`. The CpuExec overload (src/cpu/emission_cpu.cpp) runs plain row loops: the
-// generic path's `omp simd` x loop would evaluate all 25 taps of every pixel under a mask, so the
-// early exit (the sky, non-emitters: all but ~1% of sphere-env's emissive pixels) saved nothing.
+// One level on `exec`. The CpuExec overload (src/cpu/emission_cpu.cpp) copies rows with a
+// vectorised loop and runs the functor only on the pixels that may need the taps: the generic
+// path's `omp simd` x loop would evaluate all 25 taps of every pixel under a mask, so the early
+// exit (the sky, non-emitters: all but ~1% of sphere-env's emissive pixels) saved nothing.
 template <class Exec>
 void runEmissionLevel(const Exec& exec, const EmissionLevel& f) {
     exec.forEachPixel(f.eIn.width, f.eIn.height, f);
@@ -107,5 +108,9 @@ ImageView runEmissionFilter(const Exec& exec, int levels, float k, ImageView var
     }
     return cur;
 }
+// The CpuExec overload (src/cpu/emission_cpu.cpp): the first level over every pixel, the others
+// over the pixels that need the taps only (a copied pixel is copied at every level); same values.
+ImageView runEmissionFilter(const CpuExec& exec, int levels, float k, ImageView variance, ImageView input, ImageView a,
+                            ImageView b);
 
 }  // namespace atrous::filters

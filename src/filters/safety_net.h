@@ -142,9 +142,16 @@ ATROUS_INLINE float boxTaps(int radius, int x, int y, int w, int h) {
 }
 
 // The window's shrunk slope A and offset b = -A mean(a) from its sums of a, r, a², a r, r² over n taps.
+ATROUS_INLINE void giveBackSlopeInv(float significance, float n, float inv, float sa, float sr, float saa, float sar,
+                                    float srr, float& A, float& b);
 ATROUS_INLINE void giveBackSlope(float significance, float n, float sa, float sr, float saa, float sar, float srr,
                                  float& A, float& b) {
-    const float inv = 1.0f / n;
+    giveBackSlopeInv(significance, n, 1.0f / n, sa, sr, saa, sar, srr, A, b);
+}
+// The same with inv = 1 / n given (the CPU row loop divides once per distinct n, not per pixel and
+// channel: the same value).
+ATROUS_INLINE void giveBackSlopeInv(float significance, float n, float inv, float sa, float sr, float saa, float sar,
+                                    float srr, float& A, float& b) {
     const float ma = sa * inv, mr = sr * inv;
     const float va = saa * inv - ma * ma, car = sar * inv - ma * mr, vr = srr * inv - mr * mr;
     float s = 0.0f;
@@ -159,8 +166,9 @@ ATROUS_INLINE void giveBackSlope(float significance, float n, float sa, float sr
 
 // What goes back at p: mean_W(A) a(p) + mean_W(b) from the window sums of A and b over n taps
 // (0 where not finite).
-ATROUS_INLINE float giveBackTerm(float sumA, float sumB, float n, float a) {
-    const float inv = 1.0f / n;
+ATROUS_INLINE float giveBackTermInv(float sumA, float sumB, float inv, float a);
+ATROUS_INLINE float giveBackTerm(float sumA, float sumB, float n, float a) { return giveBackTermInv(sumA, sumB, 1.0f / n, a); }
+ATROUS_INLINE float giveBackTermInv(float sumA, float sumB, float inv, float a) {
     const float g = sumA * inv * a + sumB * inv;
     return finite(g) ? g : 0.0f;
 }

@@ -96,4 +96,14 @@ void runSureChoose(const Exec& exec, const SureChoose& f) {
 void runSureBoxH(const CpuExec& exec, const SureBoxH& f);
 void runSureChoose(const CpuExec& exec, const SureChoose& f);
 
+// Both passes of a level: box.out is choose.boxH. The CpuExec overload (src/cpu/sure_cpu.cpp) keeps
+// the horizontal sums of a band of rows in a ring of 2r+1 rows instead of a 2-plane image (box.out
+// and choose.boxH are not used there and may be invalid); the same sums in the same order.
+template <class Exec>
+void runSureWindow(const Exec& exec, const SureBoxH& box, const SureChoose& choose) {
+    runSureBoxH(exec, box);
+    runSureChoose(exec, choose);
+}
+void runSureWindow(const CpuExec& exec, const SureBoxH& box, const SureChoose& choose);
+
 }  // namespace atrous::filters
