@@ -245,8 +245,7 @@ TEST(LayeredInput, HeaderAttributeLargerThanTheFileIsRefusedFirst) {
 TEST(LayeredInput, FileWithoutChannelsIsRefused) {
     TempDir dir;
     // OpenEXR will not write such a file: the libFuzzer target's reproducer (1386 bytes).
-    fs::copy_file(std::string(ATROUS_SOURCE_DIR) + "/tests/fuzz/libfuzzer/findings/exr-no-channels-readbufferfile-segv.exr",
-                  dir / "empty.exr");
+    fs::copy_file(std::string(ATROUS_SOURCE_DIR) + "/tests/data/exr_regressions/no_channels.exr", dir / "empty.exr");
     io::writeImage(dir / "c.exr", Image(8, 6, 3));
     for (const std::string& args : {"denoise --color " + (dir / "empty.exr") + " --out " + (dir / "o.exr"),
                                     "denoise --color " + (dir / "c.exr") + " --albedo " + (dir / "empty.exr") + " --out " + (dir / "o.exr")}) {
@@ -255,4 +254,35 @@ TEST(LayeredInput, FileWithoutChannelsIsRefused) {
         EXPECT_NE(r.output.find("empty.exr"), std::string::npos) << r.output;
     }
     EXPECT_FALSE(fs::exists(dir / "o.exr"));
+}
+
+// The libFuzzer targets' EXR reproducers (tests/data/exr_regressions, kept here as regression
+// inputs): every command refuses each with one line naming it, within bounded memory, or reads it.
+// attribute_size_2gb / attribute_after_chlist_2gb / declared_size_desync_2gb: a header attribute
+// OpenEXR 3.1 would allocate ~2 GB for (behind a channel list or a fixed-size attribute whose
+// declared size is not its own); huge_data_window_2gb: a 234M-pixel-wide window (OpenEXR's line
+// buffers); no_channels: no channels (a SIGSEGV in readBufferFile); rgba_half_segv: a valid RGBA
+// half file (a SIGSEGV in OpenEXR Core's 4-channel half routine).
+TEST(LayeredInput, FuzzReproducersAreRefusedInOneLineOrRead) {
+    TempDir dir;
+    const std::string data = std::string(ATROUS_SOURCE_DIR) + "/tests/data/exr_regressions/";
+    for (const char* name : {"attribute_size_2gb.exr", "attribute_after_chlist_2gb.exr", "declared_size_desync_2gb.exr",
+                             "huge_data_window_2gb.exr", "no_channels.exr", "rgba_half_segv.exr"}) {
+        const std::string f = data + name;
+        const bool valid = std::string(name) == "rgba_half_segv.exr";
+        for (const std::string& args : {"denoise --in " + f + " --out " + (dir / "o.exr"), "compare --ref " + f + " " + f,
+                                        "inspect " + f + " --export " + (dir / "x")}) {
+            const CliRun r = runCliMeasured(args);
+            EXPECT_LT(r.peakMb, 150) << args;
+            if (valid) {
+                EXPECT_EQ(r.exitCode, 0) << args << "\n" << r.output;
+                continue;
+            }
+            EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.output;
+            EXPECT_TRUE(oneLine(r.output)) << r.output;
+            EXPECT_NE(r.output.find(name), std::string::npos) << r.output;
+        }
+        fs::remove_all(dir / "x");
+        fs::remove(dir / "o.exr");
+    }
 }

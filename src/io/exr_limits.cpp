@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <vector>
 
 #include "atrous/error.h"
 #include "atrous/image.h"
@@ -40,72 +41,145 @@ uint64_t exrFileBytes(const std::string& path) {
     return ec ? 0 : uint64_t(n);
 }
 
+namespace {
+
+uint32_t le32(const unsigned char* p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24; }
+
+// The size OpenEXR's classic API reads for a fixed-size attribute type (it reads that many bytes
+// whatever the attribute declares; its Core reads the declared size), or -1 for types of variable size.
+int fixedSize(const std::string& type) {
+    static const std::pair<const char*, int> kSizes[] = {
+        {"box2i", 16}, {"box2f", 16}, {"compression", 1}, {"lineOrder", 1}, {"envmap", 1}, {"deepImageState", 1},
+        {"float", 4}, {"double", 8}, {"int", 4}, {"rational", 8}, {"timecode", 8}, {"keycode", 28}, {"tiledesc", 9},
+        {"v2i", 8}, {"v2f", 8}, {"v2d", 16}, {"v3i", 12}, {"v3f", 12}, {"v3d", 24}, {"m33f", 36}, {"m33d", 72},
+        {"m44f", 64}, {"m44d", 128}, {"chromaticities", 32}};
+    for (const auto& [name, size] : kSizes)
+        if (type == name) return size;
+    return -1;
+}
+
+// What rules 1 and 2 need of a part's header.
+struct PartHeader {
+    bool hasWindow = false, deep = false;
+    std::string name;
+    int32_t window[4] = {0, 0, 0, 0};  // xmin, ymin, xmax, ymax
+    int compression = 0;
+    double bytesPerPixel = 0;  // of its channels, at their sampling
+};
+
+double maxExpansionOf(int compression) {
+    switch (compression) {
+        case 0: return 1.0;              // none
+        case 1: return 64.0;             // RLE
+        case 2: case 3: case 5: return 1100.0;  // ZIPS, ZIP, PXR24
+        case 6: case 7: return 16.0;     // B44, B44A
+        default: return 8192.0;          // PIZ, DWAA, DWAB
+    }
+}
+
+}  // namespace
+
 void requireExrHeadersFit(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     unsigned char head[8];
-    if (!in.read(reinterpret_cast<char*>(head), 8) || head[0] != 0x76 || head[1] != 0x2f || head[2] != 0x31 || head[3] != 0x01)
-        return;
+    if (!in.read(reinterpret_cast<char*>(head), 8) || le32(head) != 20000630u) return;  // not an EXR: the caller says so
     const uint64_t bytes = exrFileBytes(path);
-    const bool longNames = head[5] & 0x04, multipart = head[5] & 0x10;
-    (void)longNames;  // names up to 255 bytes either way (OpenEXR checks the flag itself)
-    const size_t maxName = 255;
+    const bool multipart = head[5] & 0x10;
+    auto corrupt = [&](const std::string& what) { return InputError(path + ": truncated or corrupt EXR header (" + what + ")"); };
     auto readName = [&](std::string& name) {
         name.clear();
         for (int ch; (ch = in.get()) != 0;) {
-            if (ch == EOF) throw InputError(path + ": truncated EXR header");
-            if (name.size() >= maxName) throw InputError(path + ": corrupt EXR header (a name longer than " +
-                                                         std::to_string(maxName) + " bytes)");
+            if (ch == EOF) throw corrupt("it ends inside a name");
+            if (name.size() >= 255) throw corrupt("a name longer than 255 bytes");
             name += char(ch);
         }
     };
-    // Headers (one, or a part's each up to an empty one), each a list of attributes up to an empty name.
-    for (int part = 0;; ++part) {
+    std::vector<PartHeader> parts;
+    std::vector<unsigned char> value;
+    // Headers (one, or a part's each up to an empty one), each a list of attributes up to an empty
+    // name. Every value is read (its declared size, bounded by the file) and checked as OpenEXR's
+    // classic API and its Core would read it: both must see the same attributes.
+    for (;;) {
         std::string name, type;
         readName(name);
-        if (name.empty()) {
-            if (part == 0 && !multipart) break;  // a single-part header ended (no attributes at all)
-            break;                               // the empty header that ends a multipart file's headers
-        }
-        for (;;) {
+        if (name.empty()) break;  // no (more) headers
+        PartHeader part;
+        for (; !name.empty(); readName(name)) {
             readName(type);
             unsigned char sz[4];
-            if (!in.read(reinterpret_cast<char*>(sz), 4)) throw InputError(path + ": truncated EXR header");
-            const int32_t size = int32_t(uint32_t(sz[0]) | uint32_t(sz[1]) << 8 | uint32_t(sz[2]) << 16 | uint32_t(sz[3]) << 24);
+            if (!in.read(reinterpret_cast<char*>(sz), 4)) throw corrupt("it ends inside attribute '" + name + "'");
+            const int64_t size = int32_t(le32(sz));
             const std::streamoff at = in.tellg();
-            auto tooLarge = [&](const std::string& what, uint64_t claimed) {
-                return InputError(path + ": truncated or corrupt EXR header (attribute '" + name + "' of type '" + type + "' claims " +
-                                  std::to_string(claimed) + " bytes" + what + " at offset " + std::to_string(at) + " of a " +
-                                  std::to_string(bytes) + "-byte file)");
-            };
-            if (size < 0 || at < 0 || uint64_t(at) + uint64_t(size) > bytes) throw tooLarge("", uint64_t(std::max(size, 0)));
+            const std::string which = "attribute '" + name + "' of type '" + type + "'";
+            if (size < 0 || at < 0 || uint64_t(at) + uint64_t(size) > bytes)
+                throw corrupt(which + " claims " + std::to_string(size) + " bytes at offset " + std::to_string(at) + " of a " +
+                              std::to_string(bytes) + "-byte file");
+            value.resize(size_t(size));
+            if (size > 0 && !in.read(reinterpret_cast<char*>(value.data()), std::streamsize(size)))
+                throw corrupt("it ends inside attribute '" + name + "'");
+            const int fixed = fixedSize(type);
+            if (fixed >= 0 && size != fixed)
+                throw corrupt(which + " has " + std::to_string(size) + " bytes; a " + type + " has " + std::to_string(fixed));
             if (type == "chlist") {
-                // OpenEXR reads a channel list by its entries (a name, then 16 bytes) up to an empty
-                // name, whatever its size says, and goes on from there: so does this walk.
-                // OpenEXR's Core reads it by its size: the two must agree.
-                std::string channel;
-                for (readName(channel); !channel.empty(); readName(channel)) {
-                    in.seekg(16, std::ios::cur);
-                    const std::streamoff now = in.tellg();
-                    if (now < 0 || uint64_t(now) > bytes) throw tooLarge(" of channels", uint64_t(std::max<std::streamoff>(now - at, 0)));
+                // Entries (a name, then type, pLinear, 3 reserved bytes, x and y sampling) up to an
+                // empty name, which must end the attribute.
+                size_t p = 0;
+                for (;;) {
+                    const size_t end = std::find(value.begin() + long(p), value.end(), 0) - value.begin();
+                    if (end >= value.size()) throw corrupt("the channel list of " + which + " is not terminated");
+                    if (end == p) {
+                        if (end + 1 != value.size()) throw corrupt("the channel list of " + which + " does not fill its size");
+                        break;
+                    }
+                    if (end - p > 255 || end + 17 > value.size()) throw corrupt("a channel of " + which + " is cut short");
+                    const uint32_t pixelType = le32(&value[end + 1]);
+                    const int32_t xs = int32_t(le32(&value[end + 9])), ys = int32_t(le32(&value[end + 13]));
+                    if (pixelType > 2 || xs < 1 || ys < 1) throw corrupt("a channel of " + which + " has a bad type or sampling");
+                    part.bytesPerPixel += (pixelType == 1 ? 2.0 : 4.0) / (double(xs) * double(ys));
+                    p = end + 17;
                 }
-                if (in.tellg() != at + std::streamoff(size))
-                    throw InputError(path + ": corrupt EXR header (the channel list's entries take " +
-                                     std::to_string(in.tellg() - at) + " bytes, its attribute says " + std::to_string(size) + ")");
             } else if (type == "preview") {
-                // A preview's width and height, then width * height * 4 bytes that OpenEXR allocates.
-                unsigned char wh[8];
-                if (size < 8 || !in.read(reinterpret_cast<char*>(wh), 8)) throw tooLarge(" (a preview without its size)", uint64_t(size));
-                const uint64_t pw = uint32_t(wh[0]) | uint32_t(wh[1]) << 8 | uint32_t(wh[2]) << 16 | uint32_t(wh[3]) << 24;
-                const uint64_t ph = uint32_t(wh[4]) | uint32_t(wh[5]) << 8 | uint32_t(wh[6]) << 16 | uint32_t(wh[7]) << 24;
-                if (pw * ph * 4 + 8 > uint64_t(size)) throw tooLarge(" of preview pixels", pw * ph * 4);
-                in.seekg(size - 8, std::ios::cur);
-            } else {
-                in.seekg(size, std::ios::cur);
+                if (size < 8 || uint64_t(le32(&value[0])) * le32(&value[4]) * 4 + 8 != uint64_t(size))
+                    throw corrupt(which + "'s pixels do not fill its " + std::to_string(size) + " bytes");
+            } else if (type == "stringvector") {
+                for (size_t p = 0; p < value.size();) {
+                    if (p + 4 > value.size()) throw corrupt("a string of " + which + " is cut short");
+                    const uint64_t len = le32(&value[p]);
+                    if (len > value.size() - p - 4) throw corrupt("a string of " + which + " claims " + std::to_string(len) + " bytes");
+                    p += 4 + size_t(len);
+                }
+            } else if (type == "box2i" && name == "dataWindow") {
+                part.hasWindow = true;
+                for (int i = 0; i < 4; ++i) part.window[i] = int32_t(le32(&value[size_t(4 * i)]));
+            } else if (type == "compression" && name == "compression") {
+                part.compression = value[0];
+            } else if (type == "string" && name == "type") {
+                part.deep = std::string(value.begin(), value.end()).rfind("deep", 0) == 0;
+            } else if (type == "string" && name == "name") {
+                part.name.assign(value.begin(), value.end());
             }
-            readName(name);
-            if (name.empty()) break;  // this header's end
         }
+        parts.push_back(part);
         if (!multipart) break;
+    }
+    // Rules 1 and 2 before OpenEXR sees the file (its classic API allocates line buffers for a
+    // data window's width when a file is opened).
+    double need = 0.0;
+    for (size_t i = 0; i < parts.size(); ++i) {
+        const PartHeader& h = parts[i];
+        if (!h.hasWindow) continue;  // OpenEXR refuses a header without one
+        const int64_t w = int64_t(h.window[2]) - h.window[0] + 1, hh = int64_t(h.window[3]) - h.window[1] + 1;
+        const std::string which =
+            parts.size() > 1 ? "part " + std::to_string(i) + (h.name.empty() ? "" : " '" + h.name + "'") + ": " : "";
+        if (w <= 0 || hh <= 0 || w > kMaxImageDim || hh > kMaxImageDim)
+            throw InputError(path + ": " + which + "unsupported image size " + sizeText(long(w), long(hh)) + " (at most " +
+                             std::to_string(kMaxImageDim) + " per side)");
+        if (h.deep) continue;
+        need += double(w) * double(hh) * h.bytesPerPixel / maxExpansionOf(h.compression);
+        if (need > double(bytes) + 65536.0)
+            throw InputError(path + ": truncated or corrupt EXR (" + (which.empty() ? "the header's " : which + "its ") +
+                             sizeText(long(w), long(hh)) + " data window needs more pixel data than the file's " +
+                             std::to_string(bytes) + " bytes can hold)");
     }
 }
 

@@ -391,6 +391,28 @@ static void checkJpegTables(const std::string& path, const std::vector<unsigned 
     }
 }
 
+// stb sniffs a file's format from its bytes, whatever its name (a ".png" that starts "P6" goes to
+// its PNM reader, whose header numbers overflow an int in 2.27: found by tests/fuzz/libfuzzer). A
+// file is read only as the format its extension names: its magic must be that format's (TGA has
+// none: it must not carry another format's).
+static void requireFormatOfExtension(const std::string& path, const std::vector<unsigned char>& b) {
+    auto starts = [&](std::initializer_list<unsigned char> m) {
+        return b.size() >= m.size() && std::equal(m.begin(), m.end(), b.begin());
+    };
+    const bool png = starts({0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'}), jpeg = starts({0xFF, 0xD8, 0xFF});
+    const bool bmp = starts({'B', 'M'}), hdr = starts({'#', '?'});
+    const bool other = starts({'G', 'I', 'F', '8'}) || starts({'8', 'B', 'P', 'S'}) || starts({0x53, 0x80, 0xF6, 0x34}) ||
+                       (b.size() >= 2 && b[0] == 'P' && b[1] >= '1' && b[1] <= '6');
+    const std::string ext = extensionOf(path);
+    const char* want = nullptr;
+    if (ext == ".png" && !png) want = "PNG";
+    if ((ext == ".jpg" || ext == ".jpeg") && !jpeg) want = "JPEG";
+    if (ext == ".bmp" && !bmp) want = "BMP";
+    if (ext == ".hdr" && !hdr) want = "Radiance HDR";
+    if (ext == ".tga" && (png || jpeg || bmp || hdr || other)) want = "TGA";
+    if (want) throw InputError(path + ": not a " + std::string(want) + " file (its first bytes are another format's, or none)");
+}
+
 static Image readStb(const std::string& path, int* sourceChannels) {
     // The whole file in memory (its size is what it holds), checked, then decoded from there.
     std::vector<unsigned char> bytes(static_cast<size_t>(fileSize(path)));
@@ -399,6 +421,7 @@ static Image readStb(const std::string& path, int* sourceChannels) {
         if (!in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(bytes.size())))
             throw InputError(path + ": cannot read the file");
     }
+    requireFormatOfExtension(path, bytes);
     checkPngChunks(path, bytes);
     checkJpegTables(path, bytes);
     const int len = bytes.size() > size_t(INT32_MAX) ? INT32_MAX : int(bytes.size());

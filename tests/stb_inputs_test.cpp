@@ -1,0 +1,96 @@
+// PNG, JPEG and the other formats stb_image reads, checked before stb sees them (src/io/image_io.cpp,
+// docs/inputs.md): the libFuzzer targets' reproducers of stb_image 2.27's faults (kept in
+// tests/data/stb_regressions) are refused in one InputError naming the file, and valid files with
+// the unusual-but-legal parts those checks touch (an empty IDAT chunk, data after IEND) still read.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "atrous/error.h"
+#include "exr_fixture.h"
+#include "io/image_io.h"
+
+using namespace atrous;
+using namespace atrous::test;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string errorOf(const std::string& path) {
+    try {
+        io::readImage(path);
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+uint32_t crc32(const std::string& s) {
+    uint32_t c = 0xffffffffu;
+    for (unsigned char ch : s) {
+        c ^= ch;
+        for (int k = 0; k < 8; ++k) c = (c >> 1) ^ (0xedb88320u & (0u - (c & 1u)));
+    }
+    return ~c;
+}
+
+std::string chunk(const std::string& type, const std::string& data) {
+    auto be = [](uint32_t v) { return std::string{char(v >> 24), char(v >> 16), char(v >> 8), char(v)}; };
+    return be(uint32_t(data.size())) + type + data + be(crc32(type + data));
+}
+
+}  // namespace
+
+TEST(StbInputs, FuzzReproducersAreRefusedNamingTheFile) {
+    const std::string data = std::string(ATROUS_SOURCE_DIR) + "/tests/data/stb_regressions/";
+    // A 326-byte PNG whose IDAT claims 2 GB (stb reallocs to it), a JPEG DHT of more than 256 codes
+    // (stb overruns its table), a PNM header named .png (stb sniffs it; its numbers overflow an
+    // int), a PNG whose first IDAT is empty and whose CRCs are wrong.
+    for (const char* name : {"idat_length_2gb.png", "jpeg_dht_overflow.jpg", "pnm_integer_overflow.png", "zero_length_idat.png"}) {
+        const std::string msg = errorOf(data + name);
+        EXPECT_NE(msg.find(name), std::string::npos) << name << ": " << msg;
+        const CliRun r = runCliMeasured("compare --ref " + data + name + " " + data + name);
+        EXPECT_EQ(r.exitCode, 2) << r.output;
+        EXPECT_TRUE(oneLine(r.output)) << r.output;
+        EXPECT_LT(r.peakMb, 100) << name;
+    }
+}
+
+TEST(StbInputs, LegalPngPartsStillRead) {
+    TempDir dir;
+    Image img(9, 5, 3);
+    for (int c = 0; c < 3; ++c)
+        for (int y = 0; y < 5; ++y)
+            for (int x = 0; x < 9; ++x) img(x, y, c) = 0.1f * float((x + y + c) % 10);
+    io::writePng(dir / "a.png", img);
+    const Image want = io::readImage(dir / "a.png");
+    // Split the file into its chunks, then add an empty IDAT before the first one and bytes after IEND.
+    const std::string bytes = fileBytes(dir / "a.png");
+    const size_t firstIdat = bytes.find("IDAT") - 4;
+    const std::string edited = bytes.substr(0, firstIdat) + chunk("IDAT", "") + bytes.substr(firstIdat) + "trailing bytes";
+    std::ofstream(dir / "b.png", std::ios::binary) << edited;
+    const Image got = io::readImage(dir / "b.png");
+    ASSERT_EQ(got.size(), want.size());
+    EXPECT_TRUE(std::equal(want.data(), want.data() + want.size(), got.data()));
+    // A flipped byte inside the pixel data fails its CRC (stb would decode it without a word).
+    std::string flipped = bytes;
+    flipped[firstIdat + 10] = char(flipped[firstIdat + 10] ^ 0x55);
+    std::ofstream(dir / "c.png", std::ios::binary) << flipped;
+    EXPECT_NE(errorOf(dir / "c.png").find("fails its CRC"), std::string::npos) << errorOf(dir / "c.png");
+}
+
+TEST(StbInputs, AFileIsReadOnlyAsTheFormatItsNameSays) {
+    TempDir dir;
+    Image img(4, 3, 3);
+    img.fill(0.5f);
+    io::writePng(dir / "a.png", img);
+    fs::copy_file(dir / "a.png", dir / "a.jpg");
+    fs::copy_file(dir / "a.png", dir / "a.tga");
+    std::ofstream(dir / "p.png", std::ios::binary) << "P6\n4 3\n255\n" << std::string(36, '\x80');
+    EXPECT_NE(errorOf(dir / "a.jpg").find("a.jpg: not a JPEG file"), std::string::npos) << errorOf(dir / "a.jpg");
+    EXPECT_NE(errorOf(dir / "a.tga").find("a.tga: not a TGA file"), std::string::npos) << errorOf(dir / "a.tga");
+    EXPECT_NE(errorOf(dir / "p.png").find("p.png: not a PNG file"), std::string::npos) << errorOf(dir / "p.png");
+}
