@@ -5,6 +5,7 @@
 // what 3-channel copies give.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <random>
 #include <string>
@@ -115,5 +116,33 @@ TEST(DenoiseBuffers, DepthInOneChannelAndIdsInTwoAreTheSame) {
         FAIL() << "1-channel ids accepted";
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("ids buffer needs 2 channels"), std::string::npos) << e.what();
+    }
+}
+
+// An uninformative variance (every value 0 or non-finite, -inf included) is dropped before its
+// values are checked, as it was by its own scan; a negative value in an informative one is an error
+// naming the variance buffer.
+TEST(DenoiseBuffers, UninformativeVarianceIsDroppedBeforeItsValuesAreChecked) {
+    const test::SyntheticScene s = test::makeScene(30, 20, 0.3f, 3);
+    Image var(30, 20, 3);
+    var.fill(-INFINITY);
+    var(3, 4, 1) = 0.0f;
+    DenoiseInputs in = s.inputs();
+    in.variance = &var;
+    DenoiseReport rep;
+    DenoiseOptions o;
+    o.report = &rep;
+    EXPECT_NO_THROW(denoise(in, o));
+    EXPECT_TRUE(rep.varianceIgnored);
+    EXPECT_TRUE(rep.noiseEstimated);
+    Image bad = s.variance.clone();
+    bad(7, 2, 0) = -1.0f;
+    in.variance = &bad;
+    try {
+        denoise(in, o);
+        FAIL() << "negative variance accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("variance buffer has a negative value"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("(7, 2)"), std::string::npos) << e.what();
     }
 }

@@ -233,6 +233,12 @@ bool varianceIsEmpty(const Image& v) {
 }
 
 PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, DenoiseReport& rep, bool deferNoiseSigma) {
+    return prepareInputsDropping(in, o, rep, deferNoiseSigma, nullptr);
+}
+
+PreparedInputs prepareInputsDropping(const DenoiseInputs& given, const DenoiseOptions& o, DenoiseReport& rep,
+                                     bool deferNoiseSigma, bool* varianceDropped) {
+    DenoiseInputs in = given;
     if (!in.color || in.color->empty()) throw InputError("no color buffer given");
     const Image& color = *in.color;
     if (color.channels() < 3) throw InputError("color buffer needs 3 channels");
@@ -260,6 +266,11 @@ PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, D
         }
         rep.nonFinitePixels = scan.nonFinite;
         p.meanLuminanceIn = scan.lumCount > 0 ? scan.lumSum / scan.lumCount : 0.0;
+        if (varianceDropped && hostVariance && !scan.varianceInformative) {
+            // All zero (or non-finite): no information, dropped before its values are checked.
+            in.variance = nullptr, hostVariance = nullptr;
+            *varianceDropped = true;
+        }
         p.meanLuminanceEmission = scan.emissionLumCount > 0 ? scan.emissionLumSum / scan.emissionLumCount : 0.0;
         if (hostVariance && scan.varianceBad != SIZE_MAX) {
             const Image& vh = *hostVariance;
@@ -405,12 +416,19 @@ namespace {
 filters::PreparedInputs prepareCall(DenoiseInputs& inputs, const DenoiseOptions& options, DenoiseReport& rep,
                                     bool deferNoiseSigma = false) {
     rep = DenoiseReport{};
-    const bool varianceIgnored = inputs.variance && inputs.color && !inputs.color->empty() &&
-                                 inputs.variance->view().sameSize(inputs.color->view()) &&
-                                 filters::varianceIsEmpty(*inputs.variance);
+    // A host variance of 3 channels or more is tested in prepareInputs' one scan of the inputs
+    // (then dropped before its values are checked); any other as before, on its own.
+    const bool fused = inputs.variance && inputs.color && !inputs.color->empty() &&
+                       inputs.color->device() == Device::Cpu && inputs.variance->device() == Device::Cpu &&
+                       inputs.variance->channels() >= 3;
+    bool varianceIgnored = !fused && inputs.variance && inputs.color && !inputs.color->empty() &&
+                           inputs.variance->view().sameSize(inputs.color->view()) &&
+                           filters::varianceIsEmpty(*inputs.variance);
     if (varianceIgnored) inputs.variance = nullptr;  // estimate the noise from the image instead
-    filters::PreparedInputs prep = filters::prepareInputs(inputs, options, rep, deferNoiseSigma);
+    filters::PreparedInputs prep = filters::prepareInputsDropping(inputs, options, rep, deferNoiseSigma,
+                                                                  fused ? &varianceIgnored : nullptr);
     if (varianceIgnored) {
+        inputs.variance = nullptr;
         rep.varianceIgnored = true;
         rep.buffersUsed += ",variance(ignored: all zero, e.g. a 1-spp render; noise estimated)";
     }

@@ -33,6 +33,11 @@ struct DriverDebug {
 // deferNoiseSigma: leave the global noise estimate of a host colour to denoiseCpu.
 PreparedInputs prepareInputs(const DenoiseInputs& in, const DenoiseOptions& o, DenoiseReport& rep,
                              bool deferNoiseSigma = false);
+// The same, and with varianceDropped given: a host variance that holds no information (every value
+// 0 or non-finite: a 1-spp render's) is found by the same scan and treated as absent, and
+// *varianceDropped set (denoise()'s rule, docs/algorithms.md).
+PreparedInputs prepareInputsDropping(const DenoiseInputs& in, const DenoiseOptions& o, DenoiseReport& rep,
+                                     bool deferNoiseSigma, bool* varianceDropped);
 // Every filter's colour rule (docs/reliability.md): a finite value beyond ±1e15 is not a
 // measurement. Throws InputError "color buffer has a value of magnitude ... at pixel (x, y)" for
 // a host image; a CUDA image is not scanned here.
