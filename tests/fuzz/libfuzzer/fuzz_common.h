@@ -155,12 +155,15 @@ inline std::vector<std::string> splitSections(const uint8_t* data, size_t size, 
 // an attribute claims more bytes than follow it, the header walked the way OpenEXR reads it: a
 // channel list up to its terminating null name and the fixed-size types by their size; the others
 // by their declared size. `parts` receives each header's channel pixel types (0 uint, 1 half, 2
-// float), `windows` each header's data window (x0, y0, x1, y1), as far as the walk got.
+// float), `windows` each header's data window (x0, y0, x1, y1), `tiles` each tile size (x, y), as
+// far as the walk got.
 inline bool exrAttributeOverrun(const uint8_t* d, size_t n, std::string* what,
                                 std::vector<std::vector<int>>* parts = nullptr,
-                                std::vector<std::array<int64_t, 4>>* windows = nullptr) {
+                                std::vector<std::array<int64_t, 4>>* windows = nullptr,
+                                std::vector<std::array<int64_t, 2>>* tiles = nullptr) {
     if (parts) parts->assign(1, {});
     if (windows) windows->clear();
+    if (tiles) tiles->clear();
     if (n < 8 || d[0] != 0x76 || d[1] != 0x2f || d[2] != 0x31 || d[3] != 0x01) return false;
     const bool multipart = (d[5] & 0x10) != 0;  // version flag 0x1000
     auto cstr = [&](size_t& i, std::string& out) {
@@ -214,6 +217,7 @@ inline bool exrAttributeOverrun(const uint8_t* d, size_t n, std::string* what,
             if (fixed > left) return false;
             if (windows && name == "dataWindow" && type == "box2i")
                 windows->push_back({i32(at), i32(at + 4), i32(at + 8), i32(at + 12)});
+            if (tiles && type == "tiledesc") tiles->push_back({int64_t(uint32_t(i32(at))), int64_t(uint32_t(i32(at + 4)))});
             at += fixed;
         } else if (type == "preview") {
             if (left < 8 || i32(at) < 0 || i32(at + 4) < 0) return false;
@@ -237,30 +241,18 @@ inline bool exrAttributeOverrun(const uint8_t* d, size_t n, std::string* what,
     return false;
 }
 
-// Known (Debian 12's stb_image 2.27, fixed in 2.28): a JPEG DHT table whose 16 code counts add up
-// to more than 256 makes stbi__build_huffman and the DHT loop write past the table's 257-byte size
-// and 256-byte values arrays (UBSan: index 257 out of bounds for stbi_uc[257]). Found by this
-// target in its first minute; reproducer tests/fuzz/libfuzzer/findings/png-stb-jpeg-dht-overflow.
-// True for an input holding such a table anywhere (DHT segments are looked for as stb reads them).
-inline bool jpegDhtOverflow(const uint8_t* data, size_t size) {
-    // Wherever they are: stb takes fill bytes before the SOI marker (FF FF D8) and sniffs JPEG in any file.
-    auto get8 = [&](size_t i) -> unsigned { return i < size ? data[i] : 0u; };  // stb reads 0 past the end
-    for (size_t at = 0; at + 1 < size; ++at) {
-        if (data[at] != 0xFF || data[at + 1] != 0xC4) continue;
-        size_t i = at + 2;
-        long left = long(get8(i) << 8 | get8(i + 1)) - 2;
-        i += 2;
-        while (left > 0 && i < size) {
-            const unsigned q = get8(i++);
-            if ((q >> 4) > 1 || (q & 15) > 3) break;
-            unsigned n = 0;
-            for (int k = 0; k < 16; ++k) n += get8(i++);
-            if (n > 256) return true;
-            i += n;
-            left -= 17 + long(n);
-        }
-    }
-    return false;
+// Known (Debian 12's stb_image 2.27; the JPEG decoder's bugs below are fixed in 2.28): its JPEG
+// decoder, which stb sniffs in any file (readImage on .png, .jpg, ...), met by the png target:
+// a DHT table of more than 256 codes writes past the Huffman table's size[257] and values[256]
+// arrays (UBSan "index 257 out of bounds", stbi__build_huffman; findings/png-stb-jpeg-dht-overflow.jpg),
+// a shift by 32 in stbi__grow_buffer_unsafe (findings/png-stb-jpeg-shift-exponent.jpg), and once
+// an STBI_ASSERT in stbi__jpeg_huff_decode, an abort in Debian's libstb.so too, not reproduced from
+// the file alone (findings/png-stb-jpeg-huff-assert-unreproduced.jpg). True for what stb takes for
+// a JPEG: 0xFF bytes, then the SOI marker 0xD8.
+inline bool stbJpeg(const uint8_t* d, size_t n) {
+    size_t i = 0;
+    while (i < n && d[i] == 0xFF) ++i;
+    return i > 0 && i < n && d[i] == 0xD8;
 }
 
 // Known (stb_image 2.27): the PNG reader grows its IDAT buffer to a chunk's claimed length before
@@ -304,22 +296,35 @@ inline bool exrWindowBeyondLimit(const std::vector<std::array<int64_t, 4>>& wind
     return false;
 }
 
+// Known (src/io at b493c61, found by the 10-minute exr_single run): the same for a tiled file's
+// tile size: TiledInputFile's constructor allocates tile buffers for it (tiles of 4 x 28835840
+// pixels: a 7.4 GB malloc; findings/exr-huge-tile-size-7.4gb.exr). True for a tile side beyond
+// kMaxImageDim.
+inline bool exrTileBeyondLimit(const std::vector<std::array<int64_t, 2>>& tiles) {
+    for (const auto& t : tiles)
+        if (t[0] > atrous::kMaxImageDim || t[1] > atrous::kMaxImageDim) return true;
+    return false;
+}
+
 inline bool skipKnownImage(const uint8_t* d, size_t n) {
     std::string what;
     std::vector<std::array<int64_t, 4>> windows;
-    if (exrAttributeOverrun(d, n, &what, nullptr, &windows) &&
+    std::vector<std::array<int64_t, 2>> tiles;
+    if (exrAttributeOverrun(d, n, &what, nullptr, &windows, &tiles) &&
         knownIssue("exr-header-size-desync", "an EXR attribute claims more than the file holds, walked as OpenEXR reads it: " + what))
         return true;
     if (exrWindowBeyondLimit(windows) &&
         knownIssue("exr-window-line-buffers", "an EXR data window beyond 16384 per side: OpenEXR allocates its line buffers first"))
+        return true;
+    if (exrTileBeyondLimit(tiles) &&
+        knownIssue("exr-tile-buffers", "an EXR tile side beyond 16384: OpenEXR allocates its tile buffers first"))
         return true;
     if (pnmLongNumber(d, n) && knownIssue("stb-pnm-integer-overflow", "stb_image 2.27 overflows an int reading a PNM header's number"))
         return true;
     if (pngIdatOverrun(d, n) &&
         knownIssue("stb-png-idat-length", "stb_image 2.27 allocates an IDAT chunk's claimed length before reading it"))
         return true;
-    return jpegDhtOverflow(d, n) &&
-           knownIssue("stb-jpeg-dht-overflow", "stb_image 2.27 writes past a Huffman table for a JPEG DHT with more than 256 codes");
+    return stbJpeg(d, n) && knownIssue("stb-jpeg-decoder", "stb_image 2.27's JPEG decoder (out-of-bounds writes, a shift by 32, an assert)");
 }
 
 // --------------------------------------------------------------------------------- the contract

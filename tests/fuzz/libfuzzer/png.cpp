@@ -6,7 +6,8 @@
 // fits the file (at most 8448 pixels per byte plus 65536, docs/reliability.md); an 8-bit image's
 // values are finite and in [0, 1] (sRGB decoded to linear); a Radiance image's are finite.
 //
-// Known (skipped unless ATROUS_FUZZ_STRICT=1, fuzz_common.h): stb_image 2.27's JPEG DHT overflow.
+// Known (skipped unless ATROUS_FUZZ_STRICT=1, fuzz_common.h): stb_image 2.27's JPEG decoder, its PNG
+// IDAT length and PNM numbers.
 #include <cmath>
 #include <cstring>
 
