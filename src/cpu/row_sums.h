@@ -51,4 +51,45 @@ ATROUS_FORCE_INLINE inline void sumRows(const float* const* rows, int count, flo
     if (i < n) sumRowsChunk<2>(rows, count, out, n - 32);
 }
 
+// G sums of row ranges at once: out[j][i] = rows[lo[j]][i] + ... + rows[hi[j]][i], added in order
+// from 0, for overlapping ranges (a vertical window sum for G consecutive output rows): each row
+// is loaded once for all the outputs it belongs to (a window of 9 rows for one output at a time
+// read every row 9 times, from L2), 2 vectors per output in registers.
+template <int G>
+ATROUS_FORCE_INLINE inline void sumRowRangesChunk(const float* const* rows, const int (&lo)[G], const int (&hi)[G],
+                                                  int first, int last, float* const (&out)[G], size_t i) {
+    Floats16 a[G][2];
+    for (int j = 0; j < G; ++j) a[j][0] = Floats16{}, a[j][1] = Floats16{};
+    for (int k = first; k <= last; ++k) {
+        Floats16 b0, b1;
+        std::memcpy(&b0, rows[k] + i, sizeof b0);
+        std::memcpy(&b1, rows[k] + i + 16, sizeof b1);
+        for (int j = 0; j < G; ++j)
+            if (k >= lo[j] && k <= hi[j]) a[j][0] += b0, a[j][1] += b1;
+    }
+    for (int j = 0; j < G; ++j) {
+        std::memcpy(out[j] + i, &a[j][0], sizeof a[j][0]);
+        std::memcpy(out[j] + i + 16, &a[j][1], sizeof a[j][1]);
+    }
+}
+
+template <int G>
+ATROUS_FORCE_INLINE inline void sumRowRanges(const float* const* rows, const int (&lo)[G], const int (&hi)[G],
+                                             float* const (&out)[G], size_t n) {
+    int first = lo[0], last = hi[0];
+    for (int j = 1; j < G; ++j) first = lo[j] < first ? lo[j] : first, last = hi[j] > last ? hi[j] : last;
+    if (n < 32) {
+        for (int j = 0; j < G; ++j)
+            for (size_t i = 0; i < n; ++i) {
+                float s = 0.0f;
+                for (int k = lo[j]; k <= hi[j]; ++k) s += rows[k][i];
+                out[j][i] = s;
+            }
+        return;
+    }
+    size_t i = 0;
+    for (; i + 32 <= n; i += 32) sumRowRangesChunk<G>(rows, lo, hi, first, last, out, i);
+    if (i < n) sumRowRangesChunk<G>(rows, lo, hi, first, last, out, n - 32);
+}
+
 }  // namespace atrous::cpu

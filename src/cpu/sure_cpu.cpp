@@ -70,17 +70,14 @@ void runSureBoxH(const CpuExec& exec, const SureBoxH& f) {
 
 namespace {
 
-// SureChoose's choice and accumulation for row y, from the window's rows of horizontal sums
-// (clamped: rows y - r..y + r) added in order dy = -r..r.
+// SureChoose's choice and accumulation for row y from the window sums sumD, sumV of its row.
 template <int kJamesStein>
-ATROUS_FORCE_INLINE inline void chooseRow(const SureChoose& f, int y, const float* const* rowsD, const float* const* rowsV,
-                                          float* sumD, float* sumV, float* sScratch) {
-    const int w = f.cI.width, h = f.cI.height, r = f.p.radius;
+ATROUS_FORCE_INLINE inline void chooseFromSums(const SureChoose& f, int y, const float* sumD, const float* sumV,
+                                               float* sScratch) {
+    const int w = f.cI.width, h = f.cI.height;
     SureChoiceParams p = f.p;
     p.jamesStein = kJamesStein;  // a constant: no branch left in the x loop
     const size_t plane = size_t(w) * h;
-    cpu::sumRows(rowsD, 2 * r + 1, sumD, size_t(w));
-    cpu::sumRows(rowsV, 2 * r + 1, sumV, size_t(w));
     const size_t o = size_t(y) * w;
     const float* ATROUS_RESTRICT ci = f.cI.data + o;
     const float* ATROUS_RESTRICT cn = f.cNext.data + o;
@@ -96,6 +93,17 @@ ATROUS_FORCE_INLINE inline void chooseRow(const SureChoose& f, int y, const floa
         acc[x + 2 * plane] += s * (ci[x + 2 * plane] - cn[x + 2 * plane]);
         sOut[x] = s;
     }
+}
+
+// The same from the window's rows of horizontal sums (clamped: rows y - r..y + r) added in order
+// dy = -r..r.
+template <int kJamesStein>
+ATROUS_FORCE_INLINE inline void chooseRow(const SureChoose& f, int y, const float* const* rowsD, const float* const* rowsV,
+                                          float* sumD, float* sumV, float* sScratch) {
+    const int w = f.cI.width, r = f.p.radius;
+    cpu::sumRows(rowsD, 2 * r + 1, sumD, size_t(w));
+    cpu::sumRows(rowsV, 2 * r + 1, sumV, size_t(w));
+    chooseFromSums<kJamesStein>(f, y, sumD, sumV, sScratch);
 }
 
 template <int kJamesStein>
@@ -117,24 +125,47 @@ void chooseRows(const SureChoose& f, int y0, int y1) {
 // (clamped) into a ring of 2r + 1 rows, the choice of each row from its window's ring rows.
 template <int kJamesStein>
 void windowRows(const SureBoxH& box, const SureChoose& f, int y0, int y1) {
+    constexpr int G = 4;  // interior rows whose window sums are taken together (cpu::sumRowRanges)
     const int w = box.in.width, h = box.in.height, r = box.radius;
-    const int slots = 2 * r + 1;
-    std::vector<float> ring(size_t(slots) * 2 * size_t(w)), sScratch(w), sumDRow(w), sumVRow(w);
+    const int slots = 2 * r + G;
     const size_t n = static_cast<size_t>(slots);
+    std::vector<float> ring(n * 2 * size_t(w)), sScratch(w), sums(size_t(G) * 2 * size_t(w));
     std::vector<const float*> rowsD(n), rowsV(n), shiftedD(n), shiftedV(n);
-    std::vector<int> have(size_t(slots), -1);
-    for (int y = y0; y < y1; ++y) {
-        for (int dy = -r; dy <= r; ++dy) {
-            const int yy = clampIdx(y + dy, h - 1);
-            float* slot = ring.data() + size_t(yy % slots) * 2 * size_t(w);
-            if (have[size_t(yy % slots)] != yy) {
-                boxRow(box, yy, slot, slot + w, shiftedD, shiftedV);
-                have[size_t(yy % slots)] = yy;
-            }
-            rowsD[size_t(dy + r)] = slot;
-            rowsV[size_t(dy + r)] = slot + w;
+    std::vector<int> have(n, -1);
+    auto slotOf = [&](int yy) {
+        float* slot = ring.data() + size_t(yy % slots) * 2 * size_t(w);
+        if (have[size_t(yy % slots)] != yy) {
+            boxRow(box, yy, slot, slot + w, shiftedD, shiftedV);
+            have[size_t(yy % slots)] = yy;
         }
-        chooseRow<kJamesStein>(f, y, rowsD.data(), rowsV.data(), sumDRow.data(), sumVRow.data(), sScratch.data());
+        return slot;
+    };
+    for (int y = y0; y < y1;) {
+        if (y - r >= 0 && y + G - 1 + r <= h - 1 && y + G <= y1) {
+            // G interior rows: their windows are rows y - r .. y + G - 1 + r, no clamping.
+            for (int k = 0; k < 2 * r + G; ++k) {
+                const float* slot = slotOf(y - r + k);
+                rowsD[size_t(k)] = slot, rowsV[size_t(k)] = slot + w;
+            }
+            int lo[G], hi[G];
+            float* outD[G];
+            float* outV[G];
+            for (int j = 0; j < G; ++j) {
+                lo[j] = j, hi[j] = j + 2 * r;
+                outD[j] = sums.data() + size_t(2 * j) * w, outV[j] = outD[j] + w;
+            }
+            cpu::sumRowRanges<G>(rowsD.data(), lo, hi, outD, size_t(w));
+            cpu::sumRowRanges<G>(rowsV.data(), lo, hi, outV, size_t(w));
+            for (int j = 0; j < G; ++j) chooseFromSums<kJamesStein>(f, y + j, outD[j], outV[j], sScratch.data());
+            y += G;
+            continue;
+        }
+        for (int dy = -r; dy <= r; ++dy) {
+            const float* slot = slotOf(clampIdx(y + dy, h - 1));
+            rowsD[size_t(dy + r)] = slot, rowsV[size_t(dy + r)] = slot + w;
+        }
+        chooseRow<kJamesStein>(f, y, rowsD.data(), rowsV.data(), sums.data(), sums.data() + w, sScratch.data());
+        ++y;
     }
 }
 
@@ -200,18 +231,29 @@ void rowWindowSums(const float* ATROUS_RESTRICT in, float* ATROUS_RESTRICT out, 
 // the whole image are never stored), and use(y, sums) takes each row's column sums.
 template <class RowFn, class UseFn>
 void bandColumnSums(int y0, int y1, int h, int w, int r, int channels, RowFn rowFn, UseFn use) {
-    const int slots = 2 * r + 1;
+    constexpr int G = 4;  // output rows whose column sums are taken together (cpu::sumRowRanges)
+    const int slots = 2 * r + G;
     const size_t rowSize = size_t(channels) * w;
-    std::vector<float> ring(rowSize * slots), sums(rowSize);
-    std::vector<const float*> rows(slots);
+    std::vector<float> ring(rowSize * slots), sums(rowSize * G);
+    std::vector<const float*> rows(static_cast<size_t>(slots));
     int next = y0 - r < 0 ? 0 : y0 - r;  // the first row not computed yet
-    for (int y = y0; y < y1; ++y) {
-        const int lo = y - r < 0 ? 0 : y - r, hi = y + r > h - 1 ? h - 1 : y + r;
-        for (; next <= hi; ++next) rowFn(next, ring.data() + rowSize * size_t(next % slots));
-        // Rows lo..hi added in order from 0 (cpu::sumRows).
-        for (int j = lo; j <= hi; ++j) rows[j - lo] = ring.data() + rowSize * size_t(j % slots);
-        cpu::sumRows(rows.data(), hi - lo + 1, sums.data(), rowSize);
-        use(y, sums.data());
+    for (int y = y0; y < y1; y += G) {
+        const int g = y1 - y < G ? y1 - y : G;
+        const int base = y - r < 0 ? 0 : y - r;  // rows[k] is image row base + k
+        int lo[G], hi[G];
+        float* out[G];
+        for (int j = 0; j < G; ++j) {
+            const int t = y + (j < g ? j : g - 1);  // (a short last group repeats its last row)
+            lo[j] = (t - r < 0 ? 0 : t - r) - base;
+            hi[j] = (t + r > h - 1 ? h - 1 : t + r) - base;
+            out[j] = sums.data() + rowSize * size_t(j);
+        }
+        const int top = hi[G - 1] + base;
+        for (; next <= top; ++next) rowFn(next, ring.data() + rowSize * size_t(next % slots));
+        for (int k = 0; k <= top - base; ++k) rows[size_t(k)] = ring.data() + rowSize * size_t((base + k) % slots);
+        // Each output's rows lo..hi added in order from 0, as BoxSum<true>.
+        cpu::sumRowRanges<G>(rows.data(), lo, hi, out, rowSize);
+        for (int j = 0; j < g; ++j) use(y + j, out[j]);
     }
 }
 
@@ -221,8 +263,9 @@ void bandColumnSums(int y0, int y1, int h, int w, int r, int channels, RowFn row
 // (and one per border column) instead of one per pixel and channel.
 void tapReciprocals(int r, int y, int w, int h, float* ATROUS_RESTRICT inv) {
     const float interior = 1.0f / boxTaps(r, std::min(r, w - 1), y, w, h);
-    for (int x = 0; x < w; ++x)
-        inv[x] = (x >= r && x < w - r) ? interior : 1.0f / boxTaps(r, x, y, w, h);
+    for (int x = 0; x < w; ++x) inv[x] = interior;
+    for (int x = 0; x < std::min(r, w); ++x) inv[x] = 1.0f / boxTaps(r, x, y, w, h);
+    for (int x = std::max(0, w - r); x < w; ++x) inv[x] = 1.0f / boxTaps(r, x, y, w, h);
 }
 
 // The give-back's passes fused into row loops over bands of rows: (1) each row's moments
