@@ -8,9 +8,12 @@
 //              CLI will run once it holds its inputs that way.
 // Prints one JSON object. Usage:
 //   bench_file_filter --in DIR [--method eaw|sure|learned] [--no-variance] [--warm N | --one-shot]
-//                     [--huge-pages]
+//                     [--huge-pages] [--threads N]
 #include <sys/resource.h>
+#include <tbb/global_control.h>
 #include <tbb/scalable_allocator.h>
+
+#include <memory>
 
 #include <algorithm>
 #include <cstdio>
@@ -46,7 +49,7 @@ Image firstChannels(Image&& src, int channels) {
 int main(int argc, char** argv) {
     std::string in, method = "eaw";
     bool noVariance = false, oneShot = false, hugePages = false;
-    int warm = 10;
+    int warm = 10, threads = 0;
     CLI::App app{"still filters on a render read from files: warm runs or one compact one-shot call"};
     app.add_option("--in", in, "render directory (atrous render --out)")->required();
     app.add_option("--method", method, "eaw | sure | learned")->check(CLI::IsMember({"eaw", "sure", "learned"}));
@@ -54,9 +57,13 @@ int main(int argc, char** argv) {
     app.add_option("--warm", warm, "timed runs of the const denoise() after 2 warm-ups");
     app.add_flag("--one-shot", oneShot, "one denoise(DenoiseBuffers&) call on compactly held buffers");
     app.add_flag("--huge-pages", hugePages, "scalable_allocation_mode(TBBMALLOC_USE_HUGE_PAGES, 1) first");
+    app.add_option("--threads", threads, "TBB threads (0 = all cores; 1 measures the work alone on a loaded machine)");
     if (const int rc = bench::parseArgs(app, argc, argv); rc >= 0) return rc;
     try {
         if (hugePages) scalable_allocation_mode(TBBMALLOC_USE_HUGE_PAGES, 1);
+        std::unique_ptr<tbb::global_control> limit;
+        if (threads > 0)
+            limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(threads));
         DenoiseOptions o;
         o.method = parseDenoiseMethod(method);
         const DenoiseBufferUse use = denoiseBufferUse(o, o.method);
