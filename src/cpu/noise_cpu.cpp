@@ -358,18 +358,21 @@ float medianFinite(const CpuExec&, const ImageView& v, float none) {
 
 void runLocalNoise(const CpuExec& exec, const LocalNoise& f) {
     const int w = f.color.width, h = f.color.height;
-    Image energy = Image::uninitialized(w, h, 3);
+    Image store;
+    const ImageView energy = f.scratch.valid() && f.scratch.channels >= 3 && f.scratch.sameSize(f.color)
+                                 ? ImageView{f.scratch.data, w, h, 3}
+                                 : (store = Image::uninitialized(w, h, 3)).view();
     DetailEnergy de;
-    de.color = f.color, de.energy = energy.view(), de.normal = f.normal, de.depth = f.depth;
+    de.color = f.color, de.energy = energy, de.normal = f.normal, de.depth = f.depth;
     for (int c = 0; c < 3; ++c) de.maxDiff2[c] = f.maxDiff2[c];
     const bool n = f.normal.valid(), z = f.depth.valid();
     const cpu::Isa isa = cpu::activeIsa();
-    if (n && z) cpu::parallelForIsa(isa, 0, h, 4, EnergyRows<true, true>{f, de, energy.view()});
-    else if (n) cpu::parallelForIsa(isa, 0, h, 4, EnergyRows<true, false>{f, de, energy.view()});
-    else if (z) cpu::parallelForIsa(isa, 0, h, 4, EnergyRows<false, true>{f, de, energy.view()});
-    else cpu::parallelForIsa(isa, 0, h, 4, EnergyRows<false, false>{f, de, energy.view()});
+    if (n && z) cpu::parallelForIsa(isa, 0, h, 4, EnergyRows<true, true>{f, de, energy});
+    else if (n) cpu::parallelForIsa(isa, 0, h, 4, EnergyRows<true, false>{f, de, energy});
+    else if (z) cpu::parallelForIsa(isa, 0, h, 4, EnergyRows<false, true>{f, de, energy});
+    else cpu::parallelForIsa(isa, 0, h, 4, EnergyRows<false, false>{f, de, energy});
     VarianceBands vb;
-    vb.f = f, vb.energy = energy.view();
+    vb.f = f, vb.energy = energy;
     vb.rule.eps = f.eps, vb.rule.floor = f.floor;  // LocalVariance's pixelModulationAlbedo defaults
     // Bands of 32 rows: the ring recomputes 2r row sums per band (cheap next to the energy).
     cpu::parallelForIsa(isa, 0, h, 32, vb);

@@ -297,6 +297,8 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         ln.depth = in.depth.valid() ? depth : ImageView{};
         ln.albedo = albedo;
         ln.var = vA.view();
+        // Its energy plane: var(c_0)'s buffer, free since the firefly pass (the σ planes come later).
+        if (!spareV.empty()) ln.scratch = spareV.view();
         runLocalNoise(exec, ln);
     }
     const char* const demodStage = noise ? "noise estimate" : "demodulate";

@@ -313,6 +313,7 @@ struct LocalNoise {
     ImageView normal, depth;   // sanitised, invalid when not given (normal: also the background test)
     ImageView albedo;          // sanitised, invalid without demodulation
     ImageView var;             // out, 3 ch
+    ImageView scratch;         // optional, 3 ch: planes the caller has no use for (the CPU's energy)
 };
 
 // On `exec`: the three functors through image-sized temporaries (energy 3 planes, row sums 8). The
