@@ -1,9 +1,10 @@
-// PNG, JPEG and the other formats stb_image reads, checked before stb sees them (src/io/image_io.cpp,
-// docs/inputs.md): the libFuzzer targets' reproducers of stb_image 2.27's faults (kept in
+// PNG and the other formats stb_image reads, checked before stb sees them, and JPEG, read by
+// libjpeg-turbo instead (src/io/image_io.cpp, docs/inputs.md): the libFuzzer targets' reproducers of stb_image 2.27's faults (kept in
 // tests/data/stb_regressions) are refused in one InputError naming the file, and valid files with
 // the unusual-but-legal parts those checks touch (an empty IDAT chunk, data after IEND) still read.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -47,9 +48,10 @@ std::string chunk(const std::string& type, const std::string& data) {
 TEST(StbInputs, FuzzReproducersAreRefusedNamingTheFile) {
     const std::string data = std::string(ATROUS_SOURCE_DIR) + "/tests/data/stb_regressions/";
     // A 326-byte PNG whose IDAT claims 2 GB (stb reallocs to it), a JPEG DHT of more than 256 codes
-    // (stb overruns its table), a PNM header named .png (stb sniffs it; its numbers overflow an
+    // (stb overruns its table), a JPEG stb shifts by 32 on, a PNM header named .png (stb sniffs it; its numbers overflow an
     // int), a PNG whose first IDAT is empty and whose CRCs are wrong.
-    for (const char* name : {"idat_length_2gb.png", "jpeg_dht_overflow.jpg", "pnm_integer_overflow.png", "zero_length_idat.png"}) {
+    for (const char* name : {"idat_length_2gb.png", "jpeg_dht_overflow.jpg", "jpeg_shift_exponent.jpg", "pnm_integer_overflow.png",
+                             "zero_length_idat.png"}) {
         const std::string msg = errorOf(data + name);
         EXPECT_NE(msg.find(name), std::string::npos) << name << ": " << msg;
         const CliRun r = runCliMeasured("compare --ref " + data + name + " " + data + name);
@@ -93,4 +95,26 @@ TEST(StbInputs, AFileIsReadOnlyAsTheFormatItsNameSays) {
     EXPECT_NE(errorOf(dir / "a.jpg").find("a.jpg: not a JPEG file"), std::string::npos) << errorOf(dir / "a.jpg");
     EXPECT_NE(errorOf(dir / "a.tga").find("a.tga: not a TGA file"), std::string::npos) << errorOf(dir / "a.tga");
     EXPECT_NE(errorOf(dir / "p.png").find("p.png: not a PNG file"), std::string::npos) << errorOf(dir / "p.png");
+}
+
+// JPEG goes to libjpeg-turbo (stb 2.27's JPEG decoder overruns its tables, shifts by 32 and asserts
+// on crafted files): two small files made with ffmpeg (tests/data/images) read as 8-bit sRGB-ish
+// values to the power 2.2, as stb read them; a damaged one is an error naming it.
+TEST(StbInputs, JpegIsReadByLibjpegTurbo) {
+    const std::string data = std::string(ATROUS_SOURCE_DIR) + "/tests/data/images/";
+    int channels = 0;
+    const Image grey = io::readImage(data + "grey_16x8.jpg", &channels);  // (YCbCr: ffmpeg writes no grey JPEG)
+    ASSERT_EQ(grey.width(), 16);
+    ASSERT_EQ(grey.height(), 8);
+    const float g = std::pow(128.0f / 255.0f, 2.2f);  // 0x80, give or take one code value of the codec
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(grey(5, 3, c), g, 0.01f) << c;
+    const Image colour = io::readImage(data + "colour_16x8.jpg", &channels);
+    EXPECT_EQ(channels, 3);
+    EXPECT_NEAR(colour(8, 4, 0), 1.0f, 0.03f);                                 // 0xff
+    EXPECT_NEAR(colour(8, 4, 1), std::pow(64.0f / 255.0f, 2.2f), 0.02f);       // 0x40
+    EXPECT_NEAR(colour(8, 4, 2), std::pow(32.0f / 255.0f, 2.2f), 0.02f);       // 0x20
+    TempDir dir;
+    std::string bytes = fileBytes(data + "colour_16x8.jpg");
+    std::ofstream(dir / "cut.jpg", std::ios::binary) << bytes.substr(0, bytes.size() - 40);
+    EXPECT_NE(errorOf(dir / "cut.jpg").find("cut.jpg"), std::string::npos) << errorOf(dir / "cut.jpg");
 }

@@ -62,6 +62,7 @@ int fixedSize(const std::string& type) {
 struct PartHeader {
     bool hasWindow = false, deep = false;
     std::string name;
+    uint32_t tileW = 0, tileH = 0;  // a tiled part's tile size (OpenEXR allocates tile buffers of it)
     int32_t window[4] = {0, 0, 0, 0};  // xmin, ymin, xmax, ymax
     int compression = 0;
     double bytesPerPixel = 0;  // of its channels, at their sampling
@@ -157,6 +158,9 @@ void requireExrHeadersFit(const std::string& path) {
                 part.deep = std::string(value.begin(), value.end()).rfind("deep", 0) == 0;
             } else if (type == "string" && name == "name") {
                 part.name.assign(value.begin(), value.end());
+            } else if (type == "tiledesc") {
+                part.tileW = le32(&value[0]);
+                part.tileH = le32(&value[4]);
             }
         }
         parts.push_back(part);
@@ -167,13 +171,23 @@ void requireExrHeadersFit(const std::string& path) {
     double need = 0.0;
     for (size_t i = 0; i < parts.size(); ++i) {
         const PartHeader& h = parts[i];
-        if (!h.hasWindow) continue;  // OpenEXR refuses a header without one
+        // OpenEXR fills in a missing data window (and then allocates for what the header's other
+        // attributes say): a header without one is refused here.
+        if (!h.hasWindow)
+            throw InputError(path + ": " + (parts.size() > 1 ? "part " + std::to_string(i) + ": " : std::string()) +
+                             "corrupt EXR header (no dataWindow attribute)");
         const int64_t w = int64_t(h.window[2]) - h.window[0] + 1, hh = int64_t(h.window[3]) - h.window[1] + 1;
         const std::string which =
             parts.size() > 1 ? "part " + std::to_string(i) + (h.name.empty() ? "" : " '" + h.name + "'") + ": " : "";
         if (w <= 0 || hh <= 0 || w > kMaxImageDim || hh > kMaxImageDim)
             throw InputError(path + ": " + which + "unsupported image size " + sizeText(long(w), long(hh)) + " (at most " +
                              std::to_string(kMaxImageDim) + " per side)");
+        // A tile side is at most the data window's, or 1024 (a small image's usual 64 x 64 tiles):
+        // OpenEXR's classic API allocates buffers of a tile's size when it opens a tiled file
+        // (4 x 28835840 tiles: 7.4 GB, found by tests/fuzz/libfuzzer).
+        if (h.tileW > uint64_t(std::max<int64_t>(w, 1024)) || h.tileH > uint64_t(std::max<int64_t>(hh, 1024)))
+            throw InputError(path + ": " + which + "corrupt EXR (tiles of " + std::to_string(h.tileW) + "x" + std::to_string(h.tileH) +
+                             " for a " + sizeText(long(w), long(hh)) + " data window)");
         if (h.deep) continue;
         need += double(w) * double(hh) * h.bytesPerPixel / maxExpansionOf(h.compression);
         if (need > double(bytes) + 65536.0)
