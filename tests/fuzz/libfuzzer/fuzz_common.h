@@ -8,20 +8,17 @@
 // a finding: the target prints one line "==atrous-fuzz== FINDING in <target>: ..." and aborts, and
 // libFuzzer keeps the input as crash-<sha1>.
 //
-// Known problems (Debian 12's stb_image 2.27; two in src/io's EXR header checks, reported to the
-// lead): a target names them once as "==atrous-fuzz== KNOWN <id>" and skips the input, so that a
-// long run can go on; with ATROUS_FUZZ_STRICT=1 they are not skipped (and then end the run as
-// findings).
+// Known problems: a target can name one with knownIssue() ("==atrous-fuzz== KNOWN <id>", once)
+// and skip the input, so that a long run goes on while it is being fixed; with ATROUS_FUZZ_STRICT=1
+// nothing is skipped. None is skipped at 2b4da78: every problem found so far is fixed
+// (tests/fuzz/libfuzzer/README.md), and its input is a seed (corpus/*/finding_*).
 #pragma once
 #include <unistd.h>
 
-#include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <exception>
 #include <filesystem>
 #include <set>
@@ -141,190 +138,6 @@ inline std::vector<std::string> splitSections(const uint8_t* data, size_t size, 
     parts.push_back(all.substr(at));
     while (parts.size() < maxParts) parts.emplace_back();
     return parts;
-}
-
-// ------------------------------------------------------------------------------ known problems
-
-// Known (src/io at f6cab04, found by the 10-minute exr runs with ATROUS_FUZZ_STRICT=1): OpenEXR 3.1's
-// Header::readFrom allocates an attribute's claimed size (a string's, opaque data, a preview's
-// pixels) before reading it. src/io/exr_limits.cpp's requireExrHeadersFit walks the header
-// first, but steps over every attribute by its declared size, while OpenEXR reads the fixed-size
-// types by their size whatever they declare: a 'compression' declaring 321 bytes (OpenEXR reads
-// 1) hides the string of 1918989835 bytes that OpenEXR then meets (reproducer
-// tests/fuzz/libfuzzer/findings/exr-header-declared-size-desync-1.9gb.exr). True, with what, when
-// an attribute claims more bytes than follow it, the header walked the way OpenEXR reads it: a
-// channel list up to its terminating null name and the fixed-size types by their size; the others
-// by their declared size. `parts` receives each header's channel pixel types (0 uint, 1 half, 2
-// float), `windows` each header's data window (x0, y0, x1, y1), `tiles` each tile size (x, y), as
-// far as the walk got.
-inline bool exrAttributeOverrun(const uint8_t* d, size_t n, std::string* what,
-                                std::vector<std::vector<int>>* parts = nullptr,
-                                std::vector<std::array<int64_t, 4>>* windows = nullptr,
-                                std::vector<std::array<int64_t, 2>>* tiles = nullptr) {
-    if (parts) parts->assign(1, {});
-    if (windows) windows->clear();
-    if (tiles) tiles->clear();
-    if (n < 8 || d[0] != 0x76 || d[1] != 0x2f || d[2] != 0x31 || d[3] != 0x01) return false;
-    const bool multipart = (d[5] & 0x10) != 0;  // version flag 0x1000
-    auto cstr = [&](size_t& i, std::string& out) {
-        const size_t start = i;
-        while (i < n && d[i] != 0 && i - start < 256) ++i;
-        if (i >= n || d[i] != 0) return false;
-        out.assign(reinterpret_cast<const char*>(d + start), i - start);
-        ++i;
-        return true;
-    };
-    auto i32 = [&](size_t i) {
-        return int64_t(int32_t(uint32_t(d[i]) | uint32_t(d[i + 1]) << 8 | uint32_t(d[i + 2]) << 16 | uint32_t(d[i + 3]) << 24));
-    };
-    auto fixedSize = [](const std::string& t) -> size_t {
-        static const std::pair<const char*, size_t> kFixed[] = {
-            {"box2i", 16}, {"box2f", 16}, {"compression", 1}, {"lineOrder", 1}, {"envmap", 1}, {"deepImageState", 1},
-            {"int", 4}, {"float", 4}, {"double", 8}, {"v2i", 8}, {"v2f", 8}, {"v2d", 16}, {"v3i", 12}, {"v3f", 12},
-            {"v3d", 24}, {"m33f", 36}, {"m33d", 72}, {"m44f", 64}, {"m44d", 128}, {"tiledesc", 9}, {"keycode", 28},
-            {"timecode", 8}, {"rational", 8}, {"chromaticities", 32}};
-        for (const auto& [name, bytes] : kFixed)
-            if (t == name) return bytes;
-        return 0;
-    };
-    auto overrun = [&](const std::string& name, const std::string& type, int64_t claim, size_t left) {
-        if (what) *what = "attribute '" + name + "' (" + type + ") claims " + std::to_string(claim) + " bytes, " + std::to_string(left) + " follow";
-        return true;
-    };
-    size_t at = 8;
-    while (at < n) {
-        if (d[at] == 0) {  // end of a header; in a multipart file an empty header ends the list
-            ++at;
-            if (!multipart || at >= n || d[at] == 0) return false;
-            if (parts) parts->emplace_back();
-            continue;
-        }
-        std::string name, type;
-        if (!cstr(at, name) || !cstr(at, type) || at + 4 > n) return false;
-        const int64_t size = i32(at);
-        at += 4;
-        if (size < 0) return false;  // OpenEXR refuses it
-        const size_t left = n - at;
-        if (type == "chlist") {
-            for (std::string channel;;) {
-                if (!cstr(at, channel)) return false;
-                if (channel.empty()) break;
-                if (at + 16 > n) return false;
-                if (parts) parts->back().push_back(int(i32(at)));
-                at += 16;
-            }
-        } else if (const size_t fixed = fixedSize(type)) {
-            if (fixed > left) return false;
-            if (windows && name == "dataWindow" && type == "box2i")
-                windows->push_back({i32(at), i32(at + 4), i32(at + 8), i32(at + 12)});
-            if (tiles && type == "tiledesc") tiles->push_back({int64_t(uint32_t(i32(at))), int64_t(uint32_t(i32(at + 4)))});
-            at += fixed;
-        } else if (type == "preview") {
-            if (left < 8 || i32(at) < 0 || i32(at + 4) < 0) return false;
-            const uint64_t pixels = uint64_t(i32(at)) * uint64_t(i32(at + 4));  // 4 bytes each
-            if (pixels > (left - 8) / 4) return overrun(name, type, int64_t(pixels * 4), left - 8);
-            at += 8 + size_t(pixels * 4);
-        } else if (type == "stringvector") {
-            for (int64_t read = 0; read < size;) {
-                if (at + 4 > n || i32(at) < 0) return false;
-                const int64_t len = i32(at);
-                at += 4;
-                if (uint64_t(len) > n - at) return overrun(name, type + " string", len, n - at);
-                at += size_t(len);
-                read += 4 + len;
-            }
-        } else {
-            if (uint64_t(size) > left) return overrun(name, type, size, left);
-            at += size_t(size);
-        }
-    }
-    return false;
-}
-
-// Known (Debian 12's stb_image 2.27; the JPEG decoder's bugs below are fixed in 2.28): its JPEG
-// decoder, which stb sniffs in any file (readImage on .png, .jpg, ...), met by the png target:
-// a DHT table of more than 256 codes writes past the Huffman table's size[257] and values[256]
-// arrays (UBSan "index 257 out of bounds", stbi__build_huffman; findings/png-stb-jpeg-dht-overflow.jpg),
-// a shift by 32 in stbi__grow_buffer_unsafe (findings/png-stb-jpeg-shift-exponent.jpg), and once
-// an STBI_ASSERT in stbi__jpeg_huff_decode, an abort in Debian's libstb.so too, not reproduced from
-// the file alone (findings/png-stb-jpeg-huff-assert-unreproduced.jpg). True for what stb takes for
-// a JPEG: 0xFF bytes, then the SOI marker 0xD8.
-inline bool stbJpeg(const uint8_t* d, size_t n) {
-    size_t i = 0;
-    while (i < n && d[i] == 0xFF) ++i;
-    return i > 0 && i < n && d[i] == 0xD8;
-}
-
-// Known (stb_image 2.27): the PNG reader grows its IDAT buffer to a chunk's claimed length before
-// reading it, so a 200-byte PNG whose IDAT claims 2^31 bytes makes it realloc 2 GB (found by png,
-// reproducer tests/fuzz/libfuzzer/findings/png-stb-idat-length-2gb.png). True when an IDAT chunk
-// claims more bytes than follow its header.
-inline bool pngIdatOverrun(const uint8_t* d, size_t n) {
-    static const uint8_t kSig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-    if (n < 8 || std::memcmp(d, kSig, 8) != 0) return false;
-    for (size_t at = 8; at + 8 <= n;) {
-        const uint64_t len = uint64_t(d[at]) << 24 | uint64_t(d[at + 1]) << 16 | uint64_t(d[at + 2]) << 8 | d[at + 3];
-        if (std::memcmp(d + at + 4, "IDAT", 4) == 0 && len > n - (at + 8)) return true;
-        at += 12 + size_t(len);
-    }
-    return false;
-}
-
-// The known-problem skips of every target that hands bytes to an image reader (the OpenEXR Core
-// reader's 4-channel SEGV and readBufferFile on an EXR without channels, known before, are fixed
-// in src/io: 7244261, 37f271e).
-// Known (src/io at f6cab04, found by the 10-minute exr_single run with ATROUS_FUZZ_STRICT=1):
-// readImage opens an Imf::InputFile before it checks the data window, and OpenEXR's constructor
-// allocates its line buffers for the window's width: a 565-byte file with a data window from
-// x = -234881024 to 1792 costs 1.9 GB (reproducer findings/exr-huge-data-window-1.9gb.exr).
-// True when a header's data window is wider or taller than atrous accepts (kMaxImageDim).
-// Known (stb_image 2.27, fixed in 2.28): the PNM reader (P5/P6, which stb sniffs in any file)
-// reads the header's numbers into an int without an overflow check (UBSan: "666666666 * 10
-// cannot be represented in type 'int'", stbi__pnm_getinteger; found by the 10-minute png run;
-// reproducer findings/png-stb-pnm-integer-overflow.pnm). True for a P5/P6 file with a run of 10
-// or more digits in its first 1 KB.
-inline bool pnmLongNumber(const uint8_t* d, size_t n) {
-    if (n < 2 || d[0] != 'P' || (d[1] != '5' && d[1] != '6')) return false;
-    for (size_t i = 2, run = 0; i < std::min<size_t>(n, 1024); ++i)
-        if ((run = d[i] >= '0' && d[i] <= '9' ? run + 1 : 0) >= 10) return true;
-    return false;
-}
-
-inline bool exrWindowBeyondLimit(const std::vector<std::array<int64_t, 4>>& windows) {
-    for (const auto& w : windows)
-        if (w[2] - w[0] + 1 > atrous::kMaxImageDim || w[3] - w[1] + 1 > atrous::kMaxImageDim) return true;
-    return false;
-}
-
-// Known (src/io at b493c61, found by the 10-minute exr_single run): the same for a tiled file's
-// tile size: TiledInputFile's constructor allocates tile buffers for it (tiles of 4 x 28835840
-// pixels: a 7.4 GB malloc; findings/exr-huge-tile-size-7.4gb.exr). True for a tile side beyond
-// kMaxImageDim.
-inline bool exrTileBeyondLimit(const std::vector<std::array<int64_t, 2>>& tiles) {
-    for (const auto& t : tiles)
-        if (t[0] > atrous::kMaxImageDim || t[1] > atrous::kMaxImageDim) return true;
-    return false;
-}
-
-inline bool skipKnownImage(const uint8_t* d, size_t n) {
-    std::string what;
-    std::vector<std::array<int64_t, 4>> windows;
-    std::vector<std::array<int64_t, 2>> tiles;
-    if (exrAttributeOverrun(d, n, &what, nullptr, &windows, &tiles) &&
-        knownIssue("exr-header-size-desync", "an EXR attribute claims more than the file holds, walked as OpenEXR reads it: " + what))
-        return true;
-    if (exrWindowBeyondLimit(windows) &&
-        knownIssue("exr-window-line-buffers", "an EXR data window beyond 16384 per side: OpenEXR allocates its line buffers first"))
-        return true;
-    if (exrTileBeyondLimit(tiles) &&
-        knownIssue("exr-tile-buffers", "an EXR tile side beyond 16384: OpenEXR allocates its tile buffers first"))
-        return true;
-    if (pnmLongNumber(d, n) && knownIssue("stb-pnm-integer-overflow", "stb_image 2.27 overflows an int reading a PNM header's number"))
-        return true;
-    if (pngIdatOverrun(d, n) &&
-        knownIssue("stb-png-idat-length", "stb_image 2.27 allocates an IDAT chunk's claimed length before reading it"))
-        return true;
-    return stbJpeg(d, n) && knownIssue("stb-jpeg-decoder", "stb_image 2.27's JPEG decoder (out-of-bounds writes, a shift by 32, an assert)");
 }
 
 // --------------------------------------------------------------------------------- the contract
