@@ -237,9 +237,10 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
             else emissionStore = Image(), emissionB = Image();
         }
     }
+    // (The learned method reads no position, and a normal only when given: no zero planes for it.)
     Image normalStore, positionStore, depthStore, idsStore;
-    const ImageView normal = sanitizedFeature(exec, in.normal, w, h, 3, normalStore);
-    const ImageView position = sanitizedFeature(exec, in.position, w, h, 3, positionStore);
+    const ImageView normal = learned && !in.normal.valid() ? ImageView{} : sanitizedFeature(exec, in.normal, w, h, 3, normalStore);
+    const ImageView position = learned ? ImageView{} : sanitizedFeature(exec, in.position, w, h, 3, positionStore);
     // Depth: for the learned network, the depth stop, and the noise estimate's edge test.
     const bool depthStop = !learned && o.eaw.sigmaDepth > 0 && in.depth.valid();
     const bool needDepth = learned || depthStop || noise || out.planes;
