@@ -338,16 +338,24 @@ struct VarianceBands {
 
 }  // namespace
 
-void globalNoiseSigma(const CpuExec&, const ImageView& color, const ImageView& albedo, float eps, float floor,
+void globalNoiseSigma(const CpuExec& exec, const ImageView& color, const ImageView& albedo, float eps, float floor,
                       float sigma[3]) {
+    globalNoiseSigma(exec, color, albedo, eps, floor, sigma, ImageView{});
+}
+
+void globalNoiseSigma(const CpuExec&, const ImageView& color, const ImageView& albedo, float eps, float floor,
+                      float sigma[3], const ImageView& scratch) {
     const int w = color.width, h = color.height;
-    Image detail = Image::uninitialized(w, h, 3);
+    Image store;
+    const ImageView detail = scratch.valid() && scratch.channels >= 3 && scratch.sameSize(color)
+                                 ? ImageView{scratch.data, w, h, 3}
+                                 : (store = Image::uninitialized(w, h, 3)).view();
     MadBand band;
-    band.color = color, band.albedo = albedo, band.detail = detail.view();
+    band.color = color, band.albedo = albedo, band.detail = detail;
     band.rule.eps = eps, band.rule.floor = floor;  // the still rule (rim on, non-finite 0)
     cpu::parallelForIsa(cpu::activeIsa(), 0, h, 16, band);
     for (int c = 0; c < 3; ++c) {
-        const float mid = radixMedian(detail.view().channel(c), detail.plane(), 0.0f);
+        const float mid = radixMedian(detail.channel(c), detail.plane(), 0.0f);
         sigma[c] = float(double(mid) / 0.6745 / std::sqrt(double(kDetailVarFactor)));
     }
 }

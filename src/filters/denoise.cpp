@@ -63,8 +63,9 @@ namespace filters {
 // σ_d = median|d_0| / 0.6745; for white noise var(d_0) = σ² (1 + Σh² - 2 h(0)), so
 // σ = σ_d / sqrt(0.7900...). Per channel, over finite pixels; of the demodulated colour when an
 // albedo is given.
-void estimateNoiseSigma(const Image& color, const Image* albedo, float eps, float floor, float sigma[3]) {
-    globalNoiseSigma(CpuExec{}, color.view(), albedo ? albedo->view() : ImageView{}, eps, floor, sigma);
+void estimateNoiseSigma(const Image& color, const Image* albedo, float eps, float floor, float sigma[3], Image* scratch) {
+    globalNoiseSigma(CpuExec{}, color.view(), albedo ? albedo->view() : ImageView{}, eps, floor, sigma,
+                     scratch ? scratch->view() : ImageView{});
 }
 
 static void checkBuffer(const Image* img, const Image& color, const char* name, int minChannels = 3) {
@@ -387,10 +388,19 @@ Image denoiseCpu(const DenoiseInputs& in, const DenoiseOptions& o, const Prepare
     cfg.learned = prep.learned;
     cfg.varianceGiven = in.variance != nullptr;
     clock->start();
+    // Without a variance, the planes the driver fills with the estimate (var(c_0)): a handed-over
+    // variance that was dropped (all zero) serves, or one made here, which the global estimate
+    // first uses for its detail planes (one 3-plane image, first touched once).
+    Image estimate;
+    if (!in.variance && !(stores && stores->variance && !stores->variance->empty())) {
+        estimate = Image::uninitialized(in.color->width(), in.color->height(), 3);
+        di.varianceStore = &estimate;
+    }
     if (!in.variance && !prep.sigmaEstimated) {
         // The global estimate (Donoho's MAD), timed as a stage of its own.
         const Image* albedo = o.demodulate && in.albedo ? in.albedo : nullptr;
-        estimateNoiseSigma(*in.color, albedo, o.albedoEpsilon, o.albedoFloor, rep.noiseSigma);
+        estimateNoiseSigma(*in.color, albedo, o.albedoEpsilon, o.albedoFloor, rep.noiseSigma,
+                           estimate.empty() ? di.varianceStore : &estimate);
         markStage(dout.clock, "noise sigma");
     }
     setNoiseEstimate(cfg, rep);

@@ -53,7 +53,8 @@ constexpr float kNoiseFloorFraction = 1.0f;
 void setNoiseEstimate(DriverConfig& cfg, const DenoiseReport& rep);
 // Per-channel noise standard deviation by Donoho's MAD of the finest B3 detail of the colour
 // divided by the modulation albedo (albedo null: of the colour itself).
-void estimateNoiseSigma(const Image& color, const Image* albedo, float eps, float floor, float sigma[3]);
+void estimateNoiseSigma(const Image& color, const Image* albedo, float eps, float floor, float sigma[3],
+                        Image* scratch = nullptr);
 // The same estimate of a colour on the GPU, computed there (src/cuda/cuda_denoise.cu): the same
 // MadDetail functor, so the same medians. A host albedo is uploaded for it.
 void estimateNoiseSigmaCuda(const Image& color, const Image* albedo, float eps, float floor, float sigma[3]);

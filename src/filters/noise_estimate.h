@@ -114,6 +114,9 @@ void globalNoiseSigma(const Exec& exec, const ImageView& color, const ImageView&
 }
 void globalNoiseSigma(const CpuExec& exec, const ImageView& color, const ImageView& albedo, float eps, float floor,
                       float sigma[3]);
+// The same with its 3-plane detail image in `scratch` (the caller's planes, written over).
+void globalNoiseSigma(const CpuExec& exec, const ImageView& color, const ImageView& albedo, float eps, float floor,
+                      float sigma[3], const ImageView& scratch);
 
 // e_c(p) = d_0,c(p)² / kDetailVarFactor: an unbiased per-pixel estimate of σ_c² on white noise.
 // The B3 taps across a geometric edge (normals further apart than kNoiseNormalDist, or depths
