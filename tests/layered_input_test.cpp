@@ -262,13 +262,15 @@ TEST(LayeredInput, FileWithoutChannelsIsRefused) {
 // OpenEXR 3.1 would allocate ~2 GB for (behind a channel list or a fixed-size attribute whose
 // declared size is not its own); huge_data_window_2gb: a 234M-pixel-wide window (OpenEXR's line
 // buffers); huge_tile_size_7gb: 4 x 28835840 tiles and no data window (OpenEXR's tile buffers);
-// no_channels: no channels (a SIGSEGV in readBufferFile); rgba_half_segv: a valid RGBA
+// duplicate_attributes: a second dataWindow (the classic API keeps the last, the Core the first:
+// a heap overflow placing the Core's narrower chunks); no_channels: no channels (a SIGSEGV in readBufferFile); rgba_half_segv: a valid RGBA
 // half file (a SIGSEGV in OpenEXR Core's 4-channel half routine).
 TEST(LayeredInput, FuzzReproducersAreRefusedInOneLineOrRead) {
     TempDir dir;
     const std::string data = std::string(ATROUS_SOURCE_DIR) + "/tests/data/exr_regressions/";
     for (const char* name : {"attribute_size_2gb.exr", "attribute_after_chlist_2gb.exr", "declared_size_desync_2gb.exr",
-                             "huge_data_window_2gb.exr", "huge_tile_size_7gb.exr", "no_channels.exr", "rgba_half_segv.exr"}) {
+                             "huge_data_window_2gb.exr", "huge_tile_size_7gb.exr", "duplicate_attributes.exr", "no_channels.exr",
+                             "rgba_half_segv.exr"}) {
         const std::string f = data + name;
         const bool valid = std::string(name) == "rgba_half_segv.exr";
         for (const std::string& args : {"denoise --in " + f + " --out " + (dir / "o.exr"), "compare --ref " + f + " " + f,

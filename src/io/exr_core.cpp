@@ -298,7 +298,11 @@ void ExrCoreFile::decode(int part, const std::vector<ExrPlaneRequest>& requests,
         };
         exr_result_t rv = exr_decoding_initialize(m.ctx, part, &c, &dec);
         if (rv != EXR_ERR_SUCCESS) return stop(rv, "read");
-        // Rows of this chunk inside the image, and whether its columns are the image's.
+        // Rows of this chunk inside the image, and whether its columns are the image's. The chunk
+        // must span the image's columns (the caller checked the data window it read from the
+        // header against the image; this is the data window OpenEXR's Core decodes).
+        if (c.start_x > win.x0 || int64_t(c.start_x) + c.width < int64_t(win.x0) + win.width)
+            return stop(EXR_ERR_INVALID_ARGUMENT, "place");
         const int y0 = std::max(c.start_y, win.y0), y1 = std::min(c.start_y + c.height - 1, win.y0 + win.height - 1);
         const bool direct = c.start_x == win.x0 && c.width == win.width && y0 == c.start_y && y1 == c.start_y + c.height - 1;
         std::vector<float> scratch;

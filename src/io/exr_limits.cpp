@@ -105,7 +105,10 @@ void requireExrHeadersFit(const std::string& path) {
         readName(name);
         if (name.empty()) break;  // no (more) headers
         PartHeader part;
+        std::vector<std::string> seen;  // an attribute twice: OpenEXR's classic API keeps the last, its Core the first
         for (; !name.empty(); readName(name)) {
+            if (std::find(seen.begin(), seen.end(), name) != seen.end()) throw corrupt("attribute '" + name + "' appears twice");
+            seen.push_back(name);
             readName(type);
             unsigned char sz[4];
             if (!in.read(reinterpret_cast<char*>(sz), 4)) throw corrupt("it ends inside attribute '" + name + "'");
