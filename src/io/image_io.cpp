@@ -289,7 +289,10 @@ void writePng(const std::string& path, const Image& img, float exposure) {
 static void requireHdrComplete(const std::string& path, int w, int h) {
     std::ifstream in(path, std::ios::binary);
     std::string line;
-    while (std::getline(in, line) && !line.empty() && line != "\r") {}  // header, up to the blank line
+    // The header, up to the first empty line, exactly as stb reads it ('\n' ends a line; a "\r"
+    // line is not empty to stb: taking it for the end put this walk 200 bytes before stb's, and a
+    // file stb then looped on for minutes passed, found by tests/fuzz/libfuzzer).
+    while (std::getline(in, line) && !line.empty()) {}
     if (!std::getline(in, line)) throw InputError(path + ": truncated HDR (no resolution line)");
     auto truncated = [&](int y) {
         return InputError(path + ": truncated HDR (scanline " + std::to_string(y) + " of " + std::to_string(h) + " is incomplete)");
@@ -438,7 +441,12 @@ static Image readStb(const std::string& path, int* sourceChannels) {
     checkPngChunks(path, bytes);
     const int len = bytes.size() > size_t(INT32_MAX) ? INT32_MAX : int(bytes.size());
     int w = 0, h = 0, n = 0;
-    if (stbi_info_from_memory(bytes.data(), len, &w, &h, &n)) {
+    // Every check below needs the header as stb reads it: a file whose header stb's info call
+    // cannot read is refused, not handed to its loader (whose header parse differs: a 203-byte .hdr
+    // with two FORMAT lines passed to the loader looped for minutes, found by tests/fuzz/libfuzzer).
+    if (!stbi_info_from_memory(bytes.data(), len, &w, &h, &n))
+        throw InputError(path + ": cannot read image (" + stbi_failure_reason() + ")");
+    {
         if (sourceChannels) *sourceChannels = n <= 2 ? 1 : 3;  // grey (+ alpha) or colour (+ alpha)
         if (w <= 0 || h <= 0 || w > kMaxImageDim || h > kMaxImageDim)
             throw InputError(path + ": unsupported image size " + std::to_string(w) + "x" + std::to_string(h) + " (at most " +
@@ -456,7 +464,7 @@ static Image readStb(const std::string& path, int* sourceChannels) {
             while (std::getline(probe, l)) {
                 headerBytes += l.size() + 1;
                 if (blank) break;  // the resolution line
-                if (l.empty() || l == "\r") blank = 1;
+                if (l.empty()) blank = 1;  // as stb (and requireHdrComplete) end the header
             }
             unsigned char first[2] = {0, 0};
             probe.read(reinterpret_cast<char*>(first), 2);
