@@ -10,8 +10,8 @@
 //
 // Known problems: a target can name one with knownIssue() ("==atrous-fuzz== KNOWN <id>", once)
 // and skip the input, so that a long run goes on while it is being fixed; with ATROUS_FUZZ_STRICT=1
-// nothing is skipped. Two are open at b46cb8b (exr-duplicate-attribute, hdr-header-cr-line); every other
-// problem found so far is fixed (tests/fuzz/libfuzzer/README.md), its input a seed (corpus/*/finding_*).
+// nothing is skipped. None is open: every problem found so far is fixed (tests/fuzz/libfuzzer/README.md),
+// its input a seed (corpus/*/finding_*).
 #pragma once
 #include <unistd.h>
 
@@ -138,72 +138,6 @@ inline std::vector<std::string> splitSections(const uint8_t* data, size_t size, 
     parts.push_back(all.substr(at));
     while (parts.size() < maxParts) parts.emplace_back();
     return parts;
-}
-
-// ------------------------------------------------------------------------------ known problems
-
-// Known (src/io/exr_core.cpp at b46cb8b, found by the final 10-minute exr_single run): a header
-// that holds an attribute twice (two dataWindows, 3..9 and 3..11) is read one way by Imf::Header
-// (the last wins) and another by OpenEXR Core (the chunks), and ExrCoreFile::decode copies
-// win.width floats per row out of a scratch buffer sized by the chunk's width: a heap-buffer
-// over-read (ASan: READ of 36 bytes past a 420-byte vector; exr_core.cpp's !direct copy).
-// Reproducer tests/fuzz/libfuzzer/findings/exr-duplicate-datawindow-heap-overread.exr. True, with
-// the name, when a header of the file names an attribute twice (walked by the declared sizes).
-inline bool exrDuplicateAttribute(const uint8_t* d, size_t n, std::string* which) {
-    if (n < 8 || d[0] != 0x76 || d[1] != 0x2f || d[2] != 0x31 || d[3] != 0x01) return false;
-    const bool multipart = (d[5] & 0x10) != 0;
-    std::set<std::string> names;
-    for (size_t at = 8; at < n;) {
-        if (d[at] == 0) {  // end of a header
-            names.clear();
-            if (!multipart || ++at >= n || d[at] == 0) return false;
-            continue;
-        }
-        std::string name, type;
-        for (std::string* out : {&name, &type}) {
-            const size_t start = at;
-            while (at < n && d[at] != 0) ++at;
-            if (at >= n) return false;
-            out->assign(reinterpret_cast<const char*>(d + start), at - start);
-            ++at;
-        }
-        if (at + 4 > n) return false;
-        const int32_t size = int32_t(uint32_t(d[at]) | uint32_t(d[at + 1]) << 8 | uint32_t(d[at + 2]) << 16 | uint32_t(d[at + 3]) << 24);
-        at += 4;
-        if (!names.insert(name).second) {
-            if (which) *which = name;
-            return true;
-        }
-        if (size < 0 || size_t(size) > n - at) return false;
-        at += size_t(size);
-    }
-    return false;
-}
-
-// Known (src/io/image_io.cpp at b46cb8b, found by the final 10-minute png run: a timeout): for a
-// Radiance .hdr, requireHdrComplete takes a header line "\r" for the blank line that ends the
-// header; stb_image ends it at an empty line only. With a "\r" line before the empty one the check
-// walks the wrong bytes (and passes), and stbi__hdr_load loops for ever on a zero-length run:
-// the hang the check was written against (docs/reliability.md). Reproducer
-// tests/fuzz/libfuzzer/findings/hdr-cr-line-header-hang.hdr. True for a "#?" file whose header has
-// a "\r" line before its first empty line.
-inline bool hdrCrLineBeforeBlank(const uint8_t* d, size_t n) {
-    if (n < 2 || d[0] != '#' || d[1] != '?') return false;
-    const std::string text(reinterpret_cast<const char*>(d), n);
-    const size_t blank = text.find("\n\n"), cr = text.find("\n\r\n");
-    return cr != std::string::npos && (blank == std::string::npos || cr < blank);
-}
-
-inline bool skipKnownHdr(const uint8_t* d, size_t n) {
-    return hdrCrLineBeforeBlank(d, n) &&
-           knownIssue("hdr-header-cr-line", "a .hdr header with a \"\\r\" line: atrous's check and stb end the header at different lines");
-}
-
-inline bool skipKnownExr(const uint8_t* d, size_t n) {
-    std::string which;
-    return exrDuplicateAttribute(d, n, &which) &&
-           knownIssue("exr-duplicate-attribute", "an EXR header with attribute '" + which +
-                                                     "' twice: Imf and OpenEXR Core disagree, exr_core.cpp's decode over-reads");
 }
 
 // --------------------------------------------------------------------------------- the contract

@@ -1,6 +1,9 @@
 // libFuzzer target: 8-bit images through atrous::io::readImage (PNG textures; JPEG through
-// libjpeg-turbo since b765052; stb_image reads BMP, TGA, GIF, PSD, PNM whatever the name says). The input is the file's bytes, written as
-// in.png, or as in.hdr when it starts like a Radiance file (so that the .hdr checks run too).
+// libjpeg-turbo since b765052; BMP and TGA through stb_image). A file is read only as the format its
+// extension names (image_io.cpp), so the input's bytes are written under the extension its first
+// bytes suggest: in.hdr for "#?", in.jpg for FF D8, in.bmp for "BM", in.png for the PNG signature,
+// and otherwise in.png or in.tga by the input's size (so that the refusal of a mismatch and stb's
+// TGA reader, which has no signature, are reached too).
 //
 // Contract (fuzz_common.h): readImage returns a 3-channel image or throws InputError. The image
 // fits the file (at most 8448 pixels per byte plus 65536, docs/reliability.md); an 8-bit image's
@@ -19,10 +22,16 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 }
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-    if (skipKnownHdr(data, size)) return 0;
-    const bool hdr = size >= 2 && std::memcmp(data, "#?", 2) == 0;
-    const std::string path = writeScratch(hdr ? "in.hdr" : "in.png", data, size);
-    const std::string what = hdr ? "readImage(.hdr)" : "readImage(.png)";
+    const auto starts = [&](const char* magic, size_t n) { return size >= n && std::memcmp(data, magic, n) == 0; };
+    const bool hdr = starts("#?", 2);
+    const char* ext = hdr                         ? ".hdr"
+                      : starts("\xff\xd8", 2)      ? ".jpg"
+                      : starts("BM", 2)             ? ".bmp"
+                      : starts("\x89PNG", 4)        ? ".png"
+                      : size % 2 == 0               ? ".png"
+                                                    : ".tga";
+    const std::string path = writeScratch(std::string("in") + ext, data, size);
+    const std::string what = std::string("readImage(") + ext + ")";
     Image img;
     if (!returnsOrInputError(what, [&] { img = atrous::io::readImage(path); })) return 0;
     checkShape(what, img);
