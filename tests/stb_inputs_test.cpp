@@ -119,3 +119,99 @@ TEST(StbInputs, JpegIsReadByLibjpegTurbo) {
     std::ofstream(dir / "cut.jpg", std::ios::binary) << bytes.substr(0, bytes.size() - 40);
     EXPECT_NE(errorOf(dir / "cut.jpg").find("cut.jpg"), std::string::npos) << errorOf(dir / "cut.jpg");
 }
+
+namespace {
+
+std::string le(uint32_t v, int bytes) {
+    std::string s;
+    for (int i = 0; i < bytes; ++i) s += char((v >> (8 * i)) & 0xff);
+    return s;
+}
+
+// Pixel (x, y) of the 7x5 test pattern: white where (x + 2y) % 3 == 0, else black with red 255 on
+// even rows. As stb reads 8-bit files: 0 and 255 are 0 and 1 exactly.
+void patternAt(int x, int y, unsigned char rgb[3]) {
+    const bool white = (x + 2 * y) % 3 == 0;
+    rgb[0] = white || y % 2 == 0 ? 255 : 0;
+    rgb[1] = rgb[2] = white ? 255 : 0;
+}
+
+void expectPattern(const Image& img, const std::string& what) {
+    ASSERT_EQ(img.width(), 7) << what;
+    ASSERT_EQ(img.height(), 5) << what;
+    for (int y = 0; y < 5; ++y)
+        for (int x = 0; x < 7; ++x) {
+            unsigned char rgb[3];
+            patternAt(x, y, rgb);
+            for (int c = 0; c < 3; ++c) ASSERT_EQ(img(x, y, c), rgb[c] / 255.0f) << what << " at " << x << "," << y << "," << c;
+        }
+}
+
+std::string tga(bool rle) {
+    std::string s = std::string(1, 0) + char(0) + char(rle ? 10 : 2) + std::string(9, 0) + le(7, 2) + le(5, 2) + char(24) + char(0x20);
+    std::string px;  // BGR, top row first (descriptor 0x20)
+    for (int y = 0; y < 5; ++y)
+        for (int x = 0; x < 7; ++x) {
+            unsigned char rgb[3];
+            patternAt(x, y, rgb);
+            px += std::string{char(rgb[2]), char(rgb[1]), char(rgb[0])};
+        }
+    if (!rle) return s + px;
+    // Raw packets of 4 pixels, except a run packet for pixels 32..34 when they are equal.
+    for (int i = 0; i < 35;) {
+        if (i == 32 && px.substr(96, 3) == px.substr(99, 3) && px.substr(99, 3) == px.substr(102, 3)) {
+            s += char(0x80 | 2) + px.substr(96, 3);
+            i += 3;
+            continue;
+        }
+        const int n = std::min(4, 35 - i);
+        s += char(n - 1) + px.substr(size_t(i) * 3, size_t(n) * 3);
+        i += n;
+    }
+    return s;
+}
+
+std::string bmp() {
+    const int stride = 24;  // 7 * 3 bytes padded to 4
+    std::string s = "BM" + le(54 + stride * 5, 4) + le(0, 4) + le(54, 4) + le(40, 4) + le(7, 4) + le(5, 4) + le(1, 2) + le(24, 2) +
+                    le(0, 4) + le(stride * 5, 4) + le(2835, 4) + le(2835, 4) + le(0, 4) + le(0, 4);
+    for (int y = 4; y >= 0; --y) {  // bottom row first
+        std::string row;
+        for (int x = 0; x < 7; ++x) {
+            unsigned char rgb[3];
+            patternAt(x, y, rgb);
+            row += std::string{char(rgb[2]), char(rgb[1]), char(rgb[0])};
+        }
+        s += row + std::string(stride - row.size(), 0);
+    }
+    return s;
+}
+
+}  // namespace
+
+// stb_image 2.27 reads a BMP or TGA cut short as black where the bytes are missing, without a word
+// (found by the png libFuzzer target once it wrote TGA files): the rows or the run-length packets
+// must reach the last pixel. Whole files read exactly; every cut before the last pixel's byte is
+// refused naming the file.
+TEST(StbInputs, BmpAndTgaCutShortAreRefused) {
+    TempDir dir;
+    struct Case {
+        const char* name;
+        std::string bytes;
+        size_t pixelStart;
+    };
+    const Case cases[] = {{"raw.tga", tga(false), 18}, {"rle.tga", tga(true), 18}, {"rows.bmp", bmp(), 54}};
+    for (const Case& c : cases) {
+        const std::string path = dir / c.name;
+        std::ofstream(path, std::ios::binary) << c.bytes;
+        expectPattern(io::readImage(path), c.name);
+        // The BMP's last row has 3 bytes of padding nobody reads: cutting those is harmless.
+        const size_t lastUsed = std::string(c.name) == "rows.bmp" ? c.bytes.size() - 3 : c.bytes.size();
+        for (size_t keep : {c.pixelStart + 1, (c.pixelStart + lastUsed) / 2, lastUsed - 1}) {
+            std::ofstream(path, std::ios::binary | std::ios::trunc) << c.bytes.substr(0, keep);
+            const std::string msg = errorOf(path);
+            EXPECT_NE(msg.find(path), std::string::npos) << c.name << " cut to " << keep << ": " << msg;
+            EXPECT_NE(msg.find("truncated"), std::string::npos) << c.name << " cut to " << keep << ": " << msg;
+        }
+    }
+}

@@ -6,7 +6,6 @@
 #include <ImfInputFile.h>
 #include <ImfRgbaFile.h>
 #include <ImfArray.h>
-#include <libdeflate.h>
 #include <stb_image.h>
 #include <turbojpeg.h>
 #include <tbb/parallel_for.h>
@@ -30,6 +29,7 @@
 #include "io/exr_core.h"
 #include "io/exr_limits.h"
 #include "io/pass_map.h"
+#include "io/stb_checks.h"
 
 namespace fs = std::filesystem;
 
@@ -284,109 +284,6 @@ void writePng(const std::string& path, const Image& img, float exposure) {
     });
 }
 
-// A Radiance .hdr must hold every scanline: stb fills a truncated file's missing pixels with
-// black without a word. Walks the scanlines (flat or new-style RLE) without decoding them.
-static void requireHdrComplete(const std::string& path, int w, int h) {
-    std::ifstream in(path, std::ios::binary);
-    std::string line;
-    // The header, up to the first empty line, exactly as stb reads it ('\n' ends a line; a "\r"
-    // line is not empty to stb: taking it for the end put this walk 200 bytes before stb's, and a
-    // file stb then looped on for minutes passed, found by tests/fuzz/libfuzzer).
-    while (std::getline(in, line) && !line.empty()) {}
-    if (!std::getline(in, line)) throw InputError(path + ": truncated HDR (no resolution line)");
-    auto truncated = [&](int y) {
-        return InputError(path + ": truncated HDR (scanline " + std::to_string(y) + " of " + std::to_string(h) + " is incomplete)");
-    };
-    std::vector<unsigned char> buf;
-    for (int y = 0; y < h; ++y) {
-        unsigned char head[4];
-        if (!in.read(reinterpret_cast<char*>(head), 4)) throw truncated(y);
-        const bool rle = w >= 8 && w < 32768 && head[0] == 2 && head[1] == 2 && !(head[2] & 0x80);
-        if (!rle && y == 0) return;  // flat pixels: readStb checks the file's size instead
-        // stb loops for ever on a zero-length run at the end of the data (EOF reads as 0): every
-        // structural fault is refused here.
-        auto corrupt = [&](const char* what) {
-            return InputError(path + ": corrupt HDR (scanline " + std::to_string(y) + ": " + what + ")");
-        };
-        if (!rle) throw corrupt("not run-length encoded like the first");
-        if (((head[2] << 8) | head[3]) != w) throw corrupt("its length is not the image width");
-        for (int c = 0; c < 4; ++c)
-            for (int x = 0; x < w;) {
-                const int count = in.get();
-                if (count == EOF) throw truncated(y);
-                if (count > 128) {
-                    if (in.get() == EOF) throw truncated(y);
-                    if (count - 128 > w - x) throw corrupt("a run past the end of the line");
-                    x += count - 128;
-                } else {
-                    if (count == 0) throw corrupt("a zero-length run");
-                    if (count > w - x) throw corrupt("a run past the end of the line");
-                    buf.resize(size_t(count));
-                    if (!in.read(reinterpret_cast<char*>(buf.data()), count)) throw truncated(y);
-                    x += count;
-                }
-            }
-    }
-}
-
-// At most this many pixels per byte of a PNG/JPEG/HDR/BMP/TGA file (a 1-bit PNG at deflate's
-// 1032:1 holds ~8256): a lying header is refused before stb allocates for it.
-constexpr double kMaxPixelsPerByte = 8448.0;
-
-static uint32_t bigEndian32(const unsigned char* p) { return uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | p[3]; }
-
-// A PNG's chunks, checked before stb sees them (stb skips CRCs, reallocates to an IDAT chunk's
-// claimed length before reading it: 2 GB from a 326-byte file, and memcpy's from a null pointer on
-// an empty IDAT; found by tests/fuzz/libfuzzer): every chunk's length fits in the file, its CRC is
-// right, and the file ends with IEND (a file cut short inside or after its last data chunk was
-// decoded without a word: tests/fuzz, seed 90210). Empty IDAT chunks (legal, and nothing to
-// decode) are dropped. Data after IEND (some tools append it) is ignored. Non-PNG bytes pass as
-// they are.
-static void checkPngChunks(const std::string& path, std::vector<unsigned char>& bytes) {
-    static const unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-    if (bytes.size() < 8 || std::memcmp(bytes.data(), kPng, 8) != 0) return;
-    std::vector<unsigned char> out(bytes.begin(), bytes.begin() + 8);
-    size_t at = 8;
-    for (;;) {
-        if (bytes.size() - at < 12) throw InputError(path + ": truncated PNG (no complete IEND chunk at its end)");
-        const uint32_t len = bigEndian32(&bytes[at]);
-        if (len > bytes.size() - at - 12)
-            throw InputError(path + ": truncated or corrupt PNG (a chunk of " + std::to_string(len) + " bytes at offset " +
-                             std::to_string(at) + " of a " + std::to_string(bytes.size()) + "-byte file)");
-        const unsigned char* type = &bytes[at + 4];
-        if (libdeflate_crc32(0, type, size_t(len) + 4) != bigEndian32(type + 4 + len))
-            throw InputError(path + ": corrupt PNG (chunk '" + std::string(reinterpret_cast<const char*>(type), 4) +
-                             "' at offset " + std::to_string(at) + " fails its CRC)");
-        const bool iend = std::memcmp(type, "IEND", 4) == 0;
-        if (!(len == 0 && std::memcmp(type, "IDAT", 4) == 0)) out.insert(out.end(), &bytes[at], &bytes[at] + len + 12);
-        at += size_t(len) + 12;
-        if (iend) break;
-    }
-    bytes.swap(out);
-}
-
-// stb sniffs a file's format from its bytes, whatever its name (a ".png" that starts "P6" goes to
-// its PNM reader, whose header numbers overflow an int in 2.27: found by tests/fuzz/libfuzzer). A
-// file is read only as the format its extension names: its magic must be that format's (TGA has
-// none: it must not carry another format's).
-static void requireFormatOfExtension(const std::string& path, const std::vector<unsigned char>& b) {
-    auto starts = [&](std::initializer_list<unsigned char> m) {
-        return b.size() >= m.size() && std::equal(m.begin(), m.end(), b.begin());
-    };
-    const bool png = starts({0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'}), jpeg = starts({0xFF, 0xD8, 0xFF});
-    const bool bmp = starts({'B', 'M'}), hdr = starts({'#', '?'});
-    const bool other = starts({'G', 'I', 'F', '8'}) || starts({'8', 'B', 'P', 'S'}) || starts({0x53, 0x80, 0xF6, 0x34}) ||
-                       (b.size() >= 2 && b[0] == 'P' && b[1] >= '1' && b[1] <= '6');
-    const std::string ext = extensionOf(path);
-    const char* want = nullptr;
-    if (ext == ".png" && !png) want = "PNG";
-    if ((ext == ".jpg" || ext == ".jpeg") && !jpeg) want = "JPEG";
-    if (ext == ".bmp" && !bmp) want = "BMP";
-    if (ext == ".hdr" && !hdr) want = "Radiance HDR";
-    if (ext == ".tga" && (png || jpeg || bmp || hdr || other)) want = "TGA";
-    if (want) throw InputError(path + ": not a " + std::string(want) + " file (its first bytes are another format's, or none)");
-}
-
 // A JPEG through libjpeg-turbo (TurboJPEG), not stb: stb_image 2.27's JPEG decoder overruns its
 // Huffman tables, shifts by 32 and asserts on crafted files (found by tests/fuzz/libfuzzer). Warnings
 // (a damaged stream) are errors. 8-bit sRGB to linear as stb's loader does for the other 8-bit
@@ -402,12 +299,7 @@ static Image readJpeg(const std::string& path, const std::vector<unsigned char>&
     int w = 0, h = 0, subsamp = 0, colorspace = 0;
     if (tjDecompressHeader3(tj.h, bytes.data(), static_cast<unsigned long>(bytes.size()), &w, &h, &subsamp, &colorspace) != 0)
         throw InputError(path + ": not a readable JPEG (" + tjGetErrorStr2(tj.h) + ")");
-    if (w <= 0 || h <= 0 || w > kMaxImageDim || h > kMaxImageDim)
-        throw InputError(path + ": unsupported image size " + std::to_string(w) + "x" + std::to_string(h) + " (at most " +
-                         std::to_string(kMaxImageDim) + " per side)");
-    if (double(w) * double(h) > double(bytes.size()) * kMaxPixelsPerByte + 65536.0)
-        throw InputError(path + ": truncated or corrupt image (" + std::to_string(w) + "x" + std::to_string(h) +
-                         " pixels cannot fit in " + std::to_string(bytes.size()) + " bytes)");
+    requireImagePixelsFit(path, bytes, w, h);
     std::vector<unsigned char> rgb(size_t(w) * size_t(h) * 3);
     if (tjDecompress2(tj.h, bytes.data(), static_cast<unsigned long>(bytes.size()), rgb.data(), w, 0, h, TJPF_RGB,
                       TJFLAG_STOPONWARNING) != 0)
@@ -446,34 +338,8 @@ static Image readStb(const std::string& path, int* sourceChannels) {
     // with two FORMAT lines passed to the loader looped for minutes, found by tests/fuzz/libfuzzer).
     if (!stbi_info_from_memory(bytes.data(), len, &w, &h, &n))
         throw InputError(path + ": cannot read image (" + stbi_failure_reason() + ")");
-    {
-        if (sourceChannels) *sourceChannels = n <= 2 ? 1 : 3;  // grey (+ alpha) or colour (+ alpha)
-        if (w <= 0 || h <= 0 || w > kMaxImageDim || h > kMaxImageDim)
-            throw InputError(path + ": unsupported image size " + std::to_string(w) + "x" + std::to_string(h) + " (at most " +
-                             std::to_string(kMaxImageDim) + " per side)");
-        if (double(w) * double(h) > double(bytes.size()) * kMaxPixelsPerByte + 65536.0)
-            throw InputError(path + ": truncated or corrupt image (" + std::to_string(w) + "x" + std::to_string(h) +
-                             " pixels cannot fit in " + std::to_string(bytes.size()) + " bytes)");
-        if (extensionOf(path) == ".hdr") {
-            requireHdrComplete(path, w, h);
-            std::ifstream probe(path, std::ios::binary);
-            std::string l;
-            // A flat (uncompressed) .hdr needs 4 bytes per pixel after its header.
-            size_t headerBytes = 0;
-            int blank = 0;
-            while (std::getline(probe, l)) {
-                headerBytes += l.size() + 1;
-                if (blank) break;  // the resolution line
-                if (l.empty()) blank = 1;  // as stb (and requireHdrComplete) end the header
-            }
-            unsigned char first[2] = {0, 0};
-            probe.read(reinterpret_cast<char*>(first), 2);
-            const bool rle = w >= 8 && w < 32768 && first[0] == 2 && first[1] == 2;
-            if (!rle && bytes.size() < headerBytes + uint64_t(w) * uint64_t(h) * 4)
-                throw InputError(path + ": truncated HDR (expected " + std::to_string(uint64_t(w) * h * 4) + " bytes of pixels, found " +
-                                 std::to_string(bytes.size() > headerBytes ? bytes.size() - headerBytes : 0) + ")");
-        }
-    }
+    if (sourceChannels) *sourceChannels = n <= 2 ? 1 : 3;  // grey (+ alpha) or colour (+ alpha)
+    requireImagePixelsFit(path, bytes, w, h);
     // stbi_loadf converts 8-bit sRGB to linear (gamma 2.2) and reads Radiance .hdr as is.
     float* data = stbi_loadf_from_memory(bytes.data(), len, &w, &h, &n, 3);
     if (!data) throw InputError(path + ": cannot read image (" + stbi_failure_reason() + ")");
