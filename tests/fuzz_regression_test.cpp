@@ -92,3 +92,29 @@ TEST(FuzzRegression, ObjSkinWeightJointIdsBeyondIntAreErrors) {
     }
     EXPECT_EQ(meshError(dir, tri + "vw 1 0 0.25 2 0.75 3.0 0\n", ""), "");
 }
+
+// obj_mtl: tinyobjloader ends a line at a lone "\r" as at "\n"; the prescans read lines with
+// std::getline, so a statement after a "\r" was the tail of the line before (of a comment, not
+// looked at, or of another statement, not recognised): "#\rvw 1 02147483648 1" reached
+// tinyobjloader's float-to-int cast (UBSan: "2.14748e+09 is outside the range of representable
+// values of type 'int'"), and a face past the last vertex or a bad value could hide the same way.
+// The prescans now split lines as tinyobjloader does. Without the fix every case loads.
+TEST(FuzzRegression, ObjStatementsAfterALoneCarriageReturnArePrescanned) {
+    ScratchDir dir;
+    const std::string tri = "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n";
+    struct Case {
+        std::string obj, mtl, needle;
+    };
+    const std::vector<Case> cases = {
+        {tri + "# skin\rvw 1 02147483648 1\n", "", "m.obj: line 6: skin weight joint id \"02147483648\""},
+        {tri + "g a\rvw 1 3e9 1\n", "", "m.obj: line 6: skin weight joint id \"3e9\""},
+        {tri + "# comment\rv 1 nan 0\n", "", "m.obj: line 6: \"nan\" is not a finite number"},
+        {"mtllib m.mtl\rusemtl a\n" + tri, "newmtl a\r\nKd 0.5 0.5 0.5\r# c\rKe 1 x 1\n", "m.mtl: line 4: Ke value \"x\" is not a finite number"},
+    };
+    for (const Case& c : cases) {
+        const std::string msg = meshError(dir, c.obj, c.mtl);
+        EXPECT_NE(msg.find(c.needle), std::string::npos) << c.needle << "\n" << msg;
+    }
+    // "\r\n" and "\r" line ends alike still load.
+    EXPECT_EQ(meshError(dir, "v 0 0 0\r\nv 1 0 0\rv 1 1 0\r\nf 1 2 3\r", ""), "");
+}

@@ -23,7 +23,12 @@ void requireFormatOfExtension(const std::string& path, const std::vector<unsigne
     auto starts = [&](std::initializer_list<unsigned char> m) {
         return b.size() >= m.size() && std::equal(m.begin(), m.end(), b.begin());
     };
-    const bool png = starts({0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'}), jpeg = starts({0xFF, 0xD8, 0xFF});
+    // stb takes a file for a JPEG when it starts with 0xFF, any more 0xFF fill bytes, then 0xD8 (a
+    // ".tga" starting FF FF D8 went to stb's JPEG header parser: found by tests/fuzz/libfuzzer).
+    size_t fill = 0;
+    while (fill < b.size() && b[fill] == 0xFF) ++fill;
+    const bool jpeg = fill > 0 && fill < b.size() && b[fill] == 0xD8;
+    const bool png = starts({0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'});
     const bool bmp = starts({'B', 'M'}), hdr = starts({'#', '?'});
     const bool other = starts({'G', 'I', 'F', '8'}) || starts({'8', 'B', 'P', 'S'}) || starts({0x53, 0x80, 0xF6, 0x34}) ||
                        (b.size() >= 2 && b[0] == 'P' && b[1] >= '1' && b[1] <= '6');
