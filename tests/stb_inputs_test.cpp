@@ -51,9 +51,11 @@ TEST(StbInputs, FuzzReproducersAreRefusedNamingTheFile) {
     // (stb overruns its table), a JPEG stb shifts by 32 on, a PNM header named .png (stb sniffs it; its numbers overflow an
     // int), a PNG whose first IDAT is empty and whose CRCs are wrong, a .hdr whose "\r" header line
     // our scanline walk took for the header's end (stb does not) and stb then looped on for minutes,
-    // a .tga starting FF FF D8 (a JPEG to stb, whose header parser overran its Huffman table).
+    // a .tga starting FF FF D8 (a JPEG to stb, whose header parser overran its Huffman table), a
+    // .hdr whose header line starting with a NUL byte ends the header for stb (a C string) but not
+    // for our walk, which then passed a file stb looped on.
     for (const char* name : {"idat_length_2gb.png", "jpeg_dht_overflow.jpg", "jpeg_shift_exponent.jpg", "pnm_integer_overflow.png",
-                             "zero_length_idat.png", "hdr_cr_header_loop.hdr", "jpeg_fill_bytes.tga"}) {
+                             "zero_length_idat.png", "hdr_cr_header_loop.hdr", "jpeg_fill_bytes.tga", "hdr_nul_header_line.hdr"}) {
         const std::string msg = errorOf(data + name);
         EXPECT_NE(msg.find(name), std::string::npos) << name << ": " << msg;
         const CliRun r = runCliMeasured("compare --ref " + data + name + " " + data + name);

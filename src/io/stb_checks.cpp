@@ -78,6 +78,12 @@ void checkPngChunks(const std::string& path, std::vector<unsigned char>& bytes) 
     bytes.swap(out);
 }
 
+// Whether a .hdr header line ends the header as stb reads it: stb copies each line into a C
+// string, so a line that is empty or starts with a NUL byte ends it (a "\0..." line did not end
+// our walk: the scanlines were read 20 bytes after stb's and a 130-byte file stb looped on passed,
+// found by tests/fuzz/libfuzzer; a "\r" line is not empty to stb, 07ee564).
+static bool hdrHeaderEnds(const std::string& line) { return line.empty() || line[0] == '\0'; }
+
 // A Radiance .hdr must hold every scanline: stb fills a truncated file's missing pixels with
 // black without a word. Walks the scanlines (flat or new-style RLE) without decoding them.
 static void requireHdrComplete(const std::string& path, int w, int h) {
@@ -86,7 +92,7 @@ static void requireHdrComplete(const std::string& path, int w, int h) {
     // The header, up to the first empty line, exactly as stb reads it ('\n' ends a line; a "\r"
     // line is not empty to stb: taking it for the end put this walk 200 bytes before stb's, and a
     // file stb then looped on for minutes passed, found by tests/fuzz/libfuzzer).
-    while (std::getline(in, line) && !line.empty()) {}
+    while (std::getline(in, line) && !hdrHeaderEnds(line)) {}
     if (!std::getline(in, line)) throw InputError(path + ": truncated HDR (no resolution line)");
     auto truncated = [&](int y) {
         return InputError(path + ": truncated HDR (scanline " + std::to_string(y) + " of " + std::to_string(h) + " is incomplete)");
@@ -191,7 +197,7 @@ void requireImagePixelsFit(const std::string& path, const std::vector<unsigned c
     while (std::getline(probe, l)) {
         headerBytes += l.size() + 1;
         if (blank) break;  // the resolution line
-        if (l.empty()) blank = 1;  // as stb (and requireHdrComplete) end the header
+        if (hdrHeaderEnds(l)) blank = 1;  // as stb (and requireHdrComplete) end the header
     }
     unsigned char first[2] = {0, 0};
     probe.read(reinterpret_cast<char*>(first), 2);
