@@ -218,3 +218,50 @@ TEST(StbInputs, BmpAndTgaCutShortAreRefused) {
         }
     }
 }
+
+// Found by a review of the checks against stb_image 2.27's loaders: a top-down BMP (negative
+// height, which stb's info call reports as is) was refused though stb reads it; a paletted BMP
+// whose pixel offset leaves no room for the palette stb reads (an OS/2 header, where stb counts 4
+// entries fewer than the file has, or an offset of 0), or whose pixels name entries stb did not
+// read, decoded from uninitialised memory; a flat .hdr whose first pixel starts 02 02 8x was
+// taken for run-length data by the size check and read past the end.
+TEST(StbInputs, BmpPalettesAndTopDownRowsAndFlatHdrAsStbReadsThem) {
+    TempDir dir;
+    auto write = [&](const std::string& name, const std::string& bytes) {
+        std::ofstream(dir / name, std::ios::binary) << bytes;
+        return dir / name;
+    };
+    auto header = [](int hsz, int w, int h, int bpp, uint32_t offset, uint32_t fileSize) {
+        std::string s = "BM" + le(fileSize, 4) + le(0, 4) + le(offset, 4) + le(uint32_t(hsz), 4);
+        if (hsz == 12) return s + le(uint32_t(w), 2) + le(uint32_t(h), 2) + le(1, 2) + le(uint32_t(bpp), 2);
+        return s + le(uint32_t(w), 4) + le(uint32_t(h), 4) + le(1, 2) + le(uint32_t(bpp), 2) + le(0, 4) + le(0, 4) + le(2835, 4) +
+               le(2835, 4) + le(0, 4) + le(0, 4);
+    };
+    // Top-down 2x2, 24 bits: rows red/green, then blue/white, first row on top.
+    const std::string rows = std::string("\x00\x00\xff\x00\xff\x00", 6) + std::string(2, '\0') +
+                             std::string("\xff\x00\x00\xff\xff\xff", 6) + std::string(2, '\0');
+    const Image td = io::readImage(write("topdown.bmp", header(40, 2, -2, 24, 54, 70) + rows));
+    ASSERT_EQ(td.height(), 2);
+    EXPECT_EQ(td(0, 0, 0), 1.0f);  // red on top
+    EXPECT_EQ(td(1, 0, 1), 1.0f);  // green
+    EXPECT_EQ(td(0, 1, 2), 1.0f);  // blue below
+    EXPECT_EQ(td(1, 1, 0), 1.0f);  // white
+    // 8 bits, a 2-entry palette (black, white): indices 0 and 1 read; an index of 5 is refused.
+    const std::string pal = std::string(4, '\0') + std::string("\xff\xff\xff\x00", 4);
+    const Image ok = io::readImage(write("pal2.bmp", header(40, 4, 1, 8, 62, 66) + pal + std::string("\x00\x01\x01\x00", 4)));
+    EXPECT_EQ(ok(1, 0, 0), 1.0f);
+    EXPECT_EQ(ok(0, 0, 0), 0.0f);
+    const std::string bad = write("pal2_index5.bmp", header(40, 4, 1, 8, 62, 66) + pal + std::string("\x00\x05\x01\x00", 4));
+    EXPECT_NE(errorOf(bad).find("names colour 5 of a 2-colour palette"), std::string::npos) << errorOf(bad);
+    // An offset of 0: no palette as stb counts it.
+    const std::string zero = write("offset0.bmp", header(40, 4, 1, 8, 0, 58) + std::string("\x01\x01\x01\x01", 4));
+    EXPECT_NE(errorOf(zero).find("leave no room for the palette"), std::string::npos) << errorOf(zero);
+    // OS/2 1-bit with its 2-entry palette at offset 32: stb counts (32 - 38) / 3 entries.
+    const std::string os2 = write("os2.bmp", header(12, 8, 2, 1, 32, 40) + std::string("\x00\x00\xff\xff\xff\xff", 6) +
+                                                 std::string("\xf0\x00\x00\x00\x0f\x00\x00\x00", 8));
+    EXPECT_NE(errorOf(os2).find("leave no room for the palette"), std::string::npos) << errorOf(os2);
+    // A flat .hdr (8x2) cut after its first two pixels, the first starting 02 02 80.
+    const std::string hdr = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 8\n";
+    const std::string cut = write("flat_cut.hdr", hdr + std::string("\x02\x02\x80\x80\x80\x40\x20\x81", 8));
+    EXPECT_NE(errorOf(cut).find("truncated HDR"), std::string::npos) << errorOf(cut);
+}

@@ -339,6 +339,8 @@ static Image readStb(const std::string& path, int* sourceChannels) {
     if (!stbi_info_from_memory(bytes.data(), len, &w, &h, &n))
         throw InputError(path + ": cannot read image (" + stbi_failure_reason() + ")");
     if (sourceChannels) *sourceChannels = n <= 2 ? 1 : 3;  // grey (+ alpha) or colour (+ alpha)
+    // stb's BMP info gives a top-down file's height negative; its loader reads it as |h|.
+    if (extensionOf(path) == ".bmp" && h < 0 && h > -65536) h = -h;
     requireImagePixelsFit(path, bytes, w, h);
     // stbi_loadf converts 8-bit sRGB to linear (gamma 2.2) and reads Radiance .hdr as is.
     float* data = stbi_loadf_from_memory(bytes.data(), len, &w, &h, &n, 3);

@@ -137,16 +137,40 @@ static InputError truncatedImage(const std::string& path, const char* format, ui
                       std::to_string(have) + ")");
 }
 
-// A BMP's rows (stb 2.27 reads past the end as 0): from the pixel offset of its file header, rows
-// padded to 4 bytes. stb refuses the run-length kinds itself.
+// A BMP's rows (stb 2.27 reads past the end as 0), from the pixel offset of its file header, rows
+// padded to 4 bytes; stb refuses the run-length kinds itself, and an offset other than the header's
+// end for a BMP without a palette. A palette is read as stb reads it: (offset - 14 - header) / 4
+// entries, or (offset - 38) / 3 for an OS/2 header (stb's count, 4 short of the file's). With no
+// entry stb reads none and starts the pixels past the offset; a pixel naming an entry stb did not
+// read takes uninitialised memory: both are refused (found by a review of the checks).
 static void requireBmpComplete(const std::string& path, const std::vector<unsigned char>& b, int w, int h) {
-    if (b.size() < 30) throw InputError(path + ": truncated BMP (a header of " + std::to_string(b.size()) + " bytes)");
-    const uint32_t offset = le32(b, 10), hsz = le32(b, 14);
+    const uint32_t hsz = b.size() >= 18 ? le32(b, 14) : 0;
+    const size_t headerEnd = hsz == 12 ? 26 : 30;  // through the bits per pixel
+    if (b.size() < headerEnd) throw InputError(path + ": truncated BMP (a header of " + std::to_string(b.size()) + " bytes)");
+    const int64_t offset = le32(b, 10);
     const uint32_t bpp = hsz == 12 ? le16(b, 24) : le16(b, 28);
-    const uint64_t start = std::max<uint64_t>(offset, 14ull + hsz);
     const uint64_t stride = (uint64_t(w) * bpp + 31) / 32 * 4, last = (uint64_t(w) * bpp + 7) / 8;
+    int64_t palette = 0;
+    if (bpp < (hsz == 12 ? 24u : 16u)) {
+        // C's integer division and shift, as stb computes it (offset is at most 2^32 - 1).
+        palette = hsz == 12 ? (offset - 38) / 3 : (offset - 14 - int64_t(hsz)) >> 2;
+        if (palette < 1)
+            throw InputError(path + ": corrupt BMP (its pixels at offset " + std::to_string(offset) +
+                             " leave no room for the palette stb_image reads)");
+    }
+    const uint64_t start = std::max<uint64_t>(uint64_t(offset), 14ull + hsz);
     const uint64_t need = start + stride * uint64_t(h - 1) + last;
     if (b.size() < need) throw truncatedImage(path, "BMP", need, b.size());
+    if ((bpp != 1 && bpp != 4 && bpp != 8) || palette >= (int64_t(1) << bpp)) return;  // stb refuses other depths
+    for (int y = 0; y < h; ++y)  // every index within the entries stb read
+        for (int x = 0; x < w; ++x) {
+            const uint64_t bit = uint64_t(x) * bpp;
+            const unsigned byte = b[size_t(start + uint64_t(y) * stride + bit / 8)];
+            const unsigned index = (byte >> (8 - bpp - unsigned(bit % 8))) & ((1u << bpp) - 1);
+            if (int64_t(index) >= palette)
+                throw InputError(path + ": corrupt BMP (a pixel of row " + std::to_string(y) + " names colour " + std::to_string(index) +
+                                 " of a " + std::to_string(palette) + "-colour palette as stb_image reads it)");
+        }
 }
 
 // A TGA's pixels (stb 2.27 reads past the end as 0): after the 18-byte header, the image id and,
@@ -199,9 +223,10 @@ void requireImagePixelsFit(const std::string& path, const std::vector<unsigned c
         if (blank) break;  // the resolution line
         if (hdrHeaderEnds(l)) blank = 1;  // as stb (and requireHdrComplete) end the header
     }
-    unsigned char first[2] = {0, 0};
-    probe.read(reinterpret_cast<char*>(first), 2);
-    const bool rle = w >= 8 && w < 32768 && first[0] == 2 && first[1] == 2;
+    unsigned char first[3] = {0, 0, 0};
+    probe.read(reinterpret_cast<char*>(first), 3);
+    // As stb (and requireHdrComplete) tell run-length data: "02 02" and a length below 0x8000.
+    const bool rle = w >= 8 && w < 32768 && first[0] == 2 && first[1] == 2 && !(first[2] & 0x80);
     if (!rle && bytes.size() < headerBytes + uint64_t(w) * uint64_t(h) * 4)
         throw InputError(path + ": truncated HDR (expected " + std::to_string(uint64_t(w) * h * 4) + " bytes of pixels, found " +
                          std::to_string(bytes.size() > headerBytes ? bytes.size() - headerBytes : 0) + ")");
