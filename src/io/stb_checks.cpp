@@ -86,7 +86,7 @@ static bool hdrHeaderEnds(const std::string& line) { return line.empty() || line
 
 // A Radiance .hdr must hold every scanline: stb fills a truncated file's missing pixels with
 // black without a word. Walks the scanlines (flat or new-style RLE) without decoding them.
-static void requireHdrComplete(const std::string& path, int w, int h) {
+static void requireHdrComplete(const std::string& path, uint64_t fileSize, int w, int h) {
     std::ifstream in(path, std::ios::binary);
     std::string line;
     // The header, up to the first empty line, exactly as stb reads it ('\n' ends a line; a "\r"
@@ -94,6 +94,7 @@ static void requireHdrComplete(const std::string& path, int w, int h) {
     // file stb then looped on for minutes passed, found by tests/fuzz/libfuzzer).
     while (std::getline(in, line) && !hdrHeaderEnds(line)) {}
     if (!std::getline(in, line)) throw InputError(path + ": truncated HDR (no resolution line)");
+    const std::streamoff headerBytes = in.tellg();
     auto truncated = [&](int y) {
         return InputError(path + ": truncated HDR (scanline " + std::to_string(y) + " of " + std::to_string(h) + " is incomplete)");
     };
@@ -102,7 +103,13 @@ static void requireHdrComplete(const std::string& path, int w, int h) {
         unsigned char head[4];
         if (!in.read(reinterpret_cast<char*>(head), 4)) throw truncated(y);
         const bool rle = w >= 8 && w < 32768 && head[0] == 2 && head[1] == 2 && !(head[2] & 0x80);
-        if (!rle && y == 0) return;  // flat pixels: readStb checks the file's size instead
+        if (!rle && y == 0) {  // flat pixels: 4 bytes each after the header
+            const uint64_t need = uint64_t(w) * uint64_t(h) * 4, have = fileSize - uint64_t(headerBytes);
+            if (have < need)
+                throw InputError(path + ": truncated HDR (expected " + std::to_string(need) + " bytes of pixels, found " +
+                                 std::to_string(have) + ")");
+            return;
+        }
         // stb loops for ever on a zero-length run at the end of the data (EOF reads as 0): every
         // structural fault is refused here.
         auto corrupt = [&](const char* what) {
@@ -212,24 +219,7 @@ void requireImagePixelsFit(const std::string& path, const std::vector<unsigned c
     if (ext == ".bmp") return requireBmpComplete(path, bytes, w, h);
     if (ext == ".tga") return requireTgaComplete(path, bytes, w, h);
     if (ext != ".hdr") return;
-    requireHdrComplete(path, w, h);
-    std::ifstream probe(path, std::ios::binary);
-    std::string l;
-    // A flat (uncompressed) .hdr needs 4 bytes per pixel after its header.
-    size_t headerBytes = 0;
-    int blank = 0;
-    while (std::getline(probe, l)) {
-        headerBytes += l.size() + 1;
-        if (blank) break;  // the resolution line
-        if (hdrHeaderEnds(l)) blank = 1;  // as stb (and requireHdrComplete) end the header
-    }
-    unsigned char first[3] = {0, 0, 0};
-    probe.read(reinterpret_cast<char*>(first), 3);
-    // As stb (and requireHdrComplete) tell run-length data: "02 02" and a length below 0x8000.
-    const bool rle = w >= 8 && w < 32768 && first[0] == 2 && first[1] == 2 && !(first[2] & 0x80);
-    if (!rle && bytes.size() < headerBytes + uint64_t(w) * uint64_t(h) * 4)
-        throw InputError(path + ": truncated HDR (expected " + std::to_string(uint64_t(w) * h * 4) + " bytes of pixels, found " +
-                         std::to_string(bytes.size() > headerBytes ? bytes.size() - headerBytes : 0) + ")");
+    requireHdrComplete(path, bytes.size(), w, h);
 }
 
 }  // namespace atrous::io
