@@ -13,6 +13,9 @@ same inputs (the scene at 2 spp, seed 7, as `atrous bench` renders them, through
   and commits the filter in every call);
 * ``oidn_filter``: pyoidn's object API, a ``pyoidn.Filter`` ("RT", hdr, quality high) created,
   bound and committed once, then only ``execute()`` timed: OIDN's own cost.
+* ``alt_*``: the default method (``atrous.denoise`` with no ``method``: auto, the learned filter
+  with these buffers, through Python) and OIDN fast and high (``Filter.execute``), one call of each
+  in turn per round, in this process: the issue-27 speed bar (default at most OIDN fast).
 
 Both are --warmup untimed calls (at least one), then the median of --runs calls (atrous.eval's
 time_call), the same counts as the atrous rows. The result
@@ -50,6 +53,24 @@ def _git_commit() -> str:
         return "unknown"
 
 
+def _oidn_filter(pyoidn, dev, color, albedo, normal, quality):
+    """An RT filter (hdr) of `quality` bound to the images and committed: execute() is OIDN's own cost.
+    Returns (filter, output array): OIDN writes into that array, so the caller keeps it alive as long
+    as the filter."""
+    flt = pyoidn.Filter(dev, pyoidn.OIDN_FILTER_TYPE_RT)
+    result = np.zeros_like(color)
+    for name, img in ((pyoidn.OIDN_IMAGE_COLOR, color), (pyoidn.OIDN_IMAGE_ALBEDO, albedo),
+                      (pyoidn.OIDN_IMAGE_NORMAL, normal), (pyoidn.OIDN_IMAGE_OUTPUT, result)):
+        flt.set_image(name, img, pyoidn.OIDN_FORMAT_FLOAT3)
+    flt.set_bool("hdr", True)
+    flt.set_quality(quality)
+    flt.commit()
+    err = dev.get_error()
+    if err:
+        raise RuntimeError(f"OIDN filter set-up failed: {err}")
+    return flt, result
+
+
 def time_oidn(b, runs: int, warmup: int) -> dict:
     import pyoidn
     from atrous.eval import oidn_inputs, time_call  # what atrous.eval's OIDN column passes and how it times
@@ -59,17 +80,7 @@ def time_oidn(b, runs: int, warmup: int) -> dict:
         lambda: pyoidn.denoise(color, albedo, normal, hdr=True, quality="high"), runs, warmup)[1]}
     dev = pyoidn.Device()
     dev.commit()
-    flt = pyoidn.Filter(dev, pyoidn.OIDN_FILTER_TYPE_RT)
-    result = np.zeros_like(color)
-    for name, img in ((pyoidn.OIDN_IMAGE_COLOR, color), (pyoidn.OIDN_IMAGE_ALBEDO, albedo),
-                      (pyoidn.OIDN_IMAGE_NORMAL, normal), (pyoidn.OIDN_IMAGE_OUTPUT, result)):
-        flt.set_image(name, img, pyoidn.OIDN_FORMAT_FLOAT3)
-    flt.set_bool("hdr", True)
-    flt.set_quality(pyoidn.OIDN_QUALITY_HIGH)
-    flt.commit()
-    err = dev.get_error()
-    if err:
-        raise RuntimeError(f"OIDN filter set-up failed: {err}")
+    flt, result = _oidn_filter(pyoidn, dev, color, albedo, normal, pyoidn.OIDN_QUALITY_HIGH)  # result: kept alive
     out["oidn_filter_ms"] = time_call(flt.execute, runs, warmup)[1]
     err = dev.get_error()
     if err:
@@ -83,6 +94,43 @@ def time_oidn(b, runs: int, warmup: int) -> dict:
     except Exception:
         out["pyoidn"] = "unknown"
     out["oidn"] = getattr(getattr(pyoidn, "version", None), "oidn_version", "unknown")
+    return out
+
+
+def time_default_alternating(b, runs: int, warmup: int) -> dict:
+    """The default method (atrous.denoise with no method: auto, learned with these buffers) and OIDN
+    fast and high (Filter.execute, committed once), in one process, one call of each in turn per
+    round: the same load on every figure. Medians of `runs` rounds after `warmup` rounds."""
+    import atrous
+    import pyoidn
+    from atrous.eval import oidn_inputs
+
+    color, albedo, normal = oidn_inputs(b)
+    feats = {k: b.get(k) for k in ("albedo", "normal", "position", "depth", "ids", "variance", "emission")
+             if b.get(k) is not None}
+    dev = pyoidn.Device()
+    dev.commit()
+    # (Each filter writes into its own output array: both are kept alive while the filters live.)
+    fast, fast_out = _oidn_filter(pyoidn, dev, color, albedo, normal, pyoidn.OIDN_QUALITY_FAST)
+    high, high_out = _oidn_filter(pyoidn, dev, color, albedo, normal, pyoidn.OIDN_QUALITY_HIGH)
+    calls = {"default": lambda: atrous.denoise(b["color"], **feats), "oidn_fast": fast.execute,
+             "oidn_high": high.execute}
+    times = {k: [] for k in calls}
+    for r in range(warmup + runs):
+        for k, f in calls.items():
+            t = time.perf_counter()
+            f()
+            if r >= warmup:
+                times[k].append((time.perf_counter() - t) * 1e3)
+    err = dev.get_error()
+    if err:
+        raise RuntimeError(f"OIDN execute failed: {err}")
+    fast.release()
+    high.release()
+    dev.release()
+    del fast_out, high_out
+    out = {f"alt_{k}_ms": float(np.median(v)) for k, v in times.items()}
+    out["alt_default_over_oidn_fast"] = out["alt_default_ms"] / out["alt_oidn_fast_ms"]
     return out
 
 
@@ -109,7 +157,7 @@ def main(argv=None) -> int:
             p.error(f"--sizes: '{s}' is not WxH")
         sizes.append((w, h))
 
-    cmd = [a.atrous, "bench", "--json", "--what", "eaw,sure,learned", "--sizes", a.sizes, "--runs", str(a.runs),
+    cmd = [a.atrous, "bench", "--json", "--what", "eaw,sure,learned,blend", "--sizes", a.sizes, "--runs", str(a.runs),
            "--warmup", str(a.warmup), "--scene", a.scene, "--device", a.device]
     if a.learned_weights:
         cmd += ["--learned-weights", a.learned_weights]
@@ -125,11 +173,12 @@ def main(argv=None) -> int:
     for w, h in sizes:
         row = {"width": w, "height": h}
         for r in bench["results"]:
-            if r["width"] == w and r["height"] == h and r["what"] in ("eaw", "sure", "learned"):
+            if r["width"] == w and r["height"] == h and r["what"] in ("eaw", "sure", "learned", "blend"):
                 row[f"{r['what']}_ms"] = r["median_ms"]
                 row[f"{r['what']}_total_ms"] = r["total_ms"]
         b = atrous.render(a.scene, width=w, height=h, spp=2, seed=7)
         row.update(time_oidn(b, a.runs, a.warmup))
+        row.update(time_default_alternating(b, a.runs, a.warmup))
         for k in ("oidn_denoise_ms", "oidn_filter_ms"):
             if row.get("learned_ms") and row.get(k):
                 row["learned_over_" + k[:-3]] = row["learned_ms"] / row[k]
@@ -147,6 +196,8 @@ def main(argv=None) -> int:
         "oidn_api": {"oidn_denoise": "pyoidn.denoise(color, albedo, normal, hdr=True, quality='high') per call",
                      "oidn_filter": "pyoidn.Filter RT (hdr, quality high) committed once, execute() timed"},
         "atrous_timing": "atrous bench median_ms (the filter alone, inputs in place); *_total_ms = the whole denoise()",
+        "alternating": "alt_*: atrous.denoise with no method (the default: auto) and OIDN fast/high Filter.execute, "
+                       "one call of each per round in this process; medians of --runs rounds after --warmup",
         "command": " ".join(cmd),
         "results": rows,
     }

@@ -31,7 +31,7 @@ namespace {
 struct BenchArgs {
     std::string device = "auto";
     std::string sizes = "512x512,1280x720,1920x1080,3840x2160";
-    std::string what = "eaw,sure,learned,svgf,render";
+    std::string what = "eaw,sure,learned,blend,svgf,render";
     std::string learnedWeights;  // "" = the built-in weights
     std::string scene = "cornell";
     int runs = 0;  // 0: 50 on CUDA, 10 on the CPU
@@ -134,10 +134,10 @@ void run(const BenchArgs& a) {
     if (a.warmup < 0) throw InputError("--warmup must be >= 0");
     std::vector<std::string> what = split(a.what);
     for (auto& w : what)
-        if (w != "eaw" && w != "sure" && w != "learned" && w != "svgf" && w != "render")
-            throw InputError("--what: unknown item '" + w + "' (expected eaw, sure, learned, svgf, render)");
+        if (w != "eaw" && w != "sure" && w != "learned" && w != "blend" && w != "svgf" && w != "render")
+            throw InputError("--what: unknown item '" + w + "' (expected eaw, sure, learned, blend, svgf, render)");
     auto wants = [&](const char* k) { return std::find(what.begin(), what.end(), k) != what.end(); };
-    if (wants("learned") && !a.learnedWeights.empty()) {
+    if ((wants("learned") || wants("blend")) && !a.learnedWeights.empty()) {
         try {
             LearnedWeights::load(a.learnedWeights);  // a bad file: one line before any timing
         } catch (const InputError& e) {
@@ -203,7 +203,7 @@ void run(const BenchArgs& a) {
         // On CUDA the inputs are uploaded once, outside the timed calls: the filters then read
         // them in place (as the viewer and DLPack callers do) and total_ms covers no transfer.
         RenderBuffers onDevice;
-        if (device == Device::Cuda && (wants("eaw") || wants("sure") || wants("learned") || wants("svgf"))) {
+        if (device == Device::Cuda && (wants("eaw") || wants("sure") || wants("learned") || wants("blend") || wants("svgf"))) {
             for (auto [dst, src] : {std::pair<Image*, const Image*>{&onDevice.color, &b.color},
                                     {&onDevice.variance, &b.variance}, {&onDevice.albedo, &b.albedo},
                                     {&onDevice.normal, &b.normal}, {&onDevice.position, &b.position},
@@ -212,14 +212,14 @@ void run(const BenchArgs& a) {
                 *dst = src->to(Device::Cuda);
         }
         const RenderBuffers& inputs = device == Device::Cuda ? onDevice : b;
-        for (const char* m : {"eaw", "sure", "learned"}) {
+        for (const char* m : {"eaw", "sure", "learned", "blend"}) {
             if (!wants(m)) continue;
             DenoiseInputs in = denoiseInputsOf(inputs);
             DenoiseReport rep;
             DenoiseOptions o;
             o.method = parseDenoiseMethod(m);
             o.learnedWeights = a.learnedWeights;
-            const bool learned = o.method == DenoiseMethod::Learned;
+            const bool learned = o.method == DenoiseMethod::Learned || o.method == DenoiseMethod::Blend;
             o.device = device;
             o.report = &rep;
             std::vector<double> total;
@@ -311,7 +311,7 @@ void addBenchCommand(CLI::App& app) {
     auto* cmd = app.add_subcommand("bench", "Time every render and denoise path at several resolutions");
     cmd->add_option("--device", args->device, "cpu, cuda or auto (cuda when a GPU is present)")->capture_default_str();
     cmd->add_option("--sizes", args->sizes, "comma-separated WxH list")->capture_default_str();
-    cmd->add_option("--what", args->what, "comma-separated: eaw, sure, learned, svgf, render")->capture_default_str();
+    cmd->add_option("--what", args->what, "comma-separated: eaw, sure, learned, blend, svgf, render")->capture_default_str();
     cmd->add_option("--learned-weights", args->learnedWeights,
                     "weight file of the learned filter (default: the built-in weights)");
     cmd->add_option("--scene", args->scene, "scene whose buffers are denoised")->capture_default_str();

@@ -30,19 +30,19 @@ struct DenoiseArgs {
     bool ldr = false, srgb = false;    // LDR input: output clamped to [0, 1]; --srgb: sRGB-encoded
     std::string oidnFilter = "RT", oidnQuality;  // oidnDenoise's -f, -q (accepted; see addOidnFlags)
     bool oidnCleanAux = false;
-    std::string method = "sure", device = "auto";
+    std::string method = "auto", device = "auto";
     DenoiseOptions opt;  // the filter parameters' flags write here (params.h's table)
     SvgfParams svgf;
 };
 
 // Option groups: the flags of one method are ignored by the others (a note says which).
-const char* const kGroupEawSure = "EAW, SURE and learned (--method eaw|sure|learned|auto; learned: see docs/denoising.md)";
-const char* const kGroupSure = "SURE (--method sure)";
+const char* const kGroupEawSure = "EAW, SURE and learned (--method eaw|sure|learned|blend|auto; learned: see docs/denoising.md)";
+const char* const kGroupSure = "SURE (--method sure|blend)";
 const char* const kGroupSvgf = "SVGF (--method svgf)";  // addSvgfOptions' group
 const char* const kGroupBuffers = "Buffers (without --sequence)";
-const char* const kGroupLearned = "Learned (--method learned|auto, or svgf --svgf-learned-spatial)";
+const char* const kGroupLearned = "Learned (--method learned|blend|auto, or svgf --svgf-learned-spatial)";
 
-bool learnedMethod(const std::string& method) { return method == "learned" || method == "auto"; }
+bool learnedMethod(const std::string& method) { return method == "learned" || method == "blend" || method == "auto"; }
 
 // The learned filter runs the still driver's preparation (fireflies, emission filter, albedo rule)
 // and the safety net, not the EAW stops or SURE (include/atrous/denoise.h): the flags it ignores.
@@ -62,7 +62,7 @@ void noteIgnoredFlags(const CLI::App& cmd, const std::string& method, bool seque
     for (const CLI::Option* opt : cmd.get_options()) {
         if (opt->count() == 0) continue;
         const std::string& g = opt->get_group();
-        const bool unused = (g == kGroupEawSure && method == "svgf") || (g == kGroupSure && method != "sure") ||
+        const bool unused = (g == kGroupEawSure && method == "svgf") || (g == kGroupSure && method != "sure" && method != "blend" && method != "auto") ||
                             (g == kGroupSvgf && method != "svgf") ||
                             (g == kGroupLearned && !learnedMethod(method) && !learnedSvgf) ||
                             (method == "learned" && ignoredByLearned(opt->get_name()));
@@ -127,7 +127,7 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     DenoiseOptions& o = a.opt;
     const bool sequence = !a.sequence.empty();
     if (a.method != "svgf" && a.method != "eaw" && a.method != "sure" && !learnedMethod(a.method))
-        throw InputError("--method: unknown denoise method '" + a.method + "' (expected eaw, sure, learned, auto or svgf)");
+        throw InputError("--method: unknown denoise method '" + a.method + "' (expected eaw, sure, learned, blend, auto or svgf)");
     if (a.method == "svgf" && !sequence)
         throw InputError("--method svgf denoises animated sequences: give --sequence DIR (and an output directory)");
     o.method = a.method == "svgf" ? DenoiseMethod::Sure : parseDenoiseMethod(a.method);
@@ -168,7 +168,7 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     // Only the buffers the method reads are decoded (auto: by the buffers present).
     files.wanted = [&](io::Buffer b, const bool present[io::kBufferCount]) {
         const DenoiseMethod m = o.method != DenoiseMethod::Auto ? o.method
-                                : present[int(io::Buffer::Albedo)] && present[int(io::Buffer::Normal)] ? DenoiseMethod::Learned
+                                : present[int(io::Buffer::Albedo)] && present[int(io::Buffer::Normal)] ? DenoiseMethod::Blend
                                                                                                       : DenoiseMethod::Sure;
         return io::methodReads(denoiseBufferUse(o, m), b);
     };
@@ -221,8 +221,8 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     const double writeMs = writeTimer.ms();
     const std::string method = o.method == DenoiseMethod::Auto
                                    ? std::string("auto -> ") + denoiseMethodName(rep.methodUsed) +
-                                         (rep.methodUsed == DenoiseMethod::Learned ? " (albedo and normal given)"
-                                                                                  : " (learned needs an albedo and a normal)")
+                                         (rep.methodUsed == DenoiseMethod::Blend ? " (albedo and normal given)"
+                                                                                : " (the learned filter needs an albedo and a normal)")
                                    : std::string(denoiseMethodName(o.method));
     std::printf("denoise: method %s on %s, %dx%d, buffers used: %s\n", method.c_str(), deviceToString(o.device), width, height,
                 rep.buffersUsed.c_str());
@@ -289,7 +289,9 @@ void addDenoiseCommand(CLI::App& app) {
                     "not write (and an old preview.mp4) are removed, named in a note on stderr")
         ->required();
     cmd->add_option("--method", a->method,
-                    "eaw | sure | learned | auto (learned with an albedo and a normal, else sure) (| svgf with --sequence)")
+                    "eaw | sure | learned | blend (the mean of learned and sure) | auto (blend with an albedo and a normal, else "
+                    "sure: the method measured best for the buffers given, docs/quality.md; the output line says "
+                    "which ran) (| svgf with --sequence)")
         ->capture_default_str();
     cmd->add_option("--learned-weights", a->opt.learnedWeights,
                     "Weight file of the learned filter (version 3, docs/learned.md; default: the built-in weights)")

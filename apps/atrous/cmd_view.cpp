@@ -30,7 +30,7 @@ void addViewCommand(CLI::App& app) {
                         const std::string n = f.name;
                         return n != "threads" && n != "light_sampling";
                     });
-    cmd->add_option("--method", o.method, "Denoiser of the main view: none | eaw | sure | svgf | learned")
+    cmd->add_option("--method", o.method, "Denoiser of the main view: none | eaw | sure | svgf | learned | blend")
         ->capture_default_str();
     cmd->add_option("--compare", o.compare, "Split screen: the method shown on the right half");
     cmd->add_flag("--no-accumulate", o.noAccumulate,

@@ -186,9 +186,10 @@ private:
 
 int runSequenceDenoise(const SequenceDenoiseArgs& args) {
     const bool svgf = args.method == "svgf";
-    if (!svgf && args.method != "eaw" && args.method != "sure" && args.method != "learned" && args.method != "auto")
+    if (!svgf && args.method != "eaw" && args.method != "sure" && args.method != "learned" && args.method != "blend" &&
+        args.method != "auto")
         throw InputError("--method '" + args.method +
-                         "' cannot denoise a sequence (expected svgf, eaw, sure, learned or auto)");
+                         "' cannot denoise a sequence (expected svgf, eaw, sure, learned, blend or auto)");
     if (args.sequenceDir.empty()) throw InputError("--sequence: no directory given");
     if (args.outDir.empty()) throw InputError("--out: no output directory given");
     if (!(args.exposure > 0.0f)) throw InputError("--exposure must be > 0");

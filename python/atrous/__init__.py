@@ -53,7 +53,7 @@ __all__ = [
 
 __version__ = "0.1.0"
 
-METHODS = ("eaw", "sure", "learned", "auto")
+METHODS = ("eaw", "sure", "learned", "blend", "auto")
 
 
 def builtin_scenes() -> list:
@@ -183,7 +183,7 @@ def denoise(
     variance: Any = None,
     ids: Any = None,
     emission: Any = None,
-    method: str = "sure",
+    method: str = "auto",
     device: str = "auto",
     learned_weights: Optional["PathLike"] = None,
     **params: Any,
@@ -199,8 +199,10 @@ def denoise(
 
     method: "eaw", "sure", "learned" (the learned à-trous filter, docs/learned.md: it uses the
     firefly, emission, albedo and safety-net parameters, not levels, the sigma's or SURE's) or
-    "auto" (learned when an albedo and a normal are given, else sure). learned_weights: a weight
-    file (version 3) for "learned"/"auto"; None = the built-in weights; a bad file raises
+    "blend" (the mean of the learned and the SURE outputs, from one preparation) or "auto" (the
+    default: blend when an albedo and a normal are given, else sure: the method measured best for
+    those buffers, docs/quality.md). learned_weights: a weight
+    file (version 3) for "learned"/"blend"/"auto"; None = the built-in weights; a bad file raises
     ValueError naming it. device: "auto" (the arrays' device: CUDA arrays on the GPU, numpy on
     the CPU), "cpu" or "cuda" (numpy inputs are then copied to the GPU and back).
 

@@ -19,7 +19,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[2]
 BUFS = ("color", "variance", "albedo", "normal", "depth", "emission")
-METHODS = ("noisy", "eaw", "sure", "learned", "oidn")
+METHODS = ("noisy", "eaw", "sure", "learned", "blend", "oidn")
 
 
 def relmse(x, r):
@@ -48,7 +48,7 @@ def run_method(method: str, b: dict, weights):
         return pyoidn.denoise(c, np.clip(np.nan_to_num(b["albedo"]), 0, 1).astype(np.float32),
                               np.clip(np.nan_to_num(b["normal"]), -1, 1).astype(np.float32), hdr=True, quality="high")
     kw = {k: v for k, v in b.items() if k != "color"}
-    extra = {"learned_weights": weights} if method == "learned" and weights else {}
+    extra = {"learned_weights": weights} if method in ("learned", "blend") and weights else {}
     return atrous.denoise(b["color"], method=method, device="cpu", **kw, **extra)
 
 
@@ -61,6 +61,9 @@ def summary(res: dict, spps=(4, 16)) -> dict:
         if "learned" in ms and "sure" in ms:
             s["learned_beats_sure"] = sum(v["learned"] < v["sure"] for v in rows.values())
             s["learned_over_sure_max"] = max(v["learned"] / v["sure"] for v in rows.values())
+        if "blend" in ms and "sure" in ms:
+            s["blend_beats_sure"] = sum(v["blend"] < v["sure"] for v in rows.values())
+            s["blend_over_sure_max"] = max(v["blend"] / v["sure"] for v in rows.values())
         if "learned" in ms and "oidn" in ms:
             s["learned_over_oidn_max"] = max(v["learned"] / v["oidn"] for v in rows.values())
         s["scenes"] = len(rows)

@@ -31,8 +31,9 @@ DenoiseMethod parseDenoiseMethod(const std::string& name) {
     if (name == "eaw") return DenoiseMethod::Eaw;
     if (name == "sure") return DenoiseMethod::Sure;
     if (name == "learned") return DenoiseMethod::Learned;
+    if (name == "blend") return DenoiseMethod::Blend;
     if (name == "auto") return DenoiseMethod::Auto;
-    throw InputError("unknown denoise method '" + name + "' (expected eaw, sure, learned or auto)");
+    throw InputError("unknown denoise method '" + name + "' (expected eaw, sure, learned, blend or auto)");
 }
 
 const char* denoiseMethodName(DenoiseMethod m) {
@@ -41,14 +42,16 @@ const char* denoiseMethodName(DenoiseMethod m) {
         case DenoiseMethod::Sure: return "sure";
         case DenoiseMethod::Learned: return "learned";
         case DenoiseMethod::Auto: return "auto";
+        case DenoiseMethod::Blend: return "blend";
     }
     return "?";
 }
 
-// The network was trained with an albedo and a normal (docs/learned.md); without them SURE.
+// The network was trained with an albedo and a normal (docs/learned.md); without them SURE. With
+// them, the mean of the two (Blend): measured best on other renderers' stills (docs/quality.md).
 DenoiseMethod resolveDenoiseMethod(DenoiseMethod m, const DenoiseInputs& in) {
     if (m != DenoiseMethod::Auto) return m;
-    return in.albedo && !in.albedo->empty() && in.normal && !in.normal->empty() ? DenoiseMethod::Learned
+    return in.albedo && !in.albedo->empty() && in.normal && !in.normal->empty() ? DenoiseMethod::Blend
                                                                                : DenoiseMethod::Sure;
 }
 
@@ -318,12 +321,13 @@ PreparedInputs prepareInputsDropping(const DenoiseInputs& given, const DenoiseOp
     }
     const DenoiseBufferUse use = denoiseBufferUse(o, o.method);
     const bool learned = o.method == DenoiseMethod::Learned;
+    const bool network = learned || o.method == DenoiseMethod::Blend;
     if (in.albedo) used += use.albedo ? ",albedo" : ",albedo(unused: demodulation off)";
     if (in.normal) used += ",normal";
     if (in.position) used += use.position ? ",position" : ",position(unused by learned)";
     // Depth steers the depth stop (sigma-depth > 0), the learned network, and, without a usable
     // variance, the noise estimate's geometric edges.
-    if (in.depth) used += learned || o.eaw.sigmaDepth > 0 || rep.noiseEstimated ? ",depth" : ",depth(unused: sigma-depth 0)";
+    if (in.depth) used += network || o.eaw.sigmaDepth > 0 || rep.noiseEstimated ? ",depth" : ",depth(unused: sigma-depth 0)";
     if (in.ids) used += use.ids ? ",ids" : learned ? ",ids(unused by learned)" : ",ids(unused)";
     if (in.emission) used += ",emission";
     rep.buffersUsed = used;
@@ -332,7 +336,8 @@ PreparedInputs prepareInputsDropping(const DenoiseInputs& given, const DenoiseOp
 
 }  // namespace filters
 
-// The learned filter's network reads depth (and no position or ids); EAW/SURE the reverse by default.
+// The learned filter's network reads depth (and no position or ids); EAW/SURE the reverse by
+// default; Blend what both read.
 DenoiseBufferUse denoiseBufferUse(const DenoiseOptions& o, DenoiseMethod resolved) {
     const bool learned = resolved == DenoiseMethod::Learned;
     DenoiseBufferUse u;
@@ -463,7 +468,7 @@ Image denoiseWith(const DenoiseInputs& given, const DenoiseOptions& options, con
     o.method = resolveDenoiseMethod(options.method, inputs);
     // The weights before any work: a bad file is an InputError naming it, nothing computed.
     LearnedWeights weights;
-    if (o.method == DenoiseMethod::Learned)
+    if (o.method == DenoiseMethod::Learned || o.method == DenoiseMethod::Blend)
         weights = o.learnedWeights.empty() ? LearnedWeights::builtin() : LearnedWeights::load(o.learnedWeights);
     filters::PreparedInputs prep = prepareCall(inputs, o, rep, true);
     prep.learned = weights;
@@ -510,6 +515,7 @@ PreparedPlanes learnedPlanes(const DenoiseInputs& given, const DenoiseOptions& o
     DriverOutputs dout;
     dout.planes = &views;
     DriverConfig cfg{options};
+    cfg.opts.method = DenoiseMethod::Learned;  // the planes of the learned method, whatever options.method says
     cfg.varianceGiven = in.variance != nullptr;
     setNoiseEstimate(cfg, rep);
     runDenoise(CpuExec{}, driverInputsOf(in, prep), cfg, dout);

@@ -163,6 +163,17 @@ inline Image takeStore(Image* store, const ImageView& v, Device dev) {
     return std::move(*store);
 }
 
+// Blend's mean: c = ((c + d) + l) / 2, d (SURE's kept detail sum) when valid.
+struct BlendMean {
+    ImageView c, d, l;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        for (int k = 0; k < 3; ++k) {
+            const float sureF = d.valid() ? c(x, y, k) + d(x, y, k) : c(x, y, k);
+            c(x, y, k) = 0.5f * (sureF + l(x, y, k));
+        }
+    }
+};
+
 // Memory (docs/architecture.md, "Memory"): every temporary is allocated without a zero fill
 // (each is written whole before it is read), once per call (the cascade's planes live through it:
 // nothing is allocated per level), and dead planes are reused: the variance's buffer becomes EAW's
@@ -175,8 +186,12 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     const int w = in.color.width, h = in.color.height;
     const Device dev = exec.device();
     const DenoiseOptions& o = cfg.opts;
-    const bool sure = o.method == DenoiseMethod::Sure;
-    const bool learned = o.method == DenoiseMethod::Learned;
+    // Blend runs the learned cascade and then SURE's on the same prepared planes (the features
+    // prepared as for SURE, which reads more of them) and averages the two before remodulation.
+    const bool blend = o.method == DenoiseMethod::Blend;
+    const bool sure = o.method == DenoiseMethod::Sure || blend;
+    const bool learned = o.method == DenoiseMethod::Learned;  // the learned method alone
+    const bool network = learned || blend;                    // the learned cascade runs
     const int levels = o.eaw.levels;
     constexpr bool kHost = std::is_same<Exec, CpuExec>::value;
     // The CPU row engine compiles the depth and id terms out when they are off: their planes are
@@ -243,7 +258,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     const ImageView position = learned ? ImageView{} : sanitizedFeature(exec, in.position, w, h, 3, positionStore);
     // Depth: for the learned network, the depth stop, and the noise estimate's edge test.
     const bool depthStop = !learned && o.eaw.sigmaDepth > 0 && in.depth.valid();
-    const bool needDepth = learned || depthStop || noise || out.planes;
+    const bool needDepth = network || depthStop || noise || out.planes;
     ImageView depth;
     if (needDepth && in.depth.valid()) depth = sanitizedFeature(exec, in.depth, w, h, 1, depthStore);
     else if (!rowEngine && !learned) depth = sanitizedFeature(exec, ImageView{}, w, h, 1, depthStore);  // zeros
@@ -334,14 +349,16 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     // `learnedOut`; a feature that was not given is an invalid plane (the network reads it as absent).
     Image* cur = &cA;
     Image cB, vB, detail, boxH, acc, learnedOut, sigmas, invZ;
-    if (learned) {
+    if (network) {
+        // (Its inputs are read only: Blend's SURE cascade then starts from the same planes.)
         learnedOut = spareC.empty() ? planes(3) : std::move(spareC);
         const LearnedPlanes P{cA.view(), vA.view(), albedo, in.normal.valid() ? normal : ImageView{},
                               in.depth.valid() ? depth : ImageView{}};
         runLearned(exec, cfg.learned, P, learnedOut.view());
-        cur = &learnedOut;
+        if (learned) cur = &learnedOut;
         markStage(out.clock, "learned");
-    } else {
+    }
+    if (!learned) {
         // 4. Per-pixel scales of the automatic σ_c and σ_x (1/σ_z only for the depth stop). The
         // colour scale S, 1/σ_x² and each level's 1/σ_c² factors (EawLevel::rS) are the three planes
         // of `sigmas`, var(c_0)'s buffer when the firefly pass freed it.
@@ -451,6 +468,13 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
                           n == 6 ? &scratch : nullptr);
         detailSum = ImageView{};
         markStage(out.clock, "give-back");
+    }
+    if (blend) {
+        // F = (SURE's F + the learned F) / 2, in the demodulated units (remodulation is linear).
+        exec.forEachPixel(w, h, BlendMean{cur->view(), detailSum, learnedOut.view()});
+        detailSum = ImageView{};
+        learnedOut = Image();
+        markStage(out.clock, "blend");
     }
     if (o.safety.enabled) {
         if (detail.empty()) detail = planes(2);

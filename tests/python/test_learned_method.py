@@ -112,8 +112,8 @@ def _fixture_weights(tmp_path):
     return p
 
 
-def test_methods_list_learned_and_auto():
-    assert "learned" in atrous.METHODS and "auto" in atrous.METHODS
+def test_methods_list_learned_blend_and_auto():
+    assert "learned" in atrous.METHODS and "blend" in atrous.METHODS and "auto" in atrous.METHODS
 
 
 def test_learned_denoise_is_finite_filters_and_takes_a_path(tmp_path):
@@ -128,8 +128,15 @@ def test_learned_denoise_is_finite_filters_and_takes_a_path(tmp_path):
     # str and PathLike give the same; levels is not a parameter of the learned filter.
     again = atrous.denoise(b["color"], method="learned", learned_weights=str(w), levels=2, **kw)
     np.testing.assert_array_equal(out, again)
-    # auto with albedo and normal is learned, without a normal it is sure.
-    np.testing.assert_array_equal(atrous.denoise(b["color"], method="auto", learned_weights=w, **kw), out)
+    # auto (the default) with albedo and normal is blend, the mean of learned and sure; without a
+    # normal it is sure.
+    blend = atrous.denoise(b["color"], method="blend", learned_weights=w, **kw)
+    np.testing.assert_array_equal(atrous.denoise(b["color"], method="auto", learned_weights=w, **kw), blend)
+    np.testing.assert_array_equal(atrous.denoise(b["color"], learned_weights=w, **kw), blend)
+    sure = atrous.denoise(b["color"], method="sure", **kw)
+    # (The mean is taken before remodulation: equal to the mean of the outputs up to float rounding.)
+    np.testing.assert_allclose(blend, 0.5 * (out + sure), rtol=1e-5, atol=1e-5)
+    assert np.abs(out - sure).max() > 1e-3
     kw.pop("normal")
     np.testing.assert_array_equal(atrous.denoise(b["color"], method="auto", learned_weights=w, **kw),
                                   atrous.denoise(b["color"], method="sure", **kw))
@@ -175,12 +182,14 @@ def test_eval_takes_learned_and_auto(tmp_path):
     with pytest.raises(SystemExit) as e:
         ev.parse_args(["--methods", "learned", "--learned-weights", str(tmp_path / "none.atrl")])
     assert e.value.code == 2
-    methods = ev.build_methods(["learned", "auto"], [], str(w))
+    methods = ev.build_methods(["learned", "blend", "auto"], [], str(w))
     b = atrous.render("cornell", width=24, height=20, spp=2, seed=1)
-    want = atrous.denoise(b["color"], albedo=b["albedo"], normal=b["normal"], position=b["position"],
-                          depth=b["depth"], variance=b["variance"], ids=b["ids"], emission=b["emission"],
-                          method="learned", learned_weights=w)
-    for name in ("learned", "auto"):
+    kw = dict(albedo=b["albedo"], normal=b["normal"], position=b["position"], depth=b["depth"],
+              variance=b["variance"], ids=b["ids"], emission=b["emission"], learned_weights=w)
+    np.testing.assert_array_equal(methods["learned"](b), atrous.denoise(b["color"], method="learned", **kw))
+    # auto with every buffer is blend, with the weight file passed through to its learned half.
+    want = atrous.denoise(b["color"], method="blend", **kw)
+    for name in ("blend", "auto"):
         np.testing.assert_array_equal(methods[name](b), want)
     # The report compares the best atrous method (learned among them) with OIDN.
     from atrous.eval import report

@@ -17,7 +17,7 @@
 namespace atrous::view {
 namespace {
 
-const char* const kMethodNames[] = {"none", "eaw", "sure", "svgf", "learned"};  // view::Method order
+const char* const kMethodNames[] = {"none", "eaw", "sure", "svgf", "learned", "blend"};  // view::Method order
 
 bool comboMethod(const char* label, Method& m) {
     int i = int(m);

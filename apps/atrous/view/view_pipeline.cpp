@@ -36,6 +36,8 @@ const char* methodName(Method m) {
             return "svgf";
         case Method::Learned:
             return "learned";
+        case Method::Blend:
+            return "blend";
     }
     return "?";
 }
@@ -46,7 +48,8 @@ Method parseMethod(const std::string& name) {
     if (name == "sure") return Method::Sure;
     if (name == "svgf") return Method::Svgf;
     if (name == "learned") return Method::Learned;
-    throw InputError("unknown method \"" + name + "\" (expected none, eaw, sure, svgf or learned)");
+    if (name == "blend") return Method::Blend;
+    throw InputError("unknown method \"" + name + "\" (expected none, eaw, sure, svgf, learned or blend)");
 }
 
 namespace {
@@ -290,7 +293,10 @@ DenoiseInputs ViewPipeline::accumulatedInputs() const {
 
 DenoiseOptions ViewPipeline::denoiseOptions(Method m, const PipelineSettings& s) const {
     DenoiseOptions o = s.denoise;
-    o.method = m == Method::Sure ? DenoiseMethod::Sure : m == Method::Learned ? DenoiseMethod::Learned : DenoiseMethod::Eaw;
+    o.method = m == Method::Sure      ? DenoiseMethod::Sure
+               : m == Method::Learned ? DenoiseMethod::Learned
+               : m == Method::Blend   ? DenoiseMethod::Blend
+                                      : DenoiseMethod::Eaw;
     o.device = mDevice;
     o.report = nullptr;
     return o;

@@ -23,9 +23,9 @@ class CudaBvhRenderer;  // render/bvh_render.h
 
 namespace atrous::view {
 
-enum class Method { None = 0, Eaw = 1, Sure = 2, Svgf = 3, Learned = 4 };
+enum class Method { None = 0, Eaw = 1, Sure = 2, Svgf = 3, Learned = 4, Blend = 5 };
 const char* methodName(Method m);
-Method parseMethod(const std::string& name);  // none | eaw | sure | svgf | learned; InputError otherwise
+Method parseMethod(const std::string& name);  // none | eaw | sure | svgf | learned | blend; InputError otherwise
 
 // Everything the user can change between frames.
 struct PipelineSettings {
@@ -36,7 +36,7 @@ struct PipelineSettings {
     // 10% of an SVGF frame's CPU time at 256x256) and the running mean restarts when needed again.
     bool needAccumulated = true;
     int maxDepth = 8;
-    Method methodA = Method::Eaw;
+    Method methodA = Method::Blend;  // what auto picks with the renderer's albedo and normal
     Method methodB = Method::None;
     bool split = false;  // compute slot B too (split-screen comparison)
     // EAW's and SURE's parameters (SURE runs on the EAW cascade); the slot sets method, device

@@ -18,7 +18,7 @@ struct ViewerOptions {
         r.spp = 1;
         return r;
     }();
-    std::string method = "eaw";  // slot A: none | eaw | sure | svgf
+    std::string method = "blend";  // slot A: none | eaw | sure | svgf | learned | blend (the renderer gives every buffer: auto's choice)
     std::string compare;         // slot B for the split screen (empty: no split)
     bool noAccumulate = false;
     std::string bufferView = "result";  // initial buffer view (see docs/viewer.md)

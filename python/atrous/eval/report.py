@@ -10,7 +10,7 @@ from typing import Any, Dict, List, Optional
 
 import numpy as np
 
-ATROUS_METHODS = ("eaw", "sure", "learned", "auto")
+ATROUS_METHODS = ("eaw", "sure", "learned", "blend", "auto")
 COLORS = {"noisy": "#7f7f7f", "eaw": "#1f77b4", "sure": "#2ca02c", "learned": "#ff7f0e", "auto": "#8c564b",
           "oidn": "#d62728", "svgf": "#9467bd",
           "render 1 spp": "#000000"}
@@ -382,7 +382,8 @@ def write_html(data: Dict[str, Any], images: Dict[str, Dict[str, Any]], path: Pa
              "<p>Methods: <b>noisy</b> = the path-traced input; <b>eaw</b> and <b>sure</b> = atrous's "
              "edge-avoiding and SURE-based à-trous filters (default parameters, every feature buffer); "
              "<b>learned</b> = atrous's learned à-trous filter (a per-pixel network steering an à-trous "
-             "cascade, docs/learned.md) and <b>auto</b> = learned with an albedo and a normal, else sure "
+             "cascade, docs/learned.md), <b>blend</b> = the mean of learned and sure, and <b>auto</b> = blend "
+             "with an albedo and a normal, else sure "
              "(when run); "
              "<b>oidn</b> = Intel Open Image Denoise (RT filter, HDR, colour + albedo + normal, quality high) "
              f"via pyoidn {html.escape(str(env.get('pyoidn')))}. Metrics: relMSE = mean((x-r)²/(r²+0.01)); PSNR and "

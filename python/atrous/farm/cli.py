@@ -67,7 +67,8 @@ def _parser() -> argparse.ArgumentParser:
     d.add_argument("--in", dest="inputs", action="append", required=True,
                    help="a render directory (color.exr, ...), a frame sequence (frame_NNNN/) or a directory of "
                         "them, such as a render job's --out; repeat or comma-separate")
-    d.add_argument("--method", default="sure", help=f"{', '.join(DENOISE_METHODS)} (default sure)")
+    d.add_argument("--method", default="auto",
+                   help=f"{', '.join(DENOISE_METHODS)} (default auto: blend with an albedo and a normal, else sure)")
     d.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                    help="a filter parameter, named as atrous.denoise's keywords (levels=4, sigma_color=0.5)")
     _run_flags(d)

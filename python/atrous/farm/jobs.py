@@ -38,8 +38,8 @@ def render(out: PathLike, scenes: Any, spp: Any = (16,), *, width: int = 512, he
     frames = positive_int(frames, "frames", 0, 100000)
     methods = name_list(denoise, "denoise") if denoise else []
     for m in methods:
-        if m not in ("eaw", "sure", "learned", "auto"):
-            raise FarmInputError(f"denoise: unknown method '{m}' (expected eaw, sure, learned or auto)")
+        if m not in ("eaw", "sure", "learned", "blend", "auto"):
+            raise FarmInputError(f"denoise: unknown method '{m}' (expected eaw, sure, learned, blend or auto)")
     if frames and methods:
         raise FarmInputError("denoise: not with frames (denoise the sequence with the denoise job)")
     if camera_path not in CAMERA_PATHS:
@@ -79,7 +79,7 @@ def render_dataset(out: PathLike, spec: Union[Dict[str, Any], PathLike], **run: 
     return run_job("render", {"dataset": s}, items, Path(out), **run)
 
 
-def denoise(out: PathLike, inputs: Any, method: str = "sure", params: Optional[Dict[str, Any]] = None,
+def denoise(out: PathLike, inputs: Any, method: str = "auto", params: Optional[Dict[str, Any]] = None,
             **run: Any) -> JobResult:
     """Render directories and frame sequences through one method: OUT/<name>/denoised_<method>.exr
     and .png per render directory, OUT/<sequence>/frame_NNNN.exr and .png per frame (svgf: one
