@@ -332,17 +332,21 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         return;
     }
     // The safety net's input y and its summed variance, kept before the cascade overwrites them.
-    // The albedo give-back reads the same y.
+    // The albedo give-back reads the same y. With the learned cascade, after it (it only reads y),
+    // when its own temporaries are gone: Blend's peak is then SURE's plus one plane set.
     const bool giveBack = cfg.albedoGiveBack && !learned && albedo.valid();
     Image safetyIn, safetyVar;
-    if (o.safety.enabled || giveBack) {
-        safetyIn = spareC.empty() ? planes(3) : std::move(spareC);
-        runCopy3(exec, cA.view(), safetyIn.view());
-    }
-    if (o.safety.enabled) {
-        safetyVar = planes(1);
-        exec.forEachPixel(w, h, SafetyVariance{vA.view(), safetyVar.view()});
-    }
+    auto keepInput = [&] {
+        if (o.safety.enabled || giveBack) {
+            safetyIn = spareC.empty() ? planes(3) : std::move(spareC);
+            runCopy3(exec, cA.view(), safetyIn.view());
+        }
+        if (o.safety.enabled) {
+            safetyVar = planes(1);
+            exec.forEachPixel(w, h, SafetyVariance{vA.view(), safetyVar.view()});
+        }
+    };
+    if (!network) keepInput();
     markStage(out.clock, demodStage);
 
     // 4-5. The learned method: its cascade (filters/learned.h) on the prepared planes, d_out in
@@ -357,6 +361,8 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         runLearned(exec, cfg.learned, P, learnedOut.view());
         if (learned) cur = &learnedOut;
         markStage(out.clock, "learned");
+        keepInput();
+        if (o.safety.enabled || giveBack) markStage(out.clock, "keep input");
     }
     if (!learned) {
         // 4. Per-pixel scales of the automatic σ_c and σ_x (1/σ_z only for the depth stop). The
