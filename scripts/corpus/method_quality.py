@@ -1,0 +1,105 @@
+#!/usr/bin/env python3
+"""relMSE of atrous CLI runs (any flags) beside OIDN fast and high on the third-party corpus's
+stills, per case and as geometric means per renderer and spp over OIDN fast and over SURE
+(docs/quality.md, "The default method").
+
+    .venv/bin/python scripts/corpus/method_quality.py --corpus out/corpus/full --json out/corpus/full/methods.json \\
+        eaw="--method eaw" sure="--method sure" learned="--method learned" default=""
+
+Each VARIANT=FLAGS runs `atrous denoise --in FILE --out X.exr FLAGS` on the file (or folder) as the
+renderer wrote it, so `default=""` is what a user gets without --method. OIDN (pyoidn, colour +
+albedo + normal as atrous.eval passes them, HDR) runs on the buffers scripts/corpus/quality.py's
+loaders read; its outputs are cached in <corpus>/oidn_cache/ (delete it after re-rendering).
+Runs in the project venv (.venv: numpy, pyoidn, atrous); needs no renderer.
+"""
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import quality as Q  # noqa: E402  (the corpus loaders, relmse, read_exr)
+
+
+def oidn_output(cache: Path, key: str, b, quality: str):
+    f = cache / f"{key}_{quality}.npy"
+    if not f.exists():
+        import pyoidn
+        from atrous.eval import oidn_inputs
+
+        cache.mkdir(parents=True, exist_ok=True)
+        np.save(f, np.asarray(pyoidn.denoise(*oidn_inputs(b), hdr=True, quality=quality), np.float32))
+    return np.load(f)
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--corpus", default="out/corpus/full")
+    ap.add_argument("--atrous", default="build/atrous")
+    ap.add_argument("--scenes", default="", help="comma-separated scene names (default: every still)")
+    ap.add_argument("--json")
+    ap.add_argument("variants", nargs="+", metavar="NAME=FLAGS")
+    a = ap.parse_args()
+    variants = []
+    for v in a.variants:
+        if "=" not in v:
+            ap.error(f"'{v}': expected NAME=FLAGS")
+        name, flags = v.split("=", 1)
+        variants.append((name, flags.split()))
+    only = set(a.scenes.split(",")) if a.scenes else None
+    corpus = Path(a.corpus)
+    rows = []
+    for man_path in sorted(corpus.glob("*/*/manifest.json")):
+        man = json.loads(man_path.read_text())
+        sd = man_path.parent
+        if "frames" in man or (only and man["scene"] not in only) or man["reference"] not in man["files"]:
+            continue
+        ref = Q.load_still(sd, man, man["reference"])["color"]
+        for stem, e in sorted(man["files"].items()):
+            if stem == man["reference"]:
+                continue
+            b = Q.load_still(sd, man, stem)
+            row = {"scene": man["scene"], "renderer": man["renderer"], "spp": e["spp"],
+                   "pixel_filter": man.get("pixel_filter", "?"), "relmse": {"noisy": Q.relmse(b["color"], ref)}}
+            for q in ("fast", "high"):
+                row["relmse"]["oidn_" + q] = Q.relmse(oidn_output(corpus / "oidn_cache", f"{man['scene']}_{stem}", b, q), ref)
+            inp = sd / (e["file"] if "file" in e else e["folder"])
+            with tempfile.TemporaryDirectory() as t:
+                for name, flags in variants:
+                    out = os.path.join(t, name + ".exr")
+                    r = subprocess.run([a.atrous, "denoise", "--in", str(inp), "--out", out] + flags,
+                                       capture_output=True, text=True)
+                    if r.returncode:
+                        print(f"{man['scene']} {stem}: {name} failed: {r.stdout}{r.stderr}", file=sys.stderr)
+                        return 2
+                    row["relmse"][name] = Q.relmse(Q._stack(Q.read_exr(out), ["R", "G", "B"]), ref)
+            rows.append(row)
+            print(row["scene"], row["spp"], " ".join(f"{k}={v:.4g}" for k, v in row["relmse"].items()), flush=True)
+    groups = defaultdict(list)
+    for r in rows:
+        groups[(r["renderer"], r["spp"])].append(r)
+    summary = {}
+    names = list(rows[0]["relmse"]) if rows else []
+    for (renderer, spp), rs in sorted(groups.items()):
+        g = {n: math.exp(np.mean([math.log(r["relmse"][n] / r["relmse"]["oidn_fast"]) for r in rs])) for n in names}
+        s = {"cases": len(rs), "geomean_over_oidn_fast": g}
+        if "sure" in names:
+            s["worst_over_sure"] = {n: max(r["relmse"][n] / r["relmse"]["sure"] for r in rs) for n in names}
+        summary[f"{renderer} {spp}spp"] = s
+        print(f"{renderer} {spp} spp ({len(rs)} cases), geomean / OIDN fast: " +
+              " ".join(f"{n}={v:.3f}" for n, v in g.items()))
+    if a.json:
+        json.dump({"corpus": str(corpus), "variants": dict((n, " ".join(f)) for n, f in variants), "rows": rows,
+                   "summary": summary}, open(a.json, "w"), indent=1)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
