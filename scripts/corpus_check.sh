@@ -11,5 +11,5 @@ cd "$(dirname "$0")/.."
 BUILD="${1:-build}"
 python3 scripts/corpus/render.py --quick
 # --max-ratio 1: every filter's relMSE below the noisy input's on every quick case (docs/quality.md).
-python3 scripts/corpus/cli_quality.py --corpus out/corpus/quick --atrous "$BUILD/atrous" --bounds tests/corpus/quick_bounds.json \
+python3 scripts/corpus/cli_quality.py --corpus out/corpus/quick --atrous "$BUILD/atrous" --methods eaw,sure,blend --bounds tests/corpus/quick_bounds.json \
     --max-ratio 1
