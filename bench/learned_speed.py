@@ -13,8 +13,8 @@ same inputs (the scene at 2 spp, seed 7, as `atrous bench` renders them, through
   and commits the filter in every call);
 * ``oidn_filter``: pyoidn's object API, a ``pyoidn.Filter`` ("RT", hdr, quality high) created,
   bound and committed once, then only ``execute()`` timed: OIDN's own cost.
-* ``alt_*``: the default method (``atrous.denoise`` with no ``method``: auto, the learned filter
-  with these buffers, through Python) and OIDN fast and high (``Filter.execute``), one call of each
+* ``alt_*``: the default method (``atrous.denoise`` with no ``method``: auto, blend with these
+  buffers, through Python) and OIDN fast, balanced and high (``Filter.execute``), one call of each
   in turn per round, in this process: the issue-27 speed bar (default at most OIDN fast).
 
 Both are --warmup untimed calls (at least one), then the median of --runs calls (atrous.eval's
@@ -98,8 +98,8 @@ def time_oidn(b, runs: int, warmup: int) -> dict:
 
 
 def time_default_alternating(b, runs: int, warmup: int) -> dict:
-    """The default method (atrous.denoise with no method: auto, learned with these buffers) and OIDN
-    fast and high (Filter.execute, committed once), in one process, one call of each in turn per
+    """The default method (atrous.denoise with no method: auto, blend with these buffers) and OIDN
+    fast, balanced and high (Filter.execute, committed once), in one process, one call of each in turn per
     round: the same load on every figure. Medians of `runs` rounds after `warmup` rounds."""
     import atrous
     import pyoidn
@@ -112,9 +112,10 @@ def time_default_alternating(b, runs: int, warmup: int) -> dict:
     dev.commit()
     # (Each filter writes into its own output array: both are kept alive while the filters live.)
     fast, fast_out = _oidn_filter(pyoidn, dev, color, albedo, normal, pyoidn.OIDN_QUALITY_FAST)
+    bal, bal_out = _oidn_filter(pyoidn, dev, color, albedo, normal, pyoidn.OIDN_QUALITY_BALANCED)
     high, high_out = _oidn_filter(pyoidn, dev, color, albedo, normal, pyoidn.OIDN_QUALITY_HIGH)
     calls = {"default": lambda: atrous.denoise(b["color"], **feats), "oidn_fast": fast.execute,
-             "oidn_high": high.execute}
+             "oidn_balanced": bal.execute, "oidn_high": high.execute}
     times = {k: [] for k in calls}
     for r in range(warmup + runs):
         for k, f in calls.items():
@@ -126,9 +127,10 @@ def time_default_alternating(b, runs: int, warmup: int) -> dict:
     if err:
         raise RuntimeError(f"OIDN execute failed: {err}")
     fast.release()
+    bal.release()
     high.release()
     dev.release()
-    del fast_out, high_out
+    del fast_out, bal_out, high_out
     out = {f"alt_{k}_ms": float(np.median(v)) for k, v in times.items()}
     out["alt_default_over_oidn_fast"] = out["alt_default_ms"] / out["alt_oidn_fast_ms"]
     return out
@@ -196,7 +198,7 @@ def main(argv=None) -> int:
         "oidn_api": {"oidn_denoise": "pyoidn.denoise(color, albedo, normal, hdr=True, quality='high') per call",
                      "oidn_filter": "pyoidn.Filter RT (hdr, quality high) committed once, execute() timed"},
         "atrous_timing": "atrous bench median_ms (the filter alone, inputs in place); *_total_ms = the whole denoise()",
-        "alternating": "alt_*: atrous.denoise with no method (the default: auto) and OIDN fast/high Filter.execute, "
+        "alternating": "alt_*: atrous.denoise with no method (the default: auto) and OIDN fast/balanced/high Filter.execute, "
                        "one call of each per round in this process; medians of --runs rounds after --warmup",
         "command": " ".join(cmd),
         "results": rows,

@@ -8,8 +8,11 @@ stills, per case and as geometric means per renderer and spp over OIDN fast and 
 
 Each VARIANT=FLAGS runs `atrous denoise --in FILE --out X.exr FLAGS` on the file (or folder) as the
 renderer wrote it, so `default=""` is what a user gets without --method. OIDN (pyoidn, colour +
-albedo + normal as atrous.eval passes them, HDR) runs on the buffers scripts/corpus/quality.py's
-loaders read; its outputs are cached in <corpus>/oidn_cache/ (delete it after re-rendering).
+albedo + normal as atrous.eval passes them, HDR; quality fast, balanced and high) runs on the
+buffers scripts/corpus/quality.py's loaders read; its outputs are cached in <corpus>/oidn_cache/
+(delete it after re-rendering). --crops DIR writes, for each --crop-cases scene/spp, a strip
+noisy | --crop-variant | OIDN fast | OIDN high | reference (the window with the most reference
+detail, 2x), DIR/<scene>_<spp>spp_oidn.png.
 Runs in the project venv (.venv: numpy, pyoidn, atrous); needs no renderer.
 """
 import argparse
@@ -45,6 +48,10 @@ def main() -> int:
     ap.add_argument("--atrous", default="build/atrous")
     ap.add_argument("--scenes", default="", help="comma-separated scene names (default: every still)")
     ap.add_argument("--json")
+    ap.add_argument("--crops", help="folder for side-by-side crops")
+    ap.add_argument("--crop-cases", default="", help="comma list of scene/spp, e.g. cy_glass_mirror/4")
+    ap.add_argument("--crop-variant", default="default")
+    ap.add_argument("--crop-size", type=int, default=96)
     ap.add_argument("variants", nargs="+", metavar="NAME=FLAGS")
     a = ap.parse_args()
     variants = []
@@ -54,6 +61,7 @@ def main() -> int:
         name, flags = v.split("=", 1)
         variants.append((name, flags.split()))
     only = set(a.scenes.split(",")) if a.scenes else None
+    crops = set(a.crop_cases.split(",")) if a.crop_cases else set()
     corpus = Path(a.corpus)
     rows = []
     for man_path in sorted(corpus.glob("*/*/manifest.json")):
@@ -68,7 +76,7 @@ def main() -> int:
             b = Q.load_still(sd, man, stem)
             row = {"scene": man["scene"], "renderer": man["renderer"], "spp": e["spp"],
                    "pixel_filter": man.get("pixel_filter", "?"), "relmse": {"noisy": Q.relmse(b["color"], ref)}}
-            for q in ("fast", "high"):
+            for q in ("fast", "balanced", "high"):
                 row["relmse"]["oidn_" + q] = Q.relmse(oidn_output(corpus / "oidn_cache", f"{man['scene']}_{stem}", b, q), ref)
             inp = sd / (e["file"] if "file" in e else e["folder"])
             with tempfile.TemporaryDirectory() as t:
@@ -79,7 +87,14 @@ def main() -> int:
                     if r.returncode:
                         print(f"{man['scene']} {stem}: {name} failed: {r.stdout}{r.stderr}", file=sys.stderr)
                         return 2
-                    row["relmse"][name] = Q.relmse(Q._stack(Q.read_exr(out), ["R", "G", "B"]), ref)
+                    img = Q._stack(Q.read_exr(out), ["R", "G", "B"])
+                    row["relmse"][name] = Q.relmse(img, ref)
+                    if a.crops and name == a.crop_variant and f"{man['scene']}/{e['spp']}" in crops:
+                        key = f"{man['scene']}_{stem}"
+                        strip = Q.crop_strip([b["color"], img, oidn_output(corpus / "oidn_cache", key, b, "fast"),
+                                              oidn_output(corpus / "oidn_cache", key, b, "high"), ref], ref, a.crop_size)
+                        Path(a.crops).mkdir(parents=True, exist_ok=True)
+                        Q.save_png(Path(a.crops) / f"{man['scene']}_{e['spp']}spp_oidn.png", strip)
             rows.append(row)
             print(row["scene"], row["spp"], " ".join(f"{k}={v:.4g}" for k, v in row["relmse"].items()), flush=True)
     groups = defaultdict(list)
