@@ -13,9 +13,9 @@ namespace atrous::io {
 
 namespace {
 
-// File names of an atrous render directory, by buffer ("" = none).
-const char* const kDirNames[kBufferCount] = {"color.exr",  "variance.exr", "albedo.exr", "normal.exr", "position.exr",
-                                             "depth.exr",  "ids.exr",      "",           "emission.exr", "motion.exr"};
+// The name of each buffer in a render directory ("" = none: the material ids come with ids.exr).
+const char* const kDirBuffer[kBufferCount] = {"color", "variance", "albedo",   "normal", "position",
+                                              "depth", "ids",      "",         "emission", "motion"};
 
 std::string sizeOf(const Image& i) { return std::to_string(i.width()) + "x" + std::to_string(i.height()); }
 
@@ -130,8 +130,8 @@ std::vector<std::string> inputFiles(const BufferFiles& f) {
     std::error_code ec;
     if (!f.in.empty()) {
         if (fs::is_directory(f.in, ec)) {
-            for (const char* name : kDirNames)
-                if (name[0]) files.push_back((fs::path(f.in) / name).string());
+            for (const char* buffer : kDirBuffer)
+                for (const std::string& name : dirBufferNames(buffer)) files.push_back((fs::path(f.in) / name).string());
         } else {
             files.push_back(f.in);
         }
@@ -139,6 +139,34 @@ std::vector<std::string> inputFiles(const BufferFiles& f) {
     for (const std::string& p : f.file)
         if (!p.empty()) files.push_back(p);
     return files;
+}
+
+std::vector<std::string> dirBufferNames(const std::string& buffer) {
+    // atrous's name first; then LuxCore's (its film outputs, named as in its documentation).
+    static const std::vector<std::pair<const char*, std::vector<std::string>>> kNames = {
+        {"color", {"color.exr", "RGB.exr"}},
+        {"variance", {"variance.exr"}},
+        {"albedo", {"albedo.exr", "ALBEDO.exr"}},
+        {"normal", {"normal.exr", "AVG_SHADING_NORMAL.exr", "SHADING_NORMAL.exr"}},
+        {"position", {"position.exr", "POSITION.exr"}},
+        {"depth", {"depth.exr", "DEPTH.exr"}},
+        {"ids", {"ids.exr"}},
+        {"emission", {"emission.exr", "EMISSION.exr"}},
+        {"motion", {"motion.exr"}},
+        {"reference", {"reference.exr"}},
+    };
+    for (const auto& [name, files] : kNames)
+        if (buffer == name) return files;
+    return {};
+}
+
+std::string dirBufferFile(const std::string& dir, const std::string& buffer) {
+    for (const std::string& name : dirBufferNames(buffer)) {
+        std::error_code ec;
+        const fs::path p = fs::path(dir) / name;
+        if (fs::exists(p, ec)) return p.string();
+    }
+    return "";
 }
 
 std::string withSourceFile(const std::string& msg, const std::function<std::string(const std::string&)>& fileOf,
@@ -174,10 +202,7 @@ BufferSet loadBuffers(const BufferFiles& f) {
     bool present[kBufferCount] = {};
     for (int b = 0; b < kBufferCount; ++b) {
         pathOf[b] = f.file[b];
-        if (pathOf[b].empty() && !dir.empty() && kDirNames[b][0]) {
-            const std::string p = (fs::path(dir) / kDirNames[b]).string();
-            if (fs::exists(p)) pathOf[b] = p;
-        }
+        if (pathOf[b].empty() && !dir.empty() && kDirBuffer[b][0]) pathOf[b] = dirBufferFile(dir, kDirBuffer[b]);
         present[b] = !pathOf[b].empty();
     }
     if (s.layered) {
@@ -250,7 +275,7 @@ BufferSet loadBuffers(const BufferFiles& f) {
                          " (--pass picks a layer of a layered EXR)");
     }
     if (s.image[int(Buffer::Color)].empty()) {
-        if (!dir.empty()) throw InputError("--in '" + dir + "': no color.exr in it");
+        if (!dir.empty()) throw InputError("--in '" + dir + "': no color.exr (or RGB.exr, LuxCore's) in it");
         throw InputError("no colour given: --color FILE, --in RENDER_DIR or --in LAYERED.exr");
     }
     const Image& color = s.image[int(Buffer::Color)];

@@ -74,6 +74,16 @@ bool methodReads(const DenoiseBufferUse& use, Buffer b);
 // against this list (io/paths.h) before anything runs.
 std::vector<std::string> inputFiles(const BufferFiles& files);
 
+// The file a render directory (`--in DIR`) or a sequence's frame folder gives for a buffer, by its
+// name ("color", "variance", "albedo", "normal", "position", "depth", "ids", "emission", "motion",
+// "reference"): atrous's own name (color.exr, ...) when it is there, else another renderer's name for
+// that buffer, in dirBufferNames()'s order (LuxCore's film outputs as its documentation names them:
+// RGB.exr, ALBEDO.exr, AVG_SHADING_NORMAL.exr or SHADING_NORMAL.exr, POSITION.exr, DEPTH.exr,
+// EMISSION.exr). "" when the directory has none of them (docs/inputs.md, "Render directories").
+std::string dirBufferFile(const std::string& dir, const std::string& buffer);
+// The file names dirBufferFile tries for `buffer`, in order (empty for an unknown name).
+std::vector<std::string> dirBufferNames(const std::string& buffer);
+
 // A denoiser's message about a buffer ("variance buffer has a value of ...", "SVGF frame: the
 // normal buffer is ...") with the file that buffer came from in front ("FILE: variance buffer has
 // ..."). fileOf(name) gives that file for a library buffer name (color, variance, albedo, normal,

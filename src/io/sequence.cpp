@@ -122,6 +122,14 @@ std::string sequenceFrameName(int index) {
     return buf;
 }
 
+int parseFolderFrameName(const std::string& name, std::string* prefix) {
+    size_t i = name.size();
+    while (i > 0 && std::isdigit(static_cast<unsigned char>(name[i - 1]))) --i;
+    if (i == name.size() || name.size() - i > 8) return -1;
+    if (prefix) *prefix = name.substr(0, i);
+    return std::stoi(name.substr(i));
+}
+
 int parseLayeredFrameName(const std::string& fileName, std::string* prefix) {
     const fs::path p(fileName);
     if (p.extension() != ".exr") return -1;
@@ -139,14 +147,28 @@ int parseLayeredFrameName(const std::string& fileName, std::string* prefix) {
 std::vector<std::string> listSequenceFrames(const std::string& dir) {
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) throw InputError("sequence " + dir + ": not a directory");
-    std::vector<std::pair<int, std::string>> frames, files;
-    std::string prefix, firstFile;
+    std::vector<std::pair<int, std::string>> frames, files, folders;
+    std::string prefix, firstFile, folderPrefix, firstFolder;
     for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
         std::error_code ec2;
         const std::string name = it->path().filename().string();
         if (it->is_directory(ec2)) {
             const int index = parseSequenceFrameName(name);
-            if (index >= 0) frames.emplace_back(index, it->path().string());
+            if (index >= 0) {
+                frames.emplace_back(index, it->path().string());
+                continue;
+            }
+            // Another renderer's numbered frame folders (LuxCore's 0001/, frame0001/ ...): one
+            // prefix, the number last, a colour file inside (dirBufferFile's names).
+            std::string pre;
+            const int n = parseFolderFrameName(name, &pre);
+            if (n < 0 || dirBufferFile(it->path().string(), "color").empty()) continue;
+            if (!folders.empty() && pre != folderPrefix)
+                throw InputError("sequence " + dir + ": numbered frame folders with two prefixes ('" + firstFolder + "' and '" +
+                                 name + "'): keep one sequence per directory");
+            folderPrefix = pre;
+            if (firstFolder.empty()) firstFolder = name;
+            folders.emplace_back(n, it->path().string());
         } else if (it->is_regular_file(ec2)) {
             std::string pre;
             const int index = parseLayeredFrameName(name, &pre);
@@ -163,12 +185,21 @@ std::vector<std::string> listSequenceFrames(const std::string& dir) {
     if (!frames.empty() && !files.empty())
         throw InputError("sequence " + dir + ": holds both frame_NNNN directories and numbered EXR files (" + firstFile +
                          "): keep one layout per directory");
+    const bool byFolder = frames.empty() && !folders.empty();
+    if (byFolder && !files.empty())
+        throw InputError("sequence " + dir + ": holds both numbered frame folders (" + firstFolder +
+                         ") and numbered EXR files (" + firstFile + "): keep one layout per directory");
+    if (byFolder) frames = folders;
     const bool layered = frames.empty();
     if (layered) frames = files;
-    if (frames.empty()) throw InputError("sequence " + dir + ": no frame_NNNN directories or numbered EXR files");
+    if (frames.empty())
+        throw InputError("sequence " + dir + ": no frame_NNNN directories, numbered frame folders with a colour file "
+                         "(color.exr or RGB.exr) or numbered EXR files");
     std::sort(frames.begin(), frames.end());
     auto label = [&](int index) {
-        return layered ? prefix + std::to_string(index) + " (a numbered EXR file)" : sequenceFrameName(index);
+        if (layered) return prefix + std::to_string(index) + " (a numbered EXR file)";
+        if (byFolder) return folderPrefix + std::to_string(index) + " (a numbered frame folder)";
+        return sequenceFrameName(index);
     };
     std::vector<std::string> out;
     for (size_t i = 0; i < frames.size(); ++i) {
@@ -220,12 +251,13 @@ std::vector<std::string> validateSequence(const std::vector<std::string>& frames
             here = layeredBuffers(frame, info, options);
         } else {
             for (const char* name : kSequenceBuffers) {
-                const std::string path = (fs::path(frame) / (std::string(name) + ".exr")).string();
-                if (fs::is_regular_file(path, ec)) {
+                const std::string path = dirBufferFile(frame, name);
+                if (!path.empty() && fs::is_regular_file(path, ec)) {
                     checkFile(path);
                     here.push_back(name);
                 } else if (std::string(name) == "color") {
-                    throw InputError(path + ": missing (every frame needs color.exr)");
+                    throw InputError((fs::path(frame) / "color.exr").string() +
+                                     ": missing (every frame needs a colour: color.exr, or RGB.exr as LuxCore names it)");
                 }
             }
         }
@@ -238,8 +270,9 @@ std::vector<std::string> validateSequence(const std::vector<std::string>& frames
             if (layered)
                 return InputError(where + ": has no " + name + " (its buffers: " + joined(where == frame ? here : present) +
                                   "), but " + has + " has one (a buffer must be in every frame or in none)");
-            return InputError((fs::path(where) / (name + ".exr")).string() + ": missing, but " + has + " has " + name +
-                              ".exr (a buffer must be in every frame or in none)");
+            const std::string hasFile = dirBufferFile(has, name);
+            return InputError((fs::path(where) / fs::path(hasFile).filename()).string() + ": missing, but " + has + " has " +
+                              fs::path(hasFile).filename().string() + " (a buffer must be in every frame or in none)");
         };
         for (const auto& name : present)
             if (std::find(here.begin(), here.end(), name) == here.end()) throw missingIn(frame, name, frames[0]);
@@ -284,15 +317,19 @@ SequenceFrame loadSequenceFrame(const std::string& frame, const std::vector<std:
     if (!options.passes.empty() || !options.viewLayer.empty())
         throw InputError(std::string(options.passes.empty() ? "--layer" : "--pass") + ": picks a layer of a layered EXR, and " +
                          frame + " is a frame_NNNN folder of plain EXRs");
-    f.index = parseSequenceFrameName(fs::path(frame).filename().string());
+    const std::string folderName = fs::path(frame).filename().string();
+    f.index = parseSequenceFrameName(folderName);
+    if (f.index < 0) f.index = parseFolderFrameName(folderName);
     std::string firstPath;
     for (int i = 0; i < 10; ++i) {
         const std::string name = kSequenceBuffers[i];
-        const std::string path = (fs::path(frame) / (name + ".exr")).string();
+        const std::string path = dirBufferFile(frame, name);
         std::error_code ec;
-        if (!fs::is_regular_file(path, ec)) {
+        if (path.empty() || !fs::is_regular_file(path, ec)) {
             const bool wanted = i == 0 || std::find(expected.begin(), expected.end(), name) != expected.end();
-            if (wanted) throw InputError(path + ": missing (every frame of this sequence has " + name + ".exr)");
+            if (wanted)
+                throw InputError((fs::path(frame) / dirBufferNames(name)[0]).string() + ": missing (every frame of this sequence has " +
+                                 name + ")");
             continue;
         }
         Image& dst = *slot[i];

@@ -1,12 +1,16 @@
 // Frame sequences for the temporal denoiser (SVGF) and per-frame denoising of animations
 // (docs/inputs.md, "Sequences").
 //
-// Two layouts:
+// Three layouts:
 // - atrous's: frame_0000/, frame_0001/, ... (four or more digits, numbered without gaps from the
 //   first one present), each with color.exr and any of albedo.exr normal.exr position.exr
 //   depth.exr ids.exr motion.exr emission.exr variance.exr reference.exr, as `atrous render
 //   --frames` writes them (depth in R, 1e30 = background; ids R = mesh id, -1 = background;
 //   motion R = dx, G = dy in pixels, previous - current, y down).
+// - numbered frame folders with another prefix (0001/, frame0001/ ...: one prefix, the number
+//   last) holding a colour file: each read as `--in DIR` reads a folder, so atrous's names or
+//   another renderer's (LuxCore's RGB.exr, ALBEDO.exr, AVG_SHADING_NORMAL.exr ...: dirBufferFile,
+//   buffer_set.h).
 // - other renderers': numbered layered EXR files (Blender's render0001.exr, ..., Mitsuba's aov
 //   output 0000.exr, ...: one common prefix, the number last), each read as `atrous denoise --in
 //   FILE.exr` reads it; motion from the file's motion pass (Blender's Vector: see buffer_set.cpp)
@@ -71,6 +75,9 @@ std::string sequenceFrameName(int index);
 
 // The number of a "frame_NNNN" name (four to eight digits), or -1 when `name` is not one.
 int parseSequenceFrameName(const std::string& name);
+// The number at the end of a frame folder's name ("0012" or "frame12" -> 12, at most eight digits),
+// and its prefix; -1 when the name does not end in a digit.
+int parseFolderFrameName(const std::string& name, std::string* prefix = nullptr);
 // The number at the end of a layered frame file's stem ("render0012.exr" -> 12, at least one
 // digit), and its prefix; -1 for companions (<stem>_motion.exr, <stem>_reference.exr) and others.
 int parseLayeredFrameName(const std::string& fileName, std::string* prefix = nullptr);

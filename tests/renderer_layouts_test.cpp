@@ -1,0 +1,113 @@
+// Other renderers' folder layouts (docs/inputs.md, "Render directories"; issue 28): a LuxCore
+// render folder (RGB.exr, ALBEDO.exr, AVG_SHADING_NORMAL.exr, POSITION.exr, DEPTH.exr,
+// EMISSION.exr) is read by `--in DIR` as atrous's own folder is, and a sequence of numbered frame
+// folders with those names by `--sequence`, without renaming anything. The inputs are made here:
+// an atrous render whose files are copied under LuxCore's names.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "io/image_io.h"
+#include "test_util.h"
+
+using atrous::test::runCli;
+using atrous::test::TempDir;
+namespace fs = std::filesystem;
+
+namespace {
+
+// atrous's file name -> LuxCore's film output name for the same buffer.
+const std::vector<std::pair<std::string, std::string>> kLuxNames = {
+    {"color.exr", "RGB.exr"},       {"albedo.exr", "ALBEDO.exr"}, {"normal.exr", "AVG_SHADING_NORMAL.exr"},
+    {"position.exr", "POSITION.exr"}, {"depth.exr", "DEPTH.exr"}, {"emission.exr", "EMISSION.exr"}};
+
+// Copies the buffers of atrous render folder `from` into `to` under LuxCore's names (lux) or
+// atrous's own (the same buffers, for the comparison).
+void copyBuffers(const std::string& from, const std::string& to, bool lux) {
+    fs::create_directories(to);
+    for (const auto& [ours, theirs] : kLuxNames) fs::copy_file(fs::path(from) / ours, fs::path(to) / (lux ? theirs : ours));
+}
+
+bool sameImages(const atrous::Image& a, const atrous::Image& b) {
+    return a.width() == b.width() && a.height() == b.height() && a.channels() == b.channels() &&
+           std::equal(a.data(), a.data() + a.size(), b.data());
+}
+
+}  // namespace
+
+TEST(RendererLayouts, LuxCoreStillFolderIsReadUnderItsOwnNames) {
+    TempDir dir;
+    const std::string render = dir / "render";
+    auto r = runCli("render --scene cornell --spp 2 --width 32 --height 24 --out " + render);
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const std::string lux = dir / "lux", ours = dir / "ours";
+    copyBuffers(render, lux, true);
+    copyBuffers(render, ours, false);
+    for (const char* method : {"sure", "blend"}) {
+        const std::string a = dir / (std::string("lux_") + method + ".exr"), b = dir / (std::string("ours_") + method + ".exr");
+        r = runCli("denoise --in " + lux + " --method " + method + " --out " + a);
+        ASSERT_EQ(r.exitCode, 0) << r.output;
+        EXPECT_NE(r.output.find("buffers used: color,albedo,normal,position,depth"), std::string::npos) << r.output;
+        auto r2 = runCli("denoise --in " + ours + " --method " + method + " --out " + b);
+        ASSERT_EQ(r2.exitCode, 0) << r2.output;
+        EXPECT_TRUE(sameImages(atrous::io::readImage(a), atrous::io::readImage(b))) << method;
+    }
+    // atrous's own name wins where a folder has both: a black color.exr beside RGB.exr gives what the
+    // black colour gives with atrous's names.
+    const atrous::Image black(32, 24, 3);
+    atrous::io::writeImage(lux + "/color.exr", black);
+    atrous::io::writeImage(ours + "/color.exr", black);
+    r = runCli("denoise --in " + lux + " --method eaw --out " + dir / "both.exr");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    r = runCli("denoise --in " + ours + " --method eaw --out " + dir / "black.exr");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_TRUE(sameImages(atrous::io::readImage(dir / "both.exr"), atrous::io::readImage(dir / "black.exr")));
+    EXPECT_FALSE(sameImages(atrous::io::readImage(dir / "both.exr"), atrous::io::readImage(dir / "lux_sure.exr")));
+    // The output may not overwrite any of LuxCore's inputs either.
+    r = runCli("denoise --in " + lux + " --method eaw --out " + lux + "/ALBEDO.exr");
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+}
+
+TEST(RendererLayouts, NumberedFrameFoldersWithLuxCoreNamesAreASequence) {
+    TempDir dir;
+    const std::string seq = dir / "seq";
+    auto r = runCli("render --scene cornell-moving --frames 3 --spp 1 --width 24 --height 16 --out " + seq);
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const std::string lux = dir / "lux";
+    for (int f = 0; f < 3; ++f)  // LuxCore renders one folder per frame; here 0001/, 0002/, 0003/
+        copyBuffers(seq + "/frame_000" + std::to_string(f), lux + "/000" + std::to_string(f + 1), true);
+    const std::string out = dir / "out";
+    r = runCli("denoise --sequence " + lux + " --method eaw --out " + out);
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    for (int f = 1; f <= 3; ++f) {
+        const std::string got = out + "/frame_000" + std::to_string(f) + ".exr";
+        ASSERT_TRUE(fs::exists(got)) << r.output;
+        // Each frame as `--in FOLDER` denoises it.
+        const std::string want = dir / ("one_" + std::to_string(f) + ".exr");
+        auto r1 = runCli("denoise --in " + lux + "/000" + std::to_string(f) + " --method eaw --out " + want);
+        ASSERT_EQ(r1.exitCode, 0) << r1.output;
+        EXPECT_TRUE(sameImages(atrous::io::readImage(got), atrous::io::readImage(want))) << f;
+    }
+    // A buffer in only some frames: one line naming the frame's file, exit 2, nothing written.
+    fs::remove(lux + "/0002/ALBEDO.exr");
+    const std::string out2 = dir / "out2";
+    r = runCli("denoise --sequence " + lux + " --method eaw --out " + out2);
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("0002/ALBEDO.exr: missing"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(out2));
+    // A gap in the numbering: the missing frame is named.
+    fs::remove_all(lux + "/0002");
+    r = runCli("denoise --sequence " + lux + " --method eaw --out " + out2);
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("2 (a numbered frame folder) is missing"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(out2));
+    // Numbered folders without a colour file are not frames.
+    fs::remove_all(lux);
+    fs::create_directories(lux + "/0001");
+    r = runCli("denoise --sequence " + lux + " --method eaw --out " + out2);
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("no frame_NNNN directories"), std::string::npos) << r.output;
+}
