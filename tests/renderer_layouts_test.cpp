@@ -111,3 +111,40 @@ TEST(RendererLayouts, NumberedFrameFoldersWithLuxCoreNamesAreASequence) {
     EXPECT_EQ(r.exitCode, 2) << r.output;
     EXPECT_NE(r.output.find("no frame_NNNN directories"), std::string::npos) << r.output;
 }
+
+TEST(RendererLayouts, NumberedFilesPerBufferAreASequence) {
+    TempDir dir;
+    const std::string seq = dir / "seq";
+    auto r = runCli("render --scene cornell-moving --frames 3 --spp 1 --width 24 --height 16 --out " + seq);
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    // One folder, one file per buffer and frame, as compositors and some renderers write them.
+    const std::string per = dir / "per";
+    fs::create_directories(per);
+    for (int f = 0; f < 3; ++f)
+        for (const char* b : {"color", "albedo", "normal", "depth"})
+            fs::copy_file(seq + "/frame_000" + std::to_string(f) + "/" + b + ".exr",
+                          per + "/" + b + "_000" + std::to_string(f + 1) + ".exr");
+    const std::string out = dir / "out";
+    r = runCli("denoise --sequence " + per + " --method sure --out " + out);
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    for (int f = 1; f <= 3; ++f) {
+        // The same buffers as a frame folder, denoised with --in.
+        const std::string one = dir / ("one_" + std::to_string(f));
+        fs::create_directories(one);
+        for (const char* b : {"color", "albedo", "normal", "depth"})
+            fs::copy_file(per + "/" + b + "_000" + std::to_string(f) + ".exr", one + "/" + b + ".exr");
+        auto r1 = runCli("denoise --in " + one + " --method sure --out " + one + ".exr");
+        ASSERT_EQ(r1.exitCode, 0) << r1.output;
+        const std::string got = out + "/frame_000" + std::to_string(f) + ".exr";
+        ASSERT_TRUE(fs::exists(got)) << r.output;
+        EXPECT_TRUE(sameImages(atrous::io::readImage(got), atrous::io::readImage(one + ".exr"))) << f;
+    }
+    // --add-pass copies layered frames only; a buffer missing in one frame is named.
+    r = runCli("denoise --sequence " + per + " --method sure --add-pass denoised --out " + dir / "out3");
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    fs::remove(per + "/normal_0002.exr");
+    r = runCli("denoise --sequence " + per + " --method sure --out " + dir / "out2");
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("normal_0002.exr: missing, but"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "out2"));
+}

@@ -199,9 +199,9 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
     // OUTDIR in the sequence directory would take its frame_NNNN.exr names (io/paths.h).
     io::refuseOutputInside("--out", args.outDir, args.sequenceDir);
     std::vector<std::string> frames = io::listSequenceFrames(args.sequenceDir);
-    if (!args.addPass.empty() && fs::is_directory(frames.front()))
+    if (!args.addPass.empty() && !io::isLayeredSequenceFrame(frames.front()))
         throw InputError("--add-pass '" + args.addPass + "': copies a layered EXR frame, and " + args.sequenceDir +
-                         " holds frame_NNNN folders of plain EXRs");
+                         " holds frames of plain EXRs");
     int width = 0, height = 0;
     const std::vector<std::string> present = io::validateSequence(frames, width, height, args.layers);
     std::unique_ptr<SvgfDenoiser> svgfDenoiser;

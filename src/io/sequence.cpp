@@ -29,7 +29,56 @@ namespace {
 const Buffer kFileBuffer[10] = {Buffer::Color,  Buffer::Albedo, Buffer::Normal,   Buffer::Position, Buffer::Depth,
                                 Buffer::ObjectId, Buffer::Motion, Buffer::Emission, Buffer::Variance, Buffer::Color};
 
-bool isLayeredFrame(const std::string& path) { return fs::path(path).extension() == ".exr"; }
+// "<stem><sep><digits>.exr" with a known stem: the stem's buffer, and <sep><digits>.exr in *tail
+// (sep one of "_", ".", "-"; one to eight digits). "" when the name is not one.
+std::string perBufferName(const std::string& name, std::string* tail) {
+    for (const char* buffer : kSequenceBuffers)
+        for (const std::string& file : dirBufferNames(buffer)) {
+            const std::string stem = file.substr(0, file.size() - 4);  // without ".exr"
+            if (name.size() < stem.size() + 6 || name.compare(0, stem.size(), stem) != 0) continue;
+            const char sep = name[stem.size()];
+            if (sep != '_' && sep != '.' && sep != '-') continue;
+            const std::string rest = name.substr(stem.size() + 1);
+            if (rest.size() < 5 || rest.size() > 12 || rest.compare(rest.size() - 4, 4, ".exr") != 0) continue;
+            const std::string digits = rest.substr(0, rest.size() - 4);
+            if (!std::all_of(digits.begin(), digits.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
+                continue;
+            if (tail) *tail = name.substr(stem.size());
+            return buffer;
+        }
+    return "";
+}
+
+// A frame of per-buffer numbered files is named by its colour file (color_0001.exr, RGB_0001.exr).
+bool perBufferFrame(const std::string& frame, std::string* tail = nullptr) {
+    return perBufferName(fs::path(frame).filename().string(), tail) == "color";
+}
+
+bool isLayeredFrame(const std::string& path) { return fs::path(path).extension() == ".exr" && !perBufferFrame(path); }
+
+// The file of `buffer` in a frame folder (dirBufferFile) or beside a per-buffer frame's colour
+// file (the same <sep><digits>.exr after one of the buffer's stems); "" when there is none.
+std::string frameBufferFile(const std::string& frame, const std::string& buffer) {
+    std::string tail;
+    if (!perBufferFrame(frame, &tail)) return dirBufferFile(frame, buffer);
+    const fs::path dir = fs::path(frame).parent_path();
+    for (const std::string& file : dirBufferNames(buffer)) {
+        const fs::path p = dir / (file.substr(0, file.size() - 4) + tail);
+        std::error_code ec;
+        if (fs::exists(p, ec)) return p.string();
+    }
+    return "";
+}
+
+// The path `buffer`'s file would have in `frame`, named as `like` (another frame's file of it).
+std::string expectedFile(const std::string& frame, const std::string& like) {
+    std::string tail, likeTail;
+    if (!perBufferFrame(frame, &tail)) return (fs::path(frame) / fs::path(like).filename()).string();
+    const std::string name = fs::path(like).filename().string();
+    std::string stem = fs::path(name).stem().string();  // albedo.exr -> albedo
+    if (!perBufferName(name, &likeTail).empty()) stem = name.substr(0, name.size() - likeTail.size());
+    return (fs::path(frame).parent_path() / (stem + tail)).string();
+}
 
 // A layered frame's companion file (<stem>_motion.exr), or "" when there is none.
 std::string companion(const std::string& frame, const char* what) {
@@ -116,6 +165,8 @@ std::vector<std::string> removeSequenceEntries(const std::string& dir, const std
     return removed;
 }
 
+bool isLayeredSequenceFrame(const std::string& frame) { return isLayeredFrame(frame); }
+
 std::string sequenceFrameName(int index) {
     char buf[32];
     std::snprintf(buf, sizeof(buf), "frame_%04d", index);
@@ -147,8 +198,8 @@ int parseLayeredFrameName(const std::string& fileName, std::string* prefix) {
 std::vector<std::string> listSequenceFrames(const std::string& dir) {
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) throw InputError("sequence " + dir + ": not a directory");
-    std::vector<std::pair<int, std::string>> frames, files, folders;
-    std::string prefix, firstFile, folderPrefix, firstFolder;
+    std::vector<std::pair<int, std::string>> frames, files, folders, perBuffer;
+    std::string prefix, firstFile, folderPrefix, firstFolder, firstPerBuffer;
     for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
         std::error_code ec2;
         const std::string name = it->path().filename().string();
@@ -170,6 +221,16 @@ std::vector<std::string> listSequenceFrames(const std::string& dir) {
             if (firstFolder.empty()) firstFolder = name;
             folders.emplace_back(n, it->path().string());
         } else if (it->is_regular_file(ec2)) {
+            // Per-buffer numbered files (color_0001.exr, albedo_0001.exr, ...): a frame per colour
+            // file; the other buffers' files are found beside it.
+            std::string tail;
+            const std::string buffer = perBufferName(name, &tail);
+            if (buffer == "color") {
+                perBuffer.emplace_back(std::stoi(tail.substr(1, tail.size() - 5)), it->path().string());
+                if (firstPerBuffer.empty()) firstPerBuffer = name;
+                continue;
+            }
+            if (!buffer.empty()) continue;
             std::string pre;
             const int index = parseLayeredFrameName(name, &pre);
             if (index < 0) continue;
@@ -185,6 +246,12 @@ std::vector<std::string> listSequenceFrames(const std::string& dir) {
     if (!frames.empty() && !files.empty())
         throw InputError("sequence " + dir + ": holds both frame_NNNN directories and numbered EXR files (" + firstFile +
                          "): keep one layout per directory");
+    if (!perBuffer.empty() && (!frames.empty() || !files.empty()))
+        throw InputError("sequence " + dir + ": holds numbered files per buffer (" + firstPerBuffer + ") and " +
+                         (frames.empty() ? "numbered EXR files (" + firstFile + ")" : std::string("frame_NNNN directories")) +
+                         ": keep one layout per directory");
+    const bool byBuffer = !perBuffer.empty();
+    if (byBuffer) frames = perBuffer;
     const bool byFolder = frames.empty() && !folders.empty();
     if (byFolder && !files.empty())
         throw InputError("sequence " + dir + ": holds both numbered frame folders (" + firstFolder +
@@ -194,11 +261,12 @@ std::vector<std::string> listSequenceFrames(const std::string& dir) {
     if (layered) frames = files;
     if (frames.empty())
         throw InputError("sequence " + dir + ": no frame_NNNN directories, numbered frame folders with a colour file "
-                         "(color.exr or RGB.exr) or numbered EXR files");
+                         "(color.exr or RGB.exr), numbered files per buffer (color_0001.exr ...) or numbered EXR files");
     std::sort(frames.begin(), frames.end());
     auto label = [&](int index) {
         if (layered) return prefix + std::to_string(index) + " (a numbered EXR file)";
         if (byFolder) return folderPrefix + std::to_string(index) + " (a numbered frame folder)";
+        if (byBuffer) return "frame " + std::to_string(index) + " (" + firstPerBuffer + "'s number)";
         return sequenceFrameName(index);
     };
     std::vector<std::string> out;
@@ -241,7 +309,7 @@ std::vector<std::string> validateSequence(const std::vector<std::string>& frames
         std::error_code ec;
         if (!layered && (!options.passes.empty() || !options.viewLayer.empty()))
             throw InputError(std::string(options.passes.empty() ? "--layer" : "--pass") + ": picks a layer of a layered EXR, and " +
-                             frame + " is a frame_NNNN folder of plain EXRs");
+                             frame + " is a frame of plain EXRs");
         std::vector<std::string> here;
         if (layered) {
             const ExrInfo info = inspectExr(frame);
@@ -251,7 +319,7 @@ std::vector<std::string> validateSequence(const std::vector<std::string>& frames
             here = layeredBuffers(frame, info, options);
         } else {
             for (const char* name : kSequenceBuffers) {
-                const std::string path = dirBufferFile(frame, name);
+                const std::string path = frameBufferFile(frame, name);
                 if (!path.empty() && fs::is_regular_file(path, ec)) {
                     checkFile(path);
                     here.push_back(name);
@@ -270,8 +338,8 @@ std::vector<std::string> validateSequence(const std::vector<std::string>& frames
             if (layered)
                 return InputError(where + ": has no " + name + " (its buffers: " + joined(where == frame ? here : present) +
                                   "), but " + has + " has one (a buffer must be in every frame or in none)");
-            const std::string hasFile = dirBufferFile(has, name);
-            return InputError((fs::path(where) / fs::path(hasFile).filename()).string() + ": missing, but " + has + " has " +
+            const std::string hasFile = frameBufferFile(has, name);
+            return InputError(expectedFile(where, hasFile) + ": missing, but " + has + " has " +
                               fs::path(hasFile).filename().string() + " (a buffer must be in every frame or in none)");
         };
         for (const auto& name : present)
@@ -316,19 +384,21 @@ SequenceFrame loadSequenceFrame(const std::string& frame, const std::vector<std:
     }
     if (!options.passes.empty() || !options.viewLayer.empty())
         throw InputError(std::string(options.passes.empty() ? "--layer" : "--pass") + ": picks a layer of a layered EXR, and " +
-                         frame + " is a frame_NNNN folder of plain EXRs");
+                         frame + " is a frame of plain EXRs");
     const std::string folderName = fs::path(frame).filename().string();
+    std::string tail;
     f.index = parseSequenceFrameName(folderName);
-    if (f.index < 0) f.index = parseFolderFrameName(folderName);
+    if (perBufferFrame(frame, &tail)) f.index = std::stoi(tail.substr(1, tail.size() - 5));
+    else if (f.index < 0) f.index = parseFolderFrameName(folderName);
     std::string firstPath;
     for (int i = 0; i < 10; ++i) {
         const std::string name = kSequenceBuffers[i];
-        const std::string path = dirBufferFile(frame, name);
+        const std::string path = frameBufferFile(frame, name);
         std::error_code ec;
         if (path.empty() || !fs::is_regular_file(path, ec)) {
             const bool wanted = i == 0 || std::find(expected.begin(), expected.end(), name) != expected.end();
             if (wanted)
-                throw InputError((fs::path(frame) / dirBufferNames(name)[0]).string() + ": missing (every frame of this sequence has " +
+                throw InputError(expectedFile(frame, dirBufferNames(name)[0]) + ": missing (every frame of this sequence has " +
                                  name + ")");
             continue;
         }

@@ -1,7 +1,7 @@
 // Frame sequences for the temporal denoiser (SVGF) and per-frame denoising of animations
 // (docs/inputs.md, "Sequences").
 //
-// Three layouts:
+// Four layouts:
 // - atrous's: frame_0000/, frame_0001/, ... (four or more digits, numbered without gaps from the
 //   first one present), each with color.exr and any of albedo.exr normal.exr position.exr
 //   depth.exr ids.exr motion.exr emission.exr variance.exr reference.exr, as `atrous render
@@ -11,6 +11,9 @@
 //   last) holding a colour file: each read as `--in DIR` reads a folder, so atrous's names or
 //   another renderer's (LuxCore's RGB.exr, ALBEDO.exr, AVG_SHADING_NORMAL.exr ...: dirBufferFile,
 //   buffer_set.h).
+// - numbered files per buffer in one folder: color_0001.exr, albedo_0001.exr, ... (a buffer's
+//   name as above without ".exr", then '_', '.' or '-', then the number); a frame per colour file,
+//   named by it.
 // - other renderers': numbered layered EXR files (Blender's render0001.exr, ..., Mitsuba's aov
 //   output 0000.exr, ...: one common prefix, the number last), each read as `atrous denoise --in
 //   FILE.exr` reads it; motion from the file's motion pass (Blender's Vector: see buffer_set.cpp)
@@ -69,6 +72,10 @@ std::vector<std::string> validateSequence(const std::vector<std::string>& frames
 // buffers differ in size.
 SequenceFrame loadSequenceFrame(const std::string& frame, const std::vector<std::string>& expected = {},
                                 const SequenceOptions& options = {});
+
+// Whether a frame of listSequenceFrames is a layered EXR file (else a folder or per-buffer files of
+// plain EXRs: `--pass`, `--layer` and `--add-pass` do not apply).
+bool isLayeredSequenceFrame(const std::string& frame);
 
 // "frame_0007" for 7 (at least four digits).
 std::string sequenceFrameName(int index);
