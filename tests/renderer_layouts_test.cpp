@@ -148,3 +148,55 @@ TEST(RendererLayouts, NumberedFilesPerBufferAreASequence) {
     EXPECT_NE(r.output.find("normal_0002.exr: missing, but"), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(dir / "out2"));
 }
+
+TEST(RendererLayouts, PatternsWithStartEndAndStep) {
+    TempDir dir;
+    const std::string seq = dir / "seq";
+    auto r = runCli("render --scene cornell --frames 5 --spp 1 --width 24 --height 16 --out " + seq);
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    // Two sequences in one folder, as a compositor leaves them: a pattern picks one.
+    const std::string src = dir / "src";
+    fs::create_directories(src);
+    for (int f = 0; f < 5; ++f)
+        for (const char* stem : {"render", "other"})
+            fs::copy_file(seq + "/frame_000" + std::to_string(f) + "/color.exr",
+                          src + "/" + stem + "000" + std::to_string(f + 1) + ".exr");
+    r = runCli("denoise --sequence " + src + " --method eaw --out " + dir / "all");
+    EXPECT_EQ(r.exitCode, 2) << r.output;  // two prefixes in the folder: refused without a pattern
+    struct Case {
+        std::string flags;
+        std::vector<int> frames;
+    };
+    for (const Case& c : {Case{"'" + src + "/render####.exr' --start 2 --end 4", {2, 3, 4}},
+                          Case{"'" + src + "/render%04d.exr' --step 2", {1, 3, 5}},
+                          Case{"'" + src + "/other%04d.exr' --start 4", {4, 5}}}) {
+        const std::string out = dir / "out";
+        fs::remove_all(out);
+        r = runCli("denoise --method eaw --out " + out + " --sequence " + c.flags);
+        ASSERT_EQ(r.exitCode, 0) << c.flags << r.output;
+        std::vector<std::string> got;
+        for (const auto& e : fs::directory_iterator(out))
+            if (e.path().extension() == ".exr") got.push_back(e.path().filename().string());
+        std::sort(got.begin(), got.end());
+        std::vector<std::string> want;
+        for (int f : c.frames) want.push_back("frame_000" + std::to_string(f) + ".exr");
+        EXPECT_EQ(got, want) << c.flags;
+    }
+    // Bad ranges and gaps: one line, exit 2, nothing written.
+    fs::remove(src + "/render0003.exr");
+    const std::string bad = dir / "bad";
+    for (const std::string& flags : {"'" + src + "/render####.exr'", "'" + src + "/render####.exr' --step 0",
+                                     "'" + src + "/render####.exr' --start 4 --end 2", "'" + src + "/none####.exr'",
+                                     "'" + src + "/render####.exr' --start 9"}) {
+        r = runCli("denoise --method eaw --out " + bad + " --sequence " + flags);
+        EXPECT_EQ(r.exitCode, 2) << flags << r.output;
+        EXPECT_FALSE(fs::exists(bad)) << flags;
+    }
+    r = runCli("denoise --method eaw --out " + bad + " --sequence '" + src + "/render####.exr' --start 1 --step 2");
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("render0003.exr (the pattern's file) is missing"), std::string::npos) << r.output;
+    r = runCli("denoise --method svgf --out " + bad + " --sequence '" + src + "/render####.exr' --start 4 --step 2");
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    r = runCli("denoise --in " + seq + "/frame_0000 --out " + dir / "x.exr --start 1");
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+}

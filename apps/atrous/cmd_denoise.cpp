@@ -31,6 +31,7 @@ struct DenoiseArgs {
     std::string oidnFilter = "RT", oidnQuality;  // oidnDenoise's -f, -q (accepted; see addOidnFlags)
     bool oidnCleanAux = false;
     std::string method = "auto", device = "auto";
+    io::FrameRange range;  // --start, --end, --step (with --sequence)
     DenoiseOptions opt;  // the filter parameters' flags write here (params.h's table)
     SvgfParams svgf;
 };
@@ -126,6 +127,8 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
         throw InputError("-f/--filter: '" + a.oidnFilter + "' is not supported (atrous denoises RT images: use RT)");
     DenoiseOptions& o = a.opt;
     const bool sequence = !a.sequence.empty();
+    for (const char* f : {"--start", "--end", "--step"})
+        if (!sequence && cmd.count(f) > 0) throw InputError(std::string(f) + ": picks frames of a --sequence; give one");
     if (a.method != "svgf" && a.method != "eaw" && a.method != "sure" && !learnedMethod(a.method))
         throw InputError("--method: unknown denoise method '" + a.method + "' (expected eaw, sure, learned, blend, auto or svgf)");
     if (a.method == "svgf" && !sequence)
@@ -154,6 +157,7 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
         s.layers.passes = withFlag("--pass", [&] { return io::parsePassRequests(a.passes); });
         s.layers.viewLayer = a.layer;
         s.addPass = a.addPass;
+        s.range = a.range;
         runSequenceDenoise(s);
         return;
     }
@@ -269,9 +273,15 @@ void addDenoiseCommand(CLI::App& app) {
                     "With --in FILE.exr: write --out as a copy of FILE with the denoised colour added as this pass "
                     "(with --sequence of layered EXRs: each frame_NNNN.exr is such a copy of its frame)");
     cmd->add_option("--sequence", a->sequence,
-                    "Sequence directory: frame_NNNN/ folders (atrous render --frames) or numbered layered EXRs "
-                    "(Blender's render0001.exr ...; --pass, --layer and --add-pass apply to every frame); --out is then "
-                    "a directory, never the sequence directory or inside it");
+                    "Sequence directory: frame_NNNN/ folders (atrous render --frames), numbered frame folders of "
+                    "another renderer (0001/ with LuxCore's RGB.exr, ALBEDO.exr ...), numbered files per buffer "
+                    "(color_0001.exr, albedo_0001.exr ...) or numbered layered EXRs (Blender's render0001.exr ...; "
+                    "--pass, --layer and --add-pass apply to every frame); or a pattern (DIR/render####.exr, "
+                    "DIR/render%04d.exr). --out is then a directory, never the sequence directory or inside it");
+    cmd->add_option("--start", a->range.start, "With --sequence: the first frame number to denoise (default: the first)");
+    cmd->add_option("--end", a->range.end, "With --sequence: the last frame number to denoise (default: the last)");
+    cmd->add_option("--step", a->range.step, "With --sequence: denoise every step-th frame from --start")
+        ->capture_default_str();
     cmd->add_option("--color,--hdr", a->color, "Noisy colour (EXR/PFM; --hdr as in oidnDenoise)");
     cmd->add_option("--ldr", a->ldrColor, "Noisy LDR colour in [0, 1] (oidnDenoise's --ldr): the output is clamped to [0, 1]");
     cmd->add_flag("--srgb", a->srgb, "With --ldr: the colour is sRGB-encoded (decoded before, encoded after)");

@@ -191,14 +191,23 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
         throw InputError("--method '" + args.method +
                          "' cannot denoise a sequence (expected svgf, eaw, sure, learned, blend or auto)");
     if (args.sequenceDir.empty()) throw InputError("--sequence: no directory given");
+    if (svgf && args.range.step > 1)
+        throw InputError("--step " + std::to_string(args.range.step) +
+                         ": SVGF carries its history from one frame to the next, and the motion vectors do not span "
+                         "skipped frames (use --step 1, or a per-frame --method)");
     if (args.outDir.empty()) throw InputError("--out: no output directory given");
     if (!(args.exposure > 0.0f)) throw InputError("--exposure must be > 0");
 
     // Everything that can be checked before writing is checked first; what only decoding finds
     // (a truncated EXR) fails inside the loop, before anything reaches OUTDIR (StagedOutput).
     // OUTDIR in the sequence directory would take its frame_NNNN.exr names (io/paths.h).
-    io::refuseOutputInside("--out", args.outDir, args.sequenceDir);
-    std::vector<std::string> frames = io::listSequenceFrames(args.sequenceDir);
+    // (A pattern's frames are in its directory.)
+    std::error_code ec;
+    const fs::path seqPath(args.sequenceDir);
+    const std::string seqDir = fs::is_directory(seqPath, ec) || !seqPath.has_parent_path() ? args.sequenceDir
+                                                                                            : seqPath.parent_path().string();
+    io::refuseOutputInside("--out", args.outDir, seqDir.empty() ? "." : seqDir);
+    std::vector<std::string> frames = io::listSequenceFrames(args.sequenceDir, args.range);
     if (!args.addPass.empty() && !io::isLayeredSequenceFrame(frames.front()))
         throw InputError("--add-pass '" + args.addPass + "': copies a layered EXR frame, and " + args.sequenceDir +
                          " holds frames of plain EXRs");

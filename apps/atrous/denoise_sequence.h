@@ -25,6 +25,7 @@ struct SequenceDenoiseArgs {
     LearnedWeights svgfLearnedWeights;  // svgf.learnedSpatial's (--learned-weights); empty = the built-in ones
     io::SequenceOptions layers;   // --pass and --layer, applied to every layered frame
     std::string addPass;          // --add-pass: each output frame a copy of its layered frame with this pass
+    io::FrameRange range;         // --start, --end, --step
     float exposure = 1.0f;        // of the PNG previews
     bool preview = true;          // animated OUTDIR/preview.mp4 through ffmpeg when it is on PATH
     bool quiet = false;           // no per-frame lines on stdout

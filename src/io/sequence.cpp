@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <utility>
 
 #include "atrous/error.h"
@@ -195,91 +196,180 @@ int parseLayeredFrameName(const std::string& fileName, std::string* prefix) {
     return std::stoi(stem.substr(i));
 }
 
-std::vector<std::string> listSequenceFrames(const std::string& dir) {
-    std::error_code ec;
-    if (!fs::is_directory(dir, ec)) throw InputError("sequence " + dir + ": not a directory");
-    std::vector<std::pair<int, std::string>> frames, files, folders, perBuffer;
-    std::string prefix, firstFile, folderPrefix, firstFolder, firstPerBuffer;
-    for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
-        std::error_code ec2;
-        const std::string name = it->path().filename().string();
-        if (it->is_directory(ec2)) {
-            const int index = parseSequenceFrameName(name);
-            if (index >= 0) {
-                frames.emplace_back(index, it->path().string());
-                continue;
-            }
-            // Another renderer's numbered frame folders (LuxCore's 0001/, frame0001/ ...): one
-            // prefix, the number last, a colour file inside (dirBufferFile's names).
-            std::string pre;
-            const int n = parseFolderFrameName(name, &pre);
-            if (n < 0 || dirBufferFile(it->path().string(), "color").empty()) continue;
-            if (!folders.empty() && pre != folderPrefix)
-                throw InputError("sequence " + dir + ": numbered frame folders with two prefixes ('" + firstFolder + "' and '" +
-                                 name + "'): keep one sequence per directory");
-            folderPrefix = pre;
-            if (firstFolder.empty()) firstFolder = name;
-            folders.emplace_back(n, it->path().string());
-        } else if (it->is_regular_file(ec2)) {
-            // Per-buffer numbered files (color_0001.exr, albedo_0001.exr, ...): a frame per colour
-            // file; the other buffers' files are found beside it.
-            std::string tail;
-            const std::string buffer = perBufferName(name, &tail);
-            if (buffer == "color") {
-                perBuffer.emplace_back(std::stoi(tail.substr(1, tail.size() - 5)), it->path().string());
-                if (firstPerBuffer.empty()) firstPerBuffer = name;
-                continue;
-            }
-            if (!buffer.empty()) continue;
-            std::string pre;
-            const int index = parseLayeredFrameName(name, &pre);
-            if (index < 0) continue;
-            if (!files.empty() && pre != prefix)
-                throw InputError("sequence " + dir + ": numbered EXR files with two prefixes ('" + firstFile + "' and '" + name +
-                                 "'): keep one sequence per directory");
-            prefix = pre;
-            if (firstFile.empty()) firstFile = name;
-            files.emplace_back(index, it->path().string());
-        }
+namespace {
+
+// A frame pattern: DIR/<prefix><#### | %0Nd | %d><suffix> (the number's digits: at least N,
+// zero-padded; any count for %d).
+struct FramePattern {
+    std::string dir, prefix, suffix;
+    int width = 0;
+};
+
+bool parseFramePattern(const std::string& arg, FramePattern* p) {
+    const fs::path path(arg);
+    const std::string name = path.filename().string();
+    size_t from = name.find('#'), to = from;
+    if (from != std::string::npos) {
+        while (to < name.size() && name[to] == '#') ++to;
+        if (name.find('#', to) != std::string::npos || name.find('%') != std::string::npos) return false;
+        p->width = int(to - from);
+    } else {
+        from = name.find('%');
+        if (from == std::string::npos) return false;
+        to = from + 1;
+        int w = 0;
+        if (to < name.size() && name[to] == '0')
+            while (++to < name.size() && std::isdigit(static_cast<unsigned char>(name[to]))) w = w * 10 + (name[to] - '0');
+        if (to >= name.size() || name[to] != 'd' || w > 8 || name.find('%', to) != std::string::npos) return false;
+        ++to;
+        p->width = w;
     }
-    if (ec) throw InputError("sequence " + dir + ": cannot list the directory (" + ec.message() + ")");
-    if (!frames.empty() && !files.empty())
-        throw InputError("sequence " + dir + ": holds both frame_NNNN directories and numbered EXR files (" + firstFile +
-                         "): keep one layout per directory");
-    if (!perBuffer.empty() && (!frames.empty() || !files.empty()))
-        throw InputError("sequence " + dir + ": holds numbered files per buffer (" + firstPerBuffer + ") and " +
-                         (frames.empty() ? "numbered EXR files (" + firstFile + ")" : std::string("frame_NNNN directories")) +
-                         ": keep one layout per directory");
-    const bool byBuffer = !perBuffer.empty();
-    if (byBuffer) frames = perBuffer;
-    const bool byFolder = frames.empty() && !folders.empty();
-    if (byFolder && !files.empty())
-        throw InputError("sequence " + dir + ": holds both numbered frame folders (" + firstFolder +
-                         ") and numbered EXR files (" + firstFile + "): keep one layout per directory");
-    if (byFolder) frames = folders;
-    const bool layered = frames.empty();
-    if (layered) frames = files;
-    if (frames.empty())
-        throw InputError("sequence " + dir + ": no frame_NNNN directories, numbered frame folders with a colour file "
-                         "(color.exr or RGB.exr), numbered files per buffer (color_0001.exr ...) or numbered EXR files");
+    p->prefix = name.substr(0, from);
+    p->suffix = name.substr(to);
+    p->dir = path.has_parent_path() ? path.parent_path().string() : ".";
+    return true;
+}
+
+// The frame number a file name gives under the pattern, or -1.
+int matchFramePattern(const FramePattern& p, const std::string& name) {
+    if (name.size() <= p.prefix.size() + p.suffix.size() || name.compare(0, p.prefix.size(), p.prefix) != 0 ||
+        name.compare(name.size() - p.suffix.size(), p.suffix.size(), p.suffix) != 0)
+        return -1;
+    const std::string digits = name.substr(p.prefix.size(), name.size() - p.prefix.size() - p.suffix.size());
+    if (digits.empty() || digits.size() > 8 || int(digits.size()) < p.width ||
+        !std::all_of(digits.begin(), digits.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
+        return -1;
+    if (int(digits.size()) > std::max(p.width, 1) && digits[0] == '0') return -1;  // padded wider than the pattern
+    return std::stoi(digits);
+}
+
+std::string framePatternName(const FramePattern& p, int index) {
+    std::string n = std::to_string(index);
+    if (int(n.size()) < p.width) n.insert(0, size_t(p.width) - n.size(), '0');
+    return p.prefix + n + p.suffix;
+}
+
+}  // namespace
+
+std::vector<std::string> listSequenceFrames(const std::string& dir, const FrameRange& range) {
+    if (range.step < 1) throw InputError("--step: must be at least 1 (got " + std::to_string(range.step) + ")");
+    if (range.start >= 0 && range.end >= 0 && range.end < range.start)
+        throw InputError("--end " + std::to_string(range.end) + " is before --start " + std::to_string(range.start));
+    std::error_code ec;
+    std::vector<std::pair<int, std::string>> frames;
+    std::function<std::string(int)> label;
+    FramePattern pat;
+    if (!fs::is_directory(dir, ec) && parseFramePattern(dir, &pat)) {
+        // A pattern as compositors write it: render####.exr, render%04d.exr.
+        if (!fs::is_directory(pat.dir, ec)) throw InputError("sequence " + dir + ": " + pat.dir + " is not a directory");
+        for (auto it = fs::directory_iterator(pat.dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
+            std::error_code ec2;
+            const int n = it->is_regular_file(ec2) ? matchFramePattern(pat, it->path().filename().string()) : -1;
+            if (n >= 0) frames.emplace_back(n, it->path().string());
+        }
+        if (ec) throw InputError("sequence " + dir + ": cannot list " + pat.dir + " (" + ec.message() + ")");
+        if (frames.empty()) throw InputError("sequence " + dir + ": no file in " + pat.dir + " matches the pattern");
+        label = [pat](int index) { return framePatternName(pat, index) + " (the pattern's file)"; };
+    } else {
+        if (!fs::is_directory(dir, ec)) throw InputError("sequence " + dir + ": not a directory");
+        std::vector<std::pair<int, std::string>> files, folders, perBuffer;
+        std::string prefix, firstFile, folderPrefix, firstFolder, firstPerBuffer;
+        for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
+            std::error_code ec2;
+            const std::string name = it->path().filename().string();
+            if (it->is_directory(ec2)) {
+                const int index = parseSequenceFrameName(name);
+                if (index >= 0) {
+                    frames.emplace_back(index, it->path().string());
+                    continue;
+                }
+                // Another renderer's numbered frame folders (LuxCore's 0001/, frame0001/ ...): one
+                // prefix, the number last, a colour file inside (dirBufferFile's names).
+                std::string pre;
+                const int n = parseFolderFrameName(name, &pre);
+                if (n < 0 || dirBufferFile(it->path().string(), "color").empty()) continue;
+                if (!folders.empty() && pre != folderPrefix)
+                    throw InputError("sequence " + dir + ": numbered frame folders with two prefixes ('" + firstFolder + "' and '" +
+                                     name + "'): keep one sequence per directory");
+                folderPrefix = pre;
+                if (firstFolder.empty()) firstFolder = name;
+                folders.emplace_back(n, it->path().string());
+            } else if (it->is_regular_file(ec2)) {
+                // Per-buffer numbered files (color_0001.exr, albedo_0001.exr, ...): a frame per colour
+                // file; the other buffers' files are found beside it.
+                std::string tail;
+                const std::string buffer = perBufferName(name, &tail);
+                if (buffer == "color") {
+                    perBuffer.emplace_back(std::stoi(tail.substr(1, tail.size() - 5)), it->path().string());
+                    if (firstPerBuffer.empty()) firstPerBuffer = name;
+                    continue;
+                }
+                if (!buffer.empty()) continue;
+                std::string pre;
+                const int index = parseLayeredFrameName(name, &pre);
+                if (index < 0) continue;
+                if (!files.empty() && pre != prefix)
+                    throw InputError("sequence " + dir + ": numbered EXR files with two prefixes ('" + firstFile + "' and '" + name +
+                                     "'): keep one sequence per directory");
+                prefix = pre;
+                if (firstFile.empty()) firstFile = name;
+                files.emplace_back(index, it->path().string());
+            }
+        }
+        if (ec) throw InputError("sequence " + dir + ": cannot list the directory (" + ec.message() + ")");
+        if (!frames.empty() && !files.empty())
+            throw InputError("sequence " + dir + ": holds both frame_NNNN directories and numbered EXR files (" + firstFile +
+                             "): keep one layout per directory");
+        if (!perBuffer.empty() && (!frames.empty() || !files.empty()))
+            throw InputError("sequence " + dir + ": holds numbered files per buffer (" + firstPerBuffer + ") and " +
+                             (frames.empty() ? "numbered EXR files (" + firstFile + ")" : std::string("frame_NNNN directories")) +
+                             ": keep one layout per directory");
+        const bool byBuffer = !perBuffer.empty();
+        if (byBuffer) frames = perBuffer;
+        const bool byFolder = frames.empty() && !folders.empty();
+        if (byFolder && !files.empty())
+            throw InputError("sequence " + dir + ": holds both numbered frame folders (" + firstFolder +
+                             ") and numbered EXR files (" + firstFile + "): keep one layout per directory");
+        if (byFolder) frames = folders;
+        const bool layered = frames.empty();
+        if (layered) frames = files;
+        if (frames.empty())
+            throw InputError("sequence " + dir + ": no frame_NNNN directories, numbered frame folders with a colour file "
+                             "(color.exr or RGB.exr), numbered files per buffer (color_0001.exr ...) or numbered EXR files");
+        label = [=](int index) {
+            if (layered) return prefix + std::to_string(index) + " (a numbered EXR file)";
+            if (byFolder) return folderPrefix + std::to_string(index) + " (a numbered frame folder)";
+            if (byBuffer) return "frame " + std::to_string(index) + " (" + firstPerBuffer + "'s number)";
+            return sequenceFrameName(index);
+        };
+    }
     std::sort(frames.begin(), frames.end());
-    auto label = [&](int index) {
-        if (layered) return prefix + std::to_string(index) + " (a numbered EXR file)";
-        if (byFolder) return folderPrefix + std::to_string(index) + " (a numbered frame folder)";
-        if (byBuffer) return "frame " + std::to_string(index) + " (" + firstPerBuffer + "'s number)";
-        return sequenceFrameName(index);
-    };
-    std::vector<std::string> out;
-    for (size_t i = 0; i < frames.size(); ++i) {
-        if (i > 0 && frames[i].first == frames[i - 1].first)
+    for (size_t i = 1; i < frames.size(); ++i)
+        if (frames[i].first == frames[i - 1].first)
             throw InputError("sequence " + dir + ": frame " + std::to_string(frames[i].first) + " appears twice (" +
                              frames[i - 1].second + ", " + frames[i].second + ")");
-        if (i > 0 && frames[i].first != frames[i - 1].first + 1)
-            throw InputError("sequence " + dir + ": " + label(frames[i - 1].first + 1) + " is missing (gap between " +
-                             fs::path(frames[i - 1].second).filename().string() + " and " +
-                             fs::path(frames[i].second).filename().string() + ")");
-        out.push_back(frames[i].second);
+    // --start, --end, --step: the frames from start to end, every step-th; none may be missing.
+    const int first = range.start >= 0 ? range.start : frames.front().first;
+    const int last = range.end >= 0 ? range.end : frames.back().first;
+    std::vector<std::pair<int, std::string>> kept;
+    for (const auto& f : frames)
+        if (f.first >= first && f.first <= last && (f.first - first) % range.step == 0) kept.push_back(f);
+    if (kept.empty())
+        throw InputError("sequence " + dir + ": no frame from " + std::to_string(first) + " to " + std::to_string(last) +
+                         " (its frames: " + std::to_string(frames.front().first) + " to " + std::to_string(frames.back().first) + ")");
+    if (range.start >= 0 && kept.front().first != first)
+        throw InputError("sequence " + dir + ": " + label(first) + " is missing (--start " + std::to_string(first) + ")");
+    std::vector<std::string> out;
+    for (size_t i = 0; i < kept.size(); ++i) {
+        if (i > 0 && kept[i].first != kept[i - 1].first + range.step)
+            throw InputError("sequence " + dir + ": " + label(kept[i - 1].first + range.step) + " is missing (gap between " +
+                             fs::path(kept[i - 1].second).filename().string() + " and " +
+                             fs::path(kept[i].second).filename().string() + ")");
+        out.push_back(kept[i].second);
     }
+    if (range.end >= 0 && kept.back().first + range.step <= last)
+        throw InputError("sequence " + dir + ": " + label(kept.back().first + range.step) + " is missing (--end " +
+                         std::to_string(last) + ")");
     return out;
 }
 

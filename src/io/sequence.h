@@ -57,7 +57,14 @@ struct SequenceFrame {
 // The frames of `dir` (frame directories or numbered layered files), sorted by number. Throws
 // InputError when `dir` is not a readable directory, holds no frame, or the numbering has a gap
 // (the message names the first missing frame).
-std::vector<std::string> listSequenceFrames(const std::string& dir);
+// `dir` may also be a pattern as compositors write one (DIR/render####.exr, DIR/render%04d.exr):
+// the files it matches, each a frame read as `--in FILE.exr` reads it. `range` picks the frames
+// from `start` to `end` (inclusive; -1: the first / the last present) every `step`-th; a frame of
+// that selection that is missing is an InputError naming it.
+struct FrameRange {
+    int start = -1, end = -1, step = 1;
+};
+std::vector<std::string> listSequenceFrames(const std::string& dir, const FrameRange& range = {});
 
 // Checks every frame without decoding pixels: each has a colour, every buffer is in every frame or
 // in none (a layered frame's passes as mapPasses finds them, its motion companion too), every
