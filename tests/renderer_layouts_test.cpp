@@ -91,8 +91,15 @@ TEST(RendererLayouts, NumberedFrameFoldersWithLuxCoreNamesAreASequence) {
         ASSERT_EQ(r1.exitCode, 0) << r1.output;
         EXPECT_TRUE(sameImages(atrous::io::readImage(got), atrous::io::readImage(want))) << f;
     }
+    // `inspect` shows what the sequence gives per buffer, from the renderer's own files.
+    r = runCli("inspect " + lux);
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("sequence of 3 frames (0001 ... 0003), 24x16"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("0001/AVG_SHADING_NORMAL.exr"), std::string::npos) << r.output;
     // A buffer in only some frames: one line naming the frame's file, exit 2, nothing written.
     fs::remove(lux + "/0002/ALBEDO.exr");
+    r = runCli("inspect " + lux);
+    EXPECT_EQ(r.exitCode, 2) << r.output;
     const std::string out2 = dir / "out2";
     r = runCli("denoise --sequence " + lux + " --method eaw --out " + out2);
     EXPECT_EQ(r.exitCode, 2) << r.output;

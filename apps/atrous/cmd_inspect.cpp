@@ -3,6 +3,7 @@
 // `--export DIR` also writes those buffers, as atrous reads them (io::loadBuffers: every
 // convention applied), as plain EXRs in DIR. A render directory (color.exr, albedo.exr, ...: a
 // Mitsuba separate-files render has that layout) is taken as `denoise --in DIR` takes it.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -18,6 +19,7 @@
 #include "io/image_io.h"
 #include "io/pass_map.h"
 #include "io/paths.h"
+#include "io/sequence.h"
 
 namespace atrous::cli {
 
@@ -96,8 +98,38 @@ void refuseExportOverInputs(const InspectArgs& a, const std::vector<io::PassRequ
         io::refuseOverwrite("--export", (fs::path(a.exportDir) / exportName(io::Buffer(b))).string(), inputs);
 }
 
+// A sequence (a folder of frames, or a pattern such as DIR/render####.exr): its layout, and what
+// `denoise --sequence` takes per buffer (the first frame's file; every frame has the same buffers,
+// validateSequence checks it).
+void inspectSequence(const InspectArgs& a, const std::vector<io::PassRequest>& requests) {
+    if (!a.exportDir.empty())
+        throw InputError("--export: writes the buffers of one frame; give one frame of the sequence " + a.file);
+    io::SequenceOptions so;
+    so.passes = requests;
+    so.viewLayer = a.layer;
+    const std::vector<std::string> frames = io::listSequenceFrames(a.file);
+    int w = 0, h = 0;
+    const std::vector<std::string> present = io::validateSequence(frames, w, h, so);
+    const io::SequenceFrame first = io::loadSequenceFrame(frames.front(), present, so);
+    std::printf("%s: sequence of %zu frame%s (%s ... %s), %dx%d\natrous denoise --sequence %s takes, in every frame:\n",
+                a.file.c_str(), frames.size(), frames.size() == 1 ? "" : "s", fs::path(frames.front()).filename().c_str(),
+                fs::path(frames.back()).filename().c_str(), w, h, a.file.c_str());
+    for (const char* name : io::kSequenceBuffers) {
+        const bool has = std::find(present.begin(), present.end(), name) != present.end();
+        std::printf("  %-12s %s\n", name, has ? (first.fileOf(name) + " ...").c_str() : "-");
+    }
+}
+
+bool isSequence(const std::string& file) {
+    std::error_code ec;
+    if (fs::is_directory(file, ec)) return io::dirBufferFile(file, "color").empty();
+    const std::string name = fs::path(file).filename().string();
+    return !fs::exists(file, ec) && (name.find('#') != std::string::npos || name.find('%') != std::string::npos);
+}
+
 void run(const InspectArgs& a) {
     const std::vector<io::PassRequest> requests = withFlag("--pass", [&] { return io::parsePassRequests(a.passes); });
+    if (isSequence(a.file)) return inspectSequence(a, requests);
     refuseExportOverInputs(a, requests);
     std::error_code ec;
     if (fs::is_directory(a.file, ec)) {  // a render directory: what denoise --in DIR takes
@@ -150,7 +182,8 @@ void run(const InspectArgs& a) {
 void addInspectCommand(CLI::App& app) {
     auto a = std::make_shared<InspectArgs>();
     auto* cmd = app.add_subcommand("inspect", "List the parts, layers and channels of an EXR and the passes atrous denoise takes");
-    cmd->add_option("file", a->file, "EXR file (or a render directory: color.exr, albedo.exr, ...)")->required();
+    cmd->add_option("file", a->file, "EXR file, a render directory (color.exr, albedo.exr, ...), or a sequence (a folder of frames, or a pattern "
+                      "DIR/render####.exr): what denoise --sequence takes per buffer")->required();
     cmd->add_option("--pass", a->passes, "BUFFER=NAME, as for atrous denoise (repeatable)");
     cmd->add_option("--layer", a->layer, "View layer, as for atrous denoise");
     cmd->add_option("--export", a->exportDir,
