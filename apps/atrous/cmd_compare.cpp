@@ -1,4 +1,6 @@
-// `atrous compare`: MSE, relMSE, tonemapped PSNR and SSIM of images against a reference.
+// `atrous compare`: MSE, relMSE, tonemapped PSNR and SSIM of images against a reference; with
+// --sequence, of denoised sequences against a reference sequence, with the temporal metrics.
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <filesystem>
@@ -13,18 +15,82 @@
 #include "commands.h"
 #include "io/image_io.h"
 #include "io/paths.h"
+#include "io/sequence.h"
 
 namespace atrous::cli {
 
 namespace {
 
 struct CompareArgs {
-    std::string ref, errorMaps;
+    std::string ref, errorMaps, sequence;
     std::vector<std::string> images;
     bool json = false;
 };
 
+// The frames of a sequence by number: a reference frame's reference.exr when it has one (`atrous
+// render --frames --reference-spp`), else its colour (frame_NNNN.exr as `denoise --sequence` writes
+// them, or any layout --sequence reads).
+std::vector<std::pair<int, Image>> sequenceImages(const std::string& dir, bool preferReference) {
+    std::vector<std::pair<int, Image>> out;
+    for (const std::string& frame : io::listSequenceFrames(dir)) {
+        io::SequenceFrame f = io::loadSequenceFrame(frame);
+        out.emplace_back(f.index, preferReference && !f.reference.empty() ? std::move(f.reference) : std::move(f.color));
+    }
+    return out;
+}
+
+void runSequence(const CompareArgs& a) {
+    if (!a.ref.empty() || !a.errorMaps.empty())
+        throw InputError("--sequence REF_DIR: compares sequences; --ref and --error-maps are for images");
+    if (a.images.empty()) throw InputError("compare --sequence REF_DIR: give at least one sequence directory to compare");
+    const auto ref = sequenceImages(a.sequence, true);
+    nlohmann::json j;
+    j["reference"] = a.sequence;
+    j["sequences"] = nlohmann::json::array();
+    if (!a.json)
+        std::printf("%-32s %7s %14s %10s %8s %14s %10s\n", "sequence", "frames", "relMSE", "PSNR(dB)", "SSIM", "temporal relMSE",
+                    "tPSNR(dB)");
+    for (const std::string& dir : a.images) {
+        const auto seq = sequenceImages(dir, false);
+        // The frames are matched by number: the same numbers in both, or one line naming the first that is not.
+        for (size_t i = 0; i < std::max(seq.size(), ref.size()); ++i) {
+            if (i >= seq.size() || i >= ref.size() || seq[i].first != ref[i].first) {
+                const bool inRef = i < ref.size() && (i >= seq.size() || ref[i].first < seq[i].first);
+                const int n = inRef ? ref[i].first : seq[i].first;
+                throw InputError(dir + ": frame " + std::to_string(n) + (inRef ? " is missing (the reference " + a.sequence + " has it)"
+                                                                             : " has no reference frame in " + a.sequence));
+            }
+        }
+        double rel = 0, psnr = 0, ssim = 0, trel = 0, tpsnr = 0;
+        for (size_t i = 0; i < seq.size(); ++i) {
+            ImageMetrics m;
+            try {
+                m = computeMetrics(seq[i].second, ref[i].second);
+                if (i > 0) {
+                    const TemporalMetrics t = computeTemporalMetrics(seq[i].second, seq[i - 1].second, ref[i].second, ref[i - 1].second);
+                    trel += t.relMse, tpsnr += t.psnr;
+                }
+            } catch (const InputError& e) {
+                throw InputError(dir + ": frame " + std::to_string(seq[i].first) + " vs the reference's: " + e.what());
+            }
+            rel += m.relMse, psnr += m.psnr, ssim += m.ssim;
+        }
+        const double n = double(seq.size()), steps = std::max(1.0, n - 1.0);
+        nlohmann::json s = {{"path", dir},           {"frames", seq.size()},       {"relmse", rel / n},
+                            {"psnr", psnr / n},      {"ssim", ssim / n},           {"temporal_relmse", trel / steps},
+                            {"tpsnr", tpsnr / steps}};
+        if (a.json)
+            j["sequences"].push_back(s);
+        else
+            std::printf("%-32s %7zu %14.6g %10.3f %8.4f %14.6g %10.3f\n", dir.c_str(), seq.size(), rel / n, psnr / n, ssim / n,
+                        trel / steps, tpsnr / steps);
+    }
+    if (a.json) std::printf("%s\n", j.dump(2).c_str());
+}
+
 void run(const CompareArgs& a) {
+    if (!a.sequence.empty()) return runSequence(a);
+    if (a.ref.empty()) throw InputError("compare: give the reference image with --ref (or --sequence REF_DIR for sequences)");
     if (a.images.empty()) throw InputError("compare: give at least one image to compare with --ref");
     if (!a.errorMaps.empty()) {
         // The error maps never overwrite an image being compared (io/paths.h).
@@ -99,9 +165,15 @@ void run(const CompareArgs& a) {
 
 void addCompareCommand(CLI::App& app) {
     auto a = std::make_shared<CompareArgs>();
-    auto* cmd = app.add_subcommand("compare", "Compare images against a reference (MSE, relMSE, PSNR, SSIM)");
-    cmd->add_option("--ref", a->ref, "Reference image (EXR/PFM)")->required();
-    cmd->add_option("images", a->images, "Images to compare");
+    auto* cmd = app.add_subcommand("compare", "Compare images against a reference (MSE, relMSE, PSNR, SSIM), or sequences "
+                                              "against a reference sequence (with temporal relMSE and tPSNR)");
+    cmd->add_option("--ref", a->ref, "Reference image (EXR/PFM)");
+    cmd->add_option("--sequence", a->sequence,
+                    "Reference sequence (any layout --sequence reads; a frame's reference.exr when it has one): the "
+                    "positional arguments are then sequences to compare with it (denoise --sequence's output "
+                    "folders), frame by frame, with the temporal relMSE and tPSNR of frame-to-frame differences "
+                    "(docs/eval.md)");
+    cmd->add_option("images", a->images, "Images (or, with --sequence, sequence directories) to compare");
     cmd->add_flag("--json", a->json, "Print JSON");
     cmd->add_option("--error-maps", a->errorMaps, "Write <name>_se.exr and <name>_relse.exr error maps into DIR");
     cmd->callback([a] { run(*a); });

@@ -20,6 +20,18 @@ struct ImageMetrics {
 // Throws InputError when the sizes differ or an image is empty.
 ImageMetrics computeMetrics(const Image& image, const Image& reference);
 
+// The temporal error of one step of a sequence (docs/eval.md, "Sequences"): with d = image −
+// previous and d_ref = reference − previousReference, relMse = mean over pixels and channels of
+// (d − d_ref)² / (reference² + 0.01) (what the evaluation report's temporal relMSE is), and psnr the
+// PSNR of the tonemapped frames' differences against the reference's (tPSNR; 100 dB when equal).
+// Flicker the reference does not have raises both. Throws InputError as computeMetrics does.
+struct TemporalMetrics {
+    double relMse = 0;
+    double psnr = 0;
+};
+TemporalMetrics computeTemporalMetrics(const Image& image, const Image& previous, const Image& reference,
+                                       const Image& previousReference);
+
 // Tonemap used by PSNR/SSIM: clamp(pow(x/(1+x), 1/2.2), 0, 1) (x < 0 → 0).
 float tonemapForMetrics(float x);
 

@@ -47,6 +47,30 @@ std::vector<double> blur(const std::vector<double>& in, int w, int h) {
 
 }  // namespace
 
+TemporalMetrics computeTemporalMetrics(const Image& a, const Image& a0, const Image& r, const Image& r0) {
+    checkPair(a, r);
+    checkPair(a0, r);
+    checkPair(r0, r);
+    const size_t plane = r.plane();
+    double rel = 0, tse = 0;
+    for (int c = 0; c < 3; ++c)
+        for (size_t i = 0; i < plane; ++i) {
+            const size_t k = size_t(c) * plane + i;
+            const double x = finiteOr0(a.data()[k]), x0 = finiteOr0(a0.data()[k]);
+            const double y = finiteOr0(r.data()[k]), y0 = finiteOr0(r0.data()[k]);
+            const double d = (x - x0) - (y - y0);
+            rel += d * d / (y * y + 0.01);
+            const double td = (double(tonemapForMetrics(float(x))) - tonemapForMetrics(float(x0))) -
+                              (double(tonemapForMetrics(float(y))) - tonemapForMetrics(float(y0)));
+            tse += td * td;
+        }
+    const double n = 3.0 * double(plane);
+    TemporalMetrics m;
+    m.relMse = rel / n;
+    m.psnr = tse > 0 ? 10.0 * std::log10(n / tse) : 100.0;  // as computeMetrics: equal differences capped at 100 dB
+    return m;
+}
+
 float tonemapForMetrics(float x) {
     x = finiteOr0(x);
     if (x <= 0) return 0.0f;

@@ -1,0 +1,90 @@
+// `atrous compare --sequence REF_DIR OUT_DIR ...` (issue 28, temporal metrics): per-sequence relMSE,
+// PSNR, SSIM and the temporal relMSE and tPSNR of frame-to-frame differences, frames matched by
+// number. The sequences are made here: a static reference, an output off by a constant (no flicker)
+// and one off by an alternating sign (flicker): the same per-frame error, different temporal error.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "atrous/image.h"
+#include "atrous/metrics.h"
+#include "io/image_io.h"
+#include "test_util.h"
+
+using atrous::test::runCli;
+using atrous::test::TempDir;
+namespace fs = std::filesystem;
+
+namespace {
+
+atrous::Image frame(float base, float offset) {
+    atrous::Image img(16, 12, 3);
+    for (int y = 0; y < 12; ++y)
+        for (int x = 0; x < 16; ++x)
+            for (int c = 0; c < 3; ++c) img(x, y, c) = base + 0.01f * float(x + y + c) + offset;
+    return img;
+}
+
+void writeSequence(const std::string& dir, int frames, float offset, bool alternate) {
+    fs::create_directories(dir);
+    for (int f = 1; f <= frames; ++f)
+        atrous::io::writeImage(dir + "/frame_000" + std::to_string(f) + ".exr",
+                               frame(0.5f, alternate && f % 2 ? -offset : offset));
+}
+
+}  // namespace
+
+TEST(SequenceCompare, TemporalErrorSeesFlickerThatPerFrameErrorDoesNot) {
+    TempDir dir;
+    writeSequence(dir / "ref", 4, 0.0f, false);
+    writeSequence(dir / "steady", 4, 0.1f, false);
+    writeSequence(dir / "flicker", 4, 0.1f, true);
+    auto r = runCli("compare --json --sequence " + dir / "ref" + " " + dir / "ref" + " " + dir / "steady" + " " + dir / "flicker");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const nlohmann::json j = nlohmann::json::parse(r.output.substr(r.output.find('{')));
+    ASSERT_EQ(j["sequences"].size(), 3u);
+    const auto& same = j["sequences"][0];
+    const auto& steady = j["sequences"][1];
+    const auto& flicker = j["sequences"][2];
+    EXPECT_EQ(same["frames"], 4);
+    EXPECT_EQ(same["relmse"].get<double>(), 0.0);
+    EXPECT_EQ(same["temporal_relmse"].get<double>(), 0.0);
+    EXPECT_EQ(same["tpsnr"].get<double>(), 100.0);
+    // The same per-frame error (|offset| 0.1 everywhere, up to float32 rounding of x ± 0.1: 1e-6 relative) ...
+    EXPECT_NEAR(steady["relmse"].get<double>(), flicker["relmse"].get<double>(), 1e-6 * steady["relmse"].get<double>());
+    EXPECT_GT(steady["relmse"].get<double>(), 1e-3);
+    // ... but only the flickering one changes from frame to frame: differences of ±0.2.
+    EXPECT_LT(steady["temporal_relmse"].get<double>(), 1e-10);
+    EXPECT_GT(flicker["temporal_relmse"].get<double>(), 0.01);
+    EXPECT_LT(flicker["tpsnr"].get<double>(), 40.0);
+    // The library's function agrees with the CLI on one step: d - d_ref = 0.2 everywhere.
+    const atrous::TemporalMetrics t =
+        atrous::computeTemporalMetrics(frame(0.5f, 0.1f), frame(0.5f, -0.1f), frame(0.5f, 0.0f), frame(0.5f, 0.0f));
+    EXPECT_GT(t.relMse, 0.04 / (1.6 * 1.6 + 0.01));
+    EXPECT_LT(t.relMse, 0.04 / (0.5 * 0.5 + 0.01));
+}
+
+TEST(SequenceCompare, FramesThatDoNotMatchAreOneLineAndExit2) {
+    TempDir dir;
+    writeSequence(dir / "ref", 3, 0.0f, false);
+    writeSequence(dir / "short", 2, 0.1f, false);
+    auto r = runCli("compare --sequence " + dir / "ref" + " " + dir / "short");
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("frame 3 is missing"), std::string::npos) << r.output;
+    // A frame of another size names the frame.
+    writeSequence(dir / "odd", 3, 0.1f, false);
+    atrous::io::writeImage(dir / "odd/frame_0002.exr", atrous::Image(8, 8, 3));
+    r = runCli("compare --sequence " + dir / "ref" + " " + dir / "odd");
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("frame 2"), std::string::npos) << r.output;
+    // --ref is for images; no sequence to compare is an error too.
+    r = runCli("compare --sequence " + dir / "ref" + " --ref " + dir / "ref/frame_0001.exr " + dir / "odd");
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    r = runCli("compare --sequence " + dir / "ref");
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    r = runCli("compare " + dir / "odd/frame_0001.exr");
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+}
