@@ -4,7 +4,9 @@
 // and one off by an alternating sign (flicker): the same per-frame error, different temporal error.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -87,4 +89,29 @@ TEST(SequenceCompare, FramesThatDoNotMatchAreOneLineAndExit2) {
     EXPECT_EQ(r.exitCode, 2) << r.output;
     r = runCli("compare " + dir / "odd/frame_0001.exr");
     EXPECT_EQ(r.exitCode, 2) << r.output;
+}
+
+TEST(SequenceCompare, VideoSideBySide) {
+    TempDir dir;
+    writeSequence(dir / "ref", 3, 0.0f, false);
+    writeSequence(dir / "flicker", 3, 0.1f, true);
+    // Refused before anything is read: not with images, not over an input, not another container.
+    auto r = runCli("compare --ref " + dir / "ref/frame_0001.exr " + dir / "flicker/frame_0001.exr --video " + dir / "v.mp4");
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    r = runCli("compare --sequence " + dir / "ref " + dir / "flicker --video " + dir / "v.avi");
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    r = runCli("compare --sequence " + dir / "ref " + dir / "flicker --video " + dir / "ref/frame_0002.exr");
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    if (system("command -v ffmpeg > /dev/null 2>&1") != 0) GTEST_SKIP() << "ffmpeg is not on PATH";
+    r = runCli("compare --sequence " + dir / "ref " + dir / "flicker --video " + dir / "v.mp4");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    ASSERT_TRUE(fs::exists(dir / "v.mp4")) << r.output;
+    std::ifstream f(dir / "v.mp4", std::ios::binary);
+    char head[8] = {};
+    f.read(head, 8);
+    EXPECT_EQ(std::string(head + 4, 4), "ftyp");  // an MP4 container
+    // No temporary folder is left beside it.
+    int entries = 0;
+    for (const auto& e : fs::directory_iterator(dir.str())) entries += e.path().filename().string().rfind(".atrous", 0) == 0;
+    EXPECT_EQ(entries, 0);
 }

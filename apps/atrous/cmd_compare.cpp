@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -13,16 +14,19 @@
 #include "atrous/error.h"
 #include "atrous/metrics.h"
 #include "commands.h"
+#include "denoise_sequence.h"
 #include "io/image_io.h"
 #include "io/paths.h"
 #include "io/sequence.h"
 
 namespace atrous::cli {
 
+namespace fs = std::filesystem;
+
 namespace {
 
 struct CompareArgs {
-    std::string ref, errorMaps, sequence;
+    std::string ref, errorMaps, sequence, video;
     std::vector<std::string> images;
     bool json = false;
 };
@@ -39,11 +43,76 @@ std::vector<std::pair<int, Image>> sequenceImages(const std::string& dir, bool p
     return out;
 }
 
+std::string shellArg(const std::string& s) {
+    std::string out = "'";
+    for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return out + "'";
+}
+
+// A label ffmpeg's drawtext takes as it is: letters, digits and "_-." (others become '_').
+std::string plainLabel(const std::string& s) {
+    std::string out;
+    for (char c : s) out += std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' ? c : '_';
+    return out.empty() ? "_" : out;
+}
+
+// --video: the sequences and the reference side by side, each labelled with its folder's name, at
+// 24 frames per second (ffmpeg: PNG strips as `denoise --sequence` writes its previews, labels by
+// drawtext), written to a temporary name and renamed.
+void writeVideo(const std::string& path, const std::vector<std::string>& names,
+                const std::vector<std::vector<std::pair<int, Image>>>& seqs) {
+    const std::string ffmpeg = findOnPath("ffmpeg");
+    if (ffmpeg.empty()) throw InputError("--video " + path + ": needs ffmpeg on PATH, and there is none");
+    const fs::path out(path);
+    const fs::path tmpDir = (out.has_parent_path() ? out.parent_path() : fs::path(".")) / (".atrous-video-" + out.stem().string());
+    std::error_code ec;
+    fs::remove_all(tmpDir, ec);
+    fs::create_directories(tmpDir, ec);
+    if (ec) throw RuntimeError(tmpDir.string() + ": cannot create (" + ec.message() + ")");
+    const int w = seqs[0][0].second.width(), h = seqs[0][0].second.height(), gap = 4;
+    const int n = int(seqs.size());
+    std::string filter = "pad=ceil(iw/2)*2:ceil(ih/2)*2";
+    const int fontSize = std::max(10, h / 14);
+    for (int k = 0; k < n; ++k)
+        filter += ",drawtext=text=" + plainLabel(fs::path(names[size_t(k)]).filename().string()) + ":x=" + std::to_string(k * (w + gap) + 4) +
+                  ":y=4:fontsize=" + std::to_string(fontSize) + ":fontcolor=white:box=1:boxcolor=black@0.5";
+    for (size_t i = 0; i < seqs[0].size(); ++i) {
+        Image strip(n * w + (n - 1) * gap, h, 3);
+        for (int c = 0; c < 3; ++c)
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < strip.width(); ++x) strip(x, y, c) = 1.0f;  // white gaps
+        for (int k = 0; k < n; ++k) {
+            const Image& img = seqs[size_t(k)][i].second;
+            for (int c = 0; c < 3; ++c)
+                for (int y = 0; y < h; ++y)
+                    for (int x = 0; x < w; ++x) strip(k * (w + gap) + x, y, c) = img(x, y, c);
+        }
+        char name[32];
+        std::snprintf(name, sizeof name, "f%06zu.png", i);
+        io::writeImage((tmpDir / name).string(), strip);
+    }
+    const std::string tmpVideo = (tmpDir / "video.mp4").string();
+    const std::string cmd = shellArg(ffmpeg) + " -nostdin -y -loglevel error -framerate 24 -i " + shellArg((tmpDir / "f%06d.png").string()) +
+                            " -vf " + shellArg(filter) + " -pix_fmt yuv420p -f mp4 " + shellArg(tmpVideo);
+    const int rc = std::system(cmd.c_str());
+    if (rc == 0) fs::rename(tmpVideo, out, ec);
+    fs::remove_all(tmpDir);
+    if (rc != 0) throw RuntimeError("--video " + path + ": ffmpeg failed (exit status " + std::to_string(rc) + ")");
+    if (ec) throw RuntimeError("--video " + path + ": cannot move the video into place (" + ec.message() + ")");
+}
+
 void runSequence(const CompareArgs& a) {
     if (!a.ref.empty() || !a.errorMaps.empty())
         throw InputError("--sequence REF_DIR: compares sequences; --ref and --error-maps are for images");
     if (a.images.empty()) throw InputError("compare --sequence REF_DIR: give at least one sequence directory to compare");
-    const auto ref = sequenceImages(a.sequence, true);
+    if (!a.video.empty()) {
+        std::vector<std::string> inputs = a.images;
+        inputs.push_back(a.sequence);
+        io::refuseOverwrite("--video", a.video, inputs);
+        if (io::extensionOf(a.video) != ".mp4") throw InputError("--video " + a.video + ": write an .mp4");
+    }
+    auto ref = sequenceImages(a.sequence, true);
+    std::vector<std::vector<std::pair<int, Image>>> all;
     nlohmann::json j;
     j["reference"] = a.sequence;
     j["sequences"] = nlohmann::json::array();
@@ -51,7 +120,7 @@ void runSequence(const CompareArgs& a) {
         std::printf("%-32s %7s %14s %10s %8s %14s %10s\n", "sequence", "frames", "relMSE", "PSNR(dB)", "SSIM", "temporal relMSE",
                     "tPSNR(dB)");
     for (const std::string& dir : a.images) {
-        const auto seq = sequenceImages(dir, false);
+        auto seq = sequenceImages(dir, false);
         // The frames are matched by number: the same numbers in both, or one line naming the first that is not.
         for (size_t i = 0; i < std::max(seq.size(), ref.size()); ++i) {
             if (i >= seq.size() || i >= ref.size() || seq[i].first != ref[i].first) {
@@ -84,12 +153,22 @@ void runSequence(const CompareArgs& a) {
         else
             std::printf("%-32s %7zu %14.6g %10.3f %8.4f %14.6g %10.3f\n", dir.c_str(), seq.size(), rel / n, psnr / n, ssim / n,
                         trel / steps, tpsnr / steps);
+        if (!a.video.empty()) all.push_back(std::move(seq));  // every frame has the reference's size (computeMetrics)
+    }
+    if (!a.video.empty()) {
+        std::vector<std::string> names = a.images;
+        names.push_back("reference");
+        all.push_back(std::move(ref));
+        writeVideo(a.video, names, all);
+        j["video"] = a.video;
+        if (!a.json) std::printf("video: %s (%s | reference)\n", a.video.c_str(), a.images.size() == 1 ? a.images[0].c_str() : "the sequences");
     }
     if (a.json) std::printf("%s\n", j.dump(2).c_str());
 }
 
 void run(const CompareArgs& a) {
     if (!a.sequence.empty()) return runSequence(a);
+    if (!a.video.empty()) throw InputError("--video: compares sequences; give --sequence REF_DIR");
     if (a.ref.empty()) throw InputError("compare: give the reference image with --ref (or --sequence REF_DIR for sequences)");
     if (a.images.empty()) throw InputError("compare: give at least one image to compare with --ref");
     if (!a.errorMaps.empty()) {
@@ -174,6 +253,9 @@ void addCompareCommand(CLI::App& app) {
                     "folders), frame by frame, with the temporal relMSE and tPSNR of frame-to-frame differences "
                     "(docs/eval.md)");
     cmd->add_option("images", a->images, "Images (or, with --sequence, sequence directories) to compare");
+    cmd->add_option("--video", a->video,
+                    "With --sequence: write an .mp4 of the sequences and the reference side by side, each labelled "
+                    "with its folder's name (needs ffmpeg)");
     cmd->add_flag("--json", a->json, "Print JSON");
     cmd->add_option("--error-maps", a->errorMaps, "Write <name>_se.exr and <name>_relse.exr error maps into DIR");
     cmd->callback([a] { run(*a); });
