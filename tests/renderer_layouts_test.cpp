@@ -31,6 +31,14 @@ void copyBuffers(const std::string& from, const std::string& to, bool lux) {
     for (const auto& [ours, theirs] : kLuxNames) fs::copy_file(fs::path(from) / ours, fs::path(to) / (lux ? theirs : ours));
 }
 
+// An atrous render of `frames` frames of `scene` at 24x16, 1 spp: DIR/seq/frame_NNNN/.
+std::string renderFrames(const TempDir& dir, const std::string& scene, int frames) {
+    const std::string seq = dir / "seq";
+    auto r = runCli("render --scene " + scene + " --frames " + std::to_string(frames) + " --spp 1 --width 24 --height 16 --out " + seq);
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    return seq;
+}
+
 bool sameImages(const atrous::Image& a, const atrous::Image& b) {
     return a.width() == b.width() && a.height() == b.height() && a.channels() == b.channels() &&
            std::equal(a.data(), a.data() + a.size(), b.data());
@@ -73,9 +81,8 @@ TEST(RendererLayouts, LuxCoreStillFolderIsReadUnderItsOwnNames) {
 
 TEST(RendererLayouts, NumberedFrameFoldersWithLuxCoreNamesAreASequence) {
     TempDir dir;
-    const std::string seq = dir / "seq";
-    auto r = runCli("render --scene cornell-moving --frames 3 --spp 1 --width 24 --height 16 --out " + seq);
-    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const std::string seq = renderFrames(dir, "cornell-moving", 3);
+    atrous::test::CliResult r;
     const std::string lux = dir / "lux";
     for (int f = 0; f < 3; ++f)  // LuxCore renders one folder per frame; here 0001/, 0002/, 0003/
         copyBuffers(seq + "/frame_000" + std::to_string(f), lux + "/000" + std::to_string(f + 1), true);
@@ -121,9 +128,8 @@ TEST(RendererLayouts, NumberedFrameFoldersWithLuxCoreNamesAreASequence) {
 
 TEST(RendererLayouts, NumberedFilesPerBufferAreASequence) {
     TempDir dir;
-    const std::string seq = dir / "seq";
-    auto r = runCli("render --scene cornell-moving --frames 3 --spp 1 --width 24 --height 16 --out " + seq);
-    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const std::string seq = renderFrames(dir, "cornell-moving", 3);
+    atrous::test::CliResult r;
     // One folder, one file per buffer and frame, as compositors and some renderers write them.
     const std::string per = dir / "per";
     fs::create_directories(per);
@@ -158,9 +164,8 @@ TEST(RendererLayouts, NumberedFilesPerBufferAreASequence) {
 
 TEST(RendererLayouts, PatternsWithStartEndAndStep) {
     TempDir dir;
-    const std::string seq = dir / "seq";
-    auto r = runCli("render --scene cornell --frames 5 --spp 1 --width 24 --height 16 --out " + seq);
-    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const std::string seq = renderFrames(dir, "cornell", 5);
+    atrous::test::CliResult r;
     // Two sequences in one folder, as a compositor leaves them: a pattern picks one.
     const std::string src = dir / "src";
     fs::create_directories(src);
