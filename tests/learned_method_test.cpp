@@ -245,6 +245,30 @@ TEST(LearnedMethod, AutoPicksBlendWithAlbedoAndNormalElseSure) {
     EXPECT_EQ(DenoiseOptions{}.method, DenoiseMethod::Auto);  // the default
 }
 
+// The one list of still methods (denoiseMethods()): names unique and round-tripping, the weighted
+// ones those that run the learned cascade, and the CLI's --help and unknown-method message built
+// from it (so a new row reaches them without another edit).
+TEST(LearnedMethod, TheMethodListIsWhatTheCliAndTheParserRead) {
+    std::vector<std::string> names;
+    for (const DenoiseMethodInfo& m : denoiseMethods()) {
+        EXPECT_EQ(parseDenoiseMethod(m.name), m.method) << m.name;
+        EXPECT_STREQ(denoiseMethodName(m.method), m.name);
+        EXPECT_EQ(findDenoiseMethod(m.name), &m);
+        const bool network = m.method == DenoiseMethod::Learned || m.method == DenoiseMethod::Blend || m.method == DenoiseMethod::Auto;
+        EXPECT_EQ(m.usesWeights, network) << m.name;
+        EXPECT_EQ(std::count(names.begin(), names.end(), m.name), 0) << m.name;
+        names.push_back(m.name);
+    }
+    EXPECT_EQ(findDenoiseMethod("svgf"), nullptr);  // temporal: not a still method
+    const test::CliResult help = test::runCli("denoise --help");
+    const test::CliResult bad = test::runCli("denoise --in nowhere --out x.exr --method nope");
+    EXPECT_EQ(bad.exitCode, 2) << bad.output;
+    for (const std::string& n : names) {
+        EXPECT_NE(help.output.find(n + ": "), std::string::npos) << n;
+        EXPECT_NE(bad.output.find(n), std::string::npos) << n;
+    }
+}
+
 // Blend = (learned + SURE) / 2 from one preparation: the mean of the two methods' own outputs up to
 // float rounding (the mean is taken before remodulation, c·a' + e, instead of after: a relative
 // 1e-5 bounds the difference of those two orders of operations on these values, which are

@@ -134,10 +134,13 @@ void run(const BenchArgs& a) {
     if (a.warmup < 0) throw InputError("--warmup must be >= 0");
     std::vector<std::string> what = split(a.what);
     for (auto& w : what)
-        if (w != "eaw" && w != "sure" && w != "learned" && w != "blend" && w != "svgf" && w != "render")
-            throw InputError("--what: unknown item '" + w + "' (expected eaw, sure, learned, blend, svgf, render)");
+        if ((!findDenoiseMethod(w) || w == "auto") && w != "svgf" && w != "render")
+            throw InputError("--what: unknown item '" + w + "' (expected a denoise method but auto (" + denoiseMethodNames() +
+                             "), svgf or render)");
     auto wants = [&](const char* k) { return std::find(what.begin(), what.end(), k) != what.end(); };
-    if ((wants("learned") || wants("blend")) && !a.learnedWeights.empty()) {
+    bool anyLearned = false;
+    for (const DenoiseMethodInfo& m : denoiseMethods()) anyLearned = anyLearned || (m.usesWeights && wants(m.name));
+    if (anyLearned && !a.learnedWeights.empty()) {
         try {
             LearnedWeights::load(a.learnedWeights);  // a bad file: one line before any timing
         } catch (const InputError& e) {
@@ -203,7 +206,9 @@ void run(const BenchArgs& a) {
         // On CUDA the inputs are uploaded once, outside the timed calls: the filters then read
         // them in place (as the viewer and DLPack callers do) and total_ms covers no transfer.
         RenderBuffers onDevice;
-        if (device == Device::Cuda && (wants("eaw") || wants("sure") || wants("learned") || wants("blend") || wants("svgf"))) {
+        bool anyFilter = wants("svgf");
+        for (const DenoiseMethodInfo& m : denoiseMethods()) anyFilter = anyFilter || wants(m.name);
+        if (device == Device::Cuda && anyFilter) {
             for (auto [dst, src] : {std::pair<Image*, const Image*>{&onDevice.color, &b.color},
                                     {&onDevice.variance, &b.variance}, {&onDevice.albedo, &b.albedo},
                                     {&onDevice.normal, &b.normal}, {&onDevice.position, &b.position},
@@ -212,14 +217,15 @@ void run(const BenchArgs& a) {
                 *dst = src->to(Device::Cuda);
         }
         const RenderBuffers& inputs = device == Device::Cuda ? onDevice : b;
-        for (const char* m : {"eaw", "sure", "learned", "blend"}) {
-            if (!wants(m)) continue;
+        for (const DenoiseMethodInfo& info : denoiseMethods()) {
+            const char* m = info.name;
+            if (info.method == DenoiseMethod::Auto || !wants(m)) continue;
             DenoiseInputs in = denoiseInputsOf(inputs);
             DenoiseReport rep;
             DenoiseOptions o;
             o.method = parseDenoiseMethod(m);
             o.learnedWeights = a.learnedWeights;
-            const bool learned = o.method == DenoiseMethod::Learned || o.method == DenoiseMethod::Blend;
+            const bool learned = info.usesWeights;
             o.device = device;
             o.report = &rep;
             std::vector<double> total;

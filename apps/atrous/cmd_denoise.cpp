@@ -43,7 +43,11 @@ const char* const kGroupSvgf = "SVGF (--method svgf)";  // addSvgfOptions' group
 const char* const kGroupBuffers = "Buffers (without --sequence)";
 const char* const kGroupLearned = "Learned (--method learned|blend|auto, or svgf --svgf-learned-spatial)";
 
-bool learnedMethod(const std::string& method) { return method == "learned" || method == "blend" || method == "auto"; }
+// A method that reads the learned filter's weights (denoiseMethods()' usesWeights).
+bool learnedMethod(const std::string& method) {
+    const DenoiseMethodInfo* m = findDenoiseMethod(method);
+    return m && m->usesWeights;
+}
 
 // The learned filter runs the still driver's preparation (fireflies, emission filter, albedo rule)
 // and the safety net, not the EAW stops or SURE (include/atrous/denoise.h): the flags it ignores.
@@ -129,8 +133,9 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     const bool sequence = !a.sequence.empty();
     for (const char* f : {"--start", "--end", "--step"})
         if (!sequence && cmd.count(f) > 0) throw InputError(std::string(f) + ": picks frames of a --sequence; give one");
-    if (a.method != "svgf" && a.method != "eaw" && a.method != "sure" && !learnedMethod(a.method))
-        throw InputError("--method: unknown denoise method '" + a.method + "' (expected eaw, sure, learned, blend, auto or svgf)");
+    if (a.method != "svgf" && !findDenoiseMethod(a.method))
+        throw InputError("--method: unknown denoise method '" + a.method + "' (expected " + denoiseMethodNames() +
+                         ", or svgf with --sequence)");
     if (a.method == "svgf" && !sequence)
         throw InputError("--method svgf denoises animated sequences: give --sequence DIR (and an output directory)");
     o.method = a.method == "svgf" ? DenoiseMethod::Sure : parseDenoiseMethod(a.method);
@@ -298,10 +303,11 @@ void addDenoiseCommand(CLI::App& app) {
                     "run's frame_NNNN.exr/.png replace the old ones, and those of an earlier run that this run does "
                     "not write (and an old preview.mp4) are removed, named in a note on stderr")
         ->required();
+    std::string methodHelp;
+    for (const DenoiseMethodInfo& m : denoiseMethods()) methodHelp += std::string(m.name) + ": " + m.summary + "; ";
     cmd->add_option("--method", a->method,
-                    "eaw | sure | learned | blend (the mean of learned and sure) | auto (blend with an albedo and a normal, else "
-                    "sure: the method measured best for the buffers given, docs/quality.md; the output line says "
-                    "which ran) (| svgf with --sequence)")
+                    methodHelp + "svgf (with --sequence): spatiotemporal variance-guided filtering. The output line says "
+                                 "which method ran")
         ->capture_default_str();
     cmd->add_option("--learned-weights", a->opt.learnedWeights,
                     "Weight file of the learned filter (version 3, docs/learned.md; default: the built-in weights)")

@@ -218,7 +218,7 @@ void addRenderCommand(CLI::App& app) {
     addParamOptions(*cmd, args->settings, renderParams(), [](const ParamField<RenderSettings>&) { return "Render settings"; });
     cmd->add_option("--device", args->device, "cpu, cuda or auto (cuda when a GPU is present; the GPU path tracer runs over a BVH built by Embree)")
         ->capture_default_str();
-    cmd->add_option("--denoise", args->denoise, "Also denoise with these methods (comma list: eaw,sure)");
+    cmd->add_option("--denoise", args->denoise, "Also denoise with these methods (a comma list of " + denoiseMethodNames() + ")");
     auto* frames = cmd->add_option("--frames", args->frames,
                                    "Render an animation of this many frames into OUT/frame_NNNN/ (time t = f / max(F-1, 1))")->check(kNonEmptyNumber);
     cmd->add_option("--reference-spp", args->referenceSpp, "With --frames: also write reference.exr per frame at this spp (other seed)")->check(kNonEmptyNumber);

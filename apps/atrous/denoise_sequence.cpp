@@ -186,10 +186,8 @@ private:
 
 int runSequenceDenoise(const SequenceDenoiseArgs& args) {
     const bool svgf = args.method == "svgf";
-    if (!svgf && args.method != "eaw" && args.method != "sure" && args.method != "learned" && args.method != "blend" &&
-        args.method != "auto")
-        throw InputError("--method '" + args.method +
-                         "' cannot denoise a sequence (expected svgf, eaw, sure, learned, blend or auto)");
+    if (!svgf && !findDenoiseMethod(args.method))
+        throw InputError("--method '" + args.method + "' cannot denoise a sequence (expected svgf, " + denoiseMethodNames() + ")");
     if (args.sequenceDir.empty()) throw InputError("--sequence: no directory given");
     if (svgf && args.range.step > 1)
         throw InputError("--step " + std::to_string(args.range.step) +

@@ -205,7 +205,22 @@ struct DenoiseBufferUse {
 };
 DenoiseBufferUse denoiseBufferUse(const DenoiseOptions& options, DenoiseMethod resolved);
 
-// "eaw" | "sure" | "learned" | "blend" | "auto"; InputError otherwise.
+// The still methods, one row each: the one list the CLI (--method, its help and messages, the
+// sequence check), `atrous bench`, and Python (atrous.METHODS, the farm, the evaluation) read, so
+// a new still method is a row here, an enum value and its branch in the driver
+// (docs/architecture.md, "A new denoising method").
+struct DenoiseMethodInfo {
+    DenoiseMethod method;
+    const char* name;     // "eaw", ...: the CLI's --method, Python's method=, the report's column
+    const char* summary;  // one line for --help
+    bool usesWeights;     // reads the learned filter's weights (DenoiseOptions::learnedWeights)
+};
+const std::vector<DenoiseMethodInfo>& denoiseMethods();  // eaw, sure, learned, blend, auto
+const DenoiseMethodInfo* findDenoiseMethod(const std::string& name);  // null when unknown
+// The names in order, "eaw, sure, learned, blend or auto".
+std::string denoiseMethodNames();
+
+// A name of denoiseMethods(); InputError otherwise.
 DenoiseMethod parseDenoiseMethod(const std::string& name);
 const char* denoiseMethodName(DenoiseMethod m);
 // What Auto becomes for these inputs: Blend with an albedo and a normal buffer, else Sure; any

@@ -49,11 +49,21 @@ __all__ = [
     "svgf_params",
     "render_params",
     "METHODS",
+    "WEIGHTED_METHODS",
+    "denoise_methods",
 ]
 
 __version__ = "0.1.0"
 
-METHODS = ("eaw", "sure", "learned", "blend", "auto")
+# The still methods, from the library's one list (denoiseMethods(), include/atrous/denoise.h).
+METHODS = tuple(str(r["name"]) for r in _core.denoise_methods())
+# Those that read the learned filter's weights (learned_weights= applies to them).
+WEIGHTED_METHODS = tuple(str(r["name"]) for r in _core.denoise_methods() if r["uses_weights"])
+
+
+def denoise_methods() -> list:
+    """The still methods, one dict per method: name, summary, uses_weights (the library's list)."""
+    return [dict(r) for r in _core.denoise_methods()]
 
 
 def builtin_scenes() -> list:

@@ -407,6 +407,19 @@ NB_MODULE(_core, m) {
     m.def("read_image", &pyReadImage, nb::arg("path"));
     m.def("write_image", &pyWriteImage, nb::arg("path"), nb::arg("image"));
     m.def("denoise_params", [] { return paramRows(denoiseParams()); });
+    // The still methods (denoiseMethods(), include/atrous/denoise.h): atrous.METHODS and the rows of
+    // atrous.denoise_methods().
+    m.def("denoise_methods", [] {
+        nb::list rows;
+        for (const DenoiseMethodInfo& i : denoiseMethods()) {
+            nb::dict d;
+            d["name"] = i.name;
+            d["summary"] = i.summary;
+            d["uses_weights"] = i.usesWeights;
+            rows.append(d);
+        }
+        return rows;
+    });
     m.def("svgf_params", [] { return paramRows(svgfParams()); });
     m.def("render_params", [] { return paramRows(renderParams()); });
     m.def("resolve_denoise_params", [](nb::dict p) { return resolveParams(denoiseParams(), p, "denoise"); });

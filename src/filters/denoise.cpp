@@ -27,23 +27,39 @@
 
 namespace atrous {
 
+const std::vector<DenoiseMethodInfo>& denoiseMethods() {
+    static const std::vector<DenoiseMethodInfo> kMethods = {
+        {DenoiseMethod::Eaw, "eaw", "the edge-avoiding a-trous wavelet filter (Dammertz et al. 2010)", false},
+        {DenoiseMethod::Sure, "sure", "EAW's cascade keeping part of each detail, chosen by SURE (Kim, Moon, Yoon 2016)", false},
+        {DenoiseMethod::Learned, "learned", "a small network steering the a-trous cascade (docs/learned.md)", true},
+        {DenoiseMethod::Blend, "blend", "the mean of learned and sure, from one preparation", true},
+        {DenoiseMethod::Auto, "auto", "blend with an albedo and a normal, else sure: the method measured best for the buffers given",
+         true},
+    };
+    return kMethods;
+}
+
+const DenoiseMethodInfo* findDenoiseMethod(const std::string& name) {
+    for (const DenoiseMethodInfo& m : denoiseMethods())
+        if (name == m.name) return &m;
+    return nullptr;
+}
+
+std::string denoiseMethodNames() {
+    const auto& ms = denoiseMethods();
+    std::string s;
+    for (size_t i = 0; i < ms.size(); ++i) s += (i == 0 ? "" : i + 1 == ms.size() ? " or " : ", ") + std::string(ms[i].name);
+    return s;
+}
+
 DenoiseMethod parseDenoiseMethod(const std::string& name) {
-    if (name == "eaw") return DenoiseMethod::Eaw;
-    if (name == "sure") return DenoiseMethod::Sure;
-    if (name == "learned") return DenoiseMethod::Learned;
-    if (name == "blend") return DenoiseMethod::Blend;
-    if (name == "auto") return DenoiseMethod::Auto;
-    throw InputError("unknown denoise method '" + name + "' (expected eaw, sure, learned, blend or auto)");
+    if (const DenoiseMethodInfo* m = findDenoiseMethod(name)) return m->method;
+    throw InputError("unknown denoise method '" + name + "' (expected " + denoiseMethodNames() + ")");
 }
 
 const char* denoiseMethodName(DenoiseMethod m) {
-    switch (m) {
-        case DenoiseMethod::Eaw: return "eaw";
-        case DenoiseMethod::Sure: return "sure";
-        case DenoiseMethod::Learned: return "learned";
-        case DenoiseMethod::Auto: return "auto";
-        case DenoiseMethod::Blend: return "blend";
-    }
+    for (const DenoiseMethodInfo& i : denoiseMethods())
+        if (i.method == m) return i.name;
     return "?";
 }
 

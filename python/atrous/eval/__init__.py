@@ -32,7 +32,7 @@ import atrous
 
 __all__ = ["EvalConfig", "run_eval", "main", "load_oidn", "oidn_inputs", "time_call", "score"]
 
-ALL_METHODS = ("noisy", "eaw", "sure", "learned", "blend", "auto", "oidn")
+ALL_METHODS = ("noisy",) + atrous.METHODS + ("oidn",)
 # The default set (--methods not given). learned (the learned à-trous filter, docs/learned.md) and
 # auto (learned with an albedo and a normal, which every render here has: the same as learned) are
 # taken when asked for: --methods noisy,eaw,sure,learned,oidn.
@@ -118,7 +118,7 @@ def _atrous_method(name: str, learned_weights: Optional[str] = None) -> Callable
         if var is not None and not np.any(var > 0):
             var = None
         kw = {k: b[k] for k in extra_kw if b.get(k) is not None}
-        if name in ("learned", "blend", "auto") and learned_weights:
+        if name in atrous.WEIGHTED_METHODS and learned_weights:
             kw["learned_weights"] = learned_weights
         return atrous.denoise(b["color"], albedo=b.get("albedo"), normal=b.get("normal"),
                               position=b.get("position"), depth=b.get("depth"),

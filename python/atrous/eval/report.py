@@ -10,8 +10,10 @@ from typing import Any, Dict, List, Optional
 
 import numpy as np
 
-ATROUS_METHODS = ("eaw", "sure", "learned", "blend", "auto")
-COLORS = {"noisy": "#7f7f7f", "eaw": "#1f77b4", "sure": "#2ca02c", "learned": "#ff7f0e", "auto": "#8c564b",
+import atrous
+
+ATROUS_METHODS = atrous.METHODS
+COLORS = {"noisy": "#7f7f7f", "eaw": "#1f77b4", "sure": "#2ca02c", "learned": "#ff7f0e", "blend": "#17becf", "auto": "#8c564b",
           "oidn": "#d62728", "svgf": "#9467bd",
           "render 1 spp": "#000000"}
 

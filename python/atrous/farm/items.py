@@ -22,9 +22,9 @@ import atrous
 __all__ = ["Item", "FarmInputError", "scene_label", "check_scenes", "parse_value", "check_denoise_params",
            "discover_inputs", "DENOISE_METHODS", "EVAL_METHODS", "EVAL_CHOICES"]
 
-DENOISE_METHODS = ("eaw", "sure", "learned", "blend", "auto", "oidn", "svgf")
+DENOISE_METHODS = atrous.METHODS + ("oidn", "svgf")
 EVAL_METHODS = ("noisy", "eaw", "sure", "oidn")  # the default set
-EVAL_CHOICES = EVAL_METHODS + ("learned", "blend", "auto")  # what an evaluation may ask for
+EVAL_CHOICES = EVAL_METHODS + tuple(m for m in atrous.METHODS if m not in EVAL_METHODS)  # what an evaluation may ask for
 _FRAME = re.compile(r"^frame_(\d{4,})$")
 _SEED_MAX = 2 ** 32 - 1
 

@@ -38,8 +38,8 @@ def render(out: PathLike, scenes: Any, spp: Any = (16,), *, width: int = 512, he
     frames = positive_int(frames, "frames", 0, 100000)
     methods = name_list(denoise, "denoise") if denoise else []
     for m in methods:
-        if m not in ("eaw", "sure", "learned", "blend", "auto"):
-            raise FarmInputError(f"denoise: unknown method '{m}' (expected eaw, sure, learned, blend or auto)")
+        if m not in atrous.METHODS:
+            raise FarmInputError(f"denoise: unknown method '{m}' (expected {', '.join(atrous.METHODS)})")
     if frames and methods:
         raise FarmInputError("denoise: not with frames (denoise the sequence with the denoise job)")
     if camera_path not in CAMERA_PATHS:
