@@ -100,7 +100,7 @@ def parse_denoise_log(out: str) -> dict:
     m = re.search(r"stages ms: (.*)", out)
     if m:
         r["stages"] = {k.strip(): float(v) for k, v in (s.rsplit(" ", 1) for s in m.group(1).split(","))}
-    m = re.search(r"method (\S+)", out)
+    m = re.search(r"method (?:auto -> )?(\S+)", out)  # without --method: "method auto -> blend (...)"
     if m:
         r["method_used"] = m.group(1)
     return r
@@ -172,7 +172,8 @@ def main(argv=None) -> int:
                                                                      "total_ms", "import_ms")}
         rows.append(size_row)
     # The filter alone, inputs in memory (the same scene and sizes; cornell, 2 spp, seed 7).
-    want = sorted({m if m != "default" else "sure" for m in methods} & {"eaw", "sure", "learned"})
+    used = {e.get("method_used") or "sure" for row in rows for m, e in row["atrous"].items() if m == "default"}
+    want = sorted(({m for m in methods if m != "default"} | used) & {"eaw", "sure", "learned", "blend"})
     bench = json.loads(subprocess.run([a.atrous, "bench", "--json", "--device", "cpu", "--what", ",".join(want), "--sizes",
                                        a.sizes], check=True, capture_output=True, text=True).stdout)
     for row in rows:
