@@ -18,6 +18,40 @@
 
 #define ATROUS_INLINE ATROUS_HOST_DEVICE inline
 
+// Host-only forced inlining for the shared per-pixel math called from the CPU row loops: a call
+// left in the x loop stops it vectorising.
+#if defined(__GNUC__) && !defined(__CUDACC__)
+#define ATROUS_FORCE_INLINE __attribute__((always_inline))
+#else
+#define ATROUS_FORCE_INLINE
+#endif
+
+// The learned filter's lane loops (the pixel index, innermost): `omp simd` on the host compiler,
+// so that GCC vectorises them rather than unrolling them into scalar code; nothing for nvcc (one
+// lane there).
+#if defined(__GNUC__) && !defined(__CUDACC__)
+#define ATROUS_LANES _Pragma("omp simd")
+#else
+#define ATROUS_LANES
+#endif
+
+// A layer's unit loop fully unrolled on the device, so that the layer's outputs (and the MLP's 34
+// raw outputs) stay in registers: without it nvcc kept v3's 34 outputs in a 136-byte local array
+// (ptxas -v, sm_90). Nothing on the host (GCC vectorises the lane loops instead).
+#if defined(__CUDACC__)
+#define ATROUS_DEVICE_UNROLL _Pragma("unroll")
+#else
+#define ATROUS_DEVICE_UNROLL
+#endif
+
+// At the top of a CPU loop file, before its includes: GCC may if-convert selects (FP exceptions are
+// never unmasked or tested here); no reassociation or contraction comes with it.
+#if defined(__GNUC__) && !defined(__clang__) && !defined(__CUDACC__)
+#define ATROUS_NO_TRAPPING_MATH _Pragma("GCC optimize(\"no-trapping-math\")")
+#else
+#define ATROUS_NO_TRAPPING_MATH
+#endif
+
 // Restrict-qualified pointers let the host compiler vectorise the per-row loops.
 #if defined(__CUDACC__) || defined(__GNUC__) || defined(__clang__)
 #define ATROUS_RESTRICT __restrict__

@@ -8,9 +8,8 @@
 // variance is below half the functor's threshold (a margin for the contraction of e² into
 // multiply-adds, which may differ from the functor's in the last bit). Outputs bit-equal
 // (tests/filter_rows_test.cpp). Before, each level read 6 planes and wrote 3 for every pixel.
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC optimize("no-trapping-math")
-#endif
+#include "atrous/platform.h"
+ATROUS_NO_TRAPPING_MATH
 
 #include <algorithm>
 #include <vector>

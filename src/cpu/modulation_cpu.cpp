@@ -5,9 +5,8 @@
 // scalar (the rim rule's 3x3 scan behind a branch): 1.3 and 2 ms at 512x512 on 2 cores.
 // FP exceptions are never unmasked or tested here; without -ftrapping-math GCC if-converts the
 // selects (results unchanged: no reassociation or contraction is allowed by this).
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC optimize("no-trapping-math")
-#endif
+#include "atrous/platform.h"
+ATROUS_NO_TRAPPING_MATH
 
 #include <vector>
 

@@ -16,9 +16,8 @@
 // path is never stored). Same sums in the same order: bit-equal (tests/noise_fit_test.cpp).
 // FP exceptions are never unmasked or tested here; without -ftrapping-math GCC if-converts the
 // selects (results unchanged: no reassociation or contraction is allowed by this).
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC optimize("no-trapping-math")
-#endif
+#include "atrous/platform.h"
+ATROUS_NO_TRAPPING_MATH
 
 #include <tbb/parallel_for.h>
 

@@ -7,9 +7,8 @@
 // FP exceptions are never unmasked or tested here; without -ftrapping-math GCC if-converts the
 // selects of the firefly rule, which it otherwise keeps as branches (no vectorisation). Results
 // are the same: no reassociation or contraction is allowed by this.
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC optimize("no-trapping-math")
-#endif
+#include "atrous/platform.h"
+ATROUS_NO_TRAPPING_MATH
 
 #include <atomic>
 #include <cmath>

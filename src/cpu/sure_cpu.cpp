@@ -7,9 +7,8 @@
 // order as in the functors, so the results are the same.
 // FP exceptions are never unmasked or tested here; without -ftrapping-math GCC if-converts the
 // selects (results unchanged: no reassociation or contraction is allowed by this).
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC optimize("no-trapping-math")
-#endif
+#include "atrous/platform.h"
+ATROUS_NO_TRAPPING_MATH
 
 #include <algorithm>
 #include <vector>

@@ -8,13 +8,6 @@
 
 #include "atrous/platform.h"
 
-// Host-only forced inlining for the shared per-pixel math called from the CPU row loops: a call
-// left in the x loop stops it vectorising.
-#if defined(__GNUC__) && !defined(__CUDACC__)
-#define ATROUS_FORCE_INLINE __attribute__((always_inline))
-#else
-#define ATROUS_FORCE_INLINE
-#endif
 
 namespace atrous::filters {
 

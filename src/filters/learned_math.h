@@ -121,21 +121,8 @@ ATROUS_FORCE_INLINE ATROUS_INLINE float learnedLocalStd(float meanL, float meanL
     return sqrtf(learnedMax(meanL2 - meanL * meanL, 0.0f));
 }
 
-// The lane loops (the pixel index, innermost): `omp simd` on the host compiler, so that GCC
-// vectorises them rather than unrolling them into scalar code; nothing for nvcc (N = 1 there).
-#if defined(__GNUC__) && !defined(__CUDACC__)
-#define ATROUS_LANES _Pragma("omp simd")
-#else
-#define ATROUS_LANES
-#endif
-// The unit loop of a layer fully unrolled on the device, so that the layer's outputs (and the MLP's
-// 34 raw outputs) stay in registers: without it nvcc kept v3's 34 outputs in a 136-byte local
-// array (ptxas -v, sm_90). Nothing on the host (GCC vectorises the lane loops instead).
-#if defined(__CUDACC__)
-#define ATROUS_DEVICE_UNROLL _Pragma("unroll")
-#else
-#define ATROUS_DEVICE_UNROLL
-#endif
+// ATROUS_LANES (the lane loops: `omp simd` on the host) and ATROUS_DEVICE_UNROLL (a layer's unit
+// loop unrolled by nvcc) are defined in atrous/platform.h, the one place that asks which compiler.
 
 // One dense layer on N pixels: y[j][l] = act(b[j] + sum_i x[i][l] w[i * NO + j]), the sum from the
 // bias in the order of i. (Four units per pass over x measured no faster: the multiply-adds, not
