@@ -43,12 +43,6 @@ std::vector<std::pair<int, Image>> sequenceImages(const std::string& dir, bool p
     return out;
 }
 
-std::string shellArg(const std::string& s) {
-    std::string out = "'";
-    for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return out + "'";
-}
-
 // A label ffmpeg's drawtext takes as it is: letters, digits and "_-." (others become '_').
 std::string plainLabel(const std::string& s) {
     std::string out;
@@ -92,8 +86,8 @@ void writeVideo(const std::string& path, const std::vector<std::string>& names,
         io::writeImage((tmpDir / name).string(), strip);
     }
     const std::string tmpVideo = (tmpDir / "video.mp4").string();
-    const std::string cmd = shellArg(ffmpeg) + " -nostdin -y -loglevel error -framerate 24 -i " + shellArg((tmpDir / "f%06d.png").string()) +
-                            " -vf " + shellArg(filter) + " -pix_fmt yuv420p -f mp4 " + shellArg(tmpVideo);
+    const std::string cmd = shellQuote(ffmpeg) + " -nostdin -y -loglevel error -framerate 24 -i " + shellQuote((tmpDir / "f%06d.png").string()) +
+                            " -vf " + shellQuote(filter) + " -pix_fmt yuv420p -f mp4 " + shellQuote(tmpVideo);
     const int rc = std::system(cmd.c_str());
     if (rc == 0) fs::rename(tmpVideo, out, ec);
     fs::remove_all(tmpDir);

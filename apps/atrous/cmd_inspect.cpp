@@ -120,11 +120,11 @@ void inspectSequence(const InspectArgs& a, const std::vector<io::PassRequest>& r
     }
 }
 
+// A folder without a colour file of its own, or a frame pattern (an existing file is inspected as one).
 bool isSequence(const std::string& file) {
     std::error_code ec;
     if (fs::is_directory(file, ec)) return io::dirBufferFile(file, "color").empty();
-    const std::string name = fs::path(file).filename().string();
-    return !fs::exists(file, ec) && (name.find('#') != std::string::npos || name.find('%') != std::string::npos);
+    return !fs::exists(file, ec) && io::isSequencePattern(file);
 }
 
 void run(const InspectArgs& a) {

@@ -41,12 +41,6 @@ double meanSquaredError(const Image& a, const Image& b) {
     return n ? sum / double(n) : 0.0;
 }
 
-std::string shellQuote(const std::string& s) {
-    std::string out = "'";
-    for (char c : s) out += (c == '\'') ? std::string("'\\''") : std::string(1, c);
-    return out + "'";
-}
-
 // Encodes the PNGs of `outDir` (the staging directory) into outDir/preview.mp4; messages name
 // `finalDir`, where the video ends up.
 void writeAnimatedPreview(const std::string& outDir, int firstIndex, bool quiet, const std::string& finalDir) {
@@ -81,6 +75,12 @@ void writeAnimatedPreview(const std::string& outDir, int firstIndex, bool quiet,
 
 void addSvgfOptions(CLI::App& cmd, SvgfParams& p) {
     addParamOptions(cmd, p, svgfParams(), [](const ParamField<SvgfParams>&) { return "SVGF (--method svgf)"; });
+}
+
+std::string shellQuote(const std::string& s) {
+    std::string out = "'";
+    for (char c : s) out += (c == '\'') ? std::string("'\\''") : std::string(1, c);
+    return out + "'";
 }
 
 std::string findOnPath(const std::string& name) {
@@ -201,10 +201,7 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
     // OUTDIR in the sequence directory would take its frame_NNNN.exr names (io/paths.h).
     // (A pattern's frames are in its directory.)
     std::error_code ec;
-    const fs::path seqPath(args.sequenceDir);
-    const std::string seqDir = fs::is_directory(seqPath, ec) || !seqPath.has_parent_path() ? args.sequenceDir
-                                                                                            : seqPath.parent_path().string();
-    io::refuseOutputInside("--out", args.outDir, seqDir.empty() ? "." : seqDir);
+    io::refuseOutputInside("--out", args.outDir, io::sequenceFolder(args.sequenceDir));
     std::vector<std::string> frames = io::listSequenceFrames(args.sequenceDir, args.range);
     if (!args.addPass.empty() && !io::isLayeredSequenceFrame(frames.front()))
         throw InputError("--add-pass '" + args.addPass + "': copies a layered EXR frame, and " + args.sequenceDir +

@@ -46,5 +46,7 @@ void addSvgfOptions(CLI::App& cmd, SvgfParams& params);
 
 // Full path of an executable named `name` on PATH, or "" when there is none.
 std::string findOnPath(const std::string& name);
+// `s` single-quoted for std::system's shell (ffmpeg's command lines).
+std::string shellQuote(const std::string& s);
 
 }  // namespace atrous::cli

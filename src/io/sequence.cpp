@@ -30,6 +30,10 @@ namespace {
 const Buffer kFileBuffer[10] = {Buffer::Color,  Buffer::Albedo, Buffer::Normal,   Buffer::Position, Buffer::Depth,
                                 Buffer::ObjectId, Buffer::Motion, Buffer::Emission, Buffer::Variance, Buffer::Color};
 
+bool allDigits(const std::string& s) {
+    return std::all_of(s.begin(), s.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
+}
+
 // "<stem><sep><digits>.exr" with a known stem: the stem's buffer, and <sep><digits>.exr in *tail
 // (sep one of "_", ".", "-"; one to eight digits). "" when the name is not one.
 std::string perBufferName(const std::string& name, std::string* tail) {
@@ -41,9 +45,7 @@ std::string perBufferName(const std::string& name, std::string* tail) {
             if (sep != '_' && sep != '.' && sep != '-') continue;
             const std::string rest = name.substr(stem.size() + 1);
             if (rest.size() < 5 || rest.size() > 12 || rest.compare(rest.size() - 4, 4, ".exr") != 0) continue;
-            const std::string digits = rest.substr(0, rest.size() - 4);
-            if (!std::all_of(digits.begin(), digits.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
-                continue;
+            if (!allDigits(rest.substr(0, rest.size() - 4))) continue;
             if (tail) *tail = name.substr(stem.size());
             return buffer;
         }
@@ -54,6 +56,9 @@ std::string perBufferName(const std::string& name, std::string* tail) {
 bool perBufferFrame(const std::string& frame, std::string* tail = nullptr) {
     return perBufferName(fs::path(frame).filename().string(), tail) == "color";
 }
+
+// The frame number of a per-buffer file's tail ("_0012.exr" -> 12).
+int perBufferIndex(const std::string& tail) { return std::stoi(tail.substr(1, tail.size() - 5)); }
 
 bool isLayeredFrame(const std::string& path) { return fs::path(path).extension() == ".exr" && !perBufferFrame(path); }
 
@@ -189,11 +194,7 @@ int parseLayeredFrameName(const std::string& fileName, std::string* prefix) {
     for (const char* suffix : {"_motion", "_reference"})
         if (stem.size() >= std::strlen(suffix) && stem.compare(stem.size() - std::strlen(suffix), std::string::npos, suffix) == 0)
             return -1;
-    size_t i = stem.size();
-    while (i > 0 && std::isdigit(static_cast<unsigned char>(stem[i - 1]))) --i;
-    if (i == stem.size() || stem.size() - i > 8) return -1;
-    if (prefix) *prefix = stem.substr(0, i);
-    return std::stoi(stem.substr(i));
+    return parseFolderFrameName(stem, prefix);  // the same rule: the number last, one to eight digits
 }
 
 namespace {
@@ -236,9 +237,7 @@ int matchFramePattern(const FramePattern& p, const std::string& name) {
         name.compare(name.size() - p.suffix.size(), p.suffix.size(), p.suffix) != 0)
         return -1;
     const std::string digits = name.substr(p.prefix.size(), name.size() - p.prefix.size() - p.suffix.size());
-    if (digits.empty() || digits.size() > 8 || int(digits.size()) < p.width ||
-        !std::all_of(digits.begin(), digits.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
-        return -1;
+    if (digits.empty() || digits.size() > 8 || int(digits.size()) < p.width || !allDigits(digits)) return -1;
     if (int(digits.size()) > std::max(p.width, 1) && digits[0] == '0') return -1;  // padded wider than the pattern
     return std::stoi(digits);
 }
@@ -251,6 +250,17 @@ std::string framePatternName(const FramePattern& p, int index) {
 
 }  // namespace
 
+bool isSequencePattern(const std::string& dirOrPattern) {
+    std::error_code ec;
+    FramePattern p;
+    return !fs::is_directory(dirOrPattern, ec) && parseFramePattern(dirOrPattern, &p);
+}
+
+std::string sequenceFolder(const std::string& dirOrPattern) {
+    FramePattern p;
+    return isSequencePattern(dirOrPattern) && parseFramePattern(dirOrPattern, &p) ? p.dir : dirOrPattern;
+}
+
 std::vector<std::string> listSequenceFrames(const std::string& dir, const FrameRange& range) {
     if (range.step < 1) throw InputError("--step: must be at least 1 (got " + std::to_string(range.step) + ")");
     if (range.start >= 0 && range.end >= 0 && range.end < range.start)
@@ -259,7 +269,7 @@ std::vector<std::string> listSequenceFrames(const std::string& dir, const FrameR
     std::vector<std::pair<int, std::string>> frames;
     std::function<std::string(int)> label;
     FramePattern pat;
-    if (!fs::is_directory(dir, ec) && parseFramePattern(dir, &pat)) {
+    if (isSequencePattern(dir) && parseFramePattern(dir, &pat)) {
         // A pattern as compositors write it: render####.exr, render%04d.exr.
         if (!fs::is_directory(pat.dir, ec)) throw InputError("sequence " + dir + ": " + pat.dir + " is not a directory");
         for (auto it = fs::directory_iterator(pat.dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
@@ -300,7 +310,7 @@ std::vector<std::string> listSequenceFrames(const std::string& dir, const FrameR
                 std::string tail;
                 const std::string buffer = perBufferName(name, &tail);
                 if (buffer == "color") {
-                    perBuffer.emplace_back(std::stoi(tail.substr(1, tail.size() - 5)), it->path().string());
+                    perBuffer.emplace_back(perBufferIndex(tail), it->path().string());
                     if (firstPerBuffer.empty()) firstPerBuffer = name;
                     continue;
                 }
@@ -478,7 +488,7 @@ SequenceFrame loadSequenceFrame(const std::string& frame, const std::vector<std:
     const std::string folderName = fs::path(frame).filename().string();
     std::string tail;
     f.index = parseSequenceFrameName(folderName);
-    if (perBufferFrame(frame, &tail)) f.index = std::stoi(tail.substr(1, tail.size() - 5));
+    if (perBufferFrame(frame, &tail)) f.index = perBufferIndex(tail);
     else if (f.index < 0) f.index = parseFolderFrameName(folderName);
     std::string firstPath;
     for (int i = 0; i < 10; ++i) {

@@ -65,6 +65,10 @@ struct FrameRange {
     int start = -1, end = -1, step = 1;
 };
 std::vector<std::string> listSequenceFrames(const std::string& dir, const FrameRange& range = {});
+// Whether a --sequence argument is a frame pattern (DIR/render####.exr, DIR/render%04d.exr; not an
+// existing directory), and the folder it names: the directory, or the pattern's ("." without one).
+bool isSequencePattern(const std::string& dirOrPattern);
+std::string sequenceFolder(const std::string& dirOrPattern);
 
 // Checks every frame without decoding pixels: each has a colour, every buffer is in every frame or
 // in none (a layered frame's passes as mapPasses finds them, its motion companion too), every
