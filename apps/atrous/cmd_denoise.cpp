@@ -176,9 +176,7 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     io::refuseOverwrite("--out", a.out, io::inputFiles(files));
     // Only the buffers the method reads are decoded (auto: by the buffers present).
     files.wanted = [&](io::Buffer b, const bool present[io::kBufferCount]) {
-        const DenoiseMethod m = o.method != DenoiseMethod::Auto ? o.method
-                                : present[int(io::Buffer::Albedo)] && present[int(io::Buffer::Normal)] ? DenoiseMethod::Blend
-                                                                                                      : DenoiseMethod::Sure;
+        const DenoiseMethod m = resolveDenoiseMethod(o.method, present[int(io::Buffer::Albedo)], present[int(io::Buffer::Normal)]);
         return io::methodReads(denoiseBufferUse(o, m), b);
     };
     Timer readTimer;

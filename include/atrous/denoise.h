@@ -217,6 +217,7 @@ struct DenoiseMethodInfo {
 };
 const std::vector<DenoiseMethodInfo>& denoiseMethods();  // eaw, sure, learned, blend, auto
 const DenoiseMethodInfo* findDenoiseMethod(const std::string& name);  // null when unknown
+const DenoiseMethodInfo& denoiseMethodInfo(DenoiseMethod m);          // the method's row
 // The names in order, "eaw, sure, learned, blend or auto".
 std::string denoiseMethodNames();
 
@@ -226,5 +227,7 @@ const char* denoiseMethodName(DenoiseMethod m);
 // What Auto becomes for these inputs: Blend with an albedo and a normal buffer, else Sure; any
 // other method is returned as it is.
 DenoiseMethod resolveDenoiseMethod(DenoiseMethod m, const DenoiseInputs& inputs);
+// The same rule from whether an albedo and a normal are given (a reader deciding what to decode).
+DenoiseMethod resolveDenoiseMethod(DenoiseMethod m, bool albedo, bool normal);
 
 }  // namespace atrous

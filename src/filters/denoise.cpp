@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,12 @@ const DenoiseMethodInfo* findDenoiseMethod(const std::string& name) {
     return nullptr;
 }
 
+const DenoiseMethodInfo& denoiseMethodInfo(DenoiseMethod m) {
+    for (const DenoiseMethodInfo& i : denoiseMethods())
+        if (i.method == m) return i;
+    throw std::logic_error("denoiseMethodInfo: a DenoiseMethod without a row in denoiseMethods()");
+}
+
 std::string denoiseMethodNames() {
     const auto& ms = denoiseMethods();
     std::string s;
@@ -57,18 +64,17 @@ DenoiseMethod parseDenoiseMethod(const std::string& name) {
     throw InputError("unknown denoise method '" + name + "' (expected " + denoiseMethodNames() + ")");
 }
 
-const char* denoiseMethodName(DenoiseMethod m) {
-    for (const DenoiseMethodInfo& i : denoiseMethods())
-        if (i.method == m) return i.name;
-    return "?";
-}
+const char* denoiseMethodName(DenoiseMethod m) { return denoiseMethodInfo(m).name; }
 
 // The network was trained with an albedo and a normal (docs/learned.md); without them SURE. With
 // them, the mean of the two (Blend): measured best on other renderers' stills (docs/quality.md).
-DenoiseMethod resolveDenoiseMethod(DenoiseMethod m, const DenoiseInputs& in) {
+DenoiseMethod resolveDenoiseMethod(DenoiseMethod m, bool albedo, bool normal) {
     if (m != DenoiseMethod::Auto) return m;
-    return in.albedo && !in.albedo->empty() && in.normal && !in.normal->empty() ? DenoiseMethod::Blend
-                                                                               : DenoiseMethod::Sure;
+    return albedo && normal ? DenoiseMethod::Blend : DenoiseMethod::Sure;
+}
+
+DenoiseMethod resolveDenoiseMethod(DenoiseMethod m, const DenoiseInputs& in) {
+    return resolveDenoiseMethod(m, in.albedo && !in.albedo->empty(), in.normal && !in.normal->empty());
 }
 
 // The ranges are params.h's table (one row per field); the library's own limits must agree.
@@ -337,7 +343,7 @@ PreparedInputs prepareInputsDropping(const DenoiseInputs& given, const DenoiseOp
     }
     const DenoiseBufferUse use = denoiseBufferUse(o, o.method);
     const bool learned = o.method == DenoiseMethod::Learned;
-    const bool network = learned || o.method == DenoiseMethod::Blend;
+    const bool network = denoiseMethodInfo(o.method).usesWeights;  // the learned cascade runs
     if (in.albedo) used += use.albedo ? ",albedo" : ",albedo(unused: demodulation off)";
     if (in.normal) used += ",normal";
     if (in.position) used += use.position ? ",position" : ",position(unused by learned)";
@@ -484,7 +490,7 @@ Image denoiseWith(const DenoiseInputs& given, const DenoiseOptions& options, con
     o.method = resolveDenoiseMethod(options.method, inputs);
     // The weights before any work: a bad file is an InputError naming it, nothing computed.
     LearnedWeights weights;
-    if (o.method == DenoiseMethod::Learned || o.method == DenoiseMethod::Blend)
+    if (denoiseMethodInfo(o.method).usesWeights)
         weights = o.learnedWeights.empty() ? LearnedWeights::builtin() : LearnedWeights::load(o.learnedWeights);
     filters::PreparedInputs prep = prepareCall(inputs, o, rep, true);
     prep.learned = weights;

@@ -97,7 +97,7 @@ inline AlbedoRule stillAlbedoRule(const DenoiseOptions& o) {
 }
 
 struct DriverConfig {
-    DenoiseOptions opts;  // opts.method is Eaw, Sure or Learned (Auto resolved by denoise())
+    DenoiseOptions opts;  // opts.method is Eaw, Sure, Learned or Blend (Auto resolved by denoise())
     LearnedWeights learned{};  // the learned method's weights (loaded by denoise())
     bool varianceGiven = true;  // false: the variance is a constant estimate
     // Without a variance: the local estimate (noise_estimate.h) over quadrants of this radius
@@ -191,7 +191,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     const bool blend = o.method == DenoiseMethod::Blend;
     const bool sure = o.method == DenoiseMethod::Sure || blend;
     const bool learned = o.method == DenoiseMethod::Learned;  // the learned method alone
-    const bool network = learned || blend;                    // the learned cascade runs
+    const bool network = denoiseMethodInfo(o.method).usesWeights;  // the learned cascade runs
     const int levels = o.eaw.levels;
     constexpr bool kHost = std::is_same<Exec, CpuExec>::value;
     // The CPU row engine compiles the depth and id terms out when they are off: their planes are
