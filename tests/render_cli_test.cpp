@@ -19,6 +19,7 @@ namespace atrous {
 namespace {
 
 namespace fs = std::filesystem;
+using test::sameImages;
 using test::countEntries;
 using test::runCli;
 using test::TempDir;
@@ -124,11 +125,6 @@ TEST(RenderCli, BadInputIsOneLineExitTwoNothingWritten) {
     expectBadInput("--scene cornell --width 0 --height 8 --spp 1", "--width: must be in 1..16384 (got 0)", tmp);
     expectBadInput("--scene cornell --width 8 --height 8 --spp 1 --max-depth 2000", "--max-depth: must be in 0..1024 (got 2000)", tmp);
     expectBadInput("--scene cornell --width 8 --height 8 --spp ''", "--spp", tmp);
-}
-
-bool sameImages(const Image& a, const Image& b) {
-    return a.width() == b.width() && a.height() == b.height() && a.channels() == b.channels() &&
-           std::equal(a.data(), a.data() + a.size(), b.data());
 }
 
 // render --denoise and denoise of the buffers it wrote take their inputs from the one assembly

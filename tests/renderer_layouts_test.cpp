@@ -14,6 +14,7 @@
 #include "test_util.h"
 
 using atrous::test::runCli;
+using atrous::test::sameImages;
 using atrous::test::TempDir;
 namespace fs = std::filesystem;
 
@@ -37,11 +38,6 @@ std::string renderFrames(const TempDir& dir, const std::string& scene, int frame
     auto r = runCli("render --scene " + scene + " --frames " + std::to_string(frames) + " --spp 1 --width 24 --height 16 --out " + seq);
     EXPECT_EQ(r.exitCode, 0) << r.output;
     return seq;
-}
-
-bool sameImages(const atrous::Image& a, const atrous::Image& b) {
-    return a.width() == b.width() && a.height() == b.height() && a.channels() == b.channels() &&
-           std::equal(a.data(), a.data() + a.size(), b.data());
 }
 
 }  // namespace

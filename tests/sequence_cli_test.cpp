@@ -12,6 +12,7 @@
 
 using atrous::test::countEntries;
 using atrous::test::runCli;
+using atrous::test::sameImages;
 using atrous::test::TempDir;
 namespace fs = std::filesystem;
 
@@ -41,11 +42,6 @@ TEST(SequenceCli, SvgfEawAndSureDenoiseEveryFrame) {
             EXPECT_EQ(img.height(), 24);
         }
     }
-}
-
-bool sameImages(const atrous::Image& a, const atrous::Image& b) {
-    return a.width() == b.width() && a.height() == b.height() && a.channels() == b.channels() &&
-           std::equal(a.data(), a.data() + a.size(), b.data());
 }
 
 // Per-frame EAW/SURE of a sequence uses every buffer of each frame, emission included, through the

@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <cstdlib>
@@ -23,6 +24,12 @@ inline Image rampImage(int w, int h, float dx, float dy, float dc) {
         for (int x = 0; x < w; ++x)
             for (int c = 0; c < 3; ++c) img(x, y, c) = dx * x + dy * y + dc * c + 0.125f;
     return img;
+}
+
+// Equal size, channels and values bit for bit (the CLI paths that must give the same image).
+inline bool sameImages(const Image& a, const Image& b) {
+    return a.width() == b.width() && a.height() == b.height() && a.channels() == b.channels() &&
+           std::equal(a.data(), a.data() + a.size(), b.data());
 }
 
 // A fresh directory under the system temp dir, removed when the object dies.
