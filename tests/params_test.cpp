@@ -58,6 +58,7 @@ TEST(ParamTables, EveryStructFieldHasARow) {
     EXPECT_EQ(rowsOf(d, "") + 8, fieldCount<DenoiseOptions>());
     EXPECT_EQ(d.count, rowsOf(d, "eaw") + rowsOf(d, "sure") + rowsOf(d, "firefly") + rowsOf(d, "safety") + rowsOf(d, ""));
     EXPECT_EQ(svgfParams().count, fieldCount<SvgfParams>());
+    EXPECT_EQ(temporalParams().count, fieldCount<TemporalParams>());
     EXPECT_EQ(renderParams().count + 1, fieldCount<RenderSettings>());  // samplesDone is no parameter
 }
 
@@ -78,6 +79,7 @@ void expectDistinctRows(const ParamTable<S>& t) {
 TEST(ParamTables, RowsAreDistinctFields) {
     expectDistinctRows(denoiseParams());
     expectDistinctRows(svgfParams());
+    expectDistinctRows(temporalParams());
     expectDistinctRows(renderParams());
 }
 
@@ -175,6 +177,7 @@ void cliRoundTrip(const ParamTable<S>& t) {
 TEST(ParamTables, EveryRowHasACliFlagThatSetsItsField) {
     cliRoundTrip(denoiseParams());
     cliRoundTrip(svgfParams());
+    cliRoundTrip(temporalParams());
     cliRoundTrip(renderParams());
 }
 
@@ -226,6 +229,7 @@ void outOfRange(const ParamTable<S>& t, void (*validate)(const S&), int minTried
 TEST(ParamTables, OutOfRangeValuesNameTheFieldOrTheFlag) {
     outOfRange(denoiseParams(), &validateDenoiseOptions);
     outOfRange(svgfParams(), &validateSvgfParams);
+    outOfRange(temporalParams(), &validateTemporalParams, 6);  // every row
     outOfRange(renderParams(), &validateRenderSettings, 5);  // width, height, spp, max_depth, threads
 }
 
@@ -318,6 +322,7 @@ void docsList(const ParamTable<S>& t, const std::string& doc) {
 TEST(ParamTables, DocsListEveryRow) {
     docsList(denoiseParams(), "denoising.md");
     docsList(svgfParams(), "svgf.md");
+    docsList(temporalParams(), "temporal.md");
 }
 
 }  // namespace

@@ -30,7 +30,7 @@ std::string renderSequence(const TempDir& dir) {
 TEST(SequenceCli, SvgfEawAndSureDenoiseEveryFrame) {
     TempDir dir;
     const std::string seq = renderSequence(dir);
-    for (const char* method : {"svgf", "eaw", "sure"}) {
+    for (const char* method : {"temporal", "svgf", "eaw", "sure"}) {
         const std::string out = dir / (std::string("out_") + method);
         auto r = runCli(std::string("denoise --method ") + method + " --sequence " + seq + " --out " + out);
         ASSERT_EQ(r.exitCode, 0) << r.output;
@@ -125,7 +125,7 @@ TEST(SequenceCli, TruncatedFrameLeavesTheOutputUntouched) {
     fs::resize_file(color, fs::file_size(color) * 2 / 3);
     fs::create_directories(dir / "old");
     std::ofstream(dir / "old/frame_0000.exr") << "old result";
-    for (const char* method : {"svgf", "eaw", "sure"}) {
+    for (const char* method : {"temporal", "svgf", "eaw", "sure"}) {
         for (const std::string out : {dir / "fresh", dir / "old"}) {
             auto r = runCli(std::string("denoise --method ") + method + " --sequence " + seq + " --out " + out);
             EXPECT_EQ(r.exitCode, 2) << r.output;

@@ -64,6 +64,7 @@ inline std::string flagOf(const ParamError& e) {
     if (e.set() == "scene") return "--scene";
     if (e.set() == "render") return in(renderParams());
     if (e.set() == "svgf") return in(svgfParams());
+    if (e.set() == "temporal") return in(temporalParams());
     if (e.set() == "denoise") return in(denoiseParams());
     return "";
 }

@@ -31,15 +31,18 @@ struct DenoiseArgs {
     std::string oidnFilter = "RT", oidnQuality;  // oidnDenoise's -f, -q (accepted; see addOidnFlags)
     bool oidnCleanAux = false;
     std::string method = "auto", device = "auto";
+    std::string spatial = "auto";  // --spatial: the still method of --method temporal
     io::FrameRange range;  // --start, --end, --step (with --sequence)
     DenoiseOptions opt;  // the filter parameters' flags write here (params.h's table)
     SvgfParams svgf;
+    TemporalParams temporal;
 };
 
 // Option groups: the flags of one method are ignored by the others (a note says which).
 const char* const kGroupEawSure = "EAW, SURE and learned (--method eaw|sure|learned|blend|auto; learned: see docs/denoising.md)";
 const char* const kGroupSure = "SURE (--method sure|blend)";
 const char* const kGroupSvgf = "SVGF (--method svgf)";  // addSvgfOptions' group
+const char* const kGroupTemporal = "Temporal (--method temporal, the default with --sequence)";  // addTemporalOptions' group
 const char* const kGroupBuffers = "Buffers (without --sequence)";
 const char* const kGroupLearned = "Learned (--method learned|blend|auto, or svgf --svgf-learned-spatial)";
 
@@ -62,15 +65,18 @@ bool ignoredByLearned(const std::string& flag) {
 
 // One note line on stderr naming the given flags that the chosen method (or --sequence) ignores.
 // learnedSvgf: --method svgf with --svgf-learned-spatial (which reads --learned-weights).
-void noteIgnoredFlags(const CLI::App& cmd, const std::string& method, bool sequence, bool learnedSvgf) {
+// still: the still method that runs (--spatial's with temporal; "svgf" with svgf).
+void noteIgnoredFlags(const CLI::App& cmd, const std::string& method, const std::string& still, bool sequence,
+                      bool learnedSvgf) {
     std::string ignored, ignoredSeq;
     for (const CLI::Option* opt : cmd.get_options()) {
         if (opt->count() == 0) continue;
         const std::string& g = opt->get_group();
-        const bool unused = (g == kGroupEawSure && method == "svgf") || (g == kGroupSure && method != "sure" && method != "blend" && method != "auto") ||
-                            (g == kGroupSvgf && method != "svgf") ||
-                            (g == kGroupLearned && !learnedMethod(method) && !learnedSvgf) ||
-                            (method == "learned" && ignoredByLearned(opt->get_name()));
+        const bool unused = (g == kGroupEawSure && still == "svgf") ||
+                            (g == kGroupSure && still != "sure" && still != "blend" && still != "auto") ||
+                            (g == kGroupSvgf && method != "svgf") || (g == kGroupTemporal && method != "temporal") ||
+                            (g == kGroupLearned && !learnedMethod(still) && !learnedSvgf) ||
+                            (still == "learned" && ignoredByLearned(opt->get_name()));
         if (unused) ignored += (ignored.empty() ? "" : ", ") + opt->get_name();
         if (g == kGroupBuffers && sequence) ignoredSeq += (ignoredSeq.empty() ? "" : ", ") + opt->get_name();
     }
@@ -133,20 +139,31 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     const bool sequence = !a.sequence.empty();
     for (const char* f : {"--start", "--end", "--step"})
         if (!sequence && cmd.count(f) > 0) throw InputError(std::string(f) + ": picks frames of a --sequence; give one");
-    if (a.method != "svgf" && !findDenoiseMethod(a.method))
+    // A sequence without --method: the offline temporal method (the frames around each one).
+    if (sequence && cmd.count("--method") == 0) a.method = "temporal";
+    const bool sequenceMethod = a.method == "svgf" || a.method == "temporal";
+    if (!sequenceMethod && !findDenoiseMethod(a.method))
         throw InputError("--method: unknown denoise method '" + a.method + "' (expected " + denoiseMethodNames() +
-                         ", or svgf with --sequence)");
-    if (a.method == "svgf" && !sequence)
-        throw InputError("--method svgf denoises animated sequences: give --sequence DIR (and an output directory)");
-    o.method = a.method == "svgf" ? DenoiseMethod::Sure : parseDenoiseMethod(a.method);
+                         ", or temporal or svgf with --sequence)");
+    if (sequenceMethod && !sequence)
+        throw InputError("--method " + a.method + " denoises animated sequences: give --sequence DIR (and an output directory)");
+    if (cmd.count("--spatial") > 0 && a.method != "temporal")
+        throw InputError("--spatial: the still method of --method temporal (the default with --sequence); --method is " +
+                         a.method);
+    if (a.method == "temporal" && !findDenoiseMethod(a.spatial))
+        throw InputError("--spatial: unknown still method '" + a.spatial + "' (expected " + denoiseMethodNames() + ")");
+    o.method = a.method == "svgf" ? DenoiseMethod::Sure
+                                  : parseDenoiseMethod(a.method == "temporal" ? a.spatial : a.method);
     checkParamFlags(o, denoiseParams(), cmd);
     if (a.method == "svgf") checkParamFlags(a.svgf, svgfParams(), cmd);
+    if (a.method == "temporal") checkParamFlags(a.temporal, temporalParams(), cmd);
     o.device = parseDevice(a.device);
     const bool learnedSvgf = a.method == "svgf" && a.svgf.learnedSpatial;
-    noteIgnoredFlags(cmd, a.method, sequence, learnedSvgf);
+    const std::string still = a.method == "temporal" ? a.spatial : a.method;
+    noteIgnoredFlags(cmd, a.method, still, sequence, learnedSvgf);
     // A bad weight file fails here, before any buffer is read or anything written.
     LearnedWeights weights;
-    if ((learnedMethod(a.method) || learnedSvgf) && !o.learnedWeights.empty())
+    if ((learnedMethod(still) || learnedSvgf) && !o.learnedWeights.empty())
         weights = withFlag("--learned-weights", [&] { return LearnedWeights::load(o.learnedWeights); });
     if (sequence) {
         if (!a.inDir.empty() || !a.color.empty())
@@ -157,6 +174,7 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
         s.outDir = a.out;
         s.device = o.device;
         s.svgf = a.svgf;
+        s.temporal = a.temporal;
         s.frameOptions = o;
         s.svgfLearnedWeights = weights;
         s.layers.passes = withFlag("--pass", [&] { return io::parsePassRequests(a.passes); });
@@ -304,9 +322,14 @@ void addDenoiseCommand(CLI::App& app) {
     std::string methodHelp;
     for (const DenoiseMethodInfo& m : denoiseMethods()) methodHelp += std::string(m.name) + ": " + m.summary + "; ";
     cmd->add_option("--method", a->method,
-                    methodHelp + "svgf (with --sequence): spatiotemporal variance-guided filtering. The output line says "
-                                 "which method ran")
+                    methodHelp +
+                        "temporal (with --sequence, its default): frames t-K..t+K reprojected onto t and averaged, "
+                        "then the still method --spatial; svgf (with --sequence): spatiotemporal variance-guided "
+                        "filtering, causal (each frame from the ones before it). The output line says which method ran")
         ->capture_default_str();
+    cmd->add_option("--spatial", a->spatial, "With --method temporal: the still method run on the averaged frame")
+        ->capture_default_str()
+        ->group(kGroupTemporal);
     cmd->add_option("--learned-weights", a->opt.learnedWeights,
                     "Weight file of the learned filter (version 3, docs/learned.md; default: the built-in weights)")
         ->group(kGroupLearned);
@@ -324,6 +347,7 @@ void addDenoiseCommand(CLI::App& app) {
         return std::string(f.group) == "sure" ? kGroupSure : kGroupEawSure;
     });
     addSvgfOptions(*cmd, a->svgf);
+    addTemporalOptions(*cmd, a->temporal);
     cmd->callback([a, cmd] { run(*a, *cmd); });
 }
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <deque>
 #include <filesystem>
 #include <future>
 #include <memory>
@@ -13,6 +14,7 @@
 #include <vector>
 
 #include "atrous/error.h"
+#include "atrous/temporal.h"
 #include "cli_flags.h"
 #include "core/timer.h"
 #include "io/buffer_set.h"
@@ -75,6 +77,12 @@ void writeAnimatedPreview(const std::string& outDir, int firstIndex, bool quiet,
 
 void addSvgfOptions(CLI::App& cmd, SvgfParams& p) {
     addParamOptions(cmd, p, svgfParams(), [](const ParamField<SvgfParams>&) { return "SVGF (--method svgf)"; });
+}
+
+void addTemporalOptions(CLI::App& cmd, TemporalParams& p) {
+    addParamOptions(cmd, p, temporalParams(), [](const ParamField<TemporalParams>&) {
+        return "Temporal (--method temporal, the default with --sequence)";
+    });
 }
 
 std::string shellQuote(const std::string& s) {
@@ -185,14 +193,16 @@ private:
 }  // namespace
 
 int runSequenceDenoise(const SequenceDenoiseArgs& args) {
-    const bool svgf = args.method == "svgf";
-    if (!svgf && !findDenoiseMethod(args.method))
-        throw InputError("--method '" + args.method + "' cannot denoise a sequence (expected svgf, " + denoiseMethodNames() + ")");
+    const bool svgf = args.method == "svgf", temporal = args.method == "temporal";
+    if (!svgf && !temporal && !findDenoiseMethod(args.method))
+        throw InputError("--method '" + args.method + "' cannot denoise a sequence (expected temporal, svgf, " +
+                         denoiseMethodNames() + ")");
     if (args.sequenceDir.empty()) throw InputError("--sequence: no directory given");
-    if (svgf && args.range.step > 1)
-        throw InputError("--step " + std::to_string(args.range.step) +
-                         ": SVGF carries its history from one frame to the next, and the motion vectors do not span "
-                         "skipped frames (use --step 1, or a per-frame --method)");
+    if ((svgf || temporal) && args.range.step > 1)
+        throw InputError("--step " + std::to_string(args.range.step) + ": " +
+                         (svgf ? "SVGF carries its history from one frame to the next"
+                               : "the temporal method averages neighbouring frames") +
+                         ", and the motion vectors do not span skipped frames (use --step 1, or a per-frame --method)");
     if (args.outDir.empty()) throw InputError("--out: no output directory given");
     if (!(args.exposure > 0.0f)) throw InputError("--exposure must be > 0");
 
@@ -200,7 +210,6 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
     // (a truncated EXR) fails inside the loop, before anything reaches OUTDIR (StagedOutput).
     // OUTDIR in the sequence directory would take its frame_NNNN.exr names (io/paths.h).
     // (A pattern's frames are in its directory.)
-    std::error_code ec;
     io::refuseOutputInside("--out", args.outDir, io::sequenceFolder(args.sequenceDir));
     std::vector<std::string> frames = io::listSequenceFrames(args.sequenceDir, args.range);
     if (!args.addPass.empty() && !io::isLayeredSequenceFrame(frames.front()))
@@ -210,11 +219,13 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
     const std::vector<std::string> present = io::validateSequence(frames, width, height, args.layers);
     std::unique_ptr<SvgfDenoiser> svgfDenoiser;
     DenoiseOptions options = args.frameOptions;
+    if (temporal) validateTemporalParams(args.temporal);
     if (svgf) {
         // The weight file was read and checked by cmd_denoise.cpp, before the frames.
         svgfDenoiser = std::make_unique<SvgfDenoiser>(args.svgf, args.device, args.svgfLearnedWeights);
     } else {
-        options.method = parseDenoiseMethod(args.method);
+        // (temporal: frameOptions.method is the still method run on the average, --spatial)
+        if (!temporal) options.method = parseDenoiseMethod(args.method);
         options.device = args.device;
         validateDenoiseOptions(options);
         // A bad --learned-weights file has failed already, in cmd_denoise.cpp (its one caller).
@@ -224,9 +235,14 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
     StagedOutput staged(args.outDir);
     const std::string stage = staged.stage();
 
-    int firstIndex = -1;
+    // Frames are read in order; frame i is denoised once frames up to i + radius are in (temporal;
+    // the other methods: radius 0). `window` holds frames winFirst .. the last read.
+    const size_t radius = temporal ? size_t(args.temporal.radius) : 0;
+    std::deque<io::SequenceFrame> window;
+    size_t winFirst = 0;
+    int firstIndex = 0;
+    std::vector<ReprojectionCheck> checks(frames.size());
     bool idsTrusted = true, warnedSign = false, notedMotion = false;
-    io::SequenceFrame prev;
     // Pipelined: frame N+1 is read and frame N-1 written (EXR and PNG) on other threads while
     // frame N is filtered. An error in either reaches this thread through its future, in frame
     // order; nothing reaches OUTDIR before every frame is done (StagedOutput).
@@ -235,44 +251,34 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
     std::future<void> writing;
     Timer wall;
     double filterMs = 0.0;
-    for (size_t i = 0; i < frames.size(); ++i) {
-        io::SequenceFrame f = next.get();
-        if (i + 1 < frames.size()) next = std::async(std::launch::async, load, i + 1);
-        if (firstIndex < 0) firstIndex = f.index;
-        std::string name = io::sequenceFrameName(f.index);
-        // Other renderers' sequences: how much reprojects, with which sign, and whether ids hold.
-        ReprojectionCheck check;
-        if (firstIndex != f.index)
-            check = checkReprojection(f.depth, f.normal, f.ids, f.motion, prev.depth, prev.normal, prev.ids);
-        if (svgf && f.motion.empty() && !notedMotion) {
-            std::printf("denoise: note: the frames have no motion vectors: SVGF assumes nothing moves on screen\n");
-            notedMotion = true;
-        }
-        if (check.tested >= 64 && !warnedSign && check.keptNegated > check.kept + 0.2 && check.keptNegated > 0.5) {
-            std::printf("denoise: warning: %s: the motion vectors look like the opposite sign convention (%.0f%% of the "
-                         "frame reprojects as given, %.0f%% negated); atrous wants previous - current, in pixels, y down\n",
-                         name.c_str(), 100 * check.kept, 100 * check.keptNegated);
-            warnedSign = true;
-        }
-        if (idsTrusted && !f.ids.empty() && check.tested >= 64 && check.kept > 0.2 && check.idsAgree < 0.9) {
-            std::printf("denoise: note: %s: the ids change between frames (%.0f%% agree after reprojection): not used "
-                         "from here on (Mitsuba renumbers shapes when a scene is loaded)\n",
-                         name.c_str(), 100 * check.idsAgree);
-            idsTrusted = false;
-        }
+
+    auto refsOf = [&](const io::SequenceFrame& f) {
+        io::BufferRefs refs = io::refsOf(f);  // every buffer the frame has, through the one input assembly
+        if (!idsTrusted) refs.set(io::Buffer::ObjectId, nullptr);
+        return refs;
+    };
+    auto denoiseOne = [&](size_t i) {
+        io::SequenceFrame& f = window[i - winFirst];
+        const std::string name = io::sequenceFrameName(f.index);
+        const ReprojectionCheck& check = checks[i];
         Timer timer;
         Image out;
-        // Every buffer the frame has (emission included), through the one input assembly.
-        io::BufferRefs refs = io::refsOf(f);
-        if (!idsTrusted) refs.set(io::Buffer::ObjectId, nullptr);
+        TemporalReport temporalReport;
         const double mseIn = f.reference.empty() ? 0.0 : meanSquaredError(f.color, f.reference);
         try {
             if (svgf) {
-                out = svgfDenoiser->denoiseFrame(io::svgfFrame(refs));
+                out = svgfDenoiser->denoiseFrame(io::svgfFrame(refsOf(f)));
+            } else if (temporal) {
+                std::vector<io::BufferRefs> refs;
+                std::vector<SvgfFrame> frameSet;
+                for (const io::SequenceFrame& w : window) refs.push_back(refsOf(w));
+                for (const io::BufferRefs& r : refs) frameSet.push_back(io::svgfFrame(r));
+                out = denoiseTemporal(frameSet, i - winFirst, args.temporal, options, &temporalReport);
+                frameReport.methodUsed = temporalReport.spatial.methodUsed;
             } else {
                 // The frame's colour, variance and emission are not read after this: the filter works
                 // in their storage.
-                const DenoiseInputs in = io::denoiseInputs(refs);
+                const DenoiseInputs in = io::denoiseInputs(refsOf(f));
                 DenoiseBuffers bufs;
                 bufs.color = &f.color;
                 bufs.variance = f.variance.empty() ? nullptr : &f.variance;
@@ -297,17 +303,74 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
                 io::writeImage(exrOut, *img);
             io::writePng((fs::path(stage) / (name + ".png")).string(), *img, args.exposure);
         });
-        if (!args.quiet) {
-            std::printf("%s: %s%s%s %.1f ms", name.c_str(), args.method.c_str(),
-                        args.method == "auto" ? " -> " : (svgf && args.svgf.learnedSpatial ? " (learned spatial)" : ""),
-                        args.method == "auto" ? denoiseMethodName(frameReport.methodUsed) : "", ms);
-            if (check.tested > 0) std::printf(", %.0f%% reprojects onto the previous frame", 100 * check.kept);
-            if (!f.reference.empty())
-                std::printf(", MSE vs reference %.6g (input %.6g)", mseOut, mseIn);
-            std::printf("\n");
-            std::fflush(stdout);
+        if (args.quiet) return;
+        const bool resolved = args.method == "auto" || (temporal && options.method == DenoiseMethod::Auto);
+        std::printf("%s: %s", name.c_str(), args.method.c_str());
+        if (temporal)
+            std::printf(" (+-%zu frames, %.1f averaged per pixel; then %s%s%s)", radius, temporalReport.meanFrames,
+                        denoiseMethodName(options.method), resolved ? " -> " : "",
+                        resolved ? denoiseMethodName(frameReport.methodUsed) : "");
+        else if (resolved)
+            std::printf(" -> %s", denoiseMethodName(frameReport.methodUsed));
+        else if (svgf && args.svgf.learnedSpatial)
+            std::printf(" (learned spatial)");
+        std::printf(" %.1f ms", ms);
+        if (check.tested > 0) std::printf(", %.0f%% reprojects onto the previous frame", 100 * check.kept);
+        if (!f.reference.empty()) std::printf(", MSE vs reference %.6g (input %.6g)", mseOut, mseIn);
+        std::printf("\n");
+        std::fflush(stdout);
+    };
+
+    size_t nextOut = 0;
+    for (size_t i = 0; i < frames.size(); ++i) {
+        io::SequenceFrame f = next.get();
+        if (i + 1 < frames.size()) next = std::async(std::launch::async, load, i + 1);
+        const std::string name = io::sequenceFrameName(f.index);
+        if (i == 0) firstIndex = f.index;
+        // Other renderers' sequences: how much reprojects, with which sign, and whether ids hold.
+        ReprojectionCheck& check = checks[i];
+        if (!window.empty()) {
+            const io::SequenceFrame& prev = window.back();
+            check = checkReprojection(f.depth, f.normal, f.ids, f.motion, prev.depth, prev.normal, prev.ids);
         }
-        prev = std::move(f);
+        if ((svgf || (temporal && radius > 0)) && f.motion.empty() && !notedMotion) {
+            std::printf("denoise: note: the frames have no motion vectors: %s\n",
+                        svgf ? "SVGF assumes nothing moves on screen"
+                             : "the temporal method takes them as still and leaves out what the depth, normal and "
+                               "colour tests find moved");
+            notedMotion = true;
+        }
+        if (check.tested >= 64 && !warnedSign && check.keptNegated > check.kept + 0.2 && check.keptNegated > 0.5) {
+            std::printf("denoise: warning: %s: the motion vectors look like the opposite sign convention (%.0f%% of the "
+                         "frame reprojects as given, %.0f%% negated); atrous wants previous - current, in pixels, y down\n",
+                         name.c_str(), 100 * check.kept, 100 * check.keptNegated);
+            warnedSign = true;
+        }
+        if (idsTrusted && !f.ids.empty() && check.tested >= 64 && check.kept > 0.2 && check.idsAgree < 0.9) {
+            std::printf("denoise: note: %s: the ids change between frames (%.0f%% agree after reprojection): not used "
+                         "from here on (Mitsuba renumbers shapes when a scene is loaded)\n",
+                         name.c_str(), 100 * check.idsAgree);
+            idsTrusted = false;
+        }
+        if (temporal) {
+            // Each frame is checked as it arrives, so a bad value is named by its own file (the
+            // window's checks would name the frame being denoised).
+            try {
+                checkTemporalFrame(io::svgfFrame(refsOf(f)));
+            } catch (const InputError& e) {
+                throw InputError(io::withSourceFile(e.what(), [&](const std::string& b) { return f.fileOf(b); }, f.dir));
+            }
+        }
+        window.push_back(std::move(f));
+        // Denoise every frame whose window is complete (at the end: all that are left).
+        for (; nextOut < frames.size() && (nextOut + radius <= i || i + 1 == frames.size()); ++nextOut) {
+            denoiseOne(nextOut);
+            // Keep the frames the next one's window needs, and always the last read (the next check's).
+            while (winFirst + radius < nextOut + 1 && window.size() > 1) {
+                window.pop_front();
+                ++winFirst;
+            }
+        }
     }
     if (writing.valid()) writing.get();
     if (!args.quiet)

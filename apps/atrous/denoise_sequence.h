@@ -1,7 +1,9 @@
-// `atrous denoise --method svgf|eaw|sure|learned|auto --sequence DIR --out OUTDIR`: denoises every frame of a
-// sequence directory (layout in src/io/sequence.h and docs/svgf.md). SVGF carries its history from
-// frame to frame; EAW, SURE and the learned filter denoise each frame on its own through
-// atrous::denoise() (auto: resolved per frame, by the buffers the frame has).
+// `atrous denoise --method temporal|svgf|eaw|sure|learned|blend|auto --sequence DIR --out OUTDIR`:
+// denoises every frame of a sequence directory (layout in src/io/sequence.h and docs/svgf.md).
+// temporal (the default with --sequence): the frames t-K..t+K averaged onto t, then a still method
+// (atrous/temporal.h, docs/temporal.md). SVGF carries its history from frame to frame; the still
+// methods denoise each frame on its own through atrous::denoise() (auto: resolved per frame, by
+// the buffers the frame has).
 #pragma once
 #include <CLI/CLI.hpp>
 
@@ -11,17 +13,21 @@
 #include "atrous/device.h"
 #include "atrous/learned.h"
 #include "atrous/svgf.h"
+#include "atrous/temporal.h"
 #include "io/sequence.h"
 
 namespace atrous::cli {
 
 struct SequenceDenoiseArgs {
-    std::string method = "svgf";  // svgf | eaw | sure | learned | auto
+    std::string method = "temporal";  // temporal | svgf | a still method (denoiseMethods())
     std::string sequenceDir;
     std::string outDir;
     Device device = Device::Cpu;
     SvgfParams svgf;              // used by --method svgf
-    DenoiseOptions frameOptions;  // used by eaw/sure/learned/auto (method and device are set from the fields above)
+    // The still methods' options (method and device are set from the fields above); with temporal,
+    // frameOptions.method is the still method run on the average (--spatial).
+    DenoiseOptions frameOptions;
+    TemporalParams temporal;      // used by --method temporal
     LearnedWeights svgfLearnedWeights;  // svgf.learnedSpatial's (--learned-weights); empty = the built-in ones
     io::SequenceOptions layers;   // --pass and --layer, applied to every layered frame
     std::string addPass;          // --add-pass: each output frame a copy of its layered frame with this pass
@@ -43,6 +49,8 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args);
 // spellings), writing into `params`; the defaults shown are the struct's. Ranges are checked later
 // (checkParamFlags, or validateSvgfParams: a ParamError naming the field).
 void addSvgfOptions(CLI::App& cmd, SvgfParams& params);
+// The same for temporalParams(): --temporal-radius, --temporal-color-sigmas, ...
+void addTemporalOptions(CLI::App& cmd, TemporalParams& params);
 
 // Full path of an executable named `name` on PATH, or "" when there is none.
 std::string findOnPath(const std::string& name);

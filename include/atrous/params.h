@@ -8,6 +8,7 @@
 //   denoiseParams(): DenoiseOptions' scalars with its EawParams, SureParams, FireflyParams and
 //                    SafetyNetParams (each row says which in `group`); CLI flag --<name>
 //   svgfParams():    SvgfParams; CLI flag --svgf-<name> (a few keep older spellings, `flag`)
+//   temporalParams(): TemporalParams (the offline sequence denoiser); CLI flag --temporal-<name>
 //   renderParams():  RenderSettings (but its progress counter); CLI flag --<name> of `atrous render`
 //                    and `atrous view`
 #pragma once
@@ -27,6 +28,7 @@
 #include "atrous/image.h"
 #include "atrous/render.h"
 #include "atrous/svgf.h"
+#include "atrous/temporal.h"
 
 namespace atrous {
 
@@ -132,6 +134,7 @@ std::string checkCandidates(const DenoiseOptions& o);
 using D = DenoiseOptions;
 using P = SvgfParams;
 using R = RenderSettings;
+using T = TemporalParams;
 // clang-format off
 inline const ParamField<D> kDenoise[] = {
     {"levels", &at2<&D::eaw, &EawParams::levels>, paramIn(1, 10), "a-trous levels (5 reach +-62 pixels)", "eaw"},
@@ -211,6 +214,19 @@ inline const ParamField<P> kSvgf[] = {
      "filter instead of SVGF's a-trous"},
 };
 
+inline const ParamField<T> kTemporal[] = {
+    {"radius", &at<&T::radius>, paramIn(0, 16), "frames on each side of the one denoised (0 = that frame alone)"},
+    {"depth_tolerance", &at<&T::depthTolerance>, paramAtLeast(0),
+     "reprojection depth test tau_z, relative to the depth gradient"},
+    {"normal_cos", &at<&T::normalCos>, paramIn(-1, 1), "reprojection: minimum cosine between normals"},
+    {"color_sigmas", &at<&T::colorSigmas>, paramAtLeast(0),
+     "leave a neighbour out where its 3x3 mean luminance differs by more than this many standard errors (0 = off)"},
+    {"falloff", &at<&T::falloff>, paramAtLeast(0),
+     "frame t+-k weighs exp(-k^2 / (2 falloff^2)) in the average (0 = all frames equal)"},
+    {"firefly_k", &at<&T::fireflyK>, paramZeroOr(1e-6, "off"),
+     "each frame's fireflies are clamped to k local standard deviations before averaging (0 = off)"},
+};
+
 // threads: a ceiling, since tbb::task_arena aborts in its destructor from 65537 threads on
 // (docs/reliability.md).
 inline const ParamField<R> kRender[] = {
@@ -234,6 +250,11 @@ inline const ParamTable<DenoiseOptions>& denoiseParams() {
 }
 inline const ParamTable<SvgfParams>& svgfParams() {
     static const ParamTable<SvgfParams> t{"svgf", "svgf-", params_detail::kSvgf, std::size(params_detail::kSvgf)};
+    return t;
+}
+inline const ParamTable<TemporalParams>& temporalParams() {
+    static const ParamTable<TemporalParams> t{"temporal", "temporal-", params_detail::kTemporal,
+                                              std::size(params_detail::kTemporal)};
     return t;
 }
 inline const ParamTable<RenderSettings>& renderParams() {

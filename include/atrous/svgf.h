@@ -84,6 +84,10 @@ struct SvgfFrame {
     const Image* ids = nullptr;       // mesh id in channel 0, -1 for background
     const Image* motion = nullptr;    // channel 0 = dx, channel 1 = dy in pixels, previous - current
     const Image* emission = nullptr;  // optional: emitted radiance at the primary hit, 3 channels
+    // Read by the offline sequence denoiser (atrous/temporal.h) only; SVGF estimates its own
+    // variance and has no use for positions.
+    const Image* variance = nullptr;  // variance of the colour's mean, per channel (1 or 3 channels)
+    const Image* position = nullptr;  // world-space hit points, 3 channels
 };
 
 // What the last timed frame did: per-stage times (SvgfDenoiser::setReport).

@@ -69,7 +69,8 @@ DenoiseInputs denoiseInputs(const BufferRefs& r) {
 // The same buffers as denoiseInputs() gives, plus motion (SvgfFrame's order).
 SvgfFrame svgfFrame(const BufferRefs& r) {
     const DenoiseInputs in = denoiseInputs(r);
-    return SvgfFrame{in.color, in.albedo, in.normal, in.depth, in.ids, r.get(Buffer::Motion), in.emission};
+    return SvgfFrame{in.color,    in.albedo,   in.normal,  in.depth, in.ids, r.get(Buffer::Motion),
+                     in.emission, in.variance, in.position};
 }
 
 namespace {

@@ -10,7 +10,7 @@ import zlib
 from fuzz_files import outputs_finite, write_exr, write_pfm
 import fuzz_proc
 from fuzz_proc import SMALL_INPUT_BYTES, entries, input_roots, modified, run_watched, snapshot
-from fuzz_mutate import (DENOISE_FLAGS, FLOAT_SPECIALS, NUM_VALUES, RENDER_FLAGS, SVGF_FLAGS, _isint, mutate_bytes,
+from fuzz_mutate import (DENOISE_FLAGS, FLOAT_SPECIALS, NUM_VALUES, RENDER_FLAGS, SVGF_FLAGS, TEMPORAL_FLAGS, _isint, mutate_bytes,
                          mutate_json, mutate_mtl, mutate_obj, mutate_pfm)
 
 FAILURES = ["crash", "hang", "wrong-code", "bad-message", "partial-output", "nan-inf", "accepted-bad", "memory",
@@ -187,7 +187,7 @@ def _build(cid, rng, seeds, work, cli, klass, d, ordinal, seed):
         f = rng.randrange(3)
         name = rng.choice(["color", "albedo", "normal", "depth", "motion", "ids"])
         p = os.path.join(seq, "frame_%04d" % f, name + ".exr")
-        method = rng.choice(["svgf", "svgf", "sure", "eaw"])
+        method = rng.choice(["svgf", "svgf", "sure", "eaw", "temporal", "temporal"])
         kind = rng.choice(["bytes", "values", "delete", "flag"])
         bad = None
         extra = []
@@ -210,7 +210,7 @@ def _build(cid, rng, seeds, work, cli, klass, d, ordinal, seed):
             os.remove(p)
             bad = True if name in ("color",) else None
         else:
-            flag, ok = rng.choice(SVGF_FLAGS if method == "svgf" else DENOISE_FLAGS)
+            flag, ok = rng.choice({"svgf": SVGF_FLAGS, "temporal": TEMPORAL_FLAGS + DENOISE_FLAGS}.get(method, DENOISE_FLAGS))
             v = rng.choice(NUM_VALUES)
             extra = [flag, v]
             bad = not ok(v)

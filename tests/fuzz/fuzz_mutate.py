@@ -203,3 +203,8 @@ SVGF_FLAGS = [
     ("--svgf-moments-alpha", _in(1e-38, 1, False)), ("--svgf-history-cap", _in(1, 1 << 20)),
     ("--svgf-levels", _in(0, 10)), ("--taa-alpha", _in(1e-38, 1, False)),
 ]
+TEMPORAL_FLAGS = [
+    ("--temporal-radius", _in(0, 16)), ("--temporal-depth-tolerance", _in(0, 3e38, False)),
+    ("--temporal-normal-cos", _in(-1, 1, False)), ("--temporal-color-sigmas", _in(0, 3e38, False)),
+    ("--temporal-falloff", _in(0, 3e38, False)), ("--temporal-firefly-k", _in(1e-6, 3e38, False, True)),
+]

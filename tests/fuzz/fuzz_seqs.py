@@ -51,7 +51,7 @@ def build_seq(cid, rng, seeds, d, cli, klass, ordinal, seed):
     os.makedirs(seq)
     nframes = 3
     pattern = rng.choice(NAMES)
-    method = rng.choice(["svgf", "svgf", "sure", "eaw"])
+    method = rng.choice(["svgf", "svgf", "sure", "eaw", "temporal", "temporal"])
     j = rng.randrange(nframes)  # the frame the kind acts on
     must, good = None, False
     names = [seq]
@@ -135,7 +135,7 @@ def build_seq(cid, rng, seeds, d, cli, klass, ordinal, seed):
             elif rng.random() < 0.5:
                 data, k2, _ = mutate_bytes(rng, open(comps[j], "rb").read(), 200)
                 open(comps[j], "wb").write(data)
-                must = True if k2 == "truncate" and method == "svgf" else None  # still methods need no motion
+                must = True if k2 == "truncate" and method in ("svgf", "temporal") else None  # still methods need no motion
                 note += " companion " + k2
             else:
                 good = True

@@ -1,0 +1,79 @@
+// The offline sequence denoiser (docs/temporal.md): frame t of an animation is denoised with the
+// frames t-K .. t+K around it. Each neighbour is reprojected onto frame t through the motion
+// vectors (chained frame by frame; the frames after t through the inverse of their own backward
+// motion, so one motion convention serves both sides), its taps kept only where depth, normal
+// and id agree with the frame it was reached from (SVGF's test, hop by hop) and, optionally,
+// where its local colour agrees with frame t's; the kept colour, albedo, normal and emission are
+// averaged, and the average is filtered by a still method (the default: auto). A film is
+// denoised after rendering, so unlike SVGF nothing here is causal: frame t uses its future too.
+#pragma once
+#include <vector>
+
+#include "atrous/denoise.h"
+#include "atrous/image.h"
+#include "atrous/svgf.h"
+
+namespace atrous {
+
+// Every knob; its table is temporalParams() in atrous/params.h (CLI --temporal-<name>, Python).
+struct TemporalParams {
+    // Frames on each side of t (0 = frame t alone: the still method per frame). Measured on the
+    // corpus's orbits (docs/quality.md, "Sequences"): 1 spp, 20 frames.
+    int radius = 3;
+    // The hop test (svgf_reproject.h's): |z_q - z_p| <= τ_z (|dz/dx| + |dz/dy| + 0.01 z), n_p·n_q >=
+    // normalCos, equal ids.
+    float depthTolerance = 2.0f;
+    float normalCos = 0.9f;
+    // A neighbour's tap is left out where its 3x3 mean luminance (of the demodulated colour) differs
+    // from frame t's by more than this many standard errors of the two means (a moving shadow or
+    // highlight, a light switched on). 0 = off.
+    float colorSigmas = 3.0f;
+    // Frame t ± k weighs exp(-k² / (2 falloff²)) in the average (frame t: 1). 0 = all equal. A
+    // glossy highlight slides over its surface as the camera moves, and the colour test above,
+    // on 3x3 means of 1-spp frames, misses part of that: the far frames smear it.
+    float falloff = 2.0f;
+    // Every frame of the window goes through the still filters' firefly pass (prepass.h, bound k
+    // local standard deviations, without a variance) before it is averaged: the bilinear taps
+    // would spread a neighbour's firefly into a 2x2 blob that the still method's own pass keeps.
+    // 0 = off (with radius 0 nothing is done: the still method has its own pass). The still
+    // filters' 4 clamps the 1-spp frames' caustics and highlights (Cycles' orbit 0.0068 -> 0.0108);
+    // 16 keeps most of them and still takes the ceiling's fireflies out of a Cornell orbit
+    // (docs/temporal.md).
+    float fireflyK = 16.0f;
+};
+
+void validateTemporalParams(const TemporalParams& p);
+
+// The checks every frame of a window gets (sizes and channels against its colour, the colour's
+// range): InputError naming the buffer. A caller that reads frames one at a time can run it on
+// each as it arrives, so that the message can name that frame's file.
+void checkTemporalFrame(const SvgfFrame& frame);
+
+// The window averaged onto its centre frame: what the still method then filters.
+struct TemporalGather {
+    Image color, albedo, normal, emission, variance;  // like the centre frame's (albedo ... empty when it has none)
+    // Channel 0: the effective number of frames each pixel averages, (Σw)² / Σw² (the centre's
+    // included; the number of frames when the weights are equal); channel 1: Σw².
+    Image frames;
+};
+
+// Reprojects and averages window[center - r .. center + r] (r = params.radius, clipped to the
+// window) onto window[center]. Every frame must have the centre's buffers and size (SvgfFrame's
+// conventions: depth and ids in channel 0, motion previous - current in pixels). Frames without
+// motion are taken as still; what moved is then rejected by the depth, normal and id test.
+// Non-finite values of a neighbour are left out; the centre's own pass through. Host images.
+TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t center, const TemporalParams& params);
+
+// What denoiseTemporal did.
+struct TemporalReport {
+    double meanFrames = 0;     // effective frames averaged per pixel (TemporalGather::frames), over the image
+    double gatherMs = 0;       // reprojecting and averaging the window
+    DenoiseReport spatial;     // the still method's report (methodUsed: what auto chose)
+};
+
+// gatherTemporal, then `spatial` (a still method's options: auto, eaw, ...) on the average, with
+// the centre frame's depth, ids and position. Returns the denoised frame on the host.
+Image denoiseTemporal(const std::vector<SvgfFrame>& window, size_t center, const TemporalParams& params,
+                      const DenoiseOptions& spatial, TemporalReport* report = nullptr);
+
+}  // namespace atrous

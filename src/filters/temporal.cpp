@@ -1,0 +1,179 @@
+// The offline sequence denoiser (include/atrous/temporal.h, docs/temporal.md): the CPU driver of
+// the per-pixel stages in temporal_window.h, then a still method on the average.
+#include "atrous/temporal.h"
+
+#include <algorithm>
+#include <string>
+#include <cmath>
+#include <cstdlib>
+
+#include "atrous/error.h"
+#include "atrous/params.h"
+#include "core/parallel.h"
+#include "core/timer.h"
+#include "filters/prepass.h"
+#include "filters/svgf_gbuffer.h"
+#include "filters/temporal_window.h"
+
+namespace atrous {
+
+namespace svgf {
+void checkFrame(const SvgfFrame& frame);  // svgf.cpp: sizes, channels, the colour's range
+}
+
+void validateTemporalParams(const TemporalParams& p) { validateParams(p, temporalParams()); }
+
+void checkTemporalFrame(const SvgfFrame& frame) { svgf::checkFrame(frame); }
+
+namespace {
+
+// A frame as the hops read it: its sanitised G-buffer and colour statistics, owned here.
+struct PreparedFrame {
+    Image depth, normal, ids, motion, grad, stats, color;
+    temporal::FrameViews views;
+};
+
+ImageView viewOf(const Image* img) { return img ? img->view() : ImageView{}; }
+
+void prepare(const CpuExec& exec, const SvgfFrame& f, bool stats, float fireflyK, PreparedFrame& p) {
+    const int w = f.color->width(), h = f.color->height();
+    p.depth = Image::uninitialized(w, h, 1);
+    p.normal = Image::uninitialized(w, h, 3);
+    p.ids = Image::uninitialized(w, h, 1);
+    p.motion = Image::uninitialized(w, h, 2);
+    p.grad = Image::uninitialized(w, h, 2);
+    exec.forEachPixel(w, h, svgf::SanitizeGbuffer{viewOf(f.depth), viewOf(f.normal), viewOf(f.ids), viewOf(f.motion),
+                                                  p.depth.view(), p.normal.view(), p.ids.view(), p.motion.view()});
+    exec.forEachPixel(w, h, svgf::DepthGradient{p.depth.view(), p.grad.view()});
+    temporal::FrameViews& v = p.views;
+    v.depth = p.depth.view(), v.normal = p.normal.view(), v.ids = p.ids.view(), v.motion = p.motion.view();
+    v.grad = p.grad.view();
+    v.color = viewOf(f.color), v.albedo = viewOf(f.albedo), v.normalRaw = viewOf(f.normal);
+    if (fireflyK > 0.0f) {
+        // The still filters' firefly pass on the frame alone (no variance: the 3x3 spread only), so
+        // that a neighbour's firefly, spread over 2x2 pixels by the bilinear taps, does not reach
+        // the average as a blob their own firefly pass keeps.
+        p.color = Image::uninitialized(w, h, 3);
+        Image zero(w, h, 3), scratch = Image::uninitialized(w, h, 3);
+        filters::runFireflyClamp(exec, filters::FireflyClamp{fireflyK, 0, v.color, zero.view(), p.color.view(),
+                                                             scratch.view(), ImageView{}});
+        v.color = p.color.view();
+    }
+    v.emission = viewOf(f.emission);
+    if (stats) {
+        p.stats = Image::uninitialized(w, h, 2);
+        v.stats = p.stats.view();
+        exec.forEachPixel(w, h, temporal::LocalStats{v});
+    }
+}
+
+Image cloneOrEmpty(const Image* img) { return img ? img->clone() : Image(); }
+
+}  // namespace
+
+TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t center, const TemporalParams& params) {
+    validateTemporalParams(params);
+    if (center >= window.size()) throw InputError("temporal window: the centre frame is outside the window");
+    const SvgfFrame& c = window[center];
+    svgf::checkFrame(c);
+    const int w = c.color->width(), h = c.color->height();
+    const size_t r = size_t(params.radius);
+    const size_t lo = center > r ? center - r : 0, hi = std::min(window.size() - 1, center + r);
+    // Every frame must carry the centre's buffers (a missing one would read as a neutral default).
+    auto same = [&](const Image* a, const Image* b) { return (a == nullptr) == (b == nullptr); };
+    for (size_t i = lo; i <= hi; ++i) {
+        const SvgfFrame& f = window[i];
+        svgf::checkFrame(f);
+        if (f.color->width() != w || f.color->height() != h)
+            throw InputError("temporal window: frame " + std::to_string(i) + " is " + std::to_string(f.color->width()) +
+                             "x" + std::to_string(f.color->height()) + ", the centre frame " + std::to_string(w) + "x" +
+                             std::to_string(h));
+        if (!same(f.albedo, c.albedo) || !same(f.normal, c.normal) || !same(f.depth, c.depth) ||
+            !same(f.ids, c.ids) || !same(f.motion, c.motion) || !same(f.emission, c.emission) ||
+            !same(f.variance, c.variance) || !same(f.position, c.position))
+            throw InputError("temporal window: frame " + std::to_string(i) + " has other buffers than the centre frame");
+        for (const Image* extra : {f.variance, f.position})
+            if (extra && (extra->width() != w || extra->height() != h || extra->channels() < 1 ||
+                          extra->channels() != (extra == f.variance ? c.variance : c.position)->channels()))
+                throw InputError("temporal window: frame " + std::to_string(i) + ": its " +
+                                 (extra == f.variance ? "variance" : "position") +
+                                 " buffer differs in size or channels from the centre frame's colour or " +
+                                 (extra == f.variance ? "variance" : "position"));
+    }
+    const CpuExec exec;
+    TemporalGather g;
+    g.albedo = cloneOrEmpty(c.albedo);
+    g.normal = cloneOrEmpty(c.normal);
+    g.emission = cloneOrEmpty(c.emission);
+    g.variance = cloneOrEmpty(c.variance);
+    g.frames = Image(w, h, 2);  // Σw and Σw² (Finish leaves the effective frame count in channel 0)
+    g.frames.fill(1.0f);
+    if (lo == hi) {
+        g.color = c.color->clone();
+        return g;
+    }
+    const bool stats = params.colorSigmas > 0.0f;
+    std::vector<PreparedFrame> prepared(hi - lo + 1);
+    for (size_t i = lo; i <= hi; ++i) prepare(exec, window[i], stats, params.fireflyK, prepared[i - lo]);
+    // The centre's colour as its neighbours' is taken (after the firefly pass).
+    const PreparedFrame& pc = prepared[center - lo];
+    g.color = pc.color.empty() ? c.color->clone() : pc.color.clone();
+    Image track(w, h, 2), alive(w, h, 1);
+    for (int dir = -1; dir <= 1; dir += 2) {
+        if ((dir < 0 && center == lo) || (dir > 0 && center == hi)) continue;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) track(x, y, 0) = float(x), track(x, y, 1) = float(y), alive(x, y, 0) = 1.0f;
+        for (size_t k = 1; k <= r; ++k) {
+            if (dir < 0 ? center < lo + k : center + k > hi) break;
+            const size_t from = dir < 0 ? center - k + 1 : center + k - 1, to = dir < 0 ? center - k : center + k;
+            temporal::Hop hop;
+            hop.from = prepared[from - lo].views, hop.to = prepared[to - lo].views, hop.centre = prepared[center - lo].views;
+            hop.to.variance = viewOf(window[to].variance);
+            hop.backward = dir < 0;
+            const float fo = params.falloff;
+            hop.weight = fo > 0.0f ? std::exp(-float(k * k) / (2.0f * fo * fo)) : 1.0f;
+            hop.depthTolerance = params.depthTolerance, hop.normalCos = params.normalCos;
+            hop.colorSigmas = params.colorSigmas;
+            hop.track = track.view(), hop.alive = alive.view();
+            hop.sumColor = g.color.view(), hop.sumAlbedo = g.albedo.view(), hop.sumNormal = g.normal.view();
+            hop.sumEmission = g.emission.view(), hop.sumVariance = g.variance.view(), hop.count = g.frames.view();
+            exec.forEachPixel(w, h, hop);
+        }
+    }
+    exec.forEachPixel(w, h, temporal::Finish{g.color.view(), g.albedo.view(), g.normal.view(), g.emission.view(),
+                                             g.variance.view(), g.frames.view()});
+    return g;
+}
+
+Image denoiseTemporal(const std::vector<SvgfFrame>& window, size_t center, const TemporalParams& params,
+                      const DenoiseOptions& spatial, TemporalReport* report) {
+    Timer timer;
+    TemporalGather g = gatherTemporal(window, center, params);
+    if (report) {
+        report->gatherMs = timer.ms();
+        double sum = 0;
+        for (size_t i = 0; i < g.frames.plane(); ++i) sum += g.frames.data()[i];  // channel 0
+        report->meanFrames = sum / double(g.frames.plane());
+    }
+    const SvgfFrame& c = window[center];
+    // DenoiseInputs reads ids as R = mesh, G = material: a 1-channel id image gets a G of 0.
+    Image ids2;
+    if (c.ids && c.ids->channels() < 2) {
+        ids2 = Image(c.ids->width(), c.ids->height(), 2);
+        std::copy(c.ids->data(), c.ids->data() + c.ids->plane(), ids2.data());
+    }
+    DenoiseBuffers b;
+    b.color = &g.color;
+    b.variance = g.variance.empty() ? nullptr : &g.variance;
+    b.emission = g.emission.empty() ? nullptr : &g.emission;
+    b.albedo = g.albedo.empty() ? nullptr : &g.albedo;
+    b.normal = g.normal.empty() ? nullptr : &g.normal;
+    b.position = c.position;
+    b.depth = c.depth;
+    b.ids = ids2.empty() ? c.ids : &ids2;
+    DenoiseOptions o = spatial;
+    if (report) o.report = &report->spatial;
+    return denoise(b, o);
+}
+
+}  // namespace atrous

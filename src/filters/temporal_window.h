@@ -1,0 +1,195 @@
+// The offline sequence denoiser's per-pixel stages (include/atrous/temporal.h, docs/temporal.md):
+// local colour statistics per frame and one hop of a neighbour's track toward or away from the
+// centre frame, gathering what the hop reaches. Host/device: the CPU driver is
+// src/filters/temporal.cpp. The G-buffer of every frame is first sanitised by SVGF's functors
+// (svgf_gbuffer.h), so depth, normal, ids and motion follow SVGF's rules here too.
+#pragma once
+#include "filters/svgf_common.h"
+
+namespace atrous::temporal {
+
+using svgf::hasNormal;
+using svgf::isBackground;
+using svgf::kMaxMotion;
+using svgf::readVec3;
+using svgf::writeVec3;
+
+// A frame's sanitised G-buffer (svgf::SanitizeGbuffer, svgf::DepthGradient) and raw buffers.
+struct FrameViews {
+    ImageView depth, normal, ids, motion, grad;           // sanitised: 1, 3, 1, 2, 2 channels
+    ImageView color, albedo, normalRaw, emission, variance;  // as given (albedo ... optional)
+    ImageView stats;                                      // 2 channels: 3x3 mean and variance of that mean (demodulated luminance)
+};
+
+// The 3x3 mean of lum((c - e) / a') (SVGF's albedo rule) and the variance of that mean, non-finite
+// samples left out. (5x5 and 7x7 were measured too: they miss a small moving highlight, docs/temporal.md.)
+struct LocalStats {
+    FrameViews f;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        const filters::AlbedoRule rule = svgf::albedoRule();
+        float s = 0.0f, s2 = 0.0f, n = 0.0f;
+        for (int j = -1; j <= 1; ++j) {
+            for (int i = -1; i <= 1; ++i) {
+                const int qx = x + i, qy = y + j;
+                if (qx < 0 || qy < 0 || qx >= f.color.width || qy >= f.color.height) continue;
+                float a[3];
+                rule.at(f.albedo, qx, qy, a);
+                const Vec3 e = svgf::sanitizedEmission(f.emission, qx, qy);
+                const float l = filters::lum((f.color(qx, qy, 0) - e.x) / a[0], (f.color(qx, qy, 1) - e.y) / a[1],
+                                             (f.color(qx, qy, 2) - e.z) / a[2]);
+                if (!isFiniteF(l)) continue;
+                s += l, s2 += l * l, n += 1.0f;
+            }
+        }
+        const float m = n > 0.0f ? s / n : 0.0f;
+        f.stats(x, y, 0) = m;
+        // the variance of the mean
+        f.stats(x, y, 1) = n > 1.0f ? fmaxf(s2 / n - m * m, 0.0f) / (n - 1.0f) : 0.0f;
+    }
+};
+
+// One hop: the track of centre pixel p is at `track` in frame `from` (the centre, or the last
+// frame it reached); this finds it in frame `to` (the next frame away from the centre), tests
+// the taps, and adds `to`'s colour, albedo, normal, emission and variance there to the sums.
+// backward: `to` is the previous frame, reached through `from`'s motion (previous - current).
+// Forward: `to` is the next frame, whose own motion points back to `from`; the position q with
+// q + motion_to(q) = track is found by a fixed-point iteration from the constant-velocity guess.
+// A track that fails (leaves the image, a disocclusion, a colour change) stops: the frames
+// farther out are not reached through it either.
+struct Hop {
+    FrameViews from, to, centre;
+    bool backward = true;
+    float depthTolerance = 2.0f, normalCos = 0.9f, colorSigmas = 3.0f;
+    float weight = 1.0f;  // this frame's weight in the average (the centre's is 1)
+    ImageView track;  // 2 channels: the position in `from`, then in `to`
+    ImageView alive;  // 1 channel: 1 while the track holds
+    ImageView sumColor, sumAlbedo, sumNormal, sumEmission, sumVariance, count;
+
+    ATROUS_HOST_DEVICE bool inside(int x, int y) const {
+        return x >= 0 && y >= 0 && x < to.depth.width && y < to.depth.height;
+    }
+
+    // SVGF's reprojection test (svgf_reproject.h) between `from` at (fx, fy) and `to` at (qx, qy).
+    ATROUS_HOST_DEVICE bool consistent(int fx, int fy, int qx, int qy) const {
+        if (!inside(qx, qy)) return false;
+        if (to.ids(qx, qy, 0) != from.ids(fx, fy, 0)) return false;
+        const float z = from.depth(fx, fy, 0), zq = to.depth(qx, qy, 0);
+        const bool bp = isBackground(z), bq = isBackground(zq);
+        if (bp || bq) return bp && bq;
+        const float tol = depthTolerance * (fabsf(from.grad(fx, fy, 0)) + fabsf(from.grad(fx, fy, 1)) + 0.01f * fabsf(z));
+        if (!(fabsf(zq - z) <= tol)) return false;
+        const Vec3 n = readVec3(from.normal, fx, fy), nq = readVec3(to.normal, qx, qy);
+        const bool hp = hasNormal(n), hq = hasNormal(nq);
+        if (hp != hq) return false;
+        return !hp || dot(n, nq) >= normalCos;
+    }
+
+    ATROUS_HOST_DEVICE static int nearest(float v) { return int(floorf(v + 0.5f)); }
+
+    ATROUS_HOST_DEVICE void stop(int x, int y) const { alive(x, y, 0) = 0.0f; }
+
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        if (alive(x, y, 0) == 0.0f) return;
+        const float tx = track(x, y, 0), ty = track(x, y, 1);
+        const int fx = nearest(tx), fy = nearest(ty);
+        if (fx < 0 || fy < 0 || fx >= from.depth.width || fy >= from.depth.height) return stop(x, y);
+        float px, py;
+        if (backward) {
+            const float mx = from.motion(fx, fy, 0), my = from.motion(fx, fy, 1);
+            if (!(fabsf(mx) < kMaxMotion) || !(fabsf(my) < kMaxMotion)) return stop(x, y);
+            px = tx + mx, py = ty + my;
+        } else {
+            // Constant velocity: the step to the next frame is minus the step to the previous one.
+            float mx = from.motion(fx, fy, 0), my = from.motion(fx, fy, 1);
+            if (!(fabsf(mx) < kMaxMotion) || !(fabsf(my) < kMaxMotion)) mx = my = 0.0f;
+            px = tx - mx, py = ty - my;
+            for (int it = 0; it < 4; ++it) {
+                const int qx = nearest(px), qy = nearest(py);
+                if (!inside(qx, qy)) return stop(x, y);
+                const float ux = to.motion(qx, qy, 0), uy = to.motion(qx, qy, 1);
+                if (!(fabsf(ux) < kMaxMotion) || !(fabsf(uy) < kMaxMotion)) return stop(x, y);
+                px = tx - ux, py = ty - uy;
+            }
+            const int qx = nearest(px), qy = nearest(py);
+            if (!inside(qx, qy)) return stop(x, y);
+            // The found pixel must map back onto the track (a fold of the motion field does not).
+            const float rx = float(qx) + to.motion(qx, qy, 0) - tx, ry = float(qy) + to.motion(qx, qy, 1) - ty;
+            if (!(fabsf(rx) <= 1.0f && fabsf(ry) <= 1.0f)) return stop(x, y);
+        }
+        const int qx = nearest(px), qy = nearest(py);
+        if (!consistent(fx, fy, qx, qy)) return stop(x, y);
+        if (colorSigmas > 0.0f) {
+            // Two 3x3 means of independent noise: their difference has the sum of their variances.
+            const float d = to.stats(qx, qy, 0) - centre.stats(x, y, 0);
+            const float se2 = to.stats(qx, qy, 1) + centre.stats(x, y, 1);
+            if (!(d * d <= colorSigmas * colorSigmas * se2 + 1e-12f)) return stop(x, y);
+        }
+        // Bilinear taps, each kept only where it passes the test against `from` too.
+        const float fx0 = floorf(px), fy0 = floorf(py);
+        const int x0 = int(fx0), y0 = int(fy0);
+        const float ax = px - fx0, ay = py - fy0;
+        float w = 0.0f, c[3] = {0, 0, 0}, a[3] = {0, 0, 0}, n[3] = {0, 0, 0}, e[3] = {0, 0, 0}, v[3] = {0, 0, 0};
+        const int vc = to.variance.valid() ? (to.variance.channels < 3 ? to.variance.channels : 3) : 0;
+        for (int j = 0; j < 2; ++j) {
+            for (int i = 0; i < 2; ++i) {
+                const float wt = (i ? ax : 1.0f - ax) * (j ? ay : 1.0f - ay);
+                const int sx = x0 + i, sy = y0 + j;
+                if (wt <= 0.0f || !consistent(fx, fy, sx, sy)) continue;
+                w += wt;
+                for (int k = 0; k < 3; ++k) {
+                    c[k] += wt * to.color(sx, sy, k);
+                    if (to.albedo.valid()) a[k] += wt * to.albedo(sx, sy, k);
+                    if (to.normalRaw.valid()) n[k] += wt * to.normalRaw(sx, sy, k);
+                    if (to.emission.valid()) e[k] += wt * to.emission(sx, sy, k);
+                }
+                for (int k = 0; k < vc; ++k) v[k] += wt * to.variance(sx, sy, k);
+            }
+        }
+        if (w < 0.01f) return stop(x, y);
+        const float iw = 1.0f / w;
+        bool finiteAll = true;
+        for (int k = 0; k < 3; ++k) {
+            c[k] *= iw, a[k] *= iw, n[k] *= iw, e[k] *= iw, v[k] *= iw;
+            finiteAll = finiteAll && isFiniteF(c[k]) && isFiniteF(a[k]) && isFiniteF(n[k]) && isFiniteF(e[k]) &&
+                        isFiniteF(v[k]);
+        }
+        if (!finiteAll) return stop(x, y);
+        track(x, y, 0) = px;
+        track(x, y, 1) = py;
+        for (int k = 0; k < 3; ++k) {
+            sumColor(x, y, k) += weight * c[k];
+            if (sumAlbedo.valid()) sumAlbedo(x, y, k) += weight * a[k];
+            if (sumNormal.valid()) sumNormal(x, y, k) += weight * n[k];
+            if (sumEmission.valid()) sumEmission(x, y, k) += weight * e[k];
+        }
+        for (int k = 0; k < vc && sumVariance.valid(); ++k) sumVariance(x, y, k) += weight * weight * v[k];
+        count(x, y, 0) += weight;
+        count(x, y, 1) += weight * weight;
+    }
+};
+
+// Sums -> means in place: colour, albedo, emission / count; variance / count² (the variance of a
+// mean of independent frames); the normal renormalised (a zero sum stays zero: background).
+struct Finish {
+    ImageView color, albedo, normal, emission, variance, count;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        const float n = count(x, y, 0), in = 1.0f / n;
+        // Σw² var / (Σw)²; the effective number of frames (Σw)² / Σw² replaces the sum of weights.
+        const float n2 = count(x, y, 1);
+        for (int k = 0; k < 3; ++k) {
+            color(x, y, k) *= in;
+            if (albedo.valid()) albedo(x, y, k) *= in;
+            if (emission.valid()) emission(x, y, k) *= in;
+        }
+        if (variance.valid())
+            for (int k = 0; k < variance.channels; ++k) variance(x, y, k) *= in * in;
+        count(x, y, 0) = n * n / n2;
+        if (normal.valid()) {
+            const Vec3 v = readVec3(normal, x, y);
+            const float l2 = dot(v, v);
+            if (l2 > 0.0f && isFiniteF(l2)) writeVec3(normal, x, y, v * (1.0f / sqrtf(l2)));
+        }
+    }
+};
+
+}  // namespace atrous::temporal

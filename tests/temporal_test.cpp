@@ -1,0 +1,269 @@
+// The offline sequence denoiser (include/atrous/temporal.h): the gather's reprojection both ways,
+// its noise reduction, its rejections, its handling of bad values and bad windows; and the CLI's
+// `denoise --sequence` default.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "atrous/error.h"
+#include "atrous/params.h"
+#include "atrous/temporal.h"
+#include "io/image_io.h"
+#include "svgf_test_util.h"
+#include "test_util.h"
+
+using namespace atrous;
+using svgf_test::makeFrame;
+using svgf_test::SceneOptions;
+using svgf_test::SynthFrame;
+using test::runCli;
+using test::sameImages;
+using test::TempDir;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::vector<SynthFrame> makeFrames(const SceneOptions& o, int n) {
+    std::vector<SynthFrame> f;
+    for (int t = 0; t < n; ++t) f.push_back(makeFrame(o, t));
+    return f;
+}
+
+std::vector<SvgfFrame> framesOf(const std::vector<SynthFrame>& s) {
+    std::vector<SvgfFrame> f;
+    for (const SynthFrame& x : s) f.push_back(x.frame());
+    return f;
+}
+
+// Variance of (img - truth) over all values.
+double errorVariance(const Image& img, const Image& truth) {
+    double s = 0, s2 = 0;
+    for (size_t i = 0; i < img.size(); ++i) {
+        const double d = double(img.data()[i]) - double(truth.data()[i]);
+        s += d, s2 += d * d;
+    }
+    const double n = double(img.size());
+    return s2 / n - (s / n) * (s / n);
+}
+
+double meanOf(const Image& img, int channel) {
+    double s = 0;
+    for (size_t i = 0; i < img.plane(); ++i) s += img.data()[size_t(channel) * img.plane() + i];
+    return s / double(img.plane());
+}
+
+}  // namespace
+
+// A textured box slides 4 pixels a frame across a static textured ground; noise-free frames with
+// exact motion. Every pixel inside the box is tracked through the three frames before the centre
+// (the motion) and the three after it (the inverse of their motion) onto the same texel: 7 frames
+// averaged, and the average is the centre's colour. Without the motion vectors the same pixels
+// land on the ground or on another texel and are left out: the test sees the reprojection.
+TEST(TemporalGather, TracksAMovingBoxThroughFramesOnBothSides) {
+    SceneOptions o;
+    o.boxApproach = 0.0f, o.boxTurn = 0.0f;  // the box only slides: its texels keep their colour
+    const auto synth = makeFrames(o, 7);
+    TemporalParams p;
+    p.falloff = 0.0f;  // equal weights: channel 0 of `frames` counts frames
+    const int bx = svgf_test::boxX0(o, 3), by = svgf_test::boxY0(o), bs = svgf_test::boxSize(o);
+    auto boxFullCount = [&](const TemporalGather& g, bool checkColour) {
+        int full = 0, n = 0;
+        for (int y = by + 1; y < by + bs - 1; ++y)
+            for (int x = bx + 1; x < bx + bs - 1; ++x, ++n) {
+                if (g.frames(x, y, 0) != 7.0f) continue;
+                ++full;
+                if (checkColour)
+                    for (int c = 0; c < 3; ++c) EXPECT_NEAR(g.color(x, y, c), synth[3].truth(x, y, c), 1e-5f) << x << "," << y;
+            }
+        return double(full) / double(n);
+    };
+    TemporalGather g = gatherTemporal(framesOf(synth), 3, p);
+    EXPECT_EQ(boxFullCount(g, true), 1.0);
+
+    std::vector<SvgfFrame> still = framesOf(synth);
+    for (SvgfFrame& f : still) f.motion = nullptr;
+    EXPECT_LT(boxFullCount(gatherTemporal(still, 3, p), false), 0.2);
+}
+
+// A static flat scene with Gaussian noise: the average of 2r + 1 frames has 1/(2r + 1) of the
+// noise's variance (equal weights), or Σw²/(Σw)² of it with the falloff, and `frames` reports that
+// effective count. 3072 independent noise values (R, G, B share theirs): the variance is measured
+// to about 3% (one standard error); 10% is allowed.
+TEST(TemporalGather, AveragingCutsTheNoiseByTheEffectiveFrameCount) {
+    SceneOptions o;
+    o.flat = true, o.withBox = false, o.noiseSigma = 0.1f;
+    const auto synth = makeFrames(o, 7);
+    const double v1 = errorVariance(synth[3].color, synth[3].truth);
+    for (float falloff : {0.0f, 2.0f}) {
+        TemporalParams p;
+        p.falloff = falloff;
+        double sw = 0, sw2 = 0;
+        for (int k = -3; k <= 3; ++k) {
+            const double w = falloff > 0 ? std::exp(-double(k * k) / (2.0 * falloff * falloff)) : 1.0;
+            sw += w, sw2 += w * w;
+        }
+        const double nEff = sw * sw / sw2;
+        TemporalGather g = gatherTemporal(framesOf(synth), 3, p);
+        EXPECT_NEAR(meanOf(g.frames, 0), nEff, 0.05 * nEff) << "falloff " << falloff;  // a few 3-sigma rejections
+        EXPECT_NEAR(errorVariance(g.color, synth[3].truth), v1 / nEff, 0.1 * v1 / nEff) << "falloff " << falloff;
+    }
+}
+
+// The neighbours are 20 noise sigmas brighter (a light switched on): the colour test leaves them
+// out and the centre stands alone. With the test off they are averaged in.
+TEST(TemporalGather, LeavesOutNeighboursWhoseColourChanged) {
+    SceneOptions o;
+    o.flat = true, o.withBox = false, o.noiseSigma = 0.05f;
+    auto synth = makeFrames(o, 5);
+    for (int t : {0, 1, 3, 4})
+        for (size_t i = 0; i < synth[size_t(t)].color.size(); ++i) synth[size_t(t)].color.data()[i] += 1.0f;
+    TemporalParams p;
+    TemporalGather g = gatherTemporal(framesOf(synth), 2, p);
+    EXPECT_LT(meanOf(g.frames, 0), 1.01);
+    EXPECT_LT(std::fabs(meanOf(g.color, 0) - 1.0), 0.01);
+    p.colorSigmas = 0.0f;
+    EXPECT_GT(meanOf(gatherTemporal(framesOf(synth), 2, p).frames, 0), 3.0);
+}
+
+// NaN and Inf in a neighbour are left out (and the track stops there); the average stays finite.
+TEST(TemporalGather, NonFiniteNeighbourValuesDoNotSpread) {
+    SceneOptions o;
+    o.flat = true, o.withBox = false, o.noiseSigma = 0.05f;
+    auto synth = makeFrames(o, 5);
+    for (int x = 10; x < 20; ++x) {
+        synth[1].color(x, 10, 0) = NAN;
+        synth[3].color(x, 20, 1) = INFINITY;
+        synth[3].albedo(x, 30, 2) = NAN;
+    }
+    TemporalParams p;
+    p.falloff = 0.0f;
+    TemporalGather g = gatherTemporal(framesOf(synth), 2, p);
+    EXPECT_TRUE(svgf_test::allFinite(g.color));
+    EXPECT_TRUE(svgf_test::allFinite(g.albedo));
+    EXPECT_EQ(g.frames(15, 10, 0), 3.0f);  // frames 1 and 0 behind the NaN are not reached
+    EXPECT_EQ(g.frames(15, 20, 0), 3.0f);
+    EXPECT_EQ(g.frames(15, 30, 0), 3.0f);
+    Image out = denoiseTemporal(framesOf(synth), 2, p, DenoiseOptions{});
+    EXPECT_TRUE(svgf_test::allFinite(out));
+}
+
+// Radius 0 is the still method on the frame alone, bit for bit.
+TEST(TemporalDenoise, RadiusZeroIsTheStillMethod) {
+    SceneOptions o;
+    o.noiseSigma = 0.05f;
+    const auto synth = makeFrames(o, 3);
+    TemporalParams p;
+    p.radius = 0;
+    for (DenoiseMethod m : {DenoiseMethod::Eaw, DenoiseMethod::Auto}) {
+        DenoiseOptions opt;
+        opt.method = m;
+        Image a = denoiseTemporal(framesOf(synth), 1, p, opt);
+        Image c = synth[1].color.clone();
+        DenoiseBuffers b;
+        b.color = &c;
+        b.albedo = &synth[1].albedo, b.normal = &synth[1].normal, b.depth = &synth[1].depth, b.ids = &synth[1].ids;
+        b.emission = nullptr;
+        EXPECT_TRUE(sameImages(a, denoise(b, opt))) << denoiseMethodName(m);
+    }
+}
+
+// On a noisy sequence the temporal denoiser is closer to the truth than the same still method per frame.
+TEST(TemporalDenoise, BeatsTheStillMethodPerFrame) {
+    SceneOptions o;
+    o.noiseSigma = 0.3f;
+    const auto synth = makeFrames(o, 7);
+    DenoiseOptions opt;
+    opt.method = DenoiseMethod::Eaw;
+    Image t = denoiseTemporal(framesOf(synth), 3, TemporalParams{}, opt);
+    TemporalParams alone;
+    alone.radius = 0;
+    Image s = denoiseTemporal(framesOf(synth), 3, alone, opt);
+    EXPECT_LT(svgf_test::mse(t, synth[3].truth), 0.7 * svgf_test::mse(s, synth[3].truth));
+}
+
+TEST(TemporalGather, BadWindowsThrow) {
+    SceneOptions o;
+    auto synth = makeFrames(o, 3);
+    std::vector<SvgfFrame> f = framesOf(synth);
+    EXPECT_THROW(gatherTemporal(f, 3, TemporalParams{}), InputError);
+    TemporalParams bad;
+    bad.radius = 17;
+    EXPECT_THROW(gatherTemporal(f, 1, bad), ParamError);
+    std::vector<SvgfFrame> missing = f;
+    missing[0].albedo = nullptr;
+    EXPECT_THROW(gatherTemporal(missing, 1, TemporalParams{}), InputError);
+    SceneOptions small = o;
+    small.width = 32;
+    SynthFrame other = makeFrame(small, 0);
+    std::vector<SvgfFrame> sizes = f;
+    sizes[2] = other.frame();
+    EXPECT_THROW(gatherTemporal(sizes, 1, TemporalParams{}), InputError);
+    // Out of the radius, a frame is not looked at.
+    TemporalParams one;
+    one.radius = 0;
+    EXPECT_NO_THROW(gatherTemporal(sizes, 0, one));
+}
+
+namespace {
+
+std::string renderSequence(const TempDir& dir, int frames = 3) {
+    const std::string seq = dir / "seq";
+    auto r = runCli("render --scene cornell --frames " + std::to_string(frames) +
+                    " --spp 1 --width 32 --height 24 --reference-spp 4 --out " + seq);
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    return seq;
+}
+
+}  // namespace
+
+// `denoise --sequence` without --method runs the temporal method and says so, per frame, with the
+// still method auto chose; --spatial picks that method.
+TEST(TemporalCli, IsTheSequenceDefaultAndSaysSo) {
+    TempDir dir;
+    const std::string seq = renderSequence(dir);
+    auto r = runCli("denoise --sequence " + seq + " --out " + (dir / "out"));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("frame_0001: temporal (+-3 frames"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("then auto -> blend)"), std::string::npos) << r.output;
+    for (int f = 0; f < 3; ++f) EXPECT_TRUE(fs::exists(dir / ("out/frame_000" + std::to_string(f) + ".exr")));
+    r = runCli("denoise --sequence " + seq + " --spatial eaw --out " + (dir / "eaw"));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("then eaw)"), std::string::npos) << r.output;
+}
+
+// Radius 0 with --spatial eaw writes what --method eaw writes, bit for bit.
+TEST(TemporalCli, RadiusZeroEqualsThePerFrameMethod) {
+    TempDir dir;
+    const std::string seq = renderSequence(dir);
+    auto r = runCli("denoise --sequence " + seq + " --temporal-radius 0 --spatial eaw --device cpu --out " + (dir / "t"));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    r = runCli("denoise --sequence " + seq + " --method eaw --device cpu --out " + (dir / "e"));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    for (int f = 0; f < 3; ++f) {
+        const std::string name = "/frame_000" + std::to_string(f) + ".exr";
+        EXPECT_TRUE(sameImages(io::readImage(dir / "t" + name), io::readImage(dir / "e" + name))) << name;
+    }
+}
+
+TEST(TemporalCli, BadFlagsExitTwoAndWriteNothing) {
+    TempDir dir;
+    const std::string seq = renderSequence(dir);
+    const std::string out = dir / "out";
+    struct Case {
+        std::string args, says;
+    };
+    for (const Case& c : {Case{"--method svgf --spatial eaw", "--spatial"}, Case{"--step 2", "--step 2"},
+                          Case{"--temporal-radius 17", "--temporal-radius"}, Case{"--spatial nope", "--spatial"},
+                          Case{"--temporal-falloff -1", "--temporal-falloff"}}) {
+        auto r = runCli("denoise --sequence " + seq + " " + c.args + " --out " + out);
+        EXPECT_EQ(r.exitCode, 2) << c.args << "\n" << r.output;
+        EXPECT_NE(r.output.find(c.says), std::string::npos) << c.args << "\n" << r.output;
+        EXPECT_FALSE(fs::exists(out)) << c.args;
+    }
+    auto r = runCli("denoise --in " + seq + "/frame_0000 --method temporal --out " + (dir / "x.exr"));
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("--sequence"), std::string::npos) << r.output;
+}
