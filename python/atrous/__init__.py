@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import os
 import textwrap
-from typing import Any, Dict, Iterator, Optional, Union
+from typing import Any, Dict, Iterator, Optional, Sequence, Union
 
 import numpy as np
 
@@ -47,6 +47,8 @@ __all__ = [
     "cuda_available",
     "denoise_params",
     "svgf_params",
+    "temporal_params",
+    "denoise_temporal",
     "render_params",
     "METHODS",
     "WEIGHTED_METHODS",
@@ -87,6 +89,11 @@ def denoise_params() -> list:
 def svgf_params() -> list:
     """The keywords of :class:`Svgf`, in the form of :func:`denoise_params`."""
     return [dict(r) for r in _core.svgf_params()]
+
+
+def temporal_params() -> list:
+    """The keywords of :func:`denoise_temporal`'s ``temporal`` dict, in the form of :func:`denoise_params`."""
+    return [dict(r) for r in _core.temporal_params()]
 
 
 def render_params() -> list:
@@ -365,6 +372,42 @@ def write_image(path: PathLike, image: Any) -> None:
     """
     p = os.fsdecode(os.fspath(path))
     _core.write_image(p, _prepare(image, p))
+
+
+_FRAME_KEYS = ("color", "albedo", "normal", "position", "depth", "variance", "ids", "emission", "motion")
+
+
+def denoise_temporal(frames: Sequence[Dict[str, Any]], center: int, *, method: str = "auto",
+                     device: str = "auto", learned_weights: Optional["PathLike"] = None,
+                     temporal: Optional[Dict[str, Any]] = None, **params: Any) -> Any:
+    """Denoises frames[center] of an animation with the frames around it (docs/temporal.md): the
+    offline sequence denoiser that `atrous denoise --sequence` runs by default.
+
+    frames: a window of consecutive frames, each a dict of H x W x C numpy arrays with the keys of
+    :func:`denoise` (color required; albedo, normal, position, depth, variance, ids, emission) and
+    motion (H x W x 2 or 3: dx, dy in pixels, previous - current); every frame has the same keys.
+    The items of :func:`render_sequence` are such dicts.
+    temporal: the rows of :func:`temporal_params` (radius: frames on each side, 3; ...).
+    method, learned_weights and params: the still method run on the average, as in :func:`denoise`.
+    device: where that still method runs ("auto", "cpu", "cuda"); the averaging runs on the CPU.
+    Returns the denoised H x W x 3 float32 array. Raises ValueError for bad input."""
+    if not isinstance(frames, (list, tuple)) or not frames:
+        raise ValueError("frames must be a non-empty list of dicts")
+    core_frames = []
+    for i, f in enumerate(frames):
+        if not isinstance(f, dict):
+            raise ValueError(f"frame {i} must be a dict of arrays")
+        unknown = sorted(set(f) - set(_FRAME_KEYS) - {"time"})  # render_sequence's items carry their time
+        if unknown:
+            raise ValueError(f"frame {i}: unknown buffer {unknown[0]!r} (expected {', '.join(_FRAME_KEYS)})")
+        core_frames.append({k: _prepare(v, f"frames[{i}].{k}", allow_gray=k != "color",
+                                        channels=(2, 3) if k == "motion" else (3,))
+                            for k, v in f.items() if v is not None and k != "time"})
+    if isinstance(center, bool) or not isinstance(center, (int, np.integer)) or not 0 <= int(center) < len(frames):
+        raise ValueError(f"center must be a frame index in 0..{len(frames) - 1}, got {center!r}")
+    weights = "" if learned_weights is None else os.fsdecode(os.fspath(learned_weights))
+    out = _core.denoise_temporal(core_frames, int(center), method, weights, device, dict(temporal or {}), dict(params))
+    return _wrap_like(out, frames[int(center)]["color"])
 
 
 class Svgf:

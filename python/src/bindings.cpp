@@ -22,6 +22,7 @@
 #include "atrous/params.h"
 #include "atrous/render.h"
 #include "atrous/svgf.h"
+#include "atrous/temporal.h"
 #include "filters/denoise_internal.h"
 #include "io/buffer_set.h"
 #include "io/image_io.h"
@@ -290,6 +291,51 @@ private:
     std::unique_ptr<SvgfDenoiser> mDenoiser;
 };
 
+// The offline sequence denoiser (include/atrous/temporal.h) on a window of frames, each a dict of
+// host arrays (color required; albedo, normal, position, depth, variance, ids, emission, motion).
+nb::object pyDenoiseTemporal(nb::list frames, size_t center, const std::string& method,
+                             const std::string& learnedWeights, const std::string& device, nb::dict temporal,
+                             nb::dict params) {
+    using B = io::Buffer;
+    static const std::pair<const char*, B> kKeys[] = {
+        {"albedo", B::Albedo}, {"normal", B::Normal}, {"position", B::Position}, {"depth", B::Depth},
+        {"variance", B::Variance}, {"ids", B::ObjectId}, {"emission", B::Emission}, {"motion", B::Motion}};
+    std::vector<std::unique_ptr<Image>> colors;
+    std::vector<std::unique_ptr<Buffers>> buffers;
+    for (size_t i = 0; i < frames.size(); ++i) {
+        const std::string at = "frame " + std::to_string(i) + ": ";
+        if (!nb::isinstance<nb::dict>(frames[i])) throw InputError(at + "must be a dict of arrays");
+        nb::dict d = nb::cast<nb::dict>(frames[i]);
+        for (auto [k, v] : d) {
+            const std::string key = nb::cast<std::string>(k);
+            bool known = key == "color";
+            for (const auto& [name, b] : kKeys) known = known || key == name;
+            if (!known) throw InputError(at + "unknown buffer '" + key + "'");
+        }
+        if (!d.contains("color")) throw InputError(at + "has no color");
+        colors.push_back(std::make_unique<Image>(toImage(nb::cast<Array>(d["color"]), "color")));
+        if (colors.back()->device() != Device::Cpu) throw InputError(at + "denoise_temporal takes host (numpy) arrays");
+        buffers.push_back(std::make_unique<Buffers>(*colors.back()));
+        for (const auto& [name, b] : kKeys)
+            if (d.contains(name)) buffers.back()->add({d[name], b, name});
+    }
+    std::vector<SvgfFrame> window;
+    for (const auto& b : buffers) window.push_back(io::svgfFrame(b->refs));
+    TemporalParams tp;
+    for (auto [k, v] : temporal) applyParam(tp, temporalParams(), nb::cast<std::string>(k), v, "temporal");
+    DenoiseOptions o;
+    o.method = parseDenoiseMethod(method);
+    o.learnedWeights = learnedWeights;
+    o.device = parseDevice(device);
+    for (auto [k, v] : params) applyParam(o, denoiseParams(), nb::cast<std::string>(k), v, "denoise");
+    Image out;
+    {
+        nb::gil_scoped_release release;
+        out = denoiseTemporal(window, center, tp, o);
+    }
+    return fromImage(std::move(out));
+}
+
 // Python's keywords are the render table's rows (params.h); the library validates the ranges.
 RenderSettings renderSettings(nb::dict params) {
     RenderSettings rs;
@@ -421,6 +467,9 @@ NB_MODULE(_core, m) {
         return rows;
     });
     m.def("svgf_params", [] { return paramRows(svgfParams()); });
+    m.def("temporal_params", [] { return paramRows(temporalParams()); });
+    m.def("denoise_temporal", &pyDenoiseTemporal, nb::arg("frames"), nb::arg("center"), nb::arg("method"),
+          nb::arg("learned_weights"), nb::arg("device"), nb::arg("temporal"), nb::arg("params"));
     m.def("render_params", [] { return paramRows(renderParams()); });
     m.def("resolve_denoise_params", [](nb::dict p) { return resolveParams(denoiseParams(), p, "denoise"); });
     m.def("resolve_svgf_params", [](nb::dict p) { return resolveParams(svgfParams(), p, "SVGF"); });

@@ -15,12 +15,18 @@ SEED_NOISY = {4: 1, 16: 2}
 SEED_REF = 1000003
 SEED_SEQ = 1          # frame f of a 1-spp sequence uses SEED_SEQ + f
 SEED_SEQ_REF = 2000003  # its reference uses SEED_SEQ_REF + f
+SEED_SEQ_SPP = 3000001  # frame f at s spp (s > 1: frames_sNNNN/) uses SEED_SEQ_SPP + 1000 s + f
+
+
+def seq_spp_folder(spp):
+    """The folder of a sequence's frames at `spp` (1: frames/, the original layout)."""
+    return "frames" if spp == 1 else f"frames_s{spp:04d}"
 
 MODES = {
     # CI-sized: 2 stills per renderer plus a 4-frame sequence, small images, 256-spp references.
-    "quick": dict(res=64, spp=[4, 16], ref_spp=256, seq_res=48, seq_frames=4, seq_ref_spp=64),
+    "quick": dict(res=64, spp=[4, 16], ref_spp=256, seq_res=48, seq_frames=4, seq_ref_spp=64, seq_spp=[1]),
     # The corpus proper.
-    "full": dict(res=256, spp=[4, 16], ref_spp=2048, seq_res=128, seq_frames=20, seq_ref_spp=512),
+    "full": dict(res=256, spp=[4, 16], ref_spp=2048, seq_res=128, seq_frames=20, seq_ref_spp=2048, seq_spp=[1, 4, 16]),
 }
 
 

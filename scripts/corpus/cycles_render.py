@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import (SEED_SEQ, SEED_SEQ_REF, done, exr_channels, merged_render_seconds,  # noqa: E402
+from common import (SEED_SEQ, SEED_SEQ_REF, SEED_SEQ_SPP, seq_spp_folder, done, exr_channels, merged_render_seconds,  # noqa: E402
                     exr_read_all,
                     log, parse_render_args, still_jobs, write_manifest)
 
@@ -496,11 +496,13 @@ def main():
         return
     n, sres, rspp = mode["seq_frames"], mode["seq_res"], mode["seq_ref_spp"]
     d = root / SEQ_NAME
-    (d / "frames").mkdir(parents=True, exist_ok=True)
-    (d / "ref").mkdir(parents=True, exist_ok=True)
+    kinds = [("frames", seq_spp_folder(s), s, SEED_SEQ if s == 1 else SEED_SEQ_SPP + 1000 * s)
+             for s in mode["seq_spp"]] + [("ref", "ref", rspp, SEED_SEQ_REF)]
+    for _, folder, _, _ in kinds:
+        (d / folder).mkdir(parents=True, exist_ok=True)
     t0 = time.time()
     frames, checks = [], {}
-    for kind, folder, spp, seed0 in (("frames", "frames", 1, SEED_SEQ), ("ref", "ref", rspp, SEED_SEQ_REF)):
+    for kind, folder, spp, seed0 in kinds:
         _obj_index[0] = 0
         sc = reset()
         what, bg = scene_orbit(sc, n)
@@ -522,6 +524,7 @@ def main():
     write_manifest(d / "manifest.json", {
         "scene": SEQ_NAME, "renderer": "blender-cycles", "version": version, "description": what,
         "resolution": [sres, sres], "spp": 1, "reference_spp": rspp, "layout": "blender-multilayer-exr-sequence",
+        "spp_folders": {str(s): seq_spp_folder(s) for s in mode["seq_spp"]},
         "frames": frames, "settings": settings, "channels": exr_channels(d / "frames" / "0000.exr"),
         "conventions": CONVENTIONS, "vector_check": {str(k): v for k, v in checks.items()}, "background": bg,
     })

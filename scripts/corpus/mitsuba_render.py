@@ -13,6 +13,7 @@ frame's camera (Mitsuba has no motion AOV).
 """
 import math
 import os
+import shutil
 import sys
 import time
 from pathlib import Path
@@ -20,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import (SEED_SEQ, SEED_SEQ_REF, done, exr_channels, merged_render_seconds,  # noqa: E402
+from common import (SEED_SEQ, SEED_SEQ_REF, SEED_SEQ_SPP, seq_spp_folder, done, exr_channels, merged_render_seconds,  # noqa: E402
                     log, parse_render_args, still_jobs, write_manifest)
 
 import mitsuba as mi  # noqa: E402
@@ -406,6 +407,13 @@ def main():
         if not done(rf):
             log(f"mitsuba {SEQ_NAME} frame {f} ref ...")
             render_aov(objects, cam, sres, "box", rspp, SEED_SEQ_REF + f, rf)
+        for s in mode["seq_spp"]:
+            if s == 1:
+                continue
+            fs_ = d / seq_spp_folder(s) / f"{f:04d}.exr"
+            fs_.parent.mkdir(parents=True, exist_ok=True)
+            if not done(fs_):
+                render_aov(objects, cam, sres, "box", s, SEED_SEQ_SPP + 1000 * s + f, fs_)
         if not done(mo):
             # motion from the REFERENCE positions would be cleaner, but a user has the 1-spp AOVs:
             # use the frame's own (1-spp, box-filtered => one sample's hit point) positions.
@@ -418,6 +426,9 @@ def main():
             prev = project(pos, orbit_camera(max(f - 1, 0), n), sres)
             motion = np.where(hit[..., None], prev - cur, 0.0)
             write_motion(mo, motion)
+        for s in mode["seq_spp"]:  # the same camera: the 1-spp frame's motion serves every spp
+            if s != 1 and not done(d / seq_spp_folder(s) / mo.name):
+                shutil.copyfile(mo, d / seq_spp_folder(s) / mo.name)
         frames.append({"frame": f, "file": f"frames/{fr.name}", "motion": f"frames/{mo.name}",
                        "reference": f"ref/{rf.name}", "seed": SEED_SEQ + f, "ref_seed": SEED_SEQ_REF + f,
                        "camera": cam})
@@ -426,6 +437,7 @@ def main():
         "scene": SEQ_NAME, "renderer": "mitsuba", "version": mi.__version__, "variant": VARIANT,
         "description": what + "; camera orbits 60 degrees, static scene", "resolution": [sres, sres],
         "pixel_filter": "box", "spp": 1, "reference_spp": rspp, "frames": frames, "layout": "aov-sequence",
+        "spp_folders": {str(s): seq_spp_folder(s) for s in mode["seq_spp"]},
         "aovs": AOVS, "channels": exr_channels(d / "frames" / "0000.exr"),
         "motion_channels": exr_channels(d / "frames" / "0000_motion.exr"),
         "reference_channels": exr_channels(d / "ref" / "0000.exr"),

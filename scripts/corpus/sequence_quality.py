@@ -8,7 +8,8 @@ frame, on the third-party corpus's animations and on atrous's own rendered seque
 
 Each VARIANT=FLAGS runs `atrous denoise --sequence SEQ --out DIR FLAGS` on the sequence as the
 renderer wrote it ("" is what a user gets without --method). Corpus sequences are the scenes of
-<corpus>/{cycles,mitsuba}/ whose manifest lists frames (frames/ beside ref/); own sequences are
+<corpus>/{cycles,mitsuba}/ whose manifest lists frames, at each spp of its spp_folders (frames/ at
+1 spp, frames_s0004/ ..., all against ref/); own sequences are
 `atrous render --frames N --reference-spp S` folders (frame_NNNN/ with reference.exr), e.g.
 
     atrous render --scene cornell-moving --frames 20 --spp 1 --reference-spp 256 --width 128 --height 128 --out out/heldout_seq/cornell_moving
@@ -16,7 +17,9 @@ renderer wrote it ("" is what a user gets without --method). Corpus sequences ar
 
 OIDN (pyoidn, HDR, colour + albedo + normal) runs per frame on the buffers the corpus loaders read
 (scripts/corpus/quality.py) or on the frame's color/albedo/normal.exr. The metrics are `atrous
-compare --sequence`'s. Runs in the project venv (.venv: numpy, pyoidn, atrous).
+compare --sequence`'s, over all pixels and again with the pixels that show a light (reference
+luminance above LIGHT_LUM in any frame, grown by a pixel) left out. Runs in the project venv
+(.venv: numpy, pyoidn, atrous).
 """
 import argparse
 import json
@@ -36,28 +39,55 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def corpus_sequences(corpus: Path):
+    """(name, scene dir, frames folder, reference folder, spp) per corpus sequence and spp."""
     for renderer in ("cycles", "mitsuba"):
         for d in sorted((corpus / renderer).glob("*")):
             man = d / "manifest.json"
-            if man.exists() and "frames" in json.loads(man.read_text()) and (d / "frames").is_dir():
-                yield d.name, d, d / "frames", d / "ref"
+            if not man.exists():
+                continue
+            m = json.loads(man.read_text())
+            if "frames" not in m or not (d / "frames").is_dir():
+                continue
+            for spp, folder in sorted(m.get("spp_folders", {"1": "frames"}).items(), key=lambda kv: int(kv[0])):
+                if (d / folder).is_dir():
+                    yield f"{d.name}_{int(spp)}spp", d, d / folder, d / "ref", int(spp)
 
 
 def own_sequences(own: Path):
     for d in sorted(own.glob("*")):
         if (d / "frame_0000" / "reference.exr").exists():
-            yield d.name, d, d, d
+            yield d.name, d, d, d, None
 
 
-def oidn_per_frame(name, scene, out: Path):
+def corpus_frames(scene: Path, folder: Path):
+    """The manifest's frames with their file in `folder` (the spp's)."""
+    man = json.loads((scene / "manifest.json").read_text())
+    frames = []
+    for fr in man["frames"]:
+        fr = dict(fr)
+        fr["file"] = f"{folder.name}/{Path(fr['file']).name}"
+        frames.append(fr)
+    return man, frames
+
+
+def references(scene: Path, folder: Path):
+    """The reference frames as H x W x 3 arrays, in frame order."""
+    import atrous
+
+    if (scene / "manifest.json").exists():
+        man, frames = corpus_frames(scene, folder)
+        return [np.asarray(Q.load_frame(scene, man, fr, ref=True)["color"], np.float32) for fr in frames]
+    return [np.asarray(atrous.read_image(str(d / "reference.exr")), np.float32) for d in sorted(scene.glob("frame_*"))]
+
+
+def oidn_per_frame(scene: Path, folder: Path, out: Path):
     import atrous
     import pyoidn
 
     out.mkdir(parents=True, exist_ok=True)
-    man_path = scene / "manifest.json"
-    if man_path.exists():
-        man = json.loads(man_path.read_text())
-        for fr in man["frames"]:
+    if (scene / "manifest.json").exists():
+        man, frames = corpus_frames(scene, folder)
+        for fr in frames:
             b = Q.load_frame(scene, man, fr)
             alb = np.ascontiguousarray(np.clip(b["albedo"], 0.0, 1.0), np.float32)
             o = pyoidn.denoise(np.ascontiguousarray(b["color"], np.float32), alb,
@@ -68,6 +98,40 @@ def oidn_per_frame(name, scene, out: Path):
         rd = lambda k: np.ascontiguousarray(np.asarray(atrous.read_image(str(d / f"{k}.exr")), np.float32))  # noqa: E731
         o = pyoidn.denoise(rd("color"), np.clip(rd("albedo"), 0.0, 1.0), rd("normal"), hdr=True, quality="high")
         atrous.write_image(str(out / f"{d.name}.exr"), np.asarray(o, np.float32))
+
+
+def light_mask(refs):
+    """Pixels that show a light in any frame: reference luminance above LIGHT_LUM (a white diffuse
+    surface under these scenes' lights stays below it; a visible emitter and its mirror images do
+    not), grown by one pixel for the partly covered edge."""
+    lum = np.stack([r[..., :3] @ np.array([0.2126, 0.7152, 0.0722], np.float32) for r in refs])
+    m = (lum > LIGHT_LUM).any(0)
+    g = m.copy()
+    g[1:] |= m[:-1]
+    g[:-1] |= m[1:]
+    g[:, 1:] |= m[:, :-1]
+    g[:, :-1] |= m[:, 1:]
+    return g
+
+
+LIGHT_LUM = 1.5
+
+
+def masked_copy(src: Path, dst: Path, refs, mask):
+    """src's frame_NNNN.exr with the masked pixels set to the reference (no error there)."""
+    import atrous
+
+    dst.mkdir(parents=True, exist_ok=True)
+    for k, f in enumerate(sorted(src.glob("frame_*.exr"))):
+        img = np.array(atrous.read_image(str(f)), np.float32)
+        img[mask] = refs[k][..., :3][mask]
+        atrous.write_image(str(dst / f.name), img)
+
+
+def atrous_write(path, img):
+    import atrous
+
+    atrous.write_image(str(path), np.ascontiguousarray(img, np.float32))
 
 
 def compare(cli, ref, outs):
@@ -94,7 +158,7 @@ def main():
         sys.exit("sequence_quality: no sequence found (give --corpus and/or --own)")
     results = {}
     with tempfile.TemporaryDirectory() as tmp:
-        for name, scene, seq, ref in seqs:
+        for name, scene, seq, ref, spp in seqs:
             outs = []
             for vname, flags in variants:
                 o = Path(tmp) / name / vname
@@ -102,16 +166,38 @@ def main():
                                check=True, stdout=subprocess.DEVNULL)
                 outs.append(o)
             o = Path(tmp) / name / "oidn_high_per_frame"
-            oidn_per_frame(name, scene, o)
+            oidn_per_frame(scene, seq, o)
             outs.append(o)
             rows = compare(a.cli, ref, outs)
-            results[name] = {Path(r["path"]).name: {k: r[k] for k in ("relmse", "temporal_relmse", "psnr")}
-                             for r in rows["sequences"]}
+            r = {Path(x["path"]).name: {k: x[k] for k in ("relmse", "temporal_relmse", "psnr")} for x in rows["sequences"]}
+            # The same with the pixels that show a light left out (their error set to 0, the means
+            # taken over the other pixels).
+            refs = references(scene, seq)
+            mask = light_mask(refs)
+            keep = 1.0 - float(mask.mean())
+            mref = Path(tmp) / name / "masked_ref"
+            mref.mkdir(parents=True)
+            for k, rimg in enumerate(refs):
+                atrous_write(mref / f"frame_{k:04d}.exr", rimg[..., :3])
+            mouts = []
+            for o in outs:
+                masked_copy(o, Path(tmp) / name / ("masked_" + o.name), refs, mask)
+                mouts.append(Path(tmp) / name / ("masked_" + o.name))
+            for x in compare(a.cli, mref, mouts)["sequences"]:
+                n = Path(x["path"]).name[len("masked_"):]
+                r[n]["relmse_no_lights"] = x["relmse"] / keep
+                r[n]["temporal_relmse_no_lights"] = x["temporal_relmse"] / keep
+            r["light_pixels"] = float(mask.mean())
+            results[name] = r
     names = [v[0] for v in variants] + ["oidn_high_per_frame"]
-    print("| sequence | " + " | ".join(names) + " |")
-    print("|---" * (len(names) + 1) + "|")
-    for s, r in results.items():
-        print(f"| {s} | " + " | ".join(f"{r[n]['relmse']:.4f} / {r[n]['temporal_relmse']:.4f}" for n in names) + " |")
+    for key, title in (("", "all pixels"), ("_no_lights", "the pixels that show a light left out")):
+        print(f"\nrelMSE / temporal relMSE, {title}:\n")
+        print("| sequence | " + " | ".join(names) + " |")
+        print("|---" * (len(names) + 1) + "|")
+        for s, r in results.items():
+            extra = f" ({100 * r['light_pixels']:.1f}% left out)" if key else ""
+            print(f"| {s}{extra} | " + " | ".join(
+                f"{r[n]['relmse' + key]:.4f} / {r[n]['temporal_relmse' + key]:.4f}" for n in names) + " |")
     if a.json:
         a.json.write_text(json.dumps(results, indent=1))
 

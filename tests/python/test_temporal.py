@@ -1,0 +1,64 @@
+"""atrous.denoise_temporal: the offline sequence denoiser from Python (docs/temporal.md)."""
+import numpy as np
+import pytest
+
+import atrous
+
+
+@pytest.fixture(scope="module")
+def frames():
+    return list(atrous.render_sequence("cornell-moving", 5, width=40, height=32, spp=2, seed=11))
+
+
+@pytest.fixture(scope="module")
+def reference():
+    # frame 2's reference: the same frame at 256 spp, another seed
+    return list(atrous.render_sequence("cornell-moving", 5, width=40, height=32, spp=256, seed=900))[2]["color"]
+
+
+def test_beats_the_still_method_on_the_centre_frame(frames, reference):
+    out = atrous.denoise_temporal(frames, 2, method="eaw")
+    assert out.shape == (32, 40, 3) and out.dtype == np.float32 and np.isfinite(out).all()
+    alone = atrous.denoise(frames[2]["color"], albedo=frames[2]["albedo"], normal=frames[2]["normal"],
+                           depth=frames[2]["depth"], ids=frames[2]["ids"], emission=frames[2]["emission"],
+                           position=frames[2]["position"], method="eaw")
+    e_t = atrous.metrics(out, reference)["relmse"]
+    e_s = atrous.metrics(alone, reference)["relmse"]
+    assert e_t < 0.9 * e_s, (e_t, e_s)
+
+
+def test_radius_zero_is_the_still_method(frames):
+    f = frames[1]
+    out = atrous.denoise_temporal(frames, 1, method="sure", device="cpu", temporal={"radius": 0})
+    alone = atrous.denoise(f["color"], albedo=f["albedo"], normal=f["normal"], depth=f["depth"], ids=f["ids"],
+                           emission=f["emission"], position=f["position"], variance=f["variance"], method="sure",
+                           device="cpu")
+    np.testing.assert_array_equal(out, alone)
+
+
+def test_params_table_and_its_keywords(frames):
+    names = [r["name"] for r in atrous.temporal_params()]
+    assert names == ["radius", "depth_tolerance", "normal_cos", "color_sigmas", "falloff", "firefly_k"]
+    with pytest.raises(ValueError, match="radius"):
+        atrous.denoise_temporal(frames, 2, temporal={"radius": 99})
+    with pytest.raises(ValueError, match="radios"):
+        atrous.denoise_temporal(frames, 2, temporal={"radios": 1})
+
+
+def test_bad_windows_raise(frames):
+    with pytest.raises(ValueError, match="center"):
+        atrous.denoise_temporal(frames, 5)
+    with pytest.raises(ValueError, match="non-empty"):
+        atrous.denoise_temporal([], 0)
+    with pytest.raises(ValueError, match="albdo"):
+        atrous.denoise_temporal([dict(frames[0], albdo=frames[0]["albedo"])] + frames[1:], 1)
+    no_albedo = {k: v for k, v in frames[0].items() if k != "albedo"}
+    with pytest.raises(ValueError, match="other buffers"):
+        atrous.denoise_temporal([no_albedo] + frames[1:], 1)
+    small = {k: (v[:16] if isinstance(v, np.ndarray) else v) for k, v in frames[0].items()}
+    with pytest.raises(ValueError, match="frame 0"):
+        atrous.denoise_temporal([small] + frames[1:], 1)
+    nan = dict(frames[3], color=frames[3]["color"].copy())
+    nan["color"][5, 5] = np.nan
+    out = atrous.denoise_temporal(frames[:3] + [nan] + frames[4:], 2)
+    assert np.isfinite(out).all()
