@@ -31,7 +31,7 @@ struct TemporalParams {
     // Frame t ± k weighs exp(-k² / (2 falloff²)) in the average (frame t: 1). 0 = all equal. A
     // glossy highlight slides over its surface as the camera moves, and the colour test above,
     // on 3x3 means of 1-spp frames, misses part of that: the far frames smear it.
-    float falloff = 2.0f;
+    float falloff = 1.5f;
     // Every frame of the window goes through the still filters' firefly pass (prepass.h, bound k
     // local standard deviations, without a variance) before it is averaged: the bilinear taps
     // would spread a neighbour's firefly into a 2x2 blob that the still method's own pass keeps.
