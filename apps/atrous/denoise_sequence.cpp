@@ -242,6 +242,7 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
     size_t winFirst = 0;
     int firstIndex = 0;
     std::vector<ReprojectionCheck> checks(frames.size());
+    TemporalCache temporalCache;  // each frame prepared once for all the windows it is in
     bool idsTrusted = true, warnedSign = false, notedMotion = false;
     // Pipelined: frame N+1 is read and frame N-1 written (EXR and PNG) on other threads while
     // frame N is filtered. An error in either reaches this thread through its future, in frame
@@ -273,7 +274,10 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
                 std::vector<SvgfFrame> frameSet;
                 for (const io::SequenceFrame& w : window) refs.push_back(refsOf(w));
                 for (const io::BufferRefs& r : refs) frameSet.push_back(io::svgfFrame(r));
-                out = denoiseTemporal(frameSet, i - winFirst, args.temporal, options, &temporalReport);
+                std::vector<long long> ids;
+                for (size_t j = 0; j < window.size(); ++j) ids.push_back((long long)(winFirst + j));
+                out = denoiseTemporal(frameSet, i - winFirst, args.temporal, options, &temporalReport, &temporalCache,
+                                      &ids);
                 frameReport.methodUsed = temporalReport.spatial.methodUsed;
             } else {
                 // The frame's colour, variance and emission are not read after this: the filter works
@@ -307,9 +311,9 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
         const bool resolved = args.method == "auto" || (temporal && options.method == DenoiseMethod::Auto);
         std::printf("%s: %s", name.c_str(), args.method.c_str());
         if (temporal)
-            std::printf(" (+-%zu frames, %.1f averaged per pixel; then %s%s%s)", radius, temporalReport.meanFrames,
-                        denoiseMethodName(options.method), resolved ? " -> " : "",
-                        resolved ? denoiseMethodName(frameReport.methodUsed) : "");
+            std::printf(" (+-%zu frames, %.1f averaged per pixel in %.0f ms; then %s%s%s)", radius,
+                        temporalReport.meanFrames, temporalReport.gatherMs, denoiseMethodName(options.method),
+                        resolved ? " -> " : "", resolved ? denoiseMethodName(frameReport.methodUsed) : "");
         else if (resolved)
             std::printf(" -> %s", denoiseMethodName(frameReport.methodUsed));
         else if (svgf && args.svgf.learnedSpatial)

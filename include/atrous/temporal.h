@@ -7,6 +7,7 @@
 // averaged, and the average is filtered by a still method (the default: auto). A film is
 // denoised after rendering, so unlike SVGF nothing here is causal: frame t uses its future too.
 #pragma once
+#include <memory>
 #include <vector>
 
 #include "atrous/denoise.h"
@@ -57,12 +58,29 @@ struct TemporalGather {
     Image frames;
 };
 
+// What a sliding window over a sequence prepares once per frame (its sanitised G-buffer, colour
+// statistics and firefly clamp), kept between calls: with a cache, gatherTemporal and
+// denoiseTemporal take one id per frame of the window (the frame number, say) and prepare only the
+// frames whose id they have not seen; frames whose id leaves the window are dropped. An id must
+// name the same, unchanged buffers as long as it is in the windows given; a change of size or of
+// the parameters that shape the preparation starts over. Not thread-safe.
+class TemporalCache {
+public:
+    TemporalCache();
+    ~TemporalCache();
+    TemporalCache(TemporalCache&&) noexcept;
+    TemporalCache& operator=(TemporalCache&&) noexcept;
+    struct Impl;
+    std::unique_ptr<Impl> mImpl;
+};
+
 // Reprojects and averages window[center - r .. center + r] (r = params.radius, clipped to the
 // window) onto window[center]. Every frame must have the centre's buffers and size (SvgfFrame's
 // conventions: depth and ids in channel 0, motion previous - current in pixels). Frames without
 // motion are taken as still; what moved is then rejected by the depth, normal and id test.
 // Non-finite values of a neighbour are left out; the centre's own pass through. Host images.
-TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t center, const TemporalParams& params);
+TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t center, const TemporalParams& params,
+                              TemporalCache* cache = nullptr, const std::vector<long long>* ids = nullptr);
 
 // What denoiseTemporal did.
 struct TemporalReport {
@@ -74,6 +92,7 @@ struct TemporalReport {
 // gatherTemporal, then `spatial` (a still method's options: auto, eaw, ...) on the average, with
 // the centre frame's depth, ids and position. Returns the denoised frame on the host.
 Image denoiseTemporal(const std::vector<SvgfFrame>& window, size_t center, const TemporalParams& params,
-                      const DenoiseOptions& spatial, TemporalReport* report = nullptr);
+                      const DenoiseOptions& spatial, TemporalReport* report = nullptr, TemporalCache* cache = nullptr,
+                      const std::vector<long long>* ids = nullptr);
 
 }  // namespace atrous

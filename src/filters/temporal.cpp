@@ -3,6 +3,7 @@
 #include "atrous/temporal.h"
 
 #include <algorithm>
+#include <map>
 #include <string>
 #include <cmath>
 #include <cstdlib>
@@ -27,11 +28,26 @@ void checkTemporalFrame(const SvgfFrame& frame) { svgf::checkFrame(frame); }
 
 namespace {
 
+}  // namespace
+
 // A frame as the hops read it: its sanitised G-buffer and colour statistics, owned here.
 struct PreparedFrame {
     Image depth, normal, ids, motion, grad, stats, color;
     temporal::FrameViews views;
 };
+
+struct TemporalCache::Impl {
+    std::map<long long, PreparedFrame> frames;  // by the caller's frame id
+    int width = 0, height = 0;
+    bool stats = false;
+    float fireflyK = 0.0f;
+};
+TemporalCache::TemporalCache() : mImpl(std::make_unique<Impl>()) {}
+TemporalCache::~TemporalCache() = default;
+TemporalCache::TemporalCache(TemporalCache&&) noexcept = default;
+TemporalCache& TemporalCache::operator=(TemporalCache&&) noexcept = default;
+
+namespace {
 
 ImageView viewOf(const Image* img) { return img ? img->view() : ImageView{}; }
 
@@ -61,8 +77,9 @@ void prepare(const CpuExec& exec, const SvgfFrame& f, bool stats, float fireflyK
     }
     v.emission = viewOf(f.emission);
     if (stats) {
-        p.stats = Image::uninitialized(w, h, 2);
+        p.stats = Image::uninitialized(w, h, 3);
         v.stats = p.stats.view();
+        exec.forEachPixel(w, h, temporal::DemodulatedLum{v});
         exec.forEachPixel(w, h, temporal::LocalStats{v});
     }
 }
@@ -71,8 +88,11 @@ Image cloneOrEmpty(const Image* img) { return img ? img->clone() : Image(); }
 
 }  // namespace
 
-TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t center, const TemporalParams& params) {
+TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t center, const TemporalParams& params,
+                              TemporalCache* cache, const std::vector<long long>* ids) {
     validateTemporalParams(params);
+    if ((cache == nullptr) != (ids == nullptr) || (ids && ids->size() != window.size()))
+        throw InputError("temporal window: a cache needs one id per frame of the window");
     if (center >= window.size()) throw InputError("temporal window: the centre frame is outside the window");
     const SvgfFrame& c = window[center];
     svgf::checkFrame(c);
@@ -113,21 +133,55 @@ TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t cente
         return g;
     }
     const bool stats = params.colorSigmas > 0.0f;
-    std::vector<PreparedFrame> prepared(hi - lo + 1);
-    for (size_t i = lo; i <= hi; ++i) prepare(exec, window[i], stats, params.fireflyK, prepared[i - lo]);
+    // The window's prepared frames: from the cache where it has them (same id, size and settings),
+    // else prepared now (and kept there for the next window).
+    std::vector<PreparedFrame> local;
+    std::vector<PreparedFrame*> prepared(hi - lo + 1);
+    TemporalCache::Impl* cached = cache ? cache->mImpl.get() : nullptr;
+    if (cached && (cached->width != w || cached->height != h || cached->stats != stats ||
+                   cached->fireflyK != params.fireflyK)) {
+        cached->frames.clear();
+        cached->width = w, cached->height = h, cached->stats = stats, cached->fireflyK = params.fireflyK;
+    }
+    if (!cached) local.resize(hi - lo + 1);
+    for (size_t i = lo; i <= hi; ++i) {
+        if (!cached) {
+            prepare(exec, window[i], stats, params.fireflyK, local[i - lo]);
+            prepared[i - lo] = &local[i - lo];
+            continue;
+        }
+        auto it = cached->frames.find((*ids)[i]);
+        if (it == cached->frames.end()) {
+            it = cached->frames.emplace((*ids)[i], PreparedFrame{}).first;
+            prepare(exec, window[i], stats, params.fireflyK, it->second);
+        } else {
+            // The derived planes are the cache's; the caller's own buffers are read where they are now.
+            temporal::FrameViews& v = it->second.views;
+            if (it->second.color.empty()) v.color = viewOf(window[i].color);
+            v.albedo = viewOf(window[i].albedo), v.normalRaw = viewOf(window[i].normal);
+            v.emission = viewOf(window[i].emission);
+        }
+        prepared[i - lo] = &it->second;
+    }
+    if (cached) {  // frames outside this window are not needed again (windows only move forward)
+        for (auto it = cached->frames.begin(); it != cached->frames.end();) {
+            bool in = false;
+            for (size_t i = lo; i <= hi && !in; ++i) in = (*ids)[i] == it->first;
+            it = in ? std::next(it) : cached->frames.erase(it);
+        }
+    }
     // The centre's colour as its neighbours' is taken (after the firefly pass).
-    const PreparedFrame& pc = prepared[center - lo];
+    const PreparedFrame& pc = *prepared[center - lo];
     g.color = pc.color.empty() ? c.color->clone() : pc.color.clone();
     Image track(w, h, 2), alive(w, h, 1);
     for (int dir = -1; dir <= 1; dir += 2) {
         if ((dir < 0 && center == lo) || (dir > 0 && center == hi)) continue;
-        for (int y = 0; y < h; ++y)
-            for (int x = 0; x < w; ++x) track(x, y, 0) = float(x), track(x, y, 1) = float(y), alive(x, y, 0) = 1.0f;
+        exec.forEachPixel(w, h, temporal::StartTracks{track.view(), alive.view()});
         for (size_t k = 1; k <= r; ++k) {
             if (dir < 0 ? center < lo + k : center + k > hi) break;
             const size_t from = dir < 0 ? center - k + 1 : center + k - 1, to = dir < 0 ? center - k : center + k;
             temporal::Hop hop;
-            hop.from = prepared[from - lo].views, hop.to = prepared[to - lo].views, hop.centre = prepared[center - lo].views;
+            hop.from = prepared[from - lo]->views, hop.to = prepared[to - lo]->views, hop.centre = pc.views;
             hop.to.variance = viewOf(window[to].variance);
             hop.backward = dir < 0;
             const float fo = params.falloff;
@@ -146,9 +200,10 @@ TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t cente
 }
 
 Image denoiseTemporal(const std::vector<SvgfFrame>& window, size_t center, const TemporalParams& params,
-                      const DenoiseOptions& spatial, TemporalReport* report) {
+                      const DenoiseOptions& spatial, TemporalReport* report, TemporalCache* cache,
+                      const std::vector<long long>* ids) {
     Timer timer;
-    TemporalGather g = gatherTemporal(window, center, params);
+    TemporalGather g = gatherTemporal(window, center, params, cache, ids);
     if (report) {
         report->gatherMs = timer.ms();
         double sum = 0;

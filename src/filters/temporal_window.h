@@ -18,33 +18,50 @@ using svgf::writeVec3;
 struct FrameViews {
     ImageView depth, normal, ids, motion, grad;           // sanitised: 1, 3, 1, 2, 2 channels
     ImageView color, albedo, normalRaw, emission, variance;  // as given (albedo ... optional)
-    ImageView stats;                                      // 2 channels: 3x3 mean and variance of that mean (demodulated luminance)
+    ImageView stats;  // 3 channels: the 3x3 mean of the demodulated luminance, that mean's variance, the luminance
 };
 
-// The 3x3 mean of lum((c - e) / a') (SVGF's albedo rule) and the variance of that mean, non-finite
-// samples left out. (5x5 and 7x7 were measured too: they miss a small moving highlight, docs/temporal.md.)
+// Channel 2 of `stats`: lum((c - e) / a') per pixel (SVGF's albedo rule; NaN where not finite),
+// read by LocalStats.
+struct DemodulatedLum {
+    FrameViews f;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        float a[3];
+        svgf::albedoRule().at(f.albedo, x, y, a);
+        const Vec3 e = svgf::sanitizedEmission(f.emission, x, y);
+        const float l = filters::lum((f.color(x, y, 0) - e.x) / a[0], (f.color(x, y, 1) - e.y) / a[1],
+                                     (f.color(x, y, 2) - e.z) / a[2]);
+        f.stats(x, y, 2) = isFiniteF(l) ? l : NAN;
+    }
+};
+
+// Channels 0 and 1 of `stats`: the 3x3 mean of channel 2 and the variance of that mean (the 3x3
+// sample variance over the number of samples), non-finite samples left out. (5x5 and 7x7 means,
+// and the quietest of four corner windows for the variance, were measured too: docs/temporal.md.)
 struct LocalStats {
     FrameViews f;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        const filters::AlbedoRule rule = svgf::albedoRule();
         float s = 0.0f, s2 = 0.0f, n = 0.0f;
         for (int j = -1; j <= 1; ++j) {
             for (int i = -1; i <= 1; ++i) {
                 const int qx = x + i, qy = y + j;
                 if (qx < 0 || qy < 0 || qx >= f.color.width || qy >= f.color.height) continue;
-                float a[3];
-                rule.at(f.albedo, qx, qy, a);
-                const Vec3 e = svgf::sanitizedEmission(f.emission, qx, qy);
-                const float l = filters::lum((f.color(qx, qy, 0) - e.x) / a[0], (f.color(qx, qy, 1) - e.y) / a[1],
-                                             (f.color(qx, qy, 2) - e.z) / a[2]);
+                const float l = f.stats(qx, qy, 2);
                 if (!isFiniteF(l)) continue;
                 s += l, s2 += l * l, n += 1.0f;
             }
         }
         const float m = n > 0.0f ? s / n : 0.0f;
         f.stats(x, y, 0) = m;
-        // the variance of the mean
         f.stats(x, y, 1) = n > 1.0f ? fmaxf(s2 / n - m * m, 0.0f) / (n - 1.0f) : 0.0f;
+    }
+};
+
+// Every track starts at its own pixel, alive.
+struct StartTracks {
+    ImageView track, alive;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        track(x, y, 0) = float(x), track(x, y, 1) = float(y), alive(x, y, 0) = 1.0f;
     }
 };
 
@@ -69,19 +86,33 @@ struct Hop {
         return x >= 0 && y >= 0 && x < to.depth.width && y < to.depth.height;
     }
 
-    // SVGF's reprojection test (svgf_reproject.h) between `from` at (fx, fy) and `to` at (qx, qy).
-    ATROUS_HOST_DEVICE bool consistent(int fx, int fy, int qx, int qy) const {
+    // SVGF's reprojection test (svgf_reproject.h) between `from` at (fx, fy) (its anchor: read once
+    // for the five taps of a hop) and `to` at (qx, qy).
+    struct Anchor {
+        float z, tol, id;
+        Vec3 n;
+        bool background, hasN;
+    };
+    ATROUS_HOST_DEVICE Anchor anchor(int fx, int fy) const {
+        Anchor a;
+        a.z = from.depth(fx, fy, 0);
+        a.id = from.ids(fx, fy, 0);
+        a.background = isBackground(a.z);
+        a.tol = depthTolerance * (fabsf(from.grad(fx, fy, 0)) + fabsf(from.grad(fx, fy, 1)) + 0.01f * fabsf(a.z));
+        a.n = readVec3(from.normal, fx, fy);
+        a.hasN = hasNormal(a.n);
+        return a;
+    }
+    ATROUS_HOST_DEVICE bool consistent(const Anchor& a, int qx, int qy) const {
         if (!inside(qx, qy)) return false;
-        if (to.ids(qx, qy, 0) != from.ids(fx, fy, 0)) return false;
-        const float z = from.depth(fx, fy, 0), zq = to.depth(qx, qy, 0);
-        const bool bp = isBackground(z), bq = isBackground(zq);
-        if (bp || bq) return bp && bq;
-        const float tol = depthTolerance * (fabsf(from.grad(fx, fy, 0)) + fabsf(from.grad(fx, fy, 1)) + 0.01f * fabsf(z));
-        if (!(fabsf(zq - z) <= tol)) return false;
-        const Vec3 n = readVec3(from.normal, fx, fy), nq = readVec3(to.normal, qx, qy);
-        const bool hp = hasNormal(n), hq = hasNormal(nq);
-        if (hp != hq) return false;
-        return !hp || dot(n, nq) >= normalCos;
+        if (to.ids(qx, qy, 0) != a.id) return false;
+        const float zq = to.depth(qx, qy, 0);
+        const bool bq = isBackground(zq);
+        if (a.background || bq) return a.background && bq;
+        if (!(fabsf(zq - a.z) <= a.tol)) return false;
+        const Vec3 nq = readVec3(to.normal, qx, qy);
+        if (a.hasN != hasNormal(nq)) return false;
+        return !a.hasN || dot(a.n, nq) >= normalCos;
     }
 
     ATROUS_HOST_DEVICE static int nearest(float v) { return int(floorf(v + 0.5f)); }
@@ -117,7 +148,8 @@ struct Hop {
             if (!(fabsf(rx) <= 1.0f && fabsf(ry) <= 1.0f)) return stop(x, y);
         }
         const int qx = nearest(px), qy = nearest(py);
-        if (!consistent(fx, fy, qx, qy)) return stop(x, y);
+        const Anchor an = anchor(fx, fy);
+        if (!consistent(an, qx, qy)) return stop(x, y);
         if (colorSigmas > 0.0f) {
             // Two 3x3 means of independent noise: their difference has the sum of their variances.
             const float d = to.stats(qx, qy, 0) - centre.stats(x, y, 0);
@@ -134,7 +166,7 @@ struct Hop {
             for (int i = 0; i < 2; ++i) {
                 const float wt = (i ? ax : 1.0f - ax) * (j ? ay : 1.0f - ay);
                 const int sx = x0 + i, sy = y0 + j;
-                if (wt <= 0.0f || !consistent(fx, fy, sx, sy)) continue;
+                if (wt <= 0.0f || !consistent(an, sx, sy)) continue;
                 w += wt;
                 for (int k = 0; k < 3; ++k) {
                     c[k] += wt * to.color(sx, sy, k);
