@@ -3,6 +3,7 @@
 // `denoise --sequence` default.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -182,6 +183,36 @@ TEST(TemporalDenoise, BeatsTheStillMethodPerFrame) {
     alone.radius = 0;
     Image s = denoiseTemporal(framesOf(synth), 3, alone, opt);
     EXPECT_LT(svgf_test::mse(t, synth[3].truth), 0.7 * svgf_test::mse(s, synth[3].truth));
+}
+
+// A cache (each frame prepared once for the windows it is in) gives what preparing every frame for
+// every window gives, bit for bit, as the window slides over a sequence, and starts over when the
+// parameters that shape the preparation change.
+TEST(TemporalGather, CacheOverASlidingWindowChangesNothing) {
+    SceneOptions o;
+    o.noiseSigma = 0.2f;
+    const auto synth = makeFrames(o, 9);
+    TemporalCache cache;  // one cache for both settings: the second must not see the first's frames
+    for (float fireflyK : {16.0f, 2.0f}) {
+        TemporalParams p;
+        p.fireflyK = fireflyK;
+        // The second setting walks back from the end, where the first left its frames in the cache.
+        for (size_t step = 0; step < synth.size(); ++step) {
+            const size_t t = fireflyK == 16.0f ? step : synth.size() - 1 - step;
+            const size_t lo = t >= 3 ? t - 3 : 0, hi = std::min(synth.size() - 1, t + 3);
+            std::vector<SvgfFrame> window;
+            std::vector<long long> ids;
+            for (size_t i = lo; i <= hi; ++i) window.push_back(synth[i].frame()), ids.push_back((long long)i);
+            const TemporalGather a = gatherTemporal(window, t - lo, p, &cache, &ids);
+            const TemporalGather b = gatherTemporal(window, t - lo, p);
+            EXPECT_TRUE(sameImages(a.color, b.color)) << t;
+            EXPECT_TRUE(sameImages(a.frames, b.frames)) << t;
+        }
+    }
+    std::vector<SvgfFrame> window = framesOf(synth);
+    EXPECT_THROW(gatherTemporal(window, 1, TemporalParams{}, &cache, nullptr), InputError);
+    std::vector<long long> shortIds = {0, 1};
+    EXPECT_THROW(gatherTemporal(window, 1, TemporalParams{}, &cache, &shortIds), InputError);
 }
 
 TEST(TemporalGather, BadWindowsThrow) {
