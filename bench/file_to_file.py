@@ -34,7 +34,7 @@ import sys
 import time
 from pathlib import Path
 
-from bench_machine import cpu_model  # bench/ (the script's own folder is on sys.path)
+from bench_machine import cpu_model, emit, git_commit  # bench/ (the script's own folder is on sys.path)
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -56,16 +56,6 @@ t4 = time.perf_counter()
 print(json.dumps({"import_ms": (t1 - t0) * 1e3, "read_ms": (t2 - t1) * 1e3, "denoise_ms": (t3 - t2) * 1e3,
                   "write_ms": (t4 - t3) * 1e3, "total_ms": (t4 - t1) * 1e3}))
 """
-
-
-def git_commit() -> str:
-    try:
-        head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True, check=True).stdout.strip()
-        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=ROOT, capture_output=True,
-                               text=True, check=True).stdout.strip()
-        return head + ("+uncommitted" if dirty else "")
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
 
 
 def run_with_rss(cmd: list) -> dict:
@@ -199,10 +189,7 @@ def main(argv=None) -> int:
             doc["sequence_1080p_eaw"] = {"frames": a.frames, "filter_ms_per_frame": float(m.group(1)),
                                          "wall_ms_per_frame": float(m.group(2)), "peak_mb": r["peak_mb"],
                                          "ratio": float(m.group(2)) / float(m.group(1))}
-    text = json.dumps(doc, indent=2)
-    print(text)
-    if a.out:
-        Path(a.out).write_text(text + "\n")
+    emit(doc, a.out)
     return 0
 
 

@@ -35,22 +35,11 @@ import sys
 import time
 from pathlib import Path
 
-from bench_machine import cpu_model  # bench/ (the script's own folder is on sys.path)
+from bench_machine import cpu_model, emit, git_commit  # bench/ (the script's own folder is on sys.path)
 
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def _git_commit() -> str:
-    try:
-        head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True,
-                              check=True).stdout.strip()
-        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=ROOT,
-                               capture_output=True, text=True, check=True).stdout.strip()
-        return head + ("+uncommitted" if dirty else "")
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
 
 
 def _oidn_filter(pyoidn, dev, color, albedo, normal, quality):
@@ -189,7 +178,7 @@ def main(argv=None) -> int:
     doc = {
         "what": "learned filter speed vs EAW, SURE and OIDN (bench/learned_speed.py)",
         "date_utc": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M:%S"),
-        "commit": _git_commit(),
+        "commit": git_commit(),
         "machine": {"host": platform.node(), "cpu": cpu_model(), "cpu_count": os.cpu_count(),
                     "load_average": list(os.getloadavg()) if hasattr(os, "getloadavg") else None},
         "atrous_device": bench.get("device"), "atrous_device_name": bench.get("device_name"),
@@ -203,11 +192,7 @@ def main(argv=None) -> int:
         "command": " ".join(cmd),
         "results": rows,
     }
-    text = json.dumps(doc, indent=2)
-    print(text)
-    if a.out:
-        Path(a.out).parent.mkdir(parents=True, exist_ok=True)
-        Path(a.out).write_text(text + "\n")
+    emit(doc, a.out)
     return 0
 
 

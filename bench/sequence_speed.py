@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import argparse
 import datetime as _dt
-import json
 import re
 import shutil
 import statistics
@@ -24,15 +23,10 @@ import subprocess
 import sys
 from pathlib import Path
 
-from bench_machine import cpu_model  # bench/ (the script's own folder is on sys.path)
+from bench_machine import cpu_model, emit, git_commit  # bench/ (the script's own folder is on sys.path)
 
 ROOT = Path(__file__).resolve().parents[1]
 VARIANTS = {"temporal": [], "per_frame_auto": ["--method", "auto"]}
-
-
-def git_commit() -> str:
-    r = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
-    return r.stdout.strip() if r.returncode == 0 else "unknown"
 
 
 def run_once(atrous: str, seq: Path, out: Path, flags: list) -> dict:
@@ -77,10 +71,7 @@ def main() -> int:
            "median_ms_per_frame": med,
            "temporal_over_per_frame": {m: med["temporal"][m] / base[m] for m in ("filter_ms", "wall_ms")},
            "samples": samples}
-    text = json.dumps(doc, indent=2)
-    print(text)
-    if a.out:
-        Path(a.out).write_text(text + "\n")
+    emit(doc, a.out)
     return 0
 
 

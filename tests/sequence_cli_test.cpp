@@ -13,19 +13,9 @@
 using atrous::test::countEntries;
 using atrous::test::runCli;
 using atrous::test::sameImages;
+using atrous::test::renderSequence;
 using atrous::test::TempDir;
 namespace fs = std::filesystem;
-
-namespace {
-
-std::string renderSequence(const TempDir& dir) {
-    const std::string seq = dir / "seq";
-    auto r = runCli("render --scene cornell --frames 3 --spp 1 --width 32 --height 24 --reference-spp 4 --out " + seq);
-    EXPECT_EQ(r.exitCode, 0) << r.output;
-    return seq;
-}
-
-}  // namespace
 
 TEST(SequenceCli, SvgfEawAndSureDenoiseEveryFrame) {
     TempDir dir;

@@ -22,6 +22,7 @@ using svgf_test::SceneOptions;
 using svgf_test::SynthFrame;
 using test::runCli;
 using test::sameImages;
+using test::renderSequence;
 using test::TempDir;
 namespace fs = std::filesystem;
 
@@ -237,18 +238,6 @@ TEST(TemporalGather, BadWindowsThrow) {
     one.radius = 0;
     EXPECT_NO_THROW(gatherTemporal(sizes, 0, one));
 }
-
-namespace {
-
-std::string renderSequence(const TempDir& dir, int frames = 3) {
-    const std::string seq = dir / "seq";
-    auto r = runCli("render --scene cornell --frames " + std::to_string(frames) +
-                    " --spp 1 --width 32 --height 24 --reference-spp 4 --out " + seq);
-    EXPECT_EQ(r.exitCode, 0) << r.output;
-    return seq;
-}
-
-}  // namespace
 
 // `denoise --sequence` without --method runs the temporal method and says so, per frame, with the
 // still method auto chose; --spatial picks that method.

@@ -93,4 +93,14 @@ inline int countEntries(const std::string& dir) {
     return n;
 }
 
+// `atrous render --frames` of the Cornell box into DIR/seq (1 spp, 32x24, 4-spp references): the
+// small sequence the CLI's sequence tests denoise. Returns its path.
+inline std::string renderSequence(const TempDir& dir, int frames = 3) {
+    const std::string seq = dir / "seq";
+    auto r = runCli("render --scene cornell --frames " + std::to_string(frames) +
+                    " --spp 1 --width 32 --height 24 --reference-spp 4 --out " + seq);
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    return seq;
+}
+
 }  // namespace atrous::test
