@@ -6,6 +6,9 @@ frame, on the third-party corpus's animations and on atrous's own rendered seque
     .venv/bin/python scripts/corpus/sequence_quality.py --corpus out/corpus/full --own out/heldout_seq \\
         temporal="" per_frame_auto="--method auto" svgf="--method svgf"
 
+With --strips DIR it also writes, per sequence, DIR/<sequence>.png (the middle frame: noisy | each
+variant | OIDN per frame | reference) and DIR/<sequence>.gif (every frame).
+
 Each VARIANT=FLAGS runs `atrous denoise --sequence SEQ --out DIR FLAGS` on the sequence as the
 renderer wrote it ("" is what a user gets without --method). Corpus sequences are the scenes of
 <corpus>/{cycles,mitsuba}/ whose manifest lists frames, at each spp of its spp_folders (frames/ at
@@ -128,6 +131,54 @@ def masked_copy(src: Path, dst: Path, refs, mask):
         atrous.write_image(str(dst / f.name), img)
 
 
+def noisy_frames(scene: Path, folder: Path):
+    """The noisy colour of every frame, as H x W x 3 arrays."""
+    import atrous
+
+    if (scene / "manifest.json").exists():
+        man, frames = corpus_frames(scene, folder)
+        return [np.asarray(Q.load_frame(scene, man, fr)["color"], np.float32) for fr in frames]
+    return [np.asarray(atrous.read_image(str(d / "color.exr")), np.float32) for d in sorted(scene.glob("frame_*"))]
+
+
+def tonemap(img):
+    x = np.clip(np.nan_to_num(img[..., :3], nan=0.0, posinf=0.0), 0.0, None)
+    return (np.clip((x / (1.0 + x)) ** (1.0 / 2.2), 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
+
+
+def write_strips(strips: Path, name: str, columns):
+    """strips/<name>.png (the middle frame, 2x nearest-neighbour) and strips/<name>.gif (every frame,
+    8 fps, 1x): the columns side by side, each labelled. columns: (label, list of frames)."""
+    strips.mkdir(parents=True, exist_ok=True)
+    for scale, frames_wanted, out in ((2, [len(columns[0][1]) // 2], "png"), (1, range(len(columns[0][1])), "gif")):
+        _strip(strips / f"{name}.{out}", columns, scale, frames_wanted)
+
+
+def _strip(path: Path, columns, scale, frames_wanted):
+    from PIL import Image, ImageDraw
+
+    images = []
+    for k in frames_wanted:
+        tiles = []
+        for label, frames in columns:
+            t = Image.fromarray(tonemap(frames[k]))
+            t = t.resize((t.width * scale, t.height * scale), Image.NEAREST)
+            canvas = Image.new("RGB", (t.width, t.height + 16), (0, 0, 0))
+            canvas.paste(t, (0, 16))
+            ImageDraw.Draw(canvas).text((3, 2), label, fill=(255, 255, 255))
+            tiles.append(canvas)
+        row = Image.new("RGB", (sum(t.width for t in tiles) + 2 * (len(tiles) - 1), tiles[0].height), (40, 40, 40))
+        x = 0
+        for t in tiles:
+            row.paste(t, (x, 0))
+            x += t.width + 2
+        images.append(row)
+    if path.suffix == ".png":
+        images[0].save(path)
+    else:
+        images[0].save(path, save_all=True, append_images=images[1:], duration=125, loop=0)
+
+
 def atrous_write(path, img):
     import atrous
 
@@ -146,6 +197,9 @@ def main():
     ap.add_argument("--own", type=Path, help="a folder of `atrous render --frames` sequences with references")
     ap.add_argument("--cli", default=str(ROOT / "build" / "atrous"))
     ap.add_argument("--json", type=Path, help="write the figures here too")
+    ap.add_argument("--strips", type=Path,
+                    help="write DIR/<sequence>.png (the middle frame) and .gif (all frames): noisy | variants | "
+                         "OIDN per frame | reference")
     ap.add_argument("variants", nargs="+", help="NAME=FLAGS")
     a = ap.parse_args()
     variants = [v.split("=", 1) for v in a.variants]
@@ -189,6 +243,16 @@ def main():
                 r[n]["temporal_relmse_no_lights"] = x["temporal_relmse"] / keep
             r["light_pixels"] = float(mask.mean())
             results[name] = r
+            if a.strips:
+                import atrous
+
+                cols = [("noisy", noisy_frames(scene, seq))]
+                for o in outs:
+                    cols.append((o.name.replace("_per_frame", "").replace("oidn_high", "OIDN high/frame"),
+                                 [np.asarray(atrous.read_image(str(f)), np.float32)
+                                  for f in sorted(o.glob("frame_*.exr"))]))
+                cols.append(("reference", refs))
+                write_strips(a.strips, name, cols)
     names = [v[0] for v in variants] + ["oidn_high_per_frame"]
     for key, title in (("", "all pixels"), ("_no_lights", "the pixels that show a light left out")):
         print(f"\nrelMSE / temporal relMSE, {title}:\n")
