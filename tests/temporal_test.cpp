@@ -287,3 +287,25 @@ TEST(TemporalCli, BadFlagsExitTwoAndWriteNothing) {
     EXPECT_EQ(r.exitCode, 2) << r.output;
     EXPECT_NE(r.output.find("--sequence"), std::string::npos) << r.output;
 }
+
+// The sequence methods come from one list: the CLI's help and its unknown-method message name every
+// row, the default with --sequence is the first row, and each row denoises a sequence.
+TEST(TemporalCli, SequenceMethodsComeFromTheList) {
+    ASSERT_FALSE(sequenceMethods().empty());
+    EXPECT_STREQ(sequenceMethods().front().name, "temporal");
+    auto help = runCli("denoise --help");
+    auto unknown = runCli("denoise --method nope --color x.exr --out y.exr");
+    EXPECT_EQ(unknown.exitCode, 2) << unknown.output;
+    TempDir dir;
+    const std::string seq = renderSequence(dir, 2);
+    for (const SequenceMethodInfo& m : sequenceMethods()) {
+        EXPECT_NE(help.output.find(std::string(m.name) + " (with --sequence): " + m.summary), std::string::npos)
+            << m.name << "\n" << help.output;
+        EXPECT_NE(unknown.output.find(m.name), std::string::npos) << unknown.output;
+        EXPECT_EQ(findSequenceMethod(m.name), &m);
+        auto r = runCli("denoise --sequence " + seq + " --method " + m.name + " --out " + (dir / m.name));
+        EXPECT_EQ(r.exitCode, 0) << r.output;
+    }
+    EXPECT_EQ(findSequenceMethod("eaw"), nullptr);
+    EXPECT_EQ(sequenceMethodNames(), "temporal, svgf");
+}

@@ -139,12 +139,12 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     const bool sequence = !a.sequence.empty();
     for (const char* f : {"--start", "--end", "--step"})
         if (!sequence && cmd.count(f) > 0) throw InputError(std::string(f) + ": picks frames of a --sequence; give one");
-    // A sequence without --method: the offline temporal method (the frames around each one).
-    if (sequence && cmd.count("--method") == 0) a.method = "temporal";
-    const bool sequenceMethod = a.method == "svgf" || a.method == "temporal";
+    // A sequence without --method: the first sequence method (temporal: the frames around each one).
+    if (sequence && cmd.count("--method") == 0) a.method = sequenceMethods().front().name;
+    const bool sequenceMethod = findSequenceMethod(a.method) != nullptr;
     if (!sequenceMethod && !findDenoiseMethod(a.method))
         throw InputError("--method: unknown denoise method '" + a.method + "' (expected " + denoiseMethodNames() +
-                         ", or temporal or svgf with --sequence)");
+                         ", or with --sequence " + sequenceMethodNames() + ")");
     if (sequenceMethod && !sequence)
         throw InputError("--method " + a.method + " denoises animated sequences: give --sequence DIR (and an output directory)");
     if (cmd.count("--spatial") > 0 && a.method != "temporal")
@@ -321,11 +321,9 @@ void addDenoiseCommand(CLI::App& app) {
         ->required();
     std::string methodHelp;
     for (const DenoiseMethodInfo& m : denoiseMethods()) methodHelp += std::string(m.name) + ": " + m.summary + "; ";
-    cmd->add_option("--method", a->method,
-                    methodHelp +
-                        "temporal (with --sequence, its default): frames t-K..t+K reprojected onto t and averaged, "
-                        "then the still method --spatial; svgf (with --sequence): spatiotemporal variance-guided "
-                        "filtering, causal (each frame from the ones before it). The output line says which method ran")
+    for (const SequenceMethodInfo& m : sequenceMethods())
+        methodHelp += std::string(m.name) + " (with --sequence): " + m.summary + "; ";
+    cmd->add_option("--method", a->method, methodHelp + "the output line says which method ran")
         ->capture_default_str();
     cmd->add_option("--spatial", a->spatial, "With --method temporal: the still method run on the averaged frame")
         ->capture_default_str()

@@ -194,9 +194,9 @@ private:
 
 int runSequenceDenoise(const SequenceDenoiseArgs& args) {
     const bool svgf = args.method == "svgf", temporal = args.method == "temporal";
-    if (!svgf && !temporal && !findDenoiseMethod(args.method))
-        throw InputError("--method '" + args.method + "' cannot denoise a sequence (expected temporal, svgf, " +
-                         denoiseMethodNames() + ")");
+    if (!findSequenceMethod(args.method) && !findDenoiseMethod(args.method))
+        throw InputError("--method '" + args.method + "' cannot denoise a sequence (expected " + sequenceMethodNames() +
+                         ", " + denoiseMethodNames() + ")");
     if (args.sequenceDir.empty()) throw InputError("--sequence: no directory given");
     if ((svgf || temporal) && args.range.step > 1)
         throw InputError("--step " + std::to_string(args.range.step) + ": " +

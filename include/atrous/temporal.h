@@ -8,6 +8,7 @@
 // denoised after rendering, so unlike SVGF nothing here is causal: frame t uses its future too.
 #pragma once
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "atrous/denoise.h"
@@ -94,5 +95,17 @@ struct TemporalReport {
 Image denoiseTemporal(const std::vector<SvgfFrame>& window, size_t center, const TemporalParams& params,
                       const DenoiseOptions& spatial, TemporalReport* report = nullptr, TemporalCache* cache = nullptr,
                       const std::vector<long long>* ids = nullptr);
+
+// The methods that denoise a sequence as a sequence, beside the still methods (denoiseMethods(),
+// which `atrous denoise --sequence` also runs frame by frame): one row each, the one list the
+// CLI's --method help and messages and Python (atrous.SEQUENCE_METHODS) read.
+struct SequenceMethodInfo {
+    const char* name;     // "temporal", "svgf": the CLI's --method
+    const char* summary;  // one line: the CLI's help
+    bool causal;          // each frame from the frames before it only (real time, the viewer)
+};
+const std::vector<SequenceMethodInfo>& sequenceMethods();  // temporal (the --sequence default) first
+const SequenceMethodInfo* findSequenceMethod(const std::string& name);  // null when unknown
+std::string sequenceMethodNames();  // "temporal, svgf"
 
 }  // namespace atrous

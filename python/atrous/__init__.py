@@ -51,6 +51,7 @@ __all__ = [
     "denoise_temporal",
     "render_params",
     "METHODS",
+    "SEQUENCE_METHODS",
     "WEIGHTED_METHODS",
     "denoise_methods",
 ]
@@ -59,6 +60,9 @@ __version__ = "0.1.0"
 
 # The still methods, from the library's one list (denoiseMethods(), include/atrous/denoise.h).
 METHODS = tuple(str(r["name"]) for r in _core.denoise_methods())
+# The methods that denoise a sequence as a sequence (sequenceMethods(), include/atrous/temporal.h):
+# temporal (denoise_temporal, the CLI's --sequence default) and svgf (Svgf).
+SEQUENCE_METHODS = tuple(str(r["name"]) for r in _core.sequence_methods())
 # Those that read the learned filter's weights (learned_weights= applies to them).
 WEIGHTED_METHODS = tuple(str(r["name"]) for r in _core.denoise_methods() if r["uses_weights"])
 

@@ -468,6 +468,18 @@ NB_MODULE(_core, m) {
     });
     m.def("svgf_params", [] { return paramRows(svgfParams()); });
     m.def("temporal_params", [] { return paramRows(temporalParams()); });
+    // The sequence methods (sequenceMethods(), include/atrous/temporal.h): atrous.SEQUENCE_METHODS.
+    m.def("sequence_methods", [] {
+        nb::list rows;
+        for (const SequenceMethodInfo& i : sequenceMethods()) {
+            nb::dict d;
+            d["name"] = i.name;
+            d["summary"] = i.summary;
+            d["causal"] = i.causal;
+            rows.append(d);
+        }
+        return rows;
+    });
     m.def("denoise_temporal", &pyDenoiseTemporal, nb::arg("frames"), nb::arg("center"), nb::arg("method"),
           nb::arg("learned_weights"), nb::arg("device"), nb::arg("temporal"), nb::arg("params"));
     m.def("render_params", [] { return paramRows(renderParams()); });

@@ -26,6 +26,30 @@ void validateTemporalParams(const TemporalParams& p) { validateParams(p, tempora
 
 void checkTemporalFrame(const SvgfFrame& frame) { svgf::checkFrame(frame); }
 
+const std::vector<SequenceMethodInfo>& sequenceMethods() {
+    static const std::vector<SequenceMethodInfo> rows = {
+        {"temporal",
+         "the default with --sequence: frames t-3..t+3 reprojected onto t and averaged, then the still method "
+         "--spatial (docs/temporal.md)",
+         false},
+        {"svgf", "spatiotemporal variance-guided filtering, causal: each frame from the ones before it (docs/svgf.md)",
+         true},
+    };
+    return rows;
+}
+
+const SequenceMethodInfo* findSequenceMethod(const std::string& name) {
+    for (const SequenceMethodInfo& m : sequenceMethods())
+        if (name == m.name) return &m;
+    return nullptr;
+}
+
+std::string sequenceMethodNames() {
+    std::string s;
+    for (const SequenceMethodInfo& m : sequenceMethods()) s += (s.empty() ? "" : ", ") + std::string(m.name);
+    return s;
+}
+
 namespace {
 
 }  // namespace

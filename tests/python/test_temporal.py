@@ -62,3 +62,8 @@ def test_bad_windows_raise(frames):
     nan["color"][5, 5] = np.nan
     out = atrous.denoise_temporal(frames[:3] + [nan] + frames[4:], 2)
     assert np.isfinite(out).all()
+
+
+def test_sequence_methods_from_the_library():
+    assert atrous.SEQUENCE_METHODS == ("temporal", "svgf")
+    assert not set(atrous.SEQUENCE_METHODS) & set(atrous.METHODS)
