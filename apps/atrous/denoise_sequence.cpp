@@ -244,6 +244,7 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
     std::vector<ReprojectionCheck> checks(frames.size());
     TemporalCache temporalCache;  // each frame prepared once for all the windows it is in
     bool idsTrusted = true, warnedSign = false, notedMotion = false;
+    CameraFit prevCamera;  // the previous frame's, for motion from positions
     // Pipelined: frame N+1 is read and frame N-1 written (EXR and PNG) on other threads while
     // frame N is filtered. An error in either reaches this thread through its future, in frame
     // order; nothing reaches OUTDIR before every frame is done (StagedOutput).
@@ -331,13 +332,31 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
         if (i + 1 < frames.size()) next = std::async(std::launch::async, load, i + 1);
         const std::string name = io::sequenceFrameName(f.index);
         if (i == 0) firstIndex = f.index;
+        // No motion vectors but a Position pass (LuxCore): motion from each frame's fitted camera.
+        const bool usesMotion = svgf || (temporal && radius > 0);
+        if (usesMotion && f.motion.empty() && !f.position.empty()) {
+            const CameraFit fit = fitCamera(f.position);
+            f.motion = motionFromPositions(f.position, fit, prevCamera);  // frame 0: no previous, NaN (no history)
+            if (i > 0 && !notedMotion) {
+                if (prevCamera.ok)
+                    std::printf("denoise: note: the frames have no motion vectors: motion from the Position pass (a "
+                                "camera fitted per frame, median reprojection error %.2f px)\n",
+                                prevCamera.medianErrorPx);
+                else
+                    std::printf("denoise: note: the frames have no motion vectors, and no pinhole camera fits their "
+                                "Position pass (median reprojection error %.2g px): no motion\n",
+                                prevCamera.medianErrorPx);
+                notedMotion = true;
+            }
+            prevCamera = fit;
+        }
         // Other renderers' sequences: how much reprojects, with which sign, and whether ids hold.
         ReprojectionCheck& check = checks[i];
         if (!window.empty()) {
             const io::SequenceFrame& prev = window.back();
             check = checkReprojection(f.depth, f.normal, f.ids, f.motion, prev.depth, prev.normal, prev.ids);
         }
-        if ((svgf || (temporal && radius > 0)) && f.motion.empty() && !notedMotion) {
+        if (usesMotion && f.motion.empty() && !notedMotion) {
             std::printf("denoise: note: the frames have no motion vectors: %s\n",
                         svgf ? "SVGF assumes nothing moves on screen"
                              : "the temporal method takes them as still and leaves out what the depth, normal and "

@@ -96,6 +96,25 @@ Image denoiseTemporal(const std::vector<SvgfFrame>& window, size_t center, const
                       const DenoiseOptions& spatial, TemporalReport* report = nullptr, TemporalCache* cache = nullptr,
                       const std::vector<long long>* ids = nullptr);
 
+// Motion vectors for frames that have a Position pass but no vectors (LuxCore's POSITION): each
+// frame's pinhole camera fitted to its own pixels and world positions (src/filters/camera_fit.cpp),
+// and a pixel's motion = its position projected by the previous frame's camera − by its own.
+// Right for a static scene seen by a moving camera; on what moves it is wrong, and the sequence
+// methods' tests leave that out. A fit whose median reprojection error exceeds
+// kCameraFitMaxErrorPx (a fisheye, a mostly moving scene, too few hit pixels) is not `ok`.
+constexpr double kCameraFitMaxErrorPx = 0.75;
+struct CameraFit {
+    double m[12] = {};           // the 3x4 projection: (u, v) = (m0..3 · P1, m4..7 · P1) / (m8..11 · P1), P1 = (P, 1)
+    double medianErrorPx = 1e30;  // over the fitted pixels (pixel centres at integer coordinates)
+    bool ok = false;
+    bool project(const double P[3], double& u, double& v) const;  // false behind the camera
+};
+CameraFit fitCamera(const Image& position);  // host image, 3 channels; 0 or non-finite = nothing hit
+// 2 channels, previous − current in pixels (SvgfFrame's motion). Where nothing is hit (the sky),
+// the direction through the pixel, mapped by the two cameras. NaN where either camera is not `ok`
+// or the point is behind one.
+Image motionFromPositions(const Image& position, const CameraFit& current, const CameraFit& previous);
+
 // The methods that denoise a sequence as a sequence, beside the still methods (denoiseMethods(),
 // which `atrous denoise --sequence` also runs frame by frame): one row each, the one list the
 // CLI's --method help and messages and Python (atrous.SEQUENCE_METHODS) read.

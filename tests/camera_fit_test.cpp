@@ -1,0 +1,167 @@
+// Motion from the Position pass (include/atrous/temporal.h, src/filters/camera_fit.cpp): a known
+// pinhole camera is recovered from its own pixels' world positions (jittered as a 1-spp render's
+// are), motion between two known cameras is recovered on geometry and on the sky, and the CLI uses
+// it for a sequence without motion vectors.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <random>
+#include <string>
+
+#include "atrous/temporal.h"
+#include "io/image_io.h"
+#include "test_util.h"
+
+using namespace atrous;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Cam {
+    double f = 90, cx = 40, cy = 30;  // pixels
+    double yaw = 0, px = 0, py = 0.5, pz = 0;  // rotation about +y (radians), centre
+    // World point -> pixel (centres at integer coordinates); false behind the camera.
+    bool project(const double P[3], double& u, double& v) const {
+        const double X = P[0] - px, Y = P[1] - py, Z = P[2] - pz;
+        const double c = std::cos(yaw), s = std::sin(yaw);
+        const double xc = c * X - s * Z, zc = s * X + c * Z;
+        if (zc <= 0) return false;
+        u = cx + f * xc / zc, v = cy - f * Y / zc;
+        return true;
+    }
+    // The ray through pixel (u, v): direction in world space.
+    void ray(double u, double v, double d[3]) const {
+        const double xc = (u - cx) / f, yc = -(v - cy) / f, zc = 1;
+        const double c = std::cos(yaw), s = std::sin(yaw);
+        d[0] = c * xc + s * zc, d[1] = yc, d[2] = -s * xc + c * zc;
+    }
+};
+
+// 80x60 Position pass of a floor (y = 0) and a wall (z = 6, up to y = 2), sky above: one jittered
+// sample per pixel, 0 where the ray hits nothing.
+Image positions(const Cam& cam, unsigned seed) {
+    Image p(80, 60, 3);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> jitter(-0.5, 0.5);
+    for (int y = 0; y < p.height(); ++y)
+        for (int x = 0; x < p.width(); ++x) {
+            double d[3];
+            cam.ray(x + jitter(rng), y + jitter(rng), d);
+            double best = 1e30;
+            if (d[1] < 0) best = std::min(best, -cam.py / d[1]);
+            if (d[2] > 0) {
+                const double t = (6 - cam.pz) / d[2];
+                if (cam.py + t * d[1] <= 2.0) best = std::min(best, t);
+            }
+            if (best == 1e30) continue;
+            p(x, y, 0) = float(cam.px + best * d[0]), p(x, y, 1) = float(cam.py + best * d[1]);
+            p(x, y, 2) = float(cam.pz + best * d[2]);
+        }
+    return p;
+}
+
+}  // namespace
+
+TEST(CameraFit, RecoversAPinholeCameraFromItsPositions) {
+    Cam cam;
+    cam.yaw = 0.2, cam.px = 0.3;
+    const CameraFit fit = fitCamera(positions(cam, 1));
+    ASSERT_TRUE(fit.ok);
+    EXPECT_GT(fit.medianErrorPx, 0.2);  // the 1-spp jitter: about 0.38 px for a uniform square
+    EXPECT_LT(fit.medianErrorPx, 0.5);
+    std::mt19937 rng(2);
+    std::uniform_real_distribution<double> any(-2, 2);
+    int tried = 0;
+    for (int i = 0; i < 1000; ++i) {  // points that the camera sees (a fit is not made to extrapolate)
+        const double P[3] = {any(rng), any(rng) + 1, 4 + any(rng)};
+        double u, v, fu, fv;
+        if (!cam.project(P, u, v) || u < 0 || v < 0 || u > 79 || v > 59) continue;
+        ++tried;
+        ASSERT_TRUE(fit.project(P, fu, fv));
+        EXPECT_NEAR(fu, u, 0.1);  // 1-spp jitter of +-0.5 px over ~2000 points: a few hundredths, more at the edges
+        EXPECT_NEAR(fv, v, 0.1);
+    }
+    EXPECT_GT(tried, 100);
+    // A flat world (every point on one plane) does not determine a camera: not ok.
+    Image flat(80, 60, 3);
+    for (int y = 0; y < 60; ++y)
+        for (int x = 0; x < 80; ++x) flat(x, y, 0) = float(x), flat(x, y, 1) = float(y), flat(x, y, 2) = 5;
+    EXPECT_FALSE(fitCamera(flat).ok);
+    EXPECT_FALSE(fitCamera(Image(80, 60, 3)).ok);  // nothing hit
+}
+
+// The camera turns and moves between frames: on the floor and the wall the motion is the point's
+// (previous projection - current, the sample's jitter cancelled), on the sky the direction's.
+TEST(CameraFit, MotionBetweenTwoCamerasOnGeometryAndSky) {
+    Cam prev, cur;
+    prev.yaw = 0.15, prev.px = -0.2;
+    cur.yaw = 0.2, cur.px = 0.0;
+    const Image pos = positions(cur, 3);
+    const Image motion = motionFromPositions(pos, fitCamera(pos), fitCamera(positions(prev, 4)));
+    int geometry = 0, sky = 0;
+    for (int y = 0; y < 60; ++y)
+        for (int x = 0; x < 80; ++x) {
+            const double P[3] = {pos(x, y, 0), pos(x, y, 1), pos(x, y, 2)};
+            double want[2];
+            if (P[0] != 0 || P[1] != 0 || P[2] != 0) {
+                double u0, v0, u1, v1;
+                ASSERT_TRUE(prev.project(P, u0, v0) && cur.project(P, u1, v1));
+                want[0] = u0 - u1, want[1] = v0 - v1;
+                ++geometry;
+            } else {
+                double d[3], u0, v0;
+                cur.ray(x, y, d);
+                const double far[3] = {prev.px + 1e7 * d[0], prev.py + 1e7 * d[1], prev.pz + 1e7 * d[2]};
+                ASSERT_TRUE(prev.project(far, u0, v0));
+                want[0] = u0 - x, want[1] = v0 - y;
+                ++sky;
+            }
+            EXPECT_NEAR(motion(x, y, 0), want[0], 0.05) << x << "," << y;
+            EXPECT_NEAR(motion(x, y, 1), want[1], 0.05) << x << "," << y;
+        }
+    EXPECT_GT(geometry, 1000);
+    EXPECT_GT(sky, 100);
+    // Without a previous camera there is no motion: NaN (no history) everywhere.
+    const Image none = motionFromPositions(pos, fitCamera(pos), CameraFit{});
+    EXPECT_TRUE(std::isnan(none(40, 50, 0)));
+}
+
+// A sequence whose frames lost their motion.exr: `denoise --sequence` fits the cameras to the
+// position.exr, says so, and gives what the motion vectors give (within 10%), better than taking
+// the frames as still (position.exr removed too).
+TEST(CameraFitCli, SequenceWithoutVectorsUsesThePositionPass) {
+    test::TempDir dir;
+    const std::string seq = dir / "seq";
+    auto r = test::runCli("render --scene cornell-spheres --camera-path orbit --frames 7 --spp 4 --width 64 "
+                          "--height 48 --reference-spp 256 --out " + seq);
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    auto error = [&](const std::string& out) {
+        double sum = 0;
+        int n = 0;
+        for (int f = 0; f < 7; ++f) {
+            const std::string frame = seq + "/frame_000" + std::to_string(f);
+            const Image ref = io::readImage(frame + "/reference.exr");
+            const Image img = io::readImage(out + "/frame_000" + std::to_string(f) + ".exr");
+            for (size_t i = 0; i < img.size(); ++i) {
+                const double d = img.data()[i] - ref.data()[i];
+                sum += d * d / (double(ref.data()[i]) * ref.data()[i] + 0.01);
+                ++n;
+            }
+        }
+        return sum / n;
+    };
+    r = test::runCli("denoise --sequence " + seq + " --spatial eaw --out " + (dir / "vectors"));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    for (int f = 0; f < 7; ++f) fs::remove(seq + "/frame_000" + std::to_string(f) + "/motion.exr");
+    r = test::runCli("denoise --sequence " + seq + " --spatial eaw --out " + (dir / "fitted"));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("motion from the Position pass"), std::string::npos) << r.output;
+    for (int f = 0; f < 7; ++f) fs::remove(seq + "/frame_000" + std::to_string(f) + "/position.exr");
+    r = test::runCli("denoise --sequence " + seq + " --spatial eaw --out " + (dir / "still"));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("takes them as still"), std::string::npos) << r.output;
+    const double vectors = error(dir / "vectors"), fitted = error(dir / "fitted"), still = error(dir / "still");
+    EXPECT_LT(fitted, 1.1 * vectors) << vectors << " " << fitted << " " << still;
+    EXPECT_LT(fitted, 0.95 * still) << vectors << " " << fitted << " " << still;
+}
