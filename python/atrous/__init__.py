@@ -390,7 +390,8 @@ def denoise_temporal(frames: Sequence[Dict[str, Any]], center: int, *, method: s
     frames: a window of consecutive frames, each a dict of H x W x C numpy arrays with the keys of
     :func:`denoise` (color required; albedo, normal, position, depth, variance, ids, emission) and
     motion (H x W x 2 or 3: dx, dy in pixels, previous - current); every frame has the same keys.
-    The items of :func:`render_sequence` are such dicts.
+    The items of :func:`render_sequence` are such dicts. Without motion in any frame but with a
+    position in every one, the motion comes from each frame's fitted camera (as the CLI does).
     temporal: the rows of :func:`temporal_params` (radius: frames on each side, 3; ...).
     method, learned_weights and params: the still method run on the average, as in :func:`denoise`.
     device: where that still method runs ("auto", "cpu", "cuda"); the averaging runs on the CPU.

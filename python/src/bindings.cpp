@@ -319,6 +319,24 @@ nb::object pyDenoiseTemporal(nb::list frames, size_t center, const std::string& 
         for (const auto& [name, b] : kKeys)
             if (d.contains(name)) buffers.back()->add({d[name], b, name});
     }
+    // No motion in any frame but positions in all: motion from each frame's fitted camera, as
+    // `atrous denoise --sequence` does (include/atrous/temporal.h, fitCamera).
+    std::vector<Image> fitted;
+    bool anyMotion = false, allPositions = true;
+    for (const auto& b : buffers) {
+        anyMotion = anyMotion || b->refs.get(B::Motion) != nullptr;
+        allPositions = allPositions && b->refs.get(B::Position) != nullptr;
+    }
+    if (!anyMotion && allPositions && buffers.size() > 1) {
+        CameraFit previous;
+        for (const auto& b : buffers) {
+            const Image& pos = *b->refs.get(B::Position);
+            const CameraFit fit = fitCamera(pos);
+            fitted.push_back(motionFromPositions(pos, fit, previous));
+            previous = fit;
+        }
+        for (size_t i = 0; i < buffers.size(); ++i) buffers[i]->refs.set(B::Motion, &fitted[i]);
+    }
     std::vector<SvgfFrame> window;
     for (const auto& b : buffers) window.push_back(io::svgfFrame(b->refs));
     TemporalParams tp;

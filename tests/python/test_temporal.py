@@ -67,3 +67,12 @@ def test_bad_windows_raise(frames):
 def test_sequence_methods_from_the_library():
     assert atrous.SEQUENCE_METHODS == ("temporal", "svgf")
     assert not set(atrous.SEQUENCE_METHODS) & set(atrous.METHODS)
+
+
+def test_motion_from_positions_when_no_frame_has_motion(frames, reference):
+    no_motion = [{k: v for k, v in f.items() if k != "motion"} for f in frames]
+    still = [{k: v for k, v in f.items() if k not in ("motion", "position")} for f in frames]
+    e = {name: atrous.metrics(atrous.denoise_temporal(fs, 2, method="eaw"), reference)["relmse"]
+         for name, fs in (("vectors", frames), ("fitted", no_motion), ("still", still))}
+    assert e["fitted"] < 1.1 * e["vectors"], e
+    assert e["fitted"] < e["still"], e
