@@ -101,8 +101,11 @@ Image denoiseTemporal(const std::vector<SvgfFrame>& window, size_t center, const
 // and a pixel's motion = its position projected by the previous frame's camera − by its own.
 // Right for a static scene seen by a moving camera; on what moves it is wrong, and the sequence
 // methods' tests leave that out. A fit whose median reprojection error exceeds
-// kCameraFitMaxErrorPx (a fisheye, a mostly moving scene, too few hit pixels) is not `ok`.
-constexpr double kCameraFitMaxErrorPx = 0.75;
+// kCameraFitMaxErrorPx (a fisheye, a mostly moving scene, too few hit pixels) is not `ok`. A
+// 1-spp position is one sample's, anywhere in the pixel filter's footprint: the median error of a
+// right fit is then about 0.4 px (a box filter: Mitsuba, atrous) to 0.6 px (LuxCore's
+// Blackman-Harris), hence 1.5.
+constexpr double kCameraFitMaxErrorPx = 1.5;
 struct CameraFit {
     double m[12] = {};           // the 3x4 projection: (u, v) = (m0..3 · P1, m4..7 · P1) / (m8..11 · P1), P1 = (P, 1)
     double medianErrorPx = 1e30;  // over the fitted pixels (pixel centres at integer coordinates)
