@@ -109,6 +109,19 @@ def test_frames_and_svgf_equal_the_cli(cluster, tmp_path):
     for f in range(3):
         name = f"frame_{f:04d}.exr"
         assert (dn / "cornell-moving_spp1" / name).read_bytes() == (tmp_path / "cli-svgf" / name).read_bytes()
+    # The temporal method: one item per frame, each reading its neighbours; what the CLI writes.
+    dt = tmp_path / "temporal"
+    r = farm(["denoise", "--in", str(got), "--method", "temporal", "--param", "temporal_radius=1", "--param",
+              "spatial=eaw", "--address", cluster.address, "--out", str(dt), "--quiet"], env=cluster.env)
+    assert r.returncode == 0, r.stderr
+    assert len(manifest(dt)["items"]) == 3
+    c = subprocess.run([cli, "denoise", "--sequence", str(seq), "--temporal-radius", "1", "--spatial", "eaw",
+                        "--device", "cpu", "--out", str(tmp_path / "cli-temporal")], capture_output=True, text=True,
+                       timeout=120)
+    assert c.returncode == 0, c.stderr
+    for f in range(3):
+        name = f"frame_{f:04d}.exr"
+        assert (dt / "cornell-moving_spp1" / name).read_bytes() == (tmp_path / "cli-temporal" / name).read_bytes()
 
 
 def test_a_killed_worker_costs_a_retry_not_the_job(cluster, tmp_path):
@@ -310,6 +323,9 @@ def test_evaluate_sweep_dataset_and_denoise_jobs(cluster, tmp_path):
     (["render", "--dataset", "SPEC"], "SPEC"),
     (["denoise", "--in", "IN", "--method", "bilateral"], "bilateral"),
     (["denoise", "--in", "IN", "--param", "sigma_colour=1"], "sigma_colour"),
+    (["denoise", "--in", "IN", "--method", "temporal", "--param", "temporal_radios=1"], "radios"),
+    (["denoise", "--in", "IN", "--method", "temporal", "--param", "spatial=nope"], "nope"),
+    (["denoise", "--in", "IN", "--method", "temporal"], "frame sequences"),
     (["sweep", "--grid", "levels=0,3"], "levels"),
     (["evaluate", "--methods", "noisy,nlm"], "nlm"),
     (["render", "--scenes", "cornell", "--bogus"], "--bogus"),

@@ -20,9 +20,13 @@ import numpy as np
 import atrous
 
 __all__ = ["Item", "FarmInputError", "scene_label", "check_scenes", "parse_value", "check_denoise_params",
-           "discover_inputs", "DENOISE_METHODS", "EVAL_METHODS", "EVAL_CHOICES"]
+           "discover_inputs", "DENOISE_METHODS", "EVAL_METHODS", "EVAL_CHOICES", "split_temporal_params"]
 
-DENOISE_METHODS = atrous.METHODS + ("oidn", "svgf")
+# The still methods, OIDN, and the sequence methods (temporal, svgf: the library's lists).
+DENOISE_METHODS = atrous.METHODS + ("oidn",) + atrous.SEQUENCE_METHODS
+# The temporal method's own parameters travel as temporal_<name> (the CLI's --temporal-<name>), and
+# its still method as spatial=...; the rest are the still method's.
+TEMPORAL_PREFIX = "temporal_"
 EVAL_METHODS = ("noisy", "eaw", "sure", "oidn")  # the default set
 EVAL_CHOICES = EVAL_METHODS + tuple(m for m in atrous.METHODS if m not in EVAL_METHODS)  # what an evaluation may ask for
 _FRAME = re.compile(r"^frame_(\d{4,})$")
@@ -140,6 +144,14 @@ def parse_assignments(pairs: Iterable[str], flag: str, lists: bool) -> Dict[str,
 _PROBE = np.full((8, 8, 3), 0.5, np.float32)
 
 
+def split_temporal_params(params: Dict[str, Any]):
+    """The temporal method's parameters: (its own table's, with the prefix dropped; the still method
+    (spatial=..., default auto); the still method's)."""
+    own = {k[len(TEMPORAL_PREFIX):]: v for k, v in params.items() if k.startswith(TEMPORAL_PREFIX)}
+    still = {k: v for k, v in params.items() if not k.startswith(TEMPORAL_PREFIX) and k != "spatial"}
+    return own, str(params.get("spatial", "auto")), still
+
+
 def check_denoise_params(method: str, params: Dict[str, Any], flag: str) -> None:
     """Denoises an 8x8 grey image with these parameters, so that an unknown name or an
     out-of-range value fails here, once, instead of in every item."""
@@ -148,6 +160,10 @@ def check_denoise_params(method: str, params: Dict[str, Any], flag: str) -> None
             atrous.denoise(_PROBE, albedo=_PROBE, normal=_PROBE, method=method, **params)
         elif method == "svgf":
             atrous.Svgf(device="cpu", **params)
+        elif method == "temporal":
+            own, spatial, still = split_temporal_params(params)
+            probe = {"color": _PROBE, "albedo": _PROBE, "normal": _PROBE}
+            atrous.denoise_temporal([probe, probe], 0, temporal=own, method=spatial, **still)
         elif params:
             raise FarmInputError(f"{flag}: {method} takes no parameters (got {', '.join(params)})")
     except FarmInputError:

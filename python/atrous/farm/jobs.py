@@ -83,7 +83,8 @@ def denoise(out: PathLike, inputs: Any, method: str = "auto", params: Optional[D
             **run: Any) -> JobResult:
     """Render directories and frame sequences through one method: OUT/<name>/denoised_<method>.exr
     and .png per render directory, OUT/<sequence>/frame_NNNN.exr and .png per frame (svgf: one
-    item per sequence, its frames in order)."""
+    item per sequence, its frames in order; temporal: one item per frame, which reads the frames
+    around it: params temporal_<name> are its own, spatial=METHOD its still method)."""
     if method not in DENOISE_METHODS:
         raise FarmInputError(f"method: unknown '{method}' (expected {', '.join(DENOISE_METHODS)})")
     params = dict(params or {})
@@ -93,11 +94,16 @@ def denoise(out: PathLike, inputs: Any, method: str = "auto", params: Optional[D
     items = []
     for f in found:
         base = {"method": method, "params": params}
+        if method in atrous.SEQUENCE_METHODS and f["kind"] != "sequence":
+            raise FarmInputError(f"inputs: {f['path']}: {method} denoises frame sequences (frame_NNNN/), "
+                                 "this is a single render")
         if method == "svgf":
-            if f["kind"] != "sequence":
-                raise FarmInputError(f"inputs: {f['path']}: svgf denoises frame sequences (frame_NNNN/), "
-                                     "this is a single render")
             items.append(Item(f["name"], "svgf", dict(base, input=f["path"], frames=f["frames"]), [f["name"]]))
+        elif method == "temporal":  # one item per frame, each reading the frames around it
+            for i, fr in enumerate(f["frames"]):
+                iid = f"{f['name']}/{fr}"
+                items.append(Item(iid, "temporal", dict(base, input=f["path"], frames=f["frames"], index=i),
+                                  [iid + ".exr", iid + ".png"]))
         elif f["kind"] == "render":
             iid = f"{f['name']}/denoised_{method}"
             items.append(Item(iid, "denoise", dict(base, input=f["path"]), [iid + ".exr", iid + ".png"]))

@@ -209,6 +209,34 @@ def run_svgf(item: Dict[str, Any], out: Path, threads: int, device: str) -> Dict
     return {"frames": len(p["frames"])}
 
 
+def run_temporal(item: Dict[str, Any], out: Path, threads: int, device: str) -> Dict[str, Any]:
+    """One frame of a sequence through the temporal method, with the frames around it:
+    OUT/<sequence>/frame_NNNN.exr/.png (what `atrous denoise --sequence` writes for it)."""
+    from atrous.eval.sequence import load_frame
+
+    from .items import split_temporal_params
+
+    p = item["params"]
+    own, spatial, still = split_temporal_params(p["params"])
+    radius = int(own.get("radius", next(r["default"] for r in atrous.temporal_params() if r["name"] == "radius")))
+    i, names = int(p["index"]), p["frames"]
+    lo, hi = max(0, i - radius), min(len(names) - 1, i + radius)
+    frames = [{k: v for k, v in load_frame(Path(p["input"]) / n).items() if k != "reference"} for n in names[lo:hi + 1]]
+    t0 = time.perf_counter()
+    img = atrous.denoise_temporal(frames, i - lo, temporal=own, method=spatial, device=device, **still)
+    ms = (time.perf_counter() - t0) * 1e3
+    files = [Path(o).name for o in item["outputs"]]
+    with staged(out, item["id"]) as stage:
+        for n in files:
+            atrous.write_image(stage / n, img)
+        publish_files(stage, out / Path(item["outputs"][0]).parent, files)
+    result: Dict[str, Any] = {"denoise_ms": ms, "frames_read": hi - lo + 1}
+    ref = Path(p["input"]) / names[i] / "reference.exr"
+    if ref.is_file():
+        result["mse_vs_reference"] = atrous.metrics(img, atrous.read_image(ref))["mse"]
+    return result
+
+
 def run_reference(item: Dict[str, Any], out: Path, threads: int, device: str) -> Dict[str, Any]:
     """A scene's reference for evaluate/sweep: reference.exr and its variance (the noise floor)."""
     from atrous.eval import reference_floor
@@ -257,7 +285,7 @@ def run_score(item: Dict[str, Any], out: Path, threads: int, device: str) -> Dic
 
 
 RUNNERS = {"render": run_render, "frame": run_frame, "dataset": run_dataset, "denoise": run_denoise,
-           "svgf": run_svgf, "reference": run_reference, "evaluate": run_score, "sweep": run_score}
+           "svgf": run_svgf, "temporal": run_temporal, "reference": run_reference, "evaluate": run_score, "sweep": run_score}
 
 
 def run_item(item: Dict[str, Any], out_root: str, threads: int, device: str, tracker: Any = None,
