@@ -14,7 +14,7 @@ import atrous
 
 ATROUS_METHODS = atrous.METHODS
 COLORS = {"noisy": "#7f7f7f", "eaw": "#1f77b4", "sure": "#2ca02c", "learned": "#ff7f0e", "blend": "#17becf", "auto": "#8c564b",
-          "oidn": "#d62728", "svgf": "#9467bd",
+          "oidn": "#d62728", "svgf": "#9467bd", "temporal": "#e377c2",
           "render 1 spp": "#000000"}
 
 
