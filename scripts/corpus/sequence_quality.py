@@ -62,45 +62,33 @@ def own_sequences(own: Path):
             yield d.name, d, d, d, None
 
 
-def corpus_frames(scene: Path, folder: Path):
-    """The manifest's frames with their file in `folder` (the spp's)."""
-    man = json.loads((scene / "manifest.json").read_text())
-    frames = []
-    for fr in man["frames"]:
-        fr = dict(fr)
-        fr["file"] = f"{folder.name}/{Path(fr['file']).name}"
-        frames.append(fr)
-    return man, frames
-
-
-def references(scene: Path, folder: Path):
-    """The reference frames as H x W x 3 arrays, in frame order."""
+def frame_buffers(scene: Path, folder: Path, ref: bool = False):
+    """(name, buffers) per frame in order: the noisy frame's color, albedo and normal at `folder`'s
+    spp through the corpus loaders (scripts/corpus/quality.py), or an own sequence's files; with
+    ref=True the reference's color. name: the frame_NNNN that `atrous denoise --sequence` writes."""
     import atrous
 
     if (scene / "manifest.json").exists():
-        man, frames = corpus_frames(scene, folder)
-        return [np.asarray(Q.load_frame(scene, man, fr, ref=True)["color"], np.float32) for fr in frames]
-    return [np.asarray(atrous.read_image(str(d / "reference.exr")), np.float32) for d in sorted(scene.glob("frame_*"))]
+        man = json.loads((scene / "manifest.json").read_text())
+        for fr in man["frames"]:
+            fr = dict(fr, file=f"{folder.name}/{Path(fr['file']).name}")  # the spp's folder
+            yield f"frame_{fr['frame']:04d}", Q.load_frame(scene, man, fr, ref=ref)
+        return
+    for d in sorted(scene.glob("frame_*")):
+        rd = lambda k: np.asarray(atrous.read_image(str(d / f"{k}.exr")), np.float32)  # noqa: E731
+        yield d.name, ({"color": rd("reference")} if ref else {k: rd(k) for k in ("color", "albedo", "normal")})
 
 
 def oidn_per_frame(scene: Path, folder: Path, out: Path):
+    """OIDN high on each frame, as the evaluation runs it (atrous.eval.oidn_inputs)."""
     import atrous
     import pyoidn
+    from atrous.eval import oidn_inputs
 
     out.mkdir(parents=True, exist_ok=True)
-    if (scene / "manifest.json").exists():
-        man, frames = corpus_frames(scene, folder)
-        for fr in frames:
-            b = Q.load_frame(scene, man, fr)
-            alb = np.ascontiguousarray(np.clip(b["albedo"], 0.0, 1.0), np.float32)
-            o = pyoidn.denoise(np.ascontiguousarray(b["color"], np.float32), alb,
-                               np.ascontiguousarray(b["normal"], np.float32), hdr=True, quality="high")
-            atrous.write_image(str(out / f"frame_{fr['frame']:04d}.exr"), np.asarray(o, np.float32))
-        return
-    for d in sorted(scene.glob("frame_*")):
-        rd = lambda k: np.ascontiguousarray(np.asarray(atrous.read_image(str(d / f"{k}.exr")), np.float32))  # noqa: E731
-        o = pyoidn.denoise(rd("color"), np.clip(rd("albedo"), 0.0, 1.0), rd("normal"), hdr=True, quality="high")
-        atrous.write_image(str(out / f"{d.name}.exr"), np.asarray(o, np.float32))
+    for name, b in frame_buffers(scene, folder):
+        o = pyoidn.denoise(*oidn_inputs(b), hdr=True, quality="high")
+        atrous.write_image(str(out / f"{name}.exr"), np.asarray(o, np.float32))
 
 
 def light_mask(refs):
@@ -129,16 +117,6 @@ def masked_copy(src: Path, dst: Path, refs, mask):
         img = np.array(atrous.read_image(str(f)), np.float32)
         img[mask] = refs[k][..., :3][mask]
         atrous.write_image(str(dst / f.name), img)
-
-
-def noisy_frames(scene: Path, folder: Path):
-    """The noisy colour of every frame, as H x W x 3 arrays."""
-    import atrous
-
-    if (scene / "manifest.json").exists():
-        man, frames = corpus_frames(scene, folder)
-        return [np.asarray(Q.load_frame(scene, man, fr)["color"], np.float32) for fr in frames]
-    return [np.asarray(atrous.read_image(str(d / "color.exr")), np.float32) for d in sorted(scene.glob("frame_*"))]
 
 
 def tonemap(img):
@@ -226,7 +204,7 @@ def main():
             r = {Path(x["path"]).name: {k: x[k] for k in ("relmse", "temporal_relmse", "psnr")} for x in rows["sequences"]}
             # The same with the pixels that show a light left out (their error set to 0, the means
             # taken over the other pixels).
-            refs = references(scene, seq)
+            refs = [np.asarray(b["color"], np.float32) for _, b in frame_buffers(scene, seq, ref=True)]
             mask = light_mask(refs)
             keep = 1.0 - float(mask.mean())
             mref = Path(tmp) / name / "masked_ref"
@@ -246,7 +224,7 @@ def main():
             if a.strips:
                 import atrous
 
-                cols = [("noisy", noisy_frames(scene, seq))]
+                cols = [("noisy", [b["color"] for _, b in frame_buffers(scene, seq)])]
                 for o in outs:
                     cols.append((o.name.replace("_per_frame", "").replace("oidn_high", "OIDN high/frame"),
                                  [np.asarray(atrous.read_image(str(f)), np.float32)
