@@ -10,7 +10,7 @@ from __future__ import annotations
 import re
 import time
 from pathlib import Path
-from typing import Any, Callable, Dict, List, Optional
+from typing import Any, Callable, Dict, List, Optional, Tuple
 
 import numpy as np
 
@@ -69,6 +69,14 @@ def write_static_sequence(seq_dir: str, scene: str, frames: int, width: int, hei
         atrous.write_image(f / "reference.exr", ref)
 
 
+def temporal_window(count: int, index: int, radius: Optional[int] = None) -> Tuple[int, int]:
+    """The first and last frame (inclusive) that atrous.denoise_temporal reads for frame `index` of
+    `count` frames: index ± radius, clipped to the sequence (radius None: the method's default)."""
+    if radius is None:
+        radius = next(int(r["default"]) for r in atrous.temporal_params() if r["name"] == "radius")
+    return max(0, index - int(radius)), min(count - 1, index + int(radius))
+
+
 def _relmse(x: np.ndarray, r: np.ndarray) -> float:
     return float(np.mean((x.astype(np.float64) - r) ** 2 / (r.astype(np.float64) ** 2 + 0.01)))
 
@@ -89,7 +97,6 @@ def evaluate_sequence(seq_dir: str, methods: Dict[str, Optional[Callable]],
     names = ["temporal", "svgf"] + [m for m in methods]
     # The temporal method reads the frames around each one: every frame is loaded first.
     loaded = [load_frame(p) for p in paths]
-    radius = next(int(r["default"]) for r in atrous.temporal_params() if r["name"] == "radius")
     window = [{k: v for k, v in b.items() if k != "reference"} for b in loaded]
     svgf = atrous.Svgf("cpu")
     frames_out: List[Dict[str, Any]] = []
@@ -104,7 +111,7 @@ def evaluate_sequence(seq_dir: str, methods: Dict[str, Optional[Callable]],
         height, width = b["color"].shape[:2]
         b.setdefault("variance", None)
         outs: Dict[str, np.ndarray] = {}
-        lo, hi = max(0, i - radius), min(len(paths) - 1, i + radius)
+        lo, hi = temporal_window(len(paths), i)
         t0 = time.perf_counter()
         outs["temporal"] = atrous.denoise_temporal(window[lo:hi + 1], i - lo, device="cpu")
         times["temporal"].append((time.perf_counter() - t0) * 1e3)

@@ -180,13 +180,18 @@ def run_denoise(item: Dict[str, Any], out: Path, threads: int, device: str) -> D
     t0 = time.perf_counter()
     img = denoise_buffers(bufs, p["method"], p["params"], device)
     ms = (time.perf_counter() - t0) * 1e3
+    return publish_denoised(item, out, img, Path(p["input"]) / "reference.exr", {"denoise_ms": ms})
+
+
+def publish_denoised(item: Dict[str, Any], out: Path, img: np.ndarray, ref: Path,
+                     result: Dict[str, Any]) -> Dict[str, Any]:
+    """Writes `img` under each of the item's output names (.exr, .png) and publishes them; adds the
+    MSE against `ref` to `result` when that reference exists."""
     names = [Path(o).name for o in item["outputs"]]
     with staged(out, item["id"]) as stage:
         for n in names:
             atrous.write_image(stage / n, img)
         publish_files(stage, out / Path(item["outputs"][0]).parent, names)
-    result: Dict[str, Any] = {"denoise_ms": ms}
-    ref = Path(p["input"]) / "reference.exr"
     if ref.is_file():
         result["mse_vs_reference"] = atrous.metrics(img, atrous.read_image(ref))["mse"]
     return result
@@ -212,29 +217,20 @@ def run_svgf(item: Dict[str, Any], out: Path, threads: int, device: str) -> Dict
 def run_temporal(item: Dict[str, Any], out: Path, threads: int, device: str) -> Dict[str, Any]:
     """One frame of a sequence through the temporal method, with the frames around it:
     OUT/<sequence>/frame_NNNN.exr/.png (what `atrous denoise --sequence` writes for it)."""
-    from atrous.eval.sequence import load_frame
+    from atrous.eval.sequence import load_frame, temporal_window
 
     from .items import split_temporal_params
 
     p = item["params"]
     own, spatial, still = split_temporal_params(p["params"])
-    radius = int(own.get("radius", next(r["default"] for r in atrous.temporal_params() if r["name"] == "radius")))
     i, names = int(p["index"]), p["frames"]
-    lo, hi = max(0, i - radius), min(len(names) - 1, i + radius)
+    lo, hi = temporal_window(len(names), i, own.get("radius"))
     frames = [{k: v for k, v in load_frame(Path(p["input"]) / n).items() if k != "reference"} for n in names[lo:hi + 1]]
     t0 = time.perf_counter()
     img = atrous.denoise_temporal(frames, i - lo, temporal=own, method=spatial, device=device, **still)
     ms = (time.perf_counter() - t0) * 1e3
-    files = [Path(o).name for o in item["outputs"]]
-    with staged(out, item["id"]) as stage:
-        for n in files:
-            atrous.write_image(stage / n, img)
-        publish_files(stage, out / Path(item["outputs"][0]).parent, files)
-    result: Dict[str, Any] = {"denoise_ms": ms, "frames_read": hi - lo + 1}
-    ref = Path(p["input"]) / names[i] / "reference.exr"
-    if ref.is_file():
-        result["mse_vs_reference"] = atrous.metrics(img, atrous.read_image(ref))["mse"]
-    return result
+    return publish_denoised(item, out, img, Path(p["input"]) / names[i] / "reference.exr",
+                            {"denoise_ms": ms, "frames_read": hi - lo + 1})
 
 
 def run_reference(item: Dict[str, Any], out: Path, threads: int, device: str) -> Dict[str, Any]:
