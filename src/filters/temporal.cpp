@@ -119,15 +119,27 @@ TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t cente
         throw InputError("temporal window: a cache needs one id per frame of the window");
     if (center >= window.size()) throw InputError("temporal window: the centre frame is outside the window");
     const SvgfFrame& c = window[center];
-    svgf::checkFrame(c);
+    if (!c.color || c.color->empty()) svgf::checkFrame(c);  // throws: the colour is missing
     const int w = c.color->width(), h = c.color->height();
     const size_t r = size_t(params.radius);
     const size_t lo = center > r ? center - r : 0, hi = std::min(window.size() - 1, center + r);
+    const bool stats = params.colorSigmas > 0.0f;
+    // The cache holds what a frame's id was prepared into, for this size and these settings only.
+    TemporalCache::Impl* cached = cache ? cache->mImpl.get() : nullptr;
+    if (cached && (cached->width != w || cached->height != h || cached->stats != stats ||
+                   cached->fireflyK != params.fireflyK)) {
+        cached->frames.clear();
+        cached->width = w, cached->height = h, cached->stats = stats, cached->fireflyK = params.fireflyK;
+    }
+    // A frame in the cache passed svgf::checkFrame (sizes, channels, the colour's range: a scan of
+    // every value) when it was prepared, and an id names unchanged buffers: not scanned again.
+    auto known = [&](size_t i) { return cached && cached->frames.count((*ids)[i]) > 0; };
+    if (!known(center)) svgf::checkFrame(c);
     // Every frame must carry the centre's buffers (a missing one would read as a neutral default).
     auto same = [&](const Image* a, const Image* b) { return (a == nullptr) == (b == nullptr); };
     for (size_t i = lo; i <= hi; ++i) {
         const SvgfFrame& f = window[i];
-        svgf::checkFrame(f);
+        if (i != center && !known(i)) svgf::checkFrame(f);
         if (f.color->width() != w || f.color->height() != h)
             throw InputError("temporal window: frame " + std::to_string(i) + " is " + std::to_string(f.color->width()) +
                              "x" + std::to_string(f.color->height()) + ", the centre frame " + std::to_string(w) + "x" +
@@ -156,17 +168,10 @@ TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t cente
         g.color = c.color->clone();
         return g;
     }
-    const bool stats = params.colorSigmas > 0.0f;
-    // The window's prepared frames: from the cache where it has them (same id, size and settings),
-    // else prepared now (and kept there for the next window).
+    // The window's prepared frames: from the cache where it has them, else prepared now (and kept
+    // there for the next window).
     std::vector<PreparedFrame> local;
     std::vector<PreparedFrame*> prepared(hi - lo + 1);
-    TemporalCache::Impl* cached = cache ? cache->mImpl.get() : nullptr;
-    if (cached && (cached->width != w || cached->height != h || cached->stats != stats ||
-                   cached->fireflyK != params.fireflyK)) {
-        cached->frames.clear();
-        cached->width = w, cached->height = h, cached->stats = stats, cached->fireflyK = params.fireflyK;
-    }
     if (!cached) local.resize(hi - lo + 1);
     for (size_t i = lo; i <= hi; ++i) {
         if (!cached) {
