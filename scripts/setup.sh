@@ -10,7 +10,7 @@ WITH_PYTHON=0
 
 PKGS=(build-essential cmake pkg-config
       libembree-dev libtbb-dev libopenexr-dev libdeflate-dev libturbojpeg0-dev libcli11-dev libtinyobjloader-dev libstb-dev
-      nlohmann-json3-dev libgtest-dev libbenchmark-dev libglfw3-dev libimgui-dev xvfb ffmpeg
+      nlohmann-json3-dev libdnnl-dev ocl-icd-opencl-dev libgtest-dev libbenchmark-dev libglfw3-dev libimgui-dev xvfb ffmpeg
       qemu-user   # qemu-x86_64 -cpu Westmere: tests/cpu_isa_test.cpp runs atrous without AVX
       clang libclang-rt-dev)  # the libFuzzer targets (scripts/libfuzz.sh): clang and its runtimes (libclang-rt-14-dev on Debian 12)
 

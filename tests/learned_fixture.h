@@ -1,5 +1,5 @@
-// tests/learned_fixture.bin (scripts/train/make_fixture.py, the learned filter v3's parity
-// fixture): "ATRF" | u32 3 | u32 width | u32 height | u32 n | the weight file (n bytes) | planes
+// tests/learned_fixture.bin (scripts/train/make_fixture.py, the learned filter v4's parity
+// fixture): "ATRF" | u32 4 | u32 width | u32 height | u32 n | the weight file (n bytes) | planes
 // d(3), var(3), albedo(3), normal(3), depth(1), out_d(3), f32 planar. Shared by learned_test and
 // tests/cuda/learned_cuda_test.cu.
 #pragma once
@@ -35,8 +35,8 @@ inline const Fixture& fixture() {
         std::ifstream f(path, std::ios::binary);
         if (!f) throw std::runtime_error(path + ": missing");
         const std::vector<std::uint8_t> b((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-        if (b.size() < 20 || std::memcmp(b.data(), "ATRF", 4) != 0 || rd32(&b[4]) != 3)
-            throw std::runtime_error(path + ": not a version-3 ATRF fixture");
+        if (b.size() < 20 || std::memcmp(b.data(), "ATRF", 4) != 0 || rd32(&b[4]) != 4)
+            throw std::runtime_error(path + ": not a version-4 ATRF fixture");
         Fixture fx;
         fx.w = int(rd32(&b[8])), fx.h = int(rd32(&b[12]));
         const size_t nw = rd32(&b[16]);

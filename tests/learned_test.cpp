@@ -156,7 +156,7 @@ TEST(Learned, HugeWeightsGiveFiniteOutput) {
     const Fixture& fx = fixture();
     std::vector<std::uint8_t> b = fx.weights;
     const float big = 3e38f;
-    for (size_t o = 28; o + 8 <= b.size(); o += 4 * 7) std::memcpy(&b[o], &big, 4);
+    for (size_t o = 36; o + 8 <= b.size(); o += 4 * 7) std::memcpy(&b[o], &big, 4);
     std::uint32_t hsh = 0x811C9DC5u;
     for (size_t i = 0; i + 4 < b.size(); ++i) hsh = (hsh ^ b[i]) * 0x01000193u;
     std::memcpy(&b[b.size() - 4], &hsh, 4);
@@ -212,7 +212,8 @@ std::string parseError(std::vector<std::uint8_t> b, bool fixChecksum = false) {
 TEST(Learned, BadWeightsAreClearErrors) {
     const std::vector<std::uint8_t> good = fixture().weights;
     EXPECT_EQ(parseError(good), "no error");
-    EXPECT_EQ(good.size(), 28 + 4 * 1834 + 4u);  // the fixture's is a v3 file (15 -> 24 -> 24 -> 34)
+    constexpr size_t kHead = 36, kFloats = 13394;  // a v4 file: the MLP's 1834 floats, the context's 11560
+    EXPECT_EQ(good.size(), kHead + 4 * kFloats + 4u);
     auto expectMsg = [](const std::string& msg, const char* want) {
         EXPECT_NE(msg.find(want), std::string::npos) << "got: " << msg << "\nwanted: " << want;
     };
@@ -234,13 +235,21 @@ TEST(Learned, BadWeightsAreClearErrors) {
     std::memcpy(&v2[24], &n2, 4);
     v2.resize(28 + 4 * 1709 + 4, 0);
     expectMsg(parseError(v2, true), "w.bin: version 2 (the network without the noise-relative colour term, retired)");
-    b[4] = 4;
-    expectMsg(parseError(b, true), "w.bin: weight file version 4, this build reads version 3");
+    b[4] = 5;
+    expectMsg(parseError(b, true), "w.bin: weight file version 5, this build reads versions 3 and 4");
+    // A version-4 body under a version-3 header: the v3 header's n_floats field is n_ctx_in (13).
+    b = good;
+    b[4] = 3;
+    expectMsg(parseError(b, true), "w.bin: network shape n_in/n_hidden/n_feat/n_levels 15/24/8/5 (13 floats) is not");
     b = good;
     b[8] = 11;  // n_in
-    expectMsg(parseError(b, true), "w.bin: network shape n_in/n_hidden/n_feat/n_levels 11/24/8/5 (1834 floats) is not");
+    expectMsg(parseError(b, true),
+              "w.bin: network shape n_in/n_hidden/n_feat/n_levels/n_ctx_in/n_ctx 11/24/8/5/13/16 (13394 floats) is not");
     b = good;
-    b[24] = 0;  // n_floats
+    b[24] = 12;  // n_ctx_in
+    expectMsg(parseError(b, true), "12/16 (13394 floats) is not this build's 15/24/8/5/13/16 (13394 floats)");
+    b = good;
+    b[32] = 0;  // n_floats
     expectMsg(parseError(b, true), "w.bin: network shape");
     b = good;
     b.resize(b.size() - 8);
@@ -256,16 +265,53 @@ TEST(Learned, BadWeightsAreClearErrors) {
     expectMsg(parseError(b), "w.bin: weight file checksum mismatch (corrupt)");
     b = good;
     const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
-    std::memcpy(&b[28 + 4 * 100], &nan, 4);
+    std::memcpy(&b[kHead + 4 * 100], &nan, 4);
     expectMsg(parseError(b, true), "w.bin: weight 100 is not finite");
     b = good;
-    std::memcpy(&b[28 + 4 * 1833], &inf, 4);
-    expectMsg(parseError(b, true), "w.bin: weight 1833 is not finite");
+    std::memcpy(&b[kHead + 4 * (kFloats - 1)], &inf, 4);
+    expectMsg(parseError(b, true), "w.bin: weight 13393 is not finite");  // the context's last bias
     try {
         LearnedWeights::load("/nonexistent/learned.bin");
         FAIL() << "no error";
     } catch (const InputError& e) {
         expectMsg(e.what(), "/nonexistent/learned.bin: cannot open the learned-filter weight file");
+    }
+}
+
+namespace {
+
+// The fixture's weight file with its context's last layer (kz, kbz: the last 408 floats) zeroed, and
+// the same MLP as a version-3 file (header of 28 bytes, the MLP's 1834 floats).
+std::vector<std::uint8_t> withChecksum(std::vector<std::uint8_t> b) {
+    std::uint32_t h = 0x811C9DC5u;
+    for (size_t i = 0; i + 4 < b.size(); ++i) h = (h ^ b[i]) * 0x01000193u;
+    std::memcpy(&b[b.size() - 4], &h, 4);
+    return b;
+}
+
+}  // namespace
+
+// A version-3 file (no context) is read as version 4 with the context zero: it gives exactly what a
+// version-4 file with the same MLP and a zero last context layer gives, and that differs from the
+// fixture's (the context is used).
+TEST(Learned, Version3FilesReadWithoutContext) {
+    const std::vector<std::uint8_t> good = fixture().weights;
+    std::vector<std::uint8_t> v4 = good;
+    std::fill(v4.end() - 4 - 4 * (16 * 24 + 24), v4.end() - 4, std::uint8_t(0));
+    v4 = withChecksum(v4);
+    std::vector<std::uint8_t> v3(good.begin(), good.begin() + 28);
+    v3[4] = 3;
+    const std::uint32_t n = 1834;
+    std::memcpy(&v3[24], &n, 4);
+    v3.insert(v3.end(), good.begin() + 36, good.begin() + 36 + 4 * 1834);
+    v3.resize(v3.size() + 4);
+    v3 = withChecksum(v3);
+    const LearnedWeights w3 = LearnedWeights::parse(v3.data(), v3.size(), "v3.bin");
+    const LearnedWeights w4 = LearnedWeights::parse(v4.data(), v4.size(), "v4.bin");
+    for (bool fast : {true, false}) {
+        const Image a = run(fixture().planes(), w3, fast), b = run(fixture().planes(), w4, fast);
+        EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0) << "fast " << fast;
+        EXPECT_GT(worstRel(a, fixture().expect), 1e-2) << "fast " << fast;
     }
 }
 
@@ -284,7 +330,7 @@ TEST(Learned, BadPlanesAreClearErrors) {
     LearnedPlanes p = fx.planes();
     EXPECT_EQ(msg(p, out.view()), "no error");
     p.albedo = small.view();
-    EXPECT_NE(msg(p, out.view()).find("learned filter: albedo: size 4x4 differs from d's 24x20"), std::string::npos)
+    EXPECT_NE(msg(p, out.view()).find("learned filter: albedo: size 4x4 differs from d's 42x37"), std::string::npos)
         << msg(p, out.view());
     p = fx.planes();
     p.var = ImageView{};

@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
-"""Writes tests/learned_fixture.bin (the learned filter v3's parity fixture): synthetic prepared
+"""Writes tests/learned_fixture.bin (the learned filter v4's parity fixture): synthetic prepared
 planes (what the still driver hands the learned cascade: d, var, albedo, normal, depth), a weight
 file with random non-trivial weights and the JAX d_out on them, which tests/learned_test.cpp (C++
 inference) and tests/python/test_learn.py (the JAX code as it is now) compare with.
 Layout (little-endian):
-  "ATRF" | u32 version (3) | u32 width | u32 height | u32 n (weight-file bytes) | the weight file
+  "ATRF" | u32 version (4) | u32 width | u32 height | u32 n (weight-file bytes) | the weight file
   | planes d(3), var(3), albedo(3), normal(3), depth(1), out_d(3): f32, planar, channel-major
     (atrous's Image layout: channel c's plane is height x width row-major)."""
 import struct
@@ -16,20 +16,20 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python" / "atrous"))
 import jax  # noqa: E402
 import jax.numpy as jnp  # noqa: E402
-from learn import features, model, weights  # noqa: E402
+from learn import context, features, model, weights  # noqa: E402
 
 PLANES = (("d", 3), ("var", 3), ("albedo", 3), ("normal", 3), ("depth", 1))
-VERSION = 3  # the fixture's own version: 3 holds a version-3 weight file and the v3 d_out
+VERSION = 4  # the fixture's own version: 4 holds a version-4 weight file and the v4 d_out
 
 
 # The terms each fixture must exercise (model.denoise_d's ablation switches, the box inputs, the
 # noise plane the cascade reads: 4 v).
 ABLATIONS = (("relative colour term", {"colour": False}), ("noise-relative colour term", {"vcolour": False}),
              ("blend", {"blend": False}), ("box inputs", {"box": False}),
-             ("noise plane (4 v instead)", {"v_scale": 4.0}))
+             ("noise plane (4 v instead)", {"v_scale": 4.0}), ("context branch", {"ctx": False}))
 
 
-def make_planes(w: int = 24, h: int = 20, seed: int = 5) -> dict:
+def make_planes(w: int = 42, h: int = 37, seed: int = 5) -> dict:
     """Prepared planes with an edge (albedo, normal and brightness change at x = w/2), a black-albedo
     patch, sky depth 1e30 (clamped to 1e4 by the inputs), a bright firefly-ish pixel and noise."""
     rng = np.random.default_rng(seed)
@@ -48,7 +48,7 @@ def make_planes(w: int = 24, h: int = 20, seed: int = 5) -> dict:
     return {"d": d, "var": var, "albedo": albedo, "normal": normal, "depth": depth}
 
 
-def fixture_params(seed: int = 10) -> dict:
+def fixture_params(seed: int = 16) -> dict:
     """Random weights of unit-ish scale (every output term active: a, m, b, c of O(1), blend spread),
     the box inputs' rows of w1 4x (else the firefly's d_out of 60 makes their effect < 1% of the
     range). The seed is one of those where every check of main() clears 1%."""
@@ -57,18 +57,26 @@ def fixture_params(seed: int = 10) -> dict:
     for name, shape in model.SHAPES:
         scale = np.sqrt(2.0 / shape[0]) if name.startswith("w") else 0.5
         p[name] = (rng.standard_normal(shape) * scale).astype(np.float32)
+    for name, shape in model.CTX_SHAPES:  # the context: He-scaled kernels, kz of the same order as w1
+        fan_in = int(np.prod(shape[:-1]))
+        scale = np.sqrt(2.0 / fan_in) if len(shape) > 1 else 0.2
+        p[name] = (rng.standard_normal(shape) * scale).astype(np.float32)
+    p["kz"] *= 5.0
     p["w3"] *= 0.5
     p["w1"][features.BOX] *= 4.0
     return {k: jnp.asarray(v) for k, v in p.items()}
 
 
-def d_out_np(params: dict, planes: dict, box: bool = True, v_scale: float = 1.0, **ablate) -> np.ndarray:
-    """JAX d_out; box=False zeroes the box inputs, v_scale scales the noise plane (the inputs unchanged)."""
+def d_out_np(params: dict, planes: dict, box: bool = True, v_scale: float = 1.0, ctx: bool = True, **ablate) -> np.ndarray:
+    """JAX d_out; box=False zeroes the box inputs, v_scale scales the noise plane (the inputs unchanged),
+    ctx=False drops the context branch."""
     x = features.inputs_of(planes)
+    cells = jnp.asarray(context.cell_inputs(x, planes["d"])[None]) if ctx else None
     if not box:
         x[..., features.BOX] = 0.0
     v = v_scale * features.variance_plane(planes["var"])
-    out = model.denoise_d(params, jnp.asarray(x[None]), jnp.asarray(planes["d"][None]), jnp.asarray(v[None]), **ablate)
+    out = model.denoise_d(params, jnp.asarray(x[None]), cells, jnp.asarray(planes["d"][None]), jnp.asarray(v[None]),
+                          **ablate)
     return np.asarray(out[0])
 
 

@@ -1,4 +1,5 @@
-// The learned filter v3 on the CPU (filters/learned.h): pass A per pixel (vectorised x loop),
+// The learned filter v4 on the CPU (filters/learned.h): the context branch once for the whole image
+// (src/cpu/learned_context_cpu.cpp), pass A per pixel (vectorised x loop),
 // pass B row-wise (the 3x3 box as column sums once per row, then the MLP on 16 pixels at a time
 // with the pixel index innermost: the lane loops of learnedMlp<16> become vector instructions),
 // the five levels through the shared row engine (src/cpu/atrous_rows.h) with the LearnedStop
@@ -55,14 +56,18 @@ struct NetRows {
     LearnedTemps T;
     ImageView acc;
     size_t pOffset = 0;
+    ImageView z;     // the context's z (whole image, 1/4 resolution); invalid: no context
+    int rowOffset = 0;  // the band's first row in the image
 
     ATROUS_FORCE_INLINE void operator()(int y0, int y1) const {
         const int w = T.lg.width, h = T.lg.height;
         const size_t stride = size_t(w) + 2;
-        std::vector<float> buf(kLearnedBoxQ * stride + size_t(w));
+        const int zw = z.valid() ? z.width : 0;
+        std::vector<float> buf(kLearnedBoxQ * stride + size_t(w) + size_t(kLearnedHidden) * size_t(zw));
         float* V[kLearnedBoxQ];
         for (int k = 0; k < kLearnedBoxQ; ++k) V[k] = buf.data() + k * stride;
         float* inv = buf.data() + kLearnedBoxQ * stride;
+        float* zr = inv + w;  // z interpolated between its two rows for this row: zr[j * zw + X]
         for (int y = y0; y < y1; ++y) {
             const bool top = y > 0, bottom = y + 1 < h;
             const size_t o = size_t(y) * size_t(w);
@@ -90,13 +95,35 @@ struct NetRows {
             }
             const int ny = 1 + int(top) + int(bottom);
             for (int x = 0; x < w; ++x) inv[x] = 1.0f / float((1 + int(x > 0) + int(x < w - 1)) * ny);
+            if (zw) {  // the rows step of up4 (learnedCtxShift's order: rows first)
+                const LearnedUpTap ty = learnedUpTap(rowOffset + y, kLearnedCell, z.height);
+                for (int j = 0; j < kLearnedHidden; ++j) {
+                    const float *a = z.channel(j) + size_t(ty.i0) * zw, *b = z.channel(j) + size_t(ty.i1) * zw;
+                    for (int X = 0; X < zw; ++X) zr[j * zw + X] = a[X] * (1.0f - ty.t) + b[X] * ty.t;
+                }
+            }
             for (int x0 = 0; x0 < w; x0 += kLanes) {
                 const int n = w - x0 < kLanes ? w - x0 : kLanes;
                 float in[kLearnedIn][kLanes], out[kLearnedOut][kLanes];
                 learnedPointInputs<kLanes>(P, T.lg, o + size_t(x0), n, in, pOffset + o + size_t(x0));
                 const float* const Vx[kLearnedBoxQ] = {V[0] + x0, V[1] + x0, V[2] + x0, V[3] + x0, V[4] + x0};
                 learnedBoxInputs<kLanes>(Vx, inv + x0, n, in);
-                learnedMlp<kLanes>(*net, in, out);
+                if (zw) {  // the columns step
+                    float shift[kLearnedHidden][kLanes];
+                    int i0[kLanes], i1[kLanes];
+                    float t[kLanes];
+                    for (int l = 0; l < kLanes; ++l) {
+                        const LearnedUpTap tx = learnedUpTap(x0 + (l < n ? l : 0), kLearnedCell, zw);
+                        i0[l] = tx.i0, i1[l] = tx.i1, t[l] = tx.t;
+                    }
+                    for (int j = 0; j < kLearnedHidden; ++j) {
+                        const float* r = zr + j * zw;
+                        for (int l = 0; l < kLanes; ++l) shift[j][l] = r[i0[l]] * (1.0f - t[l]) + r[i1[l]] * t[l];
+                    }
+                    learnedMlp<kLanes, true>(*net, in, out, shift);
+                } else {
+                    learnedMlp<kLanes>(*net, in, out);
+                }
                 learnedWriteOutputs<kLanes>(out, P.d, T, acc, o + size_t(x0), n, pOffset + o + size_t(x0));
             }
         }
@@ -164,8 +191,10 @@ void runLearned(const CpuExec& exec, const LearnedWeights& weights, const Learne
     LearnedTemps T;
     std::shared_ptr<Stores> stores;
     ImageView bandAcc;
+    LearnedCtxPlanes C;
     if (cache && cache->holds(weights, w, h)) {
         T = cache->temps;
+        C = cache->ctx;
     } else {
         stores = std::make_shared<Stores>();
         const size_t plane = size_t(w) * size_t(regionRows);
@@ -181,16 +210,24 @@ void runLearned(const CpuExec& exec, const LearnedWeights& weights, const Learne
         T.bk = alloc(kLearnedLevels), T.c = alloc(kLearnedLevels), T.beta = alloc(kLearnedLevels + 1), T.buf = alloc(3);
         T.v = alloc(1);
         if (banded) bandAcc = alloc(3);
-        if (cache) *cache = LearnedCache{w, h, weights.impl, stores, T, &weights.impl->net};
+        if (weights.impl->net.context) {  // the whole image's, also when banded (a few floats a pixel)
+            const size_t bytes = learnedCtxFloats(w, h) * sizeof(float);
+            stores->emplace_back(static_cast<float*>(scalable_aligned_malloc(bytes, 64)), scalable_aligned_free);
+            if (!stores->back()) throw RuntimeError("out of host memory for the learned filter's planes");
+            C = learnedCtxPlanes(stores->back().get(), w, h);
+        }
+        if (cache) *cache = LearnedCache{w, h, weights.impl, stores, T, &weights.impl->net, C};
     }
     const LearnedNet* net = &weights.impl->net;
     LearnedStageTimes local;
     LearnedStageTimes& t = times ? *times : local;
     clock.mark(t.allocate, unused);
     if (!atrousCpuFastPath()) {
-        runLearnedFunctors(exec, net, in, T, out);
+        runLearnedFunctors(exec, net, in, T, out, C);
         return;
     }
+    if (C.valid()) runLearnedContextCpu(exec, net->ctx, in, C);
+    clock.mark(t.context, t.cpuContext);
     const bool avx512 = atrousCpuAvx512();
     double logs = 0, network = 0, levels = 0, cpuLogs = 0, cpuNetwork = 0, cpuLevels = 0;
     LearnedStageTimes sum;  // over the bands
@@ -213,7 +250,7 @@ void runLearned(const CpuExec& exec, const LearnedWeights& weights, const Learne
                                      B.lg.channel(3), B.v.channel(0)});
         clock.mark(logs, cpuLogs);
         sum.logs += logs, sum.cpuLogs += cpuLogs;
-        cpu::parallelForIsa(cpu::activeIsa(), 0, rows, 2, NetRows{net, in, B, acc, pOffset});
+        cpu::parallelForIsa(cpu::activeIsa(), 0, rows, 2, NetRows{net, in, B, acc, pOffset, C.z, r0});
         clock.mark(network, cpuNetwork);
         sum.network += network, sum.cpuNetwork += cpuNetwork;
         // Level i over the rows the levels after it read: within H_i = 2 (2^5 - 2^(i+1)) of the band.

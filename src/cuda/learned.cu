@@ -1,5 +1,7 @@
-// The learned filter v3 on the GPU: the functors of filters/learned.h launched by CudaExec (pass A,
-// pass B one thread per pixel with the MLP in registers, the five levels as AtrousLevel<LearnedStop>).
+// The learned filter v4 on the GPU: the functors of filters/learned.h launched by CudaExec (the
+// context branch's passes and direct convolutions of filters/learned_context.h, one thread per
+// output sample; pass A, pass B one thread per pixel with the MLP in registers, the five levels as
+// AtrousLevel<LearnedStop>).
 // The weights are copied to the device and the temporaries (one device image) made once per call,
 // or once for all the calls that share a LearnedCache (SVGF's frames).
 #include <chrono>
@@ -20,6 +22,7 @@ void runLearned(const CudaExec& exec, const LearnedWeights& weights, const Learn
     struct Store {
         cuda::DeviceBuffer<LearnedNet> net{1};
         Image temps;
+        Image ctx;  // the context branch's planes (one block; none without a context)
     };
     LearnedCache local;
     LearnedCache& c = cache ? *cache : local;
@@ -28,9 +31,14 @@ void runLearned(const CudaExec& exec, const LearnedWeights& weights, const Learn
         auto store = std::make_shared<Store>();
         store->net.upload(&weights.impl->net, 1);
         store->temps = Image(w, h, kLearnedTempChannels, Device::Cuda);
-        c = LearnedCache{w, h, weights.impl, store, learnedTemps(store->temps.data(), w, h), store->net.data()};
+        LearnedCtxPlanes ctx;
+        if (weights.impl->net.context) {
+            store->ctx = Image(int(learnedCtxFloats(w, h)), 1, 1, Device::Cuda);
+            ctx = learnedCtxPlanes(store->ctx.data(), w, h);
+        }
+        c = LearnedCache{w, h, weights.impl, store, learnedTemps(store->temps.data(), w, h), store->net.data(), ctx};
     }
-    runLearnedFunctors(exec, c.net, in, c.temps, out);
+    runLearnedFunctors(exec, c.net, in, c.temps, out, c.ctx);
     exec.synchronize();
     if (times) times->levels = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }

@@ -1,10 +1,12 @@
-// The learned filter v3 (docs/learned.md) on the still driver's prepared planes: the functors of
+// The learned filter v4 (docs/learned.md) on the still driver's prepared planes: the functors of
 // its passes, host and device, and the two entry points runLearned (CpuExec: src/cpu/learned_cpu.cpp;
 // CudaExec: src/cuda/learned.cu). The same math as python/atrous/learn/model.py and features.py;
 // tests/learned_test.cpp holds them equal on tests/learned_fixture.bin.
 //
 //   pass A  LearnedLogPass      lg = log1p(max(d, 0)) (3), L = log1p(max(mean_c d_c, 0)),
 //                               v = max(mean_c var_c, 0) (the noise plane, every level's)
+//   context                     (version 4) filters/learned_context.h: z, the first hidden layer's shift
+//                               at 1/4 resolution, upsampled per pixel in pass B
 //   pass B  LearnedNetPixel     the 15 inputs (3x3 box statistics of lg and L), the MLP, and from its
 //                               outputs f, a_i, m_i, b_i (b_0 kappa_0), c_i, softmax(beta); acc = beta_0 d_0
 //   level i LearnedStop<kLast>  an edge-stop policy of the shared à-trous level (atrous_level.h):
@@ -22,6 +24,7 @@
 #include "atrous/image.h"
 #include "atrous/learned.h"
 #include "filters/atrous_level.h"
+#include "filters/learned_context.h"
 #include "filters/learned_math.h"
 
 namespace atrous {
@@ -44,8 +47,8 @@ struct LearnedPlanes {
 // Per-stage times of one runLearned call on the CPU (seconds; the bench's breakdown): wall clock,
 // and process CPU time (std::clock, all threads: what counts on a shared machine).
 struct LearnedStageTimes {
-    double allocate = 0, logs = 0, network = 0, levels = 0;
-    double cpuLogs = 0, cpuNetwork = 0, cpuLevels = 0;
+    double allocate = 0, context = 0, logs = 0, network = 0, levels = 0;
+    double cpuContext = 0, cpuLogs = 0, cpuNetwork = 0, cpuLevels = 0;
 };
 
 struct LearnedCache;
@@ -57,6 +60,10 @@ void runLearned(const CpuExec& exec, const LearnedWeights& w, const LearnedPlane
                 LearnedStageTimes* times = nullptr, LearnedCache* cache = nullptr);
 void runLearned(const CudaExec& exec, const LearnedWeights& w, const LearnedPlanes& in, const ImageView& out,
                 LearnedStageTimes* times = nullptr, LearnedCache* cache = nullptr);
+// The context branch on the CPU (src/cpu/learned_context_cpu.cpp: oneDNN's convolutions): C.z of
+// the planes P.
+void runLearnedContextCpu(const CpuExec& exec, const LearnedCtxNet& net, const LearnedPlanes& P,
+                          const LearnedCtxPlanes& C);
 // The CPU entry point's bands of rows (src/cpu/learned_cpu.cpp): 0 (default) = by size (above 4 Mpixels,
 // without a cache), > 0 = bands of that many rows whenever the image is taller (tests), < 0 = never.
 int& learnedCpuBandRows();
@@ -83,6 +90,7 @@ struct LearnedCache {
     std::shared_ptr<void> store;                          // owns the temporaries (and CUDA's copy of the net)
     LearnedTemps temps;
     const LearnedNet* net = nullptr;                      // on the executor's device
+    LearnedCtxPlanes ctx;                                 // the context branch's planes (invalid: no context)
     bool holds(const LearnedWeights& w, int width_, int height_) const {
         return store && weights == w.impl && width == width_ && height == height_;
     }
@@ -227,6 +235,7 @@ struct LearnedNetPixel {
     LearnedPlanes P;
     LearnedTemps T;
     ImageView acc;
+    ImageView z;  // the context's z (1/4 resolution); invalid: no context
 
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         const int w = P.d.width, h = P.d.height;
@@ -253,7 +262,13 @@ struct LearnedNetPixel {
         const float* V[kLearnedBoxQ] = {cs[0], cs[1], cs[2], cs[3], cs[4]};
         learnedBoxInputs<1>(V, &inv, 1, in);
         float out[kLearnedOut][1];
-        learnedMlp<1>(*net, in, out);
+        if (z.valid()) {
+            float shift[kLearnedHidden][1];
+            for (int j = 0; j < kLearnedHidden; ++j) shift[j][0] = learnedCtxShift(z, x, y, j);
+            learnedMlp<1, true>(*net, in, out, shift);
+        } else {
+            learnedMlp<1>(*net, in, out);
+        }
         learnedWriteOutputs<1>(out, P.d, T, acc, i, 1, i);
     }
 };
@@ -365,13 +380,14 @@ LearnedStop<kLast> learnedStop(const LearnedPlanes& P, const LearnedTemps& T, co
 }
 
 // The whole cascade through the functors on exec (the GPU; the CPU reference): every view on
-// exec's device, net too.
+// exec's device, net too. C: the context's planes, invalid when the weights have none.
 template <class Exec>
 void runLearnedFunctors(const Exec& exec, const LearnedNet* net, const LearnedPlanes& P, const LearnedTemps& T,
-                        const ImageView& acc) {
+                        const ImageView& acc, const LearnedCtxPlanes& C) {
     const int w = P.d.width, h = P.d.height;
+    if (C.valid()) runLearnedContextFunctors(exec, &net->ctx, P.d, P.var, P.albedo, P.normal, P.depth, C);
     exec.forEachPixel(w, h, LearnedLogPass{P.d, P.var, T.lg, T.v});
-    exec.forEachPixel(w, h, LearnedNetPixel{net, P, T, acc});
+    exec.forEachPixel(w, h, LearnedNetPixel{net, P, T, acc, C.z});
     for (int i = 0; i + 1 < kLearnedLevels; ++i) runAtrousLevelFunctor(exec, learnedStop<false>(P, T, acc, i));
     runAtrousLevelFunctor(exec, learnedStop<true>(P, T, acc, kLearnedLevels - 1));
 }

@@ -1,4 +1,4 @@
-// The learned filter v3's per-pixel math (docs/learned.md), host and device: the network's shape,
+// The learned filter v4's per-pixel math (docs/learned.md), host and device: the network's shape,
 // its parameters, the input transfers, the MLP and its output transfers. Written once; the
 // functors of filters/learned.h (the GPU, and the CPU reference) and the CPU row loops of
 // src/cpu/learned_cpu.cpp call these same functions. Lane-parallel where it matters: learnedMlp<N>
@@ -10,6 +10,7 @@
 // without -ffast-math) and host and device compute the same values.
 #pragma once
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 
 #include "filters/atrous_math.h"
@@ -27,15 +28,33 @@ constexpr float kLearnedDepthMin = 1e-3f, kLearnedDepthMax = 1e4f, kLearnedKappa
 // it keeps nu's denominator >= 1e-5.
 constexpr float kLearnedNuRel = 0.001f;
 
+// The context branch (version 4; filters/learned_context.h): 13 cell inputs at a quarter of the
+// resolution, convolutions of kLearnedCtx channels, and a 1x1 layer to the first hidden layer.
+constexpr int kLearnedCell = 4, kLearnedCtxIn = 13, kLearnedCtx = 16;
+// Its parameters, the weight file's order: kernels HWIO (k[((ky * 3 + kx) * in + i) * out + o]).
+struct LearnedCtxNet {
+    float k1[9 * kLearnedCtxIn * kLearnedCtx], kb1[kLearnedCtx];
+    float k2[9 * kLearnedCtx * kLearnedCtx], kb2[kLearnedCtx];
+    float k3[9 * kLearnedCtx * kLearnedCtx], kb3[kLearnedCtx];
+    float k4[9 * 2 * kLearnedCtx * kLearnedCtx], kb4[kLearnedCtx];
+    float kz[kLearnedCtx * kLearnedHidden], kbz[kLearnedHidden];
+};
+
 // The network's parameters, the weight file's order (row-major: w1[i * kLearnedHidden + j] maps
-// input i to unit j).
+// input i to unit j), then the context branch's. context: false for a version-3 file (ctx all
+// zero: the context changes nothing and is not computed).
 struct LearnedNet {
     float w1[kLearnedIn * kLearnedHidden], b1[kLearnedHidden];
     float w2[kLearnedHidden * kLearnedHidden], b2[kLearnedHidden];
     float w3[kLearnedHidden * kLearnedOut], b3[kLearnedOut];
+    LearnedCtxNet ctx;
+    bool context;
 };
-constexpr int kLearnedParams = int(sizeof(LearnedNet) / sizeof(float));
-static_assert(kLearnedParams == 1834, "the v3 network has 1834 parameters");
+constexpr int kLearnedMlpParams = 1834;
+constexpr int kLearnedCtxParams = int(sizeof(LearnedCtxNet) / sizeof(float));
+constexpr int kLearnedParams = kLearnedMlpParams + kLearnedCtxParams;
+static_assert(offsetof(LearnedNet, ctx) == kLearnedMlpParams * sizeof(float), "the MLP has 1834 parameters");
+static_assert(kLearnedCtxParams == 11560, "the context branch has 11560 parameters");
 
 ATROUS_FORCE_INLINE ATROUS_INLINE float learnedFinite(float v) { return selectF(finite(v), v, 0.0f); }
 // maxSel/minSel (the same values, NaN a gives b) as bit selects: after learnedFinite's select GCC
@@ -127,15 +146,20 @@ ATROUS_FORCE_INLINE ATROUS_INLINE float learnedLocalStd(float meanL, float meanL
 // One dense layer on N pixels: y[j][l] = act(b[j] + sum_i x[i][l] w[i * NO + j]), the sum from the
 // bias in the order of i. (Four units per pass over x measured no faster: the multiply-adds, not
 // the loads, bound it.)
-template <int NI, int NO, bool kRelu, int N>
+// shift (kShift): a per-lane addition to the bias, shift[j][l] (the context's, layer 1).
+template <int NI, int NO, bool kRelu, int N, bool kShift = false>
 ATROUS_FORCE_INLINE ATROUS_INLINE void learnedLayer(const float* w, const float* b, const float (&x)[NI][N],
-                                                    float (&y)[NO][N]) {
+                                                    float (&y)[NO][N], const float (*shift)[N] = nullptr) {
     ATROUS_DEVICE_UNROLL
     for (int j = 0; j < NO; ++j) {
         float a[N];
         const float bj = b[j];
         ATROUS_LANES
         for (int l = 0; l < N; ++l) a[l] = bj;
+        if constexpr (kShift) {
+            ATROUS_LANES
+            for (int l = 0; l < N; ++l) a[l] += shift[j][l];
+        }
         for (int i = 0; i < NI; ++i) {
             const float wij = w[i * NO + j];
             ATROUS_LANES
@@ -146,12 +170,13 @@ ATROUS_FORCE_INLINE ATROUS_INLINE void learnedLayer(const float* w, const float*
     }
 }
 
-// The MLP on N pixels: x[i][l] input i of lane l -> y[j][l] the 34 raw (linear) outputs.
-template <int N>
+// The MLP on N pixels: x[i][l] input i of lane l -> y[j][l] the 34 raw (linear) outputs; kShift:
+// shift[j][l] (the context's up4(z)) added to the first hidden layer's pre-activation.
+template <int N, bool kShift = false>
 ATROUS_FORCE_INLINE ATROUS_INLINE void learnedMlp(const LearnedNet& net, const float (&x)[kLearnedIn][N],
-                                                  float (&y)[kLearnedOut][N]) {
+                                                  float (&y)[kLearnedOut][N], const float (*shift)[N] = nullptr) {
     float h1[kLearnedHidden][N], h2[kLearnedHidden][N];
-    learnedLayer<kLearnedIn, kLearnedHidden, true>(net.w1, net.b1, x, h1);
+    learnedLayer<kLearnedIn, kLearnedHidden, true, N, kShift>(net.w1, net.b1, x, h1, shift);
     learnedLayer<kLearnedHidden, kLearnedHidden, true>(net.w2, net.b2, h1, h2);
     learnedLayer<kLearnedHidden, kLearnedOut, false>(net.w3, net.b3, h2, y);
 }

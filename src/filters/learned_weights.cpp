@@ -1,7 +1,9 @@
-// The learned filter's weight file, version 3 (python/atrous/learn/weights.py, docs/learned.md):
-// little-endian "ATRL" | u32 version | u32 n_in, n_hidden, n_feat, n_levels, n_floats | the floats
-// (w1, b1, w2, b2, w3, b3) | u32 FNV-1a 32 of every byte before it. And the plane checks of the
-// two runLearned entry points (filters/learned.h).
+// The learned filter's weight file, version 4 (python/atrous/learn/weights.py, docs/learned.md):
+// little-endian "ATRL" | u32 version | u32 n_in, n_hidden, n_feat, n_levels, n_ctx_in, n_ctx, n_floats
+// | the floats (w1, b1, w2, b2, w3, b3, then the context branch's k1, kb1, ..., kz, kbz) | u32 FNV-1a
+// 32 of every byte before it. Version 3 (no n_ctx_in, n_ctx; the MLP's floats only) is read as
+// version 4 without a context. And the plane checks of the two runLearned entry points
+// (filters/learned.h).
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -23,7 +25,7 @@ namespace atrous {
 
 namespace {
 
-constexpr size_t kHeaderBytes = 28;
+constexpr size_t kHeaderBytesV3 = 28, kHeaderBytesV4 = 36;
 
 std::uint32_t fnv1a(const std::uint8_t* p, size_t n) {
     std::uint32_t h = 0x811C9DC5u;
@@ -35,9 +37,11 @@ std::uint32_t u32(const std::uint8_t* p) {
     return std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 | std::uint32_t(p[3]) << 24;
 }
 
-std::string shapeText(std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d, std::uint32_t n) {
-    return std::to_string(a) + "/" + std::to_string(b) + "/" + std::to_string(c) + "/" + std::to_string(d) + " (" +
-           std::to_string(n) + " floats)";
+std::string shapeText(std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d, bool ctx, std::uint32_t e,
+                      std::uint32_t f, std::uint32_t n) {
+    return std::to_string(a) + "/" + std::to_string(b) + "/" + std::to_string(c) + "/" + std::to_string(d) +
+           (ctx ? "/" + std::to_string(e) + "/" + std::to_string(f) : std::string()) + " (" + std::to_string(n) +
+           " floats)";
 }
 
 }  // namespace
@@ -53,16 +57,22 @@ LearnedWeights LearnedWeights::parse(const void* data, size_t size, const std::s
     if (version == 2)
         throw InputError(name + ": version 2 (the network without the noise-relative colour term, retired); " +
                          "retrain with make train");
-    if (version != 3)
-        throw InputError(name + ": weight file version " + std::to_string(version) + ", this build reads version 3");
-    if (size < kHeaderBytes + 4) throw InputError(name + ": truncated weight file (" + std::to_string(size) + " bytes)");
-    const std::uint32_t nIn = u32(p + 8), nHid = u32(p + 12), nFeat = u32(p + 16), nLev = u32(p + 20), n = u32(p + 24);
-    if (nIn != kLearnedIn || nHid != kLearnedHidden || nFeat != kLearnedFeat || nLev != kLearnedLevels ||
-        n != std::uint32_t(kLearnedParams))
-        throw InputError(name + ": network shape n_in/n_hidden/n_feat/n_levels " + shapeText(nIn, nHid, nFeat, nLev, n) +
-                         " is not this build's " +
-                         shapeText(kLearnedIn, kLearnedHidden, kLearnedFeat, kLearnedLevels, kLearnedParams));
-    const size_t expect = kHeaderBytes + 4 * size_t(n) + 4;
+    if (version != 3 && version != 4)
+        throw InputError(name + ": weight file version " + std::to_string(version) +
+                         ", this build reads versions 3 and 4");
+    const bool v4 = version == 4;
+    const size_t head = v4 ? kHeaderBytesV4 : kHeaderBytesV3;
+    if (size < head + 4) throw InputError(name + ": truncated weight file (" + std::to_string(size) + " bytes)");
+    const std::uint32_t nIn = u32(p + 8), nHid = u32(p + 12), nFeat = u32(p + 16), nLev = u32(p + 20);
+    const std::uint32_t nCtxIn = v4 ? u32(p + 24) : 0, nCtx = v4 ? u32(p + 28) : 0, n = u32(p + head - 4);
+    const std::uint32_t want = v4 ? std::uint32_t(kLearnedParams) : std::uint32_t(kLearnedMlpParams);
+    if (nIn != kLearnedIn || nHid != kLearnedHidden || nFeat != kLearnedFeat || nLev != kLearnedLevels || n != want ||
+        (v4 && (nCtxIn != kLearnedCtxIn || nCtx != kLearnedCtx)))
+        throw InputError(name + ": network shape n_in/n_hidden/n_feat/n_levels" + (v4 ? "/n_ctx_in/n_ctx " : " ") +
+                         shapeText(nIn, nHid, nFeat, nLev, v4, nCtxIn, nCtx, n) + " is not this build's " +
+                         shapeText(kLearnedIn, kLearnedHidden, kLearnedFeat, kLearnedLevels, v4, kLearnedCtxIn,
+                                   kLearnedCtx, want));
+    const size_t expect = head + 4 * size_t(n) + 4;
     if (size < expect)
         throw InputError(name + ": truncated weight file (" + std::to_string(size) + " bytes, " +
                          std::to_string(expect) + " expected)");
@@ -71,12 +81,19 @@ LearnedWeights LearnedWeights::parse(const void* data, size_t size, const std::s
                          std::to_string(expect) + " expected)");
     if (fnv1a(p, size - 4) != u32(p + size - 4)) throw InputError(name + ": weight file checksum mismatch (corrupt)");
     auto impl = std::make_shared<Impl>();
+    std::memset(&impl->net, 0, sizeof(impl->net));
+    // The floats in the file's order: the MLP's, then (version 4) the context's, as LearnedNet lays them out.
     float* w = reinterpret_cast<float*>(&impl->net);
     for (std::uint32_t i = 0; i < n; ++i) {
-        const std::uint32_t b = u32(p + kHeaderBytes + 4 * size_t(i));
+        const std::uint32_t b = u32(p + head + 4 * size_t(i));
         std::memcpy(&w[i], &b, 4);
         if (!std::isfinite(w[i])) throw InputError(name + ": weight " + std::to_string(i) + " is not finite");
     }
+    // A context whose last layer is all zero changes nothing: not computed (every version-3 file).
+    bool context = false;
+    for (float v : impl->net.ctx.kz) context = context || v != 0.0f;
+    for (float v : impl->net.ctx.kbz) context = context || v != 0.0f;
+    impl->net.context = context;
     LearnedWeights out;
     out.impl = impl;
     return out;

@@ -1,8 +1,9 @@
-"""The learned filter v3's training side (python/atrous/learn, docs/learned.md): the JAX forward pass
+"""The learned filter v4's training side (python/atrous/learn, docs/learned.md): the JAX forward pass
 still gives tests/learned_fixture.bin's d_out (the file tests/learned_test.cpp holds the C++
-inference to), the fixture exercises every term of the spec (the noise-relative colour term
-included), the inputs and the noise plane follow the spec's formulas, and the weight file
-round-trips and rejects corruption and the retired versions 1 and 2. Skipped without
+inference to), the fixture exercises every term of the spec (the noise-relative colour term and the
+context branch included), the inputs, the context's cell inputs and the noise plane follow the
+spec's formulas, and the weight file round-trips, reads version 3 as version 4 without a context and
+rejects corruption and the retired versions 1 and 2. Skipped without
 jax (it lives in .venv-train: scripts/train/setup.sh)."""
 import struct
 import sys
@@ -15,7 +16,7 @@ jax = pytest.importorskip("jax")
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "python" / "atrous"))
 sys.path.insert(0, str(ROOT / "scripts" / "train"))
-from learn import features, model, weights  # noqa: E402
+from learn import context, features, model, weights  # noqa: E402
 
 import make_fixture  # noqa: E402
 
@@ -30,7 +31,7 @@ def _fixture():
 
 def test_jax_forward_equals_fixture():
     w, h, params, planes = _fixture()
-    assert (w, h) == (24, 20)
+    assert (w, h) == (42, 37)  # partial 4x4 cells and 8x8 blocks on both axes
     out = make_fixture.d_out_np(params, planes)
     # Same code, same float32 inputs: only XLA's reduction order may differ between versions/CPUs
     # (float32 rounding, ~1e-7 relative a step, a few hundred steps: 1e-5 is far above it and far
@@ -48,7 +49,7 @@ def test_fixture_exercises_every_term():
     # make_fixture.ABLATIONS: colour=False, vcolour=False, blend=False, the box inputs zeroed, and the
     # noise plane 4 v with the inputs unchanged (the cascade reads v itself, not only input 10).
     names = [name for name, _ in make_fixture.ABLATIONS]
-    assert len(names) == 5 and "noise-relative colour term" in names
+    assert len(names) == 6 and "noise-relative colour term" in names and "context branch" in names
     for name, kw in make_fixture.ABLATIONS:
         assert np.abs(make_fixture.d_out_np(params, planes, **kw) - out).max() > 0.01 * scale, name
     # The fixture has sky depth, black albedo and a bright pixel (the cases the spec names).
@@ -88,10 +89,18 @@ def test_inputs_follow_the_spec():
 def test_weight_file_round_trip_and_errors():
     params = make_fixture.fixture_params()
     b = weights.to_bytes(params)
-    assert len(b) == 28 + 4 * 1834 + 4
+    assert len(b) == 36 + 4 * (1834 + 11560) + 4
     back = weights.from_bytes(b)
     for k, v in params.items():
         np.testing.assert_array_equal(np.asarray(v), back[k])
+    assert weights.has_context(back)
+    # Version 3: the MLP alone, read with the context zero (the same function as no context).
+    body = b[:4] + struct.pack("<6I", 3, *struct.unpack("<4I", b[8:24]), 1834) + b[36:36 + 4 * 1834]
+    v3 = weights.from_bytes(body + struct.pack("<I", weights.fnv1a(body)), "v3.bin")
+    np.testing.assert_array_equal(v3["w1"], back["w1"])
+    assert not weights.has_context(v3) and not np.any(v3["k1"])
+    with pytest.raises(ValueError, match="w.bin: version 5, this build reads versions 3 and 4"):
+        weights.from_bytes(b[:4] + struct.pack("<I", 5) + b[8:], "w.bin")
     bad = bytearray(b)
     bad[40] ^= 1
     with pytest.raises(ValueError, match="w.bin: truncated or corrupt"):
@@ -118,3 +127,44 @@ def test_init_starts_near_a_plain_cascade():
     f, a, m, b, c, beta = model.network(p, x)
     assert c.shape == b.shape == (1, 8, 8, model.N_LEVELS) and model.N_OUT == 34
     assert float(b.max()) < 0.2 and float(c.max()) < 0.2 and bool((beta.argmax(-1) == model.N_LEVELS).all())
+
+
+def test_cell_inputs_follow_the_spec():
+    # 4x4 cells, the last ones partial (7 x 6 pixels: 2 x 2 cells): means over the pixels inside, the
+    # spreads of L and of the mean albedo input within each cell.
+    rng = np.random.default_rng(4)
+    d = rng.uniform(0.0, 3.0, (7, 6, 3)).astype(np.float32)
+    var = rng.uniform(0.0, 0.5, (7, 6, 3)).astype(np.float32)
+    alb = rng.uniform(0.0, 1.0, (7, 6, 3)).astype(np.float32)
+    x = features.inputs(d, var, alb, rng.normal(0, 1, (7, 6, 3)), rng.uniform(1, 9, (7, 6, 1)))
+    c = context.cell_inputs(x, d)
+    assert c.shape == (2, 2, context.N_CTX_IN)
+    for cy, cx, ys, xs in ((0, 0, slice(0, 4), slice(0, 4)), (1, 1, slice(4, 7), slice(4, 6))):
+        cell = x[ys, xs]
+        np.testing.assert_allclose(c[cy, cx, 0:3], cell[..., 0:3].reshape(-1, 3).mean(0), rtol=1e-5)
+        lum = np.log1p(d[ys, xs].mean(axis=2))
+        assert c[cy, cx, 3] == pytest.approx(lum.std(), rel=1e-3, abs=1e-5)
+        np.testing.assert_allclose(c[cy, cx, 4:7], cell[..., 3:6].reshape(-1, 3).mean(0), rtol=1e-5)
+        assert c[cy, cx, 7] == pytest.approx(cell[..., 3:6].mean(axis=2).std(), rel=1e-3, abs=1e-5)
+        np.testing.assert_allclose(c[cy, cx, 8:13], cell[..., 6:11].reshape(-1, 5).mean(0), rtol=1e-5)
+
+
+def test_upsampling_and_pooling_follow_the_spec():
+    # Bilinear x4 with half-pixel centres and clamped indices: output 0 and 1 are sample 0, output 2
+    # is 7/8 sample 0 + 1/8 sample 1; the pooling averages the samples inside (a 3-wide row: 2 + 1).
+    a = jax.numpy.asarray(np.arange(3, dtype=np.float32).reshape(1, 1, 3, 1))
+    up = np.asarray(context.upsample(a, 4, 1, 11))[0, 0, :, 0]
+    np.testing.assert_allclose(up[:4], [0.0, 0.0, 0.125, 0.375], atol=1e-7)
+    assert up[-1] == 2.0 and up[-2] == 1.875  # 9.5 / 4 - 0.5 = 1.875; 10.5 / 4 - 0.5 = 2.125 clamps to 2
+    pooled = np.asarray(context.pool2(a))[0, 0, :, 0]
+    np.testing.assert_allclose(pooled, [0.5, 2.0])
+
+
+def test_zero_context_is_the_mlp_alone():
+    # kz = kbz = 0 (a version-3 file, or the start of training from one): exactly no context.
+    p = model.init_params(2)
+    rng = np.random.default_rng(1)
+    x = jax.numpy.asarray(rng.normal(0, 1, (1, 12, 9, features.N_IN)).astype(np.float32))
+    cells = jax.numpy.asarray(rng.normal(0, 1, (1, 3, 3, context.N_CTX_IN)).astype(np.float32))
+    for a, b in zip(model.network(p, x, cells), model.network(p, x, None)):
+        np.testing.assert_array_equal(np.asarray(a), np.asarray(b))

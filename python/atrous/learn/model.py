@@ -1,4 +1,5 @@
-"""The learned filter v3's forward pass in JAX (docs/learned.md): a per-pixel MLP 15 -> 24 -> 24 -> 34 gives
+"""The learned filter v4's forward pass in JAX (docs/learned.md): a per-pixel MLP 15 -> 24 -> 24 -> 34, whose
+first hidden layer the context branch (context.py) shifts per pixel, gives
 a guide feature vector f, per level i a feature bandwidth a_i, a centre weight m_i, a relative colour
 bandwidth b_i and a noise-relative colour bandwidth c_i, and 6 blend logits beta; a 5-level à-trous
 cascade (B3 5x5 taps at step 2^i, taps outside the image dropped, as src/filters/atrous_level.h)
@@ -24,6 +25,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from . import context
 from .features import N_IN
 
 N_HIDDEN = 24
@@ -35,6 +37,9 @@ KAPPA_EPS = 0.01
 NU_REL = 0.001  # nu's floor, relative to the pixel's brightness (0.01 + mean d^2)
 SHAPES = (("w1", (N_IN, N_HIDDEN)), ("b1", (N_HIDDEN,)), ("w2", (N_HIDDEN, N_HIDDEN)), ("b2", (N_HIDDEN,)),
           ("w3", (N_HIDDEN, N_OUT)), ("b3", (N_OUT,)))
+# Version 4: the context branch's parameters follow the MLP's.
+CTX_SHAPES = context.SHAPES + context.z_shapes(N_HIDDEN)
+ALL_SHAPES = SHAPES + CTX_SHAPES
 # Output slices, in the weight file's order.
 F_ = slice(0, N_FEAT)
 A_ = slice(N_FEAT, N_FEAT + N_LEVELS)
@@ -59,6 +64,7 @@ def init_params(seed: int) -> dict:
     p["b3"][BC_] = -3.0
     p["b3"][BV_] = -3.0
     p["b3"][BETA_.stop - 1] = 1.0
+    p.update(context.init_params(rng, N_HIDDEN))
     return {k: jnp.asarray(v) for k, v in p.items()}
 
 
@@ -67,9 +73,13 @@ def softplus(x):
     return jnp.maximum(x, 0.0) + jnp.log1p(jnp.exp(-jnp.abs(x)))
 
 
-def network(params: dict, x):
-    """x: ... x N_IN -> (f ... x N_FEAT, a, m, b, c ... x N_LEVELS, beta ... x N_LEVELS + 1)."""
-    h = jax.nn.relu(x @ params["w1"] + params["b1"])
+def network(params: dict, x, cells=None):
+    """x: B x H x W x N_IN, cells: its context cell inputs (context.cell_inputs) or None (no context)
+    -> (f ... x N_FEAT, a, m, b, c ... x N_LEVELS, beta ... x N_LEVELS + 1)."""
+    pre = x @ params["w1"] + params["b1"]
+    if cells is not None:
+        pre = pre + context.hidden_shift(params, cells, x.shape[1], x.shape[2])
+    h = jax.nn.relu(pre)
     h = jax.nn.relu(h @ params["w2"] + params["b2"])
     o = h @ params["w3"] + params["b3"]
     return (o[..., F_], softplus(o[..., A_]), softplus(o[..., M_]), softplus(o[..., BC_]), softplus(o[..., BV_]),
@@ -133,15 +143,16 @@ def cascade(d, v, f, a, m, b, c, beta, colour: bool = True, blend: bool = True, 
     return wts[..., :1] * d + jnp.einsum("bhwl,lbhwc->bhwc", wts[..., 1:], levels)
 
 
-def denoise_d(params: dict, x, d, v, colour: bool = True, blend: bool = True, vcolour: bool = True):
-    """d_out of the network inputs x (B x H x W x N_IN), the demodulated colour d and its variance v."""
-    f, a, m, b, c, beta = network(params, x)
+def denoise_d(params: dict, x, cells, d, v, colour: bool = True, blend: bool = True, vcolour: bool = True):
+    """d_out of the network inputs x (B x H x W x N_IN), their cell inputs (None: no context), the
+    demodulated colour d and its variance v."""
+    f, a, m, b, c, beta = network(params, x, cells)
     return cascade(d, v, f, a, m, b, c, beta, colour, blend, vcolour)
 
 
-def forward(params: dict, x, d, v, mod, e, colour: bool = True, blend: bool = True, vcolour: bool = True):
+def forward(params: dict, x, cells, d, v, mod, e, colour: bool = True, blend: bool = True, vcolour: bool = True):
     """The library's output (safety net off): d_out mod + e (B x H x W x 3)."""
-    return denoise_d(params, x, d, v, colour, blend, vcolour) * mod + e
+    return denoise_d(params, x, cells, d, v, colour, blend, vcolour) * mod + e
 
 
 def relmse(out, ref, eps: float = 0.01):

@@ -1,4 +1,4 @@
-"""Training loop of the learned filter v3 (docs/learned.md, "Training"): optax Adam on relMSE of the
+"""Training loop of the learned filter v4 (docs/learned.md, "Training"): optax Adam on relMSE of the
 library's output d_out mod + emission over random crops of the prepared planes
 (scripts/train/prepare.py), fixed seed, checkpoints (resume), loss curve (JSON + PNG), weight
 export, and a JAX evaluation on the held-out split (the ablation tables)."""
@@ -15,7 +15,7 @@ import jax.numpy as jnp
 import numpy as np
 import optax
 
-from . import features, model, weights
+from . import context, features, model, weights
 
 DEFAULTS = {
     "splits": ["train", "corpus_train"],  # prepared training splits (missing ones are skipped)
@@ -24,6 +24,7 @@ DEFAULTS = {
     "batch": 4, "crop": 96, "lr": 3e-3, "eps": 0.01,
     "corpus_share": None,  # None: crops drawn uniformly from all images; else this fraction from corpus_train
     "colour": True, "vcolour": True, "blend": True, "box": True,  # ablations (C++ implements all four)
+    "context": True,  # version 4's context branch (False: train the MLP alone, as version 3)
 }
 
 
@@ -71,7 +72,9 @@ def batch(items, rng, n: int, crop: int, groups=None):
         for k in range(6):
             c = it[k][y:y + crop, x:x + crop]
             out[k].append(c[:, ::-1] if flip else c)
-    return [jnp.asarray(np.stack(o)) for o in out]
+    xs, ds = np.stack(out[0]), np.stack(out[1])
+    cells = context.cell_inputs(xs, ds)  # of the crop, as the library computes them for an image that size
+    return [jnp.asarray(xs), jnp.asarray(cells)] + [jnp.asarray(np.stack(o)) for o in out[1:]]
 
 
 def relmse_np(x, r) -> float:
@@ -82,11 +85,13 @@ def relmse_np(x, r) -> float:
 
 def evaluate(params: dict, prep_test: Path, cfg: dict, spps=(4, 16), variants=("given",)) -> dict:
     """JAX relMSE on a held-out split (default variant `given`, full images): per image and geomean/spp."""
-    fwd = jax.jit(lambda p, x, d, v, m, e: model.forward(p, x, d, v, m, e, cfg["colour"], cfg["blend"],
-                                                         cfg["vcolour"]))
+    ctx = cfg.get("context", True)
+    fwd = jax.jit(lambda p, x, c, d, v, m, e: model.forward(p, x, c if ctx else None, d, v, m, e, cfg["colour"],
+                                                            cfg["blend"], cfg["vcolour"]))
     res = {}
     for x, d, v, mod, e, ref, name in load_items(prep_test, spps, list(variants), cfg["box"]):
-        out = fwd(params, *(jnp.asarray(a[None]) for a in (x, d, v, mod, e)))
+        cells = context.cell_inputs(x, d)
+        out = fwd(params, *(jnp.asarray(a[None]) for a in (x, cells, d, v, mod, e)))
         res[name] = relmse_np(np.asarray(out[0]), ref)
     for spp in spps:
         v = [r for k, r in res.items() if k.endswith(f" {spp}spp")]
@@ -115,6 +120,9 @@ def train(prep: Path, out: Path, steps: int, seed: int = 1, minutes: float | Non
     params = model.init_params(seed)
     if init:  # fine-tuning: start from a weight file (the seed still drives the crops)
         params = {k: jnp.asarray(v) for k, v in weights.from_bytes(Path(init).read_bytes(), init).items()}
+        if cfg["context"] and not weights.has_context(params):  # a version-3 start: fresh convolutions, kz = 0
+            fresh = context.init_params(np.random.default_rng(seed), model.N_HIDDEN)
+            params.update({k: jnp.asarray(v) for k, v in fresh.items()})
     opt = optax.chain(optax.clip_by_global_norm(1.0), optax.adam(optax.cosine_decay_schedule(cfg["lr"], steps, 0.05)))
     state = opt.init(params)
     curve, start = [], 0
@@ -126,12 +134,13 @@ def train(prep: Path, out: Path, steps: int, seed: int = 1, minutes: float | Non
         start, curve = int(z["step"]), json.loads(str(z["curve"]))
     rng = np.random.default_rng([seed, start])
 
-    def loss_fn(p, x, d, v, m, e, r):
-        return model.relmse(model.forward(p, x, d, v, m, e, cfg["colour"], cfg["blend"], cfg["vcolour"]), r, cfg["eps"])
+    def loss_fn(p, x, c, d, v, m, e, r):
+        out = model.forward(p, x, c if cfg["context"] else None, d, v, m, e, cfg["colour"], cfg["blend"], cfg["vcolour"])
+        return model.relmse(out, r, cfg["eps"])
 
     @jax.jit
-    def step_fn(p, s, x, d, v, m, e, r):
-        l, g = jax.value_and_grad(loss_fn)(p, x, d, v, m, e, r)
+    def step_fn(p, s, x, c, d, v, m, e, r):
+        l, g = jax.value_and_grad(loss_fn)(p, x, c, d, v, m, e, r)
         u, s = opt.update(g, s, p)
         return optax.apply_updates(p, u), s, l
 

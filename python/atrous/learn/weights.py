@@ -1,19 +1,24 @@
-"""The learned filter's weight file, version 3 (docs/learned.md, "Weight file"), read by
+"""The learned filter's weight file, version 4 (docs/learned.md, "Weight file"), read by
 src/filters/learned_weights.cpp: little-endian
-  "ATRL" | u32 version (3) | u32 n_in | u32 n_hidden | u32 n_feat | u32 n_levels | u32 n_floats
-  | n_floats f32 (w1 [n_in][n_hidden], b1, w2 [n_hidden][n_hidden], b2, w3 [n_hidden][n_out], b3)
-  | u32 FNV-1a of every byte before it (n_out = n_feat + 4 n_levels + n_levels + 1). Versions 1 (the first
-  network, 11 -> 16 -> 16 -> 18) and 2 (15 -> 24 -> 24 -> 29, no noise-relative colour term) are refused."""
+  "ATRL" | u32 version (4) | u32 n_in | u32 n_hidden | u32 n_feat | u32 n_levels | u32 n_ctx_in | u32 n_ctx
+  | u32 n_floats | n_floats f32 (w1 [n_in][n_hidden], b1, w2 [n_hidden][n_hidden], b2, w3 [n_hidden][n_out],
+  b3, then the context branch: k1 [3][3][n_ctx_in][n_ctx], kb1, k2 [3][3][n_ctx][n_ctx], kb2, k3, kb3,
+  k4 [3][3][2 n_ctx][n_ctx], kb4, kz [n_ctx][n_hidden], kbz) | u32 FNV-1a of every byte before it
+  (n_out = n_feat + 4 n_levels + n_levels + 1).
+Version 3 (the same MLP, no context branch: the header without n_ctx_in, n_ctx, the MLP's floats only)
+is still read, as version 4 with the context branch zero (the same function). Versions 1 (the first
+network, 11 -> 16 -> 16 -> 18) and 2 (15 -> 24 -> 24 -> 29, no noise-relative colour term) are refused."""
 from __future__ import annotations
 
 import struct
 
 import numpy as np
 
-from .model import N_FEAT, N_HIDDEN, N_IN, N_LEVELS, SHAPES
+from .context import N_CTX, N_CTX_IN
+from .model import ALL_SHAPES, N_FEAT, N_HIDDEN, N_IN, N_LEVELS, SHAPES
 
 MAGIC = b"ATRL"
-VERSION = 3
+VERSION = 4
 RETIRED = {1: "the first network", 2: "the network without the noise-relative colour term"}
 
 
@@ -25,32 +30,50 @@ def fnv1a(data: bytes) -> int:
 
 
 def to_bytes(params: dict) -> bytes:
-    flat = np.concatenate([np.asarray(params[n], np.float32).reshape(-1) for n, _ in SHAPES]).astype("<f4")
-    body = MAGIC + struct.pack("<6I", VERSION, N_IN, N_HIDDEN, N_FEAT, N_LEVELS, flat.size) + flat.tobytes()
+    flat = np.concatenate([np.asarray(params[n], np.float32).reshape(-1) for n, _ in ALL_SHAPES]).astype("<f4")
+    body = MAGIC + struct.pack("<8I", VERSION, N_IN, N_HIDDEN, N_FEAT, N_LEVELS, N_CTX_IN, N_CTX, flat.size) + flat.tobytes()
     return body + struct.pack("<I", fnv1a(body))
+
+
+def has_context(params: dict) -> bool:
+    """False for a version-3 file's parameters (the context branch all zero)."""
+    return any(np.any(np.asarray(params[n]) != 0) for n in ("kz", "kbz"))
 
 
 def from_bytes(data: bytes, name: str = "weights") -> dict:
     if len(data) < 32 or data[:4] != MAGIC:
         raise ValueError(f"{name}: not an atrous learned-filter weight file (no ATRL header)")
-    version, n_in, n_hid, n_feat, n_lev, n = struct.unpack("<6I", data[4:28])
+    version = struct.unpack("<I", data[4:8])[0]
     if version in RETIRED:
         raise ValueError(f"{name}: version {version} ({RETIRED[version]}, retired); retrain with make train")
-    if version != VERSION:
-        raise ValueError(f"{name}: version {version}, this build reads version {VERSION}")
-    if (n_in, n_hid, n_feat, n_lev) != (N_IN, N_HIDDEN, N_FEAT, N_LEVELS):
-        raise ValueError(f"{name}: network shape (n_in, n_hidden, n_feat, n_levels) = {(n_in, n_hid, n_feat, n_lev)}, "
-                         f"this build's is {(N_IN, N_HIDDEN, N_FEAT, N_LEVELS)}")
-    if len(data) != 28 + 4 * n + 4 or fnv1a(data[:-4]) != struct.unpack("<I", data[-4:])[0]:
+    if version not in (3, VERSION):
+        raise ValueError(f"{name}: version {version}, this build reads versions 3 and {VERSION}")
+    if version == 3:
+        n_in, n_hid, n_feat, n_lev, n = struct.unpack("<5I", data[8:28])
+        shape, want, head, shapes = (n_in, n_hid, n_feat, n_lev), (N_IN, N_HIDDEN, N_FEAT, N_LEVELS), 28, SHAPES
+        names = "(n_in, n_hidden, n_feat, n_levels)"
+    else:
+        if len(data) < 40:
+            raise ValueError(f"{name}: truncated or corrupt (size or checksum)")
+        n_in, n_hid, n_feat, n_lev, n_ci, n_c, n = struct.unpack("<7I", data[8:36])
+        shape, want = (n_in, n_hid, n_feat, n_lev, n_ci, n_c), (N_IN, N_HIDDEN, N_FEAT, N_LEVELS, N_CTX_IN, N_CTX)
+        head, shapes, names = 36, ALL_SHAPES, "(n_in, n_hidden, n_feat, n_levels, n_ctx_in, n_ctx)"
+    if shape != want:
+        raise ValueError(f"{name}: network shape {names} = {shape}, this build's is {want}")
+    if len(data) != head + 4 * n + 4 or fnv1a(data[:-4]) != struct.unpack("<I", data[-4:])[0]:
         raise ValueError(f"{name}: truncated or corrupt (size or checksum)")
-    flat = np.frombuffer(data[28:28 + 4 * n], "<f4")
+    flat = np.frombuffer(data[head:head + 4 * n], "<f4")
     out, o = {}, 0
-    for k, shape in SHAPES:
-        size = int(np.prod(shape))
-        out[k] = flat[o:o + size].reshape(shape).copy()
+    for k, shp in shapes:
+        size = int(np.prod(shp))
+        if o + size > n:
+            raise ValueError(f"{name}: {n} floats, this build expects more")
+        out[k] = flat[o:o + size].reshape(shp).copy()
         o += size
     if o != n:
         raise ValueError(f"{name}: {n} floats, this build expects {o}")
+    for k, shp in ALL_SHAPES:  # version 3: no context (zero: the same function)
+        out.setdefault(k, np.zeros(shp, np.float32))
     return out
 
 
