@@ -99,7 +99,7 @@ int main(int argc, char** argv) {
         const filters::LearnedPlanes P{s.color.view(), s.variance.view(), s.albedo.view(), s.normal.view(),
                                        s.depth.view()};
         if (only != "denoise") {
-        std::vector<double> total, alloc, logs, net, levels, cpuLogs, cpuNet, cpuLevels;
+        std::vector<double> total, alloc, ctx, logs, net, levels, cpuCtx, cpuLogs, cpuNet, cpuLevels;
         for (int i = 0; i < 3 + runs; ++i) {
             filters::LearnedStageTimes t;
             Timer timer;
@@ -107,16 +107,18 @@ int main(int argc, char** argv) {
             if (i < 3) continue;
             total.push_back(timer.ms());
             alloc.push_back(t.allocate * 1e3), logs.push_back(t.logs * 1e3), net.push_back(t.network * 1e3);
-            levels.push_back(t.levels * 1e3);
+            levels.push_back(t.levels * 1e3), ctx.push_back(t.context * 1e3), cpuCtx.push_back(t.cpuContext * 1e3);
             cpuLogs.push_back(t.cpuLogs * 1e3), cpuNet.push_back(t.cpuNetwork * 1e3), cpuLevels.push_back(t.cpuLevels * 1e3);
         }
         std::printf("%s    {\"what\": \"cascade\", \"device\": \"%s\", \"width\": %d, \"height\": %d, \"median_ms\": %.3f, "
-                    "\"min_ms\": %.3f, \"stage_median_ms\": {\"allocate\": %.3f, \"logs\": %.3f, \"network\": %.3f, "
-                    "\"levels\": %.3f}, \"stage_min_ms\": {\"allocate\": %.3f, \"logs\": %.3f, \"network\": %.3f, "
-                    "\"levels\": %.3f}, \"stage_cpu_median_ms\": {\"logs\": %.3f, \"network\": %.3f, \"levels\": %.3f}}",
+                    "\"min_ms\": %.3f, \"stage_median_ms\": {\"allocate\": %.3f, \"context\": %.3f, \"logs\": %.3f, "
+                    "\"network\": %.3f, \"levels\": %.3f}, \"stage_min_ms\": {\"allocate\": %.3f, \"context\": %.3f, "
+                    "\"logs\": %.3f, \"network\": %.3f, \"levels\": %.3f}, \"stage_cpu_median_ms\": {\"context\": %.3f, "
+                    "\"logs\": %.3f, \"network\": %.3f, \"levels\": %.3f}}",
                     first ? "" : ",\n", deviceName(Device::Cpu).c_str(), w, h, median(total), minOf(total),
-                    median(alloc), median(logs), median(net), median(levels), minOf(alloc), minOf(logs), minOf(net),
-                    minOf(levels), median(cpuLogs), median(cpuNet), median(cpuLevels));
+                    median(alloc), median(ctx), median(logs), median(net), median(levels), minOf(alloc), minOf(ctx),
+                    minOf(logs), minOf(net), minOf(levels), median(cpuCtx), median(cpuLogs), median(cpuNet),
+                    median(cpuLevels));
         first = false;
         }
         if (only == "cascade") continue;

@@ -56,18 +56,20 @@ struct NetRows {
     LearnedTemps T;
     ImageView acc;
     size_t pOffset = 0;
-    ImageView z;     // the context's z (whole image, 1/4 resolution); invalid: no context
+    LearnedTensor z;    // the context's z (whole image, 1/4 resolution); invalid: no context
     int rowOffset = 0;  // the band's first row in the image
 
     ATROUS_FORCE_INLINE void operator()(int y0, int y1) const {
         const int w = T.lg.width, h = T.lg.height;
         const size_t stride = size_t(w) + 2;
         const int zw = z.valid() ? z.width : 0;
-        std::vector<float> buf(kLearnedBoxQ * stride + size_t(w) + size_t(kLearnedHidden) * size_t(zw));
+        std::vector<float> buf(kLearnedBoxQ * stride + size_t(w) +
+                               (zw ? size_t(kLearnedHidden) * (size_t(zw) + size_t(w)) : 0));
         float* V[kLearnedBoxQ];
         for (int k = 0; k < kLearnedBoxQ; ++k) V[k] = buf.data() + k * stride;
         float* inv = buf.data() + kLearnedBoxQ * stride;
-        float* zr = inv + w;  // z interpolated between its two rows for this row: zr[j * zw + X]
+        float* zr = inv + w;                           // z between its two rows for this row: zr[j * zw + X]
+        float* zx = zr + size_t(kLearnedHidden) * zw;  // and between its columns: the row's shift, zx[j * w + x]
         for (int y = y0; y < y1; ++y) {
             const bool top = y > 0, bottom = y + 1 < h;
             const size_t o = size_t(y) * size_t(w);
@@ -97,10 +99,11 @@ struct NetRows {
             for (int x = 0; x < w; ++x) inv[x] = 1.0f / float((1 + int(x > 0) + int(x < w - 1)) * ny);
             if (zw) {  // the rows step of up4 (learnedCtxShift's order: rows first)
                 const LearnedUpTap ty = learnedUpTap(rowOffset + y, kLearnedCell, z.height);
-                for (int j = 0; j < kLearnedHidden; ++j) {
-                    const float *a = z.channel(j) + size_t(ty.i0) * zw, *b = z.channel(j) + size_t(ty.i1) * zw;
-                    for (int X = 0; X < zw; ++X) zr[j * zw + X] = a[X] * (1.0f - ty.t) + b[X] * ty.t;
+                for (int X = 0; X < zw; ++X) {
+                    const float *a = z.at(X, ty.i0), *b = z.at(X, ty.i1);
+                    for (int j = 0; j < kLearnedHidden; ++j) zr[j * zw + X] = a[j] * (1.0f - ty.t) + b[j] * ty.t;
                 }
+                for (int j = 0; j < kLearnedHidden; ++j) learnedUp4Row(zr + j * zw, zw, zx + size_t(j) * w, w);
             }
             for (int x0 = 0; x0 < w; x0 += kLanes) {
                 const int n = w - x0 < kLanes ? w - x0 : kLanes;
@@ -108,17 +111,11 @@ struct NetRows {
                 learnedPointInputs<kLanes>(P, T.lg, o + size_t(x0), n, in, pOffset + o + size_t(x0));
                 const float* const Vx[kLearnedBoxQ] = {V[0] + x0, V[1] + x0, V[2] + x0, V[3] + x0, V[4] + x0};
                 learnedBoxInputs<kLanes>(Vx, inv + x0, n, in);
-                if (zw) {  // the columns step
+                if (zw) {
                     float shift[kLearnedHidden][kLanes];
-                    int i0[kLanes], i1[kLanes];
-                    float t[kLanes];
-                    for (int l = 0; l < kLanes; ++l) {
-                        const LearnedUpTap tx = learnedUpTap(x0 + (l < n ? l : 0), kLearnedCell, zw);
-                        i0[l] = tx.i0, i1[l] = tx.i1, t[l] = tx.t;
-                    }
                     for (int j = 0; j < kLearnedHidden; ++j) {
-                        const float* r = zr + j * zw;
-                        for (int l = 0; l < kLanes; ++l) shift[j][l] = r[i0[l]] * (1.0f - t[l]) + r[i1[l]] * t[l];
+                        const float* r = zx + size_t(j) * w + x0;
+                        for (int l = 0; l < kLanes; ++l) shift[j][l] = l < n ? r[l] : 0.0f;
                     }
                     learnedMlp<kLanes, true>(*net, in, out, shift);
                 } else {

@@ -235,7 +235,7 @@ struct LearnedNetPixel {
     LearnedPlanes P;
     LearnedTemps T;
     ImageView acc;
-    ImageView z;  // the context's z (1/4 resolution); invalid: no context
+    LearnedTensor z;  // the context's z (1/4 resolution); invalid: no context
 
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         const int w = P.d.width, h = P.d.height;
