@@ -102,6 +102,19 @@ def load_blender(path, layer="ViewLayer"):
     return b
 
 
+def load_luxcore(folder):
+    """LuxCoreRender film outputs, one file each (scripts/corpus/luxcore_stills.py): RGB, ALBEDO,
+    AVG_SHADING_NORMAL, POSITION, DEPTH (R, G, B channels; the sky at +inf depth and position)."""
+    folder = Path(folder)
+    rgb = lambda n: _stack(read_exr(folder / f"{n}.exr"), ["R", "G", "B"])  # noqa: E731
+    depth = read_exr(folder / "DEPTH.exr")["R"]
+    sky = ~np.isfinite(depth)
+    pos = rgb("POSITION")
+    return {"color": rgb("RGB"), "albedo": rgb("ALBEDO"), "normal": _unit(np.nan_to_num(rgb("AVG_SHADING_NORMAL"))),
+            "position": np.where(sky[..., None], 0.0, pos).astype(np.float32),
+            "depth": np.where(sky, 0.0, depth).astype(np.float32)}
+
+
 def load_mitsuba_motion(path):
     ch = read_exr(path)
     return _stack(ch, ["motion.X", "motion.Y"])
@@ -116,6 +129,8 @@ def load_still(scene_dir, man, stem):
         return load_mitsuba_separate(scene_dir / entry["folder"], man["pixel_filter"])
     if layout == "blender-multilayer-exr":
         return load_blender(scene_dir / entry["file"])
+    if layout == "luxcore":
+        return load_luxcore(scene_dir / entry["folder"])
     raise ValueError(f"unknown layout {layout}")
 
 
