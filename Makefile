@@ -80,9 +80,13 @@ TRAIN_BUILD ?= build-learn
 TRAIN_STEPS ?= 4000
 TRAIN_MINUTES ?= 60
 # Phase 2: fine-tuning with the `noem` images too (variance and emission withheld) and a quarter of the
-# crops from the corpus's training split (docs/learned.md).
+# crops from the corpus's training split (docs/learned.md). Both train the MLP alone (version 3's network;
+# the built-in weights). `make train-context` then adds the context branch (version 4) to phase 2's weights
+# and fine-tunes both (docs/learned.md, "Version 4"; measured, not built in).
 TRAIN_FT_STEPS ?= 2000
 TRAIN_FT_MINUTES ?= 25
+TRAIN_CTX_STEPS ?= 1500
+TRAIN_CTX_MINUTES ?= 30
 .PHONY: train train-smoke
 train: python
 	@./scripts/train/setup.sh
@@ -93,9 +97,19 @@ train: python
 	@# Where the corpus's test stills are rendered (make quality), --eval also reports them (never trained on).
 	@if [ -d out/corpus/full ] && [ -x .venv-corpus/bin/python ]; then .venv-corpus/bin/python scripts/corpus/train_export.py --test --atrous $(TRAIN_BUILD)/atrous \
 	  && .venv/bin/python scripts/train/prepare.py --splits corpus_test --variants est; fi
-	@.venv-train/bin/python scripts/train/train.py --variants given est --steps $(TRAIN_STEPS) --minutes $(TRAIN_MINUTES) --eval
+	@.venv-train/bin/python scripts/train/train.py --variants given est --steps $(TRAIN_STEPS) --minutes $(TRAIN_MINUTES) \
+	  --eval --no-context
 	@.venv-train/bin/python scripts/train/train.py --out out/train/run_ft --init out/train/run/weights.bin --lr 1e-3 \
-	  --corpus-share 0.25 --steps $(TRAIN_FT_STEPS) --minutes $(TRAIN_FT_MINUTES) --eval --export
+	  --corpus-share 0.25 --steps $(TRAIN_FT_STEPS) --minutes $(TRAIN_FT_MINUTES) --eval --export --no-context
+
+# Version 4 (the context branch) from `make train`'s weights (or the built-in ones, out/train/v3.bin): whole
+# 128² images, half of them from the corpus's training split; writes out/train/run_ctx/weights.bin.
+.PHONY: train-context
+train-context:
+	@./scripts/train/setup.sh
+	@test -f out/train/run_ft/weights.bin || { echo "train-context: run make train first (out/train/run_ft/weights.bin)"; exit 2; }
+	@.venv-train/bin/python scripts/train/train.py --out out/train/run_ctx --init out/train/run_ft/weights.bin --lr 1e-3 \
+	  --corpus-share 0.5 --crop 128 --variants given est noem --steps $(TRAIN_CTX_STEPS) --minutes $(TRAIN_CTX_MINUTES) --eval
 
 train-smoke: python
 	@./scripts/train/setup.sh

@@ -73,7 +73,7 @@ int main(int argc, char** argv) {
     atrous::bench::addSizeOption(app, sizes);
     app.add_option("--threads", threads, "TBB threads (0 = all cores)")->check(CLI::Range(0, 4096))->capture_default_str();
     app.add_option("--only", only, "time only the cascade or only denoise()")->check(CLI::IsMember({"cascade", "denoise"}));
-    app.add_option("--weights", weightsPath, "weight file (version 3; default: the built-in weights)");
+    app.add_option("--weights", weightsPath, "weight file (version 4, or 3; default: the built-in weights)");
     if (int rc = atrous::bench::parseArgs(app, argc, argv); rc >= 0) return rc;
     runs = std::max(20, runs);
     Device device = Device::Cpu;

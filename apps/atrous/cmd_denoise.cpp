@@ -329,7 +329,7 @@ void addDenoiseCommand(CLI::App& app) {
         ->capture_default_str()
         ->group(kGroupTemporal);
     cmd->add_option("--learned-weights", a->opt.learnedWeights,
-                    "Weight file of the learned filter (version 3, docs/learned.md; default: the built-in weights)")
+                    "Weight file of the learned filter (version 4, or 3; docs/learned.md; default: the built-in weights)")
         ->group(kGroupLearned);
     cmd->add_option("--device,-d", a->device, "cpu | cuda | auto (cuda when a GPU is present; oidnDenoise's 'default' = auto)")
         ->capture_default_str()

@@ -223,7 +223,7 @@ def denoise(
     "blend" (the mean of the learned and the SURE outputs, from one preparation) or "auto" (the
     default: blend when an albedo and a normal are given, else sure: the method measured best for
     those buffers, docs/quality.md). learned_weights: a weight
-    file (version 3) for "learned"/"blend"/"auto"; None = the built-in weights; a bad file raises
+    file (version 4, or 3) for "learned"/"blend"/"auto"; None = the built-in weights; a bad file raises
     ValueError naming it. device: "auto" (the arrays' device: CUDA arrays on the GPU, numpy on
     the CPU), "cpu" or "cuda" (numpy inputs are then copied to the GPU and back).
 
@@ -427,7 +427,7 @@ class Svgf:
                  **params: Any) -> None:
         """device: "auto" (CUDA when this build has a usable GPU, else the CPU, as everywhere in
         atrous), "cpu" or "cuda". Frames on another device than the filter's are copied over.
-        learned_weights: a weight file (version 3) for learned_spatial=True; None = the built-in
+        learned_weights: a weight file (version 4, or 3) for learned_spatial=True; None = the built-in
         weights; a bad file raises ValueError naming it; unused without learned_spatial."""
         weights = "" if learned_weights is None else os.fsdecode(os.fspath(learned_weights))
         self._impl = _core.Svgf(device, weights, dict(params))

@@ -74,7 +74,7 @@ def summary(res: dict, spps=(4, 16)) -> dict:
 def main() -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--data", default="out/train/data/test")
-    p.add_argument("--weights", default=None, help="a weight file (version 3) (default: the built-in weights)")
+    p.add_argument("--weights", default=None, help="a weight file (version 4, or 3) (default: the built-in weights)")
     p.add_argument("--methods", nargs="+", default=list(METHODS), choices=METHODS)
     p.add_argument("--no-variance", action="store_true",
                    help="withhold the variance buffer (every atrous method then estimates it, as for other renderers)")

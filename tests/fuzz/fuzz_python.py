@@ -129,10 +129,11 @@ def _weight_files(d):
     import struct
     w = builtin_weights()
     body = w[:-4]
-    files = {"valid": w, "truncated": w[:len(w) // 2], "empty": b"", "version4": with_checksum(
-        body[:4] + struct.pack("<I", 4) + body[8:]), "version1": with_checksum(body[:4] + struct.pack("<I", 1) + body[8:]),
+    head = 36 if struct.unpack("<I", w[4:8])[0] == 4 else 28  # the first weight's offset (versions 4, 3)
+    files = {"valid": w, "truncated": w[:len(w) // 2], "empty": b"", "version5": with_checksum(
+        body[:4] + struct.pack("<I", 5) + body[8:]), "version1": with_checksum(body[:4] + struct.pack("<I", 1) + body[8:]),
         "flip": w[:100] + bytes([w[100] ^ 0x10]) + w[101:], "nonfinite": with_checksum(
-        body[:28] + struct.pack("<f", float("nan")) + body[32:]), "shape": with_checksum(
+        body[:head] + struct.pack("<f", float("nan")) + body[head + 4:]), "shape": with_checksum(
         body[:12] + struct.pack("<I", 25) + body[16:]), "overlong": with_checksum(body + b"\0" * 8),
         "notweights": b"\x89PNG\r\n\x1a\n" + b"\0" * 40}
     out = {}
