@@ -117,6 +117,14 @@ SCENES = {"lx_glass": (scene_glass, "glass sphere and a glossy-coated sphere, ar
           "lx_room": (scene_room, "closed room lit by the sun through a window, a table and a glass block")}
 
 
+def typed(p, kind, items):
+    """scene.<kind>.<name>.type and its properties, for {name: (type, {property: value})}."""
+    for n, (ty, kv) in items.items():
+        p.Set(pyluxcore.Property(f"scene.{kind}.{n}.type", ty))
+        for k, v in kv.items():
+            p.Set(pyluxcore.Property(f"scene.{kind}.{n}.{k}", v))
+
+
 def render(build, out, spp, seed, size=SIZE):
     parts = build()
     mats, shapes, lights, (orig, target, fov) = parts[:4]
@@ -128,24 +136,15 @@ def render(build, out, spp, seed, size=SIZE):
     p.Set(pyluxcore.Property("scene.camera.lookat.target", list(target)))
     p.Set(pyluxcore.Property("scene.camera.up", [0, 1, 0]))
     p.Set(pyluxcore.Property("scene.camera.fieldofview", fov))
-    for t, (ty, kv) in tex.items():
-        p.Set(pyluxcore.Property(f"scene.textures.{t}.type", ty))
-        for k, v in kv.items():
-            p.Set(pyluxcore.Property(f"scene.textures.{t}.{k}", v))
-    for m, (ty, kv) in mats.items():
-        p.Set(pyluxcore.Property(f"scene.materials.{m}.type", ty))
-        for k, v in kv.items():
-            p.Set(pyluxcore.Property(f"scene.materials.{m}.{k}", v))
+    typed(p, "textures", tex)
+    typed(p, "materials", mats)
     scene.Parse(p)
     p = pyluxcore.Properties()
     for n, ((v, f), m) in shapes.items():
         scene.DefineMesh(n + "_m", v, f, None, None, None, None)
         p.Set(pyluxcore.Property(f"scene.objects.{n}.shape", n + "_m"))
         p.Set(pyluxcore.Property(f"scene.objects.{n}.material", m))
-    for n, (ty, kv) in lights.items():
-        p.Set(pyluxcore.Property(f"scene.lights.{n}.type", ty))
-        for k, v in kv.items():
-            p.Set(pyluxcore.Property(f"scene.lights.{n}.{k}", v))
+    typed(p, "lights", lights)
     scene.Parse(p)
     c = pyluxcore.Properties()
     for k, v in {"renderengine.type": "PATHCPU", "sampler.type": "RANDOM", "batch.haltspp": spp, "film.width": size,
