@@ -295,6 +295,8 @@ def build_weights(cid, rng, seeds, d, cli, klass, ordinal, seed):
     kind = WEIGHT_KINDS[(ordinal + seed) % len(WEIGHT_KINDS)]
     w = builtin_weights()
     body = w[:-4]
+    v4 = struct.unpack("<I", w[4:8])[0] == 4
+    head = 36 if v4 else 28  # the first weight's offset (versions 4 and 3)
     p = os.path.join(d, rng.choice(["weights.bin", "learned_v3.atrl", "w"]))
     must, good = True, False
     if kind in ("valid", "sure-ignores"):
@@ -309,7 +311,8 @@ def build_weights(cid, rng, seeds, d, cli, klass, ordinal, seed):
     elif kind == "truncated":
         data = w[:rng.choice([0, 3, 8, 27, 28, 31, rng.randrange(32, len(w))])]
     elif kind == "version":
-        data = with_checksum(body[:4] + struct.pack("<I", rng.choice([0, 1, 2, 4, 0xFFFFFFFF])) + body[8:])
+        # The other readable version on this body has the wrong header (its shape fields disagree).
+        data = with_checksum(body[:4] + struct.pack("<I", rng.choice([0, 1, 2, 3 if v4 else 4, 5, 0xFFFFFFFF])) + body[8:])
     elif kind == "flip":
         b = bytearray(w)
         i = rng.randrange(len(b))
@@ -317,12 +320,12 @@ def build_weights(cid, rng, seeds, d, cli, klass, ordinal, seed):
         data = bytes(b)
     elif kind == "nonfinite":
         b = bytearray(body)
-        i = 28 + 4 * rng.randrange((len(body) - 28) // 4)
+        i = head + 4 * rng.randrange((len(body) - head) // 4)
         b[i:i + 4] = struct.pack("<f", rng.choice([float("nan"), float("inf"), float("-inf")]))
         data = with_checksum(bytes(b))
     elif kind == "shape":
         b = bytearray(body)
-        i = rng.choice([8, 12, 16, 20, 24])
+        i = rng.choice([8, 12, 16, 20, 24] + ([28, 32] if v4 else []))
         b[i:i + 4] = struct.pack("<I", rng.choice([0, 1, 16, 25, 0xFFFFFFFF]))
         data = with_checksum(bytes(b))
     elif kind == "overlong":
