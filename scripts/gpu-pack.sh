@@ -57,7 +57,7 @@ say "sources: $SOURCE ($COMMIT)"
 
 # ---- configure + build (Release, SASS for sm_90 only, no viewer: the GPU machine has no GL) ----
 cmake -S "$LINK/src" -B "$LINK/build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CUDA_ARCHITECTURES=90 \
-  -DATROUS_BUILD_VIEWER=OFF -DATROUS_INSTALL=OFF -DATROUS_BUILD_PYTHON=OFF \
+  -DATROUS_BUILD_VIEWER=OFF -DATROUS_INSTALL=OFF -DATROUS_BUILD_PYTHON=OFF -DATROUS_ONEDNN=OFF \
   > "$G/configure.log" 2>&1 || { cat "$G/configure.log"; exit 1; }
 grep -q "CUDA backend ON" "$G/configure.log" || { echo "gpu-pack: CUDA backend is OFF (see $G/configure.log)" >&2; exit 1; }
 TESTS=()

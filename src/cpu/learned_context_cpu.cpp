@@ -10,8 +10,10 @@
 // reorder took 10 ms); each convolution here is a few ms on one core. So oneDNN runs on the calling
 // thread alone (omp_set_num_threads(1), which sets that thread's team size only), and the
 // convolutions over the image's halves run as two TBB tasks, each a oneDNN call on its rows.
+#if ATROUS_HAVE_ONEDNN
 #include <dnnl.hpp>
 #include <omp.h>
+#endif
 
 #include <tbb/parallel_for.h>
 
@@ -27,11 +29,6 @@
 namespace atrous::filters {
 
 namespace {
-
-dnnl::engine& cpuEngine() {
-    static dnnl::engine e(dnnl::engine::kind::cpu, 0);
-    return e;
-}
 
 // The cell inputs of cell rows [cy0, cy1): per pixel row the 15 quantities in vector loops (the
 // same learnedCellQuantities as the functor), added per column over the cell's rows, then each
@@ -113,6 +110,12 @@ struct CellRows {
     }
 };
 
+#if ATROUS_HAVE_ONEDNN
+dnnl::engine& cpuEngine() {
+    static dnnl::engine e(dnnl::engine::kind::cpu, 0);
+    return e;
+}
+
 // The convolution's output rows [y0, y1) from the input rows they read (one above and below where
 // the image has them; zero padding only at the image's edges): channels-last bands are dense.
 void dnnlConvRows(const LearnedTensor& in, const LearnedTensor& out, const float* k, const float* b, int ks, bool relu,
@@ -157,13 +160,19 @@ void conv(const LearnedTensor& in, const LearnedTensor& out, const float* k, con
     tbb::parallel_for(0, parts,
                       [&](int i) { dnnlConvRows(in, out, k, b, ks, relu, h * i / parts, h * (i + 1) / parts); });
 }
+#else
+// Built without oneDNN (ATROUS_ONEDNN=OFF: the GPU check's pack): the direct-convolution functor.
+void conv(const LearnedTensor& in, const LearnedTensor& out, const float* k, const float* b, int ks, bool relu) {
+    CpuExec{}.forEachPixel(out.width, out.height, LearnedConv{in, out, k, b, ks, relu});
+}
+#endif
 
 }  // namespace
 
 void runLearnedContextCpu(const CpuExec& exec, const LearnedCtxNet& net, const LearnedPlanes& P,
                           const LearnedCtxPlanes& C) {
     cpu::parallelForIsa(cpu::activeIsa(), 0, C.cells.height, 1, CellRows{P.d, P.var, P.albedo, P.normal, P.depth, C.cells});
-    try {
+    auto convolutions = [&] {
         conv(C.cells, C.c1, net.k1, net.kb1, 3, true);
         exec.forEachPixel(C.pool.width, C.pool.height, LearnedPool2{C.c1, C.pool});
         conv(C.pool, C.c2, net.k2, net.kb2, 3, true);
@@ -171,9 +180,16 @@ void runLearnedContextCpu(const CpuExec& exec, const LearnedCtxNet& net, const L
         exec.forEachPixel(C.cat.width, C.cat.height, LearnedUp2Cat{C.c1, C.c3, C.cat});
         conv(C.cat, C.c4, net.k4, net.kb4, 3, true);
         conv(C.c4, C.z, net.kz, net.kbz, 1, false);
+    };
+#if ATROUS_HAVE_ONEDNN
+    try {
+        convolutions();
     } catch (const dnnl::error& e) {
         throw RuntimeError(std::string("learned filter: oneDNN: ") + e.what());
     }
+#else
+    convolutions();
+#endif
 }
 
 }  // namespace atrous::filters
