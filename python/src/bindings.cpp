@@ -174,6 +174,21 @@ nb::dict resolveParams(const ParamTable<S>& t, nb::dict params, const char* what
     return d;
 }
 
+// A method registry for Python (atrous.denoise_methods(), atrous.sequence_methods()): one dict per
+// row, its name, summary and the registry's one flag under `flagName`.
+template <class Info>
+nb::list methodRows(const std::vector<Info>& infos, const char* flagName, bool Info::*flag) {
+    nb::list rows;
+    for (const Info& i : infos) {
+        nb::dict d;
+        d["name"] = i.name;
+        d["summary"] = i.summary;
+        d[flagName] = i.*flag;
+        rows.append(d);
+    }
+    return rows;
+}
+
 // The table for Python (atrous.denoise_params(), atrous.svgf_params()): one dict per row.
 template <class S>
 nb::list paramRows(const ParamTable<S>& t) {
@@ -473,31 +488,12 @@ NB_MODULE(_core, m) {
     m.def("denoise_params", [] { return paramRows(denoiseParams()); });
     // The still methods (denoiseMethods(), include/atrous/denoise.h): atrous.METHODS and the rows of
     // atrous.denoise_methods().
-    m.def("denoise_methods", [] {
-        nb::list rows;
-        for (const DenoiseMethodInfo& i : denoiseMethods()) {
-            nb::dict d;
-            d["name"] = i.name;
-            d["summary"] = i.summary;
-            d["uses_weights"] = i.usesWeights;
-            rows.append(d);
-        }
-        return rows;
-    });
+    m.def("denoise_methods",
+          [] { return methodRows(denoiseMethods(), "uses_weights", &DenoiseMethodInfo::usesWeights); });
     m.def("svgf_params", [] { return paramRows(svgfParams()); });
     m.def("temporal_params", [] { return paramRows(temporalParams()); });
     // The sequence methods (sequenceMethods(), include/atrous/temporal.h): atrous.SEQUENCE_METHODS.
-    m.def("sequence_methods", [] {
-        nb::list rows;
-        for (const SequenceMethodInfo& i : sequenceMethods()) {
-            nb::dict d;
-            d["name"] = i.name;
-            d["summary"] = i.summary;
-            d["causal"] = i.causal;
-            rows.append(d);
-        }
-        return rows;
-    });
+    m.def("sequence_methods", [] { return methodRows(sequenceMethods(), "causal", &SequenceMethodInfo::causal); });
     m.def("denoise_temporal", &pyDenoiseTemporal, nb::arg("frames"), nb::arg("center"), nb::arg("method"),
           nb::arg("learned_weights"), nb::arg("device"), nb::arg("temporal"), nb::arg("params"));
     m.def("render_params", [] { return paramRows(renderParams()); });
