@@ -24,6 +24,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .features import _finite
+
 CELL = 4
 N_CTX_IN = 13
 N_CTX = 16
@@ -34,11 +36,6 @@ SHAPES = (("k1", (3, 3, N_CTX_IN, N_CTX)), ("kb1", (N_CTX,)), ("k2", (3, 3, N_CT
 
 def z_shapes(n_hidden: int):
     return (("kz", (N_CTX, n_hidden)), ("kbz", (n_hidden,)))
-
-
-def _finite(x):
-    x = np.asarray(x, np.float32)
-    return np.where(np.isfinite(x), x, np.float32(0.0)).astype(np.float32)
 
 
 def cell_mean(q: np.ndarray, f: int) -> np.ndarray:
