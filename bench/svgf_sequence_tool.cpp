@@ -31,8 +31,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "../apps/atrous/denoise_sequence.cpp"  // runSequenceDenoise without the CLI wiring
-#include "../apps/atrous/sequence_checks.cpp"
+#include "../apps/atrous/denoise_sequence.cpp"  // runSequenceDenoise and the SVGF flags without the CLI wiring
 #include "atrous/error.h"
 #include "atrous/metrics.h"
 #include "io/image_io.h"
@@ -193,12 +192,12 @@ int main(int argc, char** argv) {
         if (argc >= 2 && std::strcmp(argv[1], "denoise") == 0) {
             CLI::App app("svgf_sequence_tool denoise");
             atrous::cli::SequenceDenoiseArgs a;
-            a.preview = false;
-            app.add_option("--method", a.method)->required();
+            a.options.preview = false;
+            app.add_option("--method", a.options.method)->required();
             app.add_option("--sequence", a.sequenceDir)->required();
             app.add_option("--out", a.outDir)->required();
             app.add_flag("--quiet", a.quiet);
-            atrous::cli::addSvgfOptions(app, a.svgf);
+            atrous::cli::addSvgfOptions(app, a.options.svgf);
             try {
                 app.parse(argc - 1, argv + 1);
             } catch (const CLI::CallForHelp& e) {

@@ -23,10 +23,11 @@
 #include "svgf_test_util.h"
 #include "test_util.h"
 
-// The sequence command lives in the CLI's sources, which are not part of atrous_lib; compile its
-// translation unit into this test so it can be tested as a function.
+// The sequence command's flags live in the CLI's sources, which are not part of atrous_lib;
+// compile its translation unit into this test so they can be tested as functions. The session
+// itself is the library's (include/atrous/sequence.h).
 #include "../apps/atrous/denoise_sequence.cpp"
-#include "../apps/atrous/sequence_checks.cpp"
+#include "io/staged_dir.h"
 
 using namespace atrous;
 using namespace atrous::svgf_test;
@@ -155,7 +156,7 @@ TEST(SvgfSequence, GapsMissingBuffersAndSizeMismatchesAreNamed) {
 // input (measured ~5-20x; bound 2x).
 static void checkSequenceCommand(const test::TempDir& dir, bool learnedSpatial) {
     cli::SequenceDenoiseArgs args = sequenceArgs(dir, 48, 32, 0.2f, 4);
-    args.svgf.learnedSpatial = learnedSpatial;
+    args.options.svgf.learnedSpatial = learnedSpatial;
     SceneOptions o;
     o.width = 48, o.height = 32;
     o.noiseSigma = 0.2f;
@@ -173,7 +174,7 @@ static void checkSequenceCommand(const test::TempDir& dir, bool learnedSpatial) 
 TEST(SvgfSequence, DenoiseCommandWritesEveryFrameAndBeatsTheInput) {
     test::TempDir dir;
     checkSequenceCommand(dir, false);
-    if (cli::findOnPath("ffmpeg").empty())
+    if (io::findOnPath("ffmpeg").empty())
         EXPECT_FALSE(std::filesystem::exists(dir / "out/preview.mp4"));
     else
         EXPECT_TRUE(std::filesystem::exists(dir / "out/preview.mp4"));
@@ -264,8 +265,8 @@ TEST(SvgfSequence, LearnedWeightsReachTheLearnedSpatialFilter) {
 TEST(SvgfSequence, PerFrameEawAlsoRuns) {
     test::TempDir dir;
     cli::SequenceDenoiseArgs args = sequenceArgs(dir, 32, 24, 0.2f, 2);
-    args.method = "eaw";
-    args.preview = false;
+    args.options.method = "eaw";
+    args.options.preview = false;
     EXPECT_EQ(cli::runSequenceDenoise(args), 0);
     EXPECT_TRUE(std::filesystem::exists(dir / "out/frame_0001.exr"));
 }
@@ -277,6 +278,6 @@ TEST(SvgfSequence, BadSequencesWriteNothing) {
     std::string msg = errorOf([&] { cli::runSequenceDenoise(args); });
     EXPECT_NE(msg.find("frame_0002/albedo.exr"), std::string::npos) << msg;
     EXPECT_FALSE(std::filesystem::exists(dir / "out"));
-    args.method = "median";
+    args.options.method = "median";
     EXPECT_NE(errorOf([&] { cli::runSequenceDenoise(args); }).find("median"), std::string::npos);
 }

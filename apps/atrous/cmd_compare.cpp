@@ -14,7 +14,7 @@
 #include "atrous/error.h"
 #include "atrous/metrics.h"
 #include "commands.h"
-#include "denoise_sequence.h"
+#include "io/staged_dir.h"
 #include "io/image_io.h"
 #include "io/paths.h"
 #include "io/sequence.h"
@@ -55,7 +55,7 @@ std::string plainLabel(const std::string& s) {
 // drawtext), written to a temporary name and renamed.
 void writeVideo(const std::string& path, const std::vector<std::string>& names,
                 const std::vector<std::vector<std::pair<int, Image>>>& seqs) {
-    const std::string ffmpeg = findOnPath("ffmpeg");
+    const std::string ffmpeg = io::findOnPath("ffmpeg");
     if (ffmpeg.empty()) throw InputError("--video " + path + ": needs ffmpeg on PATH, and there is none");
     const fs::path out(path);
     const fs::path tmpDir = (out.has_parent_path() ? out.parent_path() : fs::path(".")) / (".atrous-video-" + out.stem().string());
@@ -86,8 +86,8 @@ void writeVideo(const std::string& path, const std::vector<std::string>& names,
         io::writeImage((tmpDir / name).string(), strip);
     }
     const std::string tmpVideo = (tmpDir / "video.mp4").string();
-    const std::string cmd = shellQuote(ffmpeg) + " -nostdin -y -loglevel error -framerate 24 -i " + shellQuote((tmpDir / "f%06d.png").string()) +
-                            " -vf " + shellQuote(filter) + " -pix_fmt yuv420p -f mp4 " + shellQuote(tmpVideo);
+    const std::string cmd = io::shellQuote(ffmpeg) + " -nostdin -y -loglevel error -framerate 24 -i " + io::shellQuote((tmpDir / "f%06d.png").string()) +
+                            " -vf " + io::shellQuote(filter) + " -pix_fmt yuv420p -f mp4 " + io::shellQuote(tmpVideo);
     const int rc = std::system(cmd.c_str());
     if (rc == 0) fs::rename(tmpVideo, out, ec);
     fs::remove_all(tmpDir);

@@ -169,18 +169,20 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
         if (!a.inDir.empty() || !a.color.empty())
             throw InputError("--sequence DIR denoises the frames of DIR: drop --in/--color");
         SequenceDenoiseArgs s;
-        s.method = a.method;
         s.sequenceDir = a.sequence;
         s.outDir = a.out;
-        s.device = o.device;
-        s.svgf = a.svgf;
-        s.temporal = a.temporal;
-        s.frameOptions = o;
-        s.svgfLearnedWeights = weights;
-        s.layers.passes = withFlag("--pass", [&] { return io::parsePassRequests(a.passes); });
-        s.layers.viewLayer = a.layer;
-        s.addPass = a.addPass;
-        s.range = a.range;
+        SequenceDenoiseOptions& so = s.options;
+        so.method = a.method;
+        so.device = o.device;
+        so.svgf = a.svgf;
+        so.temporal = a.temporal;
+        so.frame = o;
+        so.svgfWeights = weights;
+        withFlag("--pass", [&] { return io::parsePassRequests(a.passes); });  // its own message first
+        so.passes = a.passes;
+        so.viewLayer = a.layer;
+        so.addPass = a.addPass;
+        so.start = a.range.start, so.end = a.range.end, so.step = a.range.step;
         runSequenceDenoise(s);
         return;
     }
@@ -317,7 +319,7 @@ void addDenoiseCommand(CLI::App& app) {
                     "Output file (.exr, .pfm or .png); with --sequence, an output directory, written only once every "
                     "frame is denoised (on error it is left as it was). An existing one keeps its other files; this "
                     "run's frame_NNNN.exr/.png replace the old ones, and those of an earlier run that this run does "
-                    "not write (and an old preview.mp4) are removed, named in a note on stderr")
+                    "not write (and an old preview.mp4) are removed, named in a note")
         ->required();
     std::string methodHelp;
     for (const DenoiseMethodInfo& m : denoiseMethods()) methodHelp += std::string(m.name) + ": " + m.summary + "; ";

@@ -49,6 +49,7 @@ __all__ = [
     "svgf_params",
     "temporal_params",
     "denoise_temporal",
+    "denoise_sequence",
     "render_params",
     "METHODS",
     "SEQUENCE_METHODS",
@@ -413,6 +414,38 @@ def denoise_temporal(frames: Sequence[Dict[str, Any]], center: int, *, method: s
     weights = "" if learned_weights is None else os.fsdecode(os.fspath(learned_weights))
     out = _core.denoise_temporal(core_frames, int(center), method, weights, device, dict(temporal or {}), dict(params))
     return _wrap_like(out, frames[int(center)]["color"])
+
+
+def denoise_sequence(input: "PathLike", out: "PathLike", *, method: str = "temporal", spatial: str = "auto",
+                     device: str = "auto", learned_weights: Optional["PathLike"] = None,
+                     passes: Optional[Dict[str, str]] = None, layer: str = "", add_pass: str = "",
+                     start: Optional[int] = None, end: Optional[int] = None, step: int = 1,
+                     exposure: float = 1.0, pngs: bool = True, preview: bool = True,
+                     temporal: Optional[Dict[str, Any]] = None, svgf: Optional[Dict[str, Any]] = None,
+                     on_frame: Any = None, **params: Any) -> Dict[str, Any]:
+    """Denoises an animation from its files into the folder `out`: what `atrous denoise --sequence
+    INPUT --out OUT` does (docs/temporal.md), from Python and the Blender add-on.
+
+    input: a folder in any layout the CLI reads (atrous's frame_NNNN folders, one folder per frame
+    with a renderer's own names such as LuxCore's, color_0001.exr-style numbered files, Blender's
+    numbered multilayer renderNNNN.exr) or a pattern ("renders/render####.exr", "%04d").
+    method: "temporal" (frames t-3..t+3, the default), "svgf", or a still method of :data:`METHODS`
+    run on each frame alone. spatial: the still method temporal runs on its average.
+    passes: {buffer: pass name} for layered frames (the CLI's --pass); layer: the view layer.
+    start/end/step: the frames to denoise (None: the first / the last).
+    temporal, svgf: rows of :func:`temporal_params` / :func:`svgf_params`; params: the still
+    method's rows (:func:`denoise_params`). on_frame(dict) is called as each frame is done.
+    Writes out/frame_NNNN.exr (+ .png and preview.mp4 unless pngs/preview are False) only when
+    every frame is done. Returns the run's report: width, height, buffers, frames (one dict each:
+    index, input, output, method, method_used, ms, reprojected, mse, mse_input, line), notes.
+    Raises ValueError for bad input (nothing is written then)."""
+    pass_specs = [f"{k}={v}" for k, v in (passes or {}).items()]
+    weights = "" if learned_weights is None else os.fsdecode(os.fspath(learned_weights))
+    return _core.denoise_sequence(os.fsdecode(os.fspath(input)), os.fsdecode(os.fspath(out)), method, spatial,
+                                  device, weights, pass_specs, layer, add_pass,
+                                  -1 if start is None else int(start), -1 if end is None else int(end), int(step),
+                                  float(exposure), bool(pngs), bool(preview), dict(temporal or {}),
+                                  dict(svgf or {}), dict(params), on_frame)
 
 
 class Svgf:

@@ -21,6 +21,7 @@
 #include "atrous/metrics.h"
 #include "atrous/params.h"
 #include "atrous/render.h"
+#include "atrous/sequence.h"
 #include "atrous/svgf.h"
 #include "atrous/temporal.h"
 #include "filters/denoise_internal.h"
@@ -369,6 +370,56 @@ nb::object pyDenoiseTemporal(nb::list frames, size_t center, const std::string& 
     return fromImage(std::move(out));
 }
 
+// A sequence from its files to files (include/atrous/sequence.h): the session `atrous denoise
+// --sequence` runs. on_frame (or None) is called with each frame's dict as it is done.
+nb::dict pyDenoiseSequence(const std::string& input, const std::string& out, const std::string& method,
+                           const std::string& spatial, const std::string& device, const std::string& learnedWeights,
+                           const std::vector<std::string>& passes, const std::string& layer, const std::string& addPass,
+                           int start, int end, int step, float exposure, bool pngs, bool preview, nb::dict temporal,
+                           nb::dict svgf, nb::dict params, nb::object onFrame) {
+    SequenceDenoiseOptions o;
+    o.method = method;
+    o.device = parseDevice(device);
+    for (auto [k, v] : temporal) applyParam(o.temporal, temporalParams(), nb::cast<std::string>(k), v, "temporal");
+    for (auto [k, v] : svgf) applyParam(o.svgf, svgfParams(), nb::cast<std::string>(k), v, "SVGF");
+    o.frame.method = parseDenoiseMethod(spatial);
+    o.frame.learnedWeights = learnedWeights;
+    for (auto [k, v] : params) applyParam(o.frame, denoiseParams(), nb::cast<std::string>(k), v, "denoise");
+    if (o.svgf.learnedSpatial && !learnedWeights.empty()) o.svgfWeights = LearnedWeights::load(learnedWeights);
+    o.passes = passes, o.viewLayer = layer, o.addPass = addPass;
+    o.start = start, o.end = end, o.step = step;
+    o.exposure = exposure, o.pngs = pngs, o.preview = preview;
+    auto frameDict = [](const SequenceFrameReport& f) {
+        nb::dict d;
+        d["index"] = f.index, d["input"] = f.input, d["output"] = f.output, d["method"] = f.method;
+        d["method_used"] = f.methodUsed, d["ms"] = f.milliseconds;
+        d["reprojected"] = f.reprojected < 0 ? nb::none() : nb::cast(f.reprojected);
+        d["mse"] = f.hasReference ? nb::cast(f.mse) : nb::none();
+        d["mse_input"] = f.hasReference ? nb::cast(f.mseInput) : nb::none();
+        d["line"] = f.line;
+        return d;
+    };
+    SequenceEvents events;
+    if (!onFrame.is_none())
+        events.frame = [&](const SequenceFrameReport& f) {
+            nb::gil_scoped_acquire gil;
+            onFrame(frameDict(f));
+        };
+    SequenceReport r;
+    {
+        nb::gil_scoped_release release;
+        r = denoiseSequence(input, out, o, events);
+    }
+    nb::dict d;
+    nb::list frames;
+    for (const SequenceFrameReport& f : r.frames) frames.append(frameDict(f));
+    d["width"] = r.width, d["height"] = r.height, d["buffers"] = r.buffers, d["frames"] = frames;
+    d["filter_ms_per_frame"] = r.filterMsPerFrame, d["wall_ms_per_frame"] = r.wallMsPerFrame;
+    d["preview"] = r.preview.empty() ? nb::none() : nb::cast(r.preview);
+    d["notes"] = r.notes;
+    return d;
+}
+
 // Python's keywords are the render table's rows (params.h); the library validates the ranges.
 RenderSettings renderSettings(nb::dict params) {
     RenderSettings rs;
@@ -496,6 +547,10 @@ NB_MODULE(_core, m) {
     m.def("sequence_methods", [] { return methodRows(sequenceMethods(), "causal", &SequenceMethodInfo::causal); });
     m.def("denoise_temporal", &pyDenoiseTemporal, nb::arg("frames"), nb::arg("center"), nb::arg("method"),
           nb::arg("learned_weights"), nb::arg("device"), nb::arg("temporal"), nb::arg("params"));
+    m.def("denoise_sequence", &pyDenoiseSequence, nb::arg("input"), nb::arg("out"), nb::arg("method"), nb::arg("spatial"),
+          nb::arg("device"), nb::arg("learned_weights"), nb::arg("passes"), nb::arg("layer"), nb::arg("add_pass"),
+          nb::arg("start"), nb::arg("end"), nb::arg("step"), nb::arg("exposure"), nb::arg("pngs"), nb::arg("preview"),
+          nb::arg("temporal"), nb::arg("svgf"), nb::arg("params"), nb::arg("on_frame").none());
     m.def("render_params", [] { return paramRows(renderParams()); });
     m.def("resolve_denoise_params", [](nb::dict p) { return resolveParams(denoiseParams(), p, "denoise"); });
     m.def("resolve_svgf_params", [](nb::dict p) { return resolveParams(svgfParams(), p, "SVGF"); });

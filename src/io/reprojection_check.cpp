@@ -1,8 +1,8 @@
-#include "sequence_checks.h"
+#include "io/reprojection_check.h"
 
 #include <cmath>
 
-namespace atrous::cli {
+namespace atrous::io {
 
 namespace {
 
@@ -59,4 +59,4 @@ ReprojectionCheck checkReprojection(const Image& depth, const Image& normal, con
     return r;
 }
 
-}  // namespace atrous::cli
+}  // namespace atrous::io

@@ -1,12 +1,13 @@
 // Consistency checks of an animated sequence from another renderer (docs/inputs.md,
-// "Sequences"), run by `atrous denoise --sequence` before each frame is filtered: how much of the
-// frame reprojects onto the previous one with the motion vectors as given and negated (a wrong
-// sign convention reprojects far less), and whether the ids survive reprojection (Mitsuba
-// renumbers its shapes whenever a scene is loaded: such ids must not cut the history).
+// "Sequences"), run by the sequence session (include/atrous/sequence.h) before each frame is
+// filtered: how much of the frame reprojects onto the previous one with the motion vectors as
+// given and negated (a wrong sign convention reprojects far less), and whether the ids survive
+// reprojection (Mitsuba renumbers its shapes whenever a scene is loaded: such ids must not cut
+// the history).
 #pragma once
 #include "atrous/image.h"
 
-namespace atrous::cli {
+namespace atrous::io {
 
 struct ReprojectionCheck {
     int tested = 0;            // pixels of this frame on a surface (not background)
@@ -21,4 +22,4 @@ struct ReprojectionCheck {
 ReprojectionCheck checkReprojection(const Image& depth, const Image& normal, const Image& ids, const Image& motion,
                                     const Image& prevDepth, const Image& prevNormal, const Image& prevIds);
 
-}  // namespace atrous::cli
+}  // namespace atrous::io

@@ -1,0 +1,84 @@
+// Denoising an animation from its files to files (docs/temporal.md, docs/inputs.md "Sequences"):
+// the session `atrous denoise --sequence`, Python's atrous.denoise_sequence and the Blender add-on
+// run. It reads any layout src/io/sequence.h lists (atrous's frame_NNNN folders, one folder per
+// frame with a renderer's own file names such as LuxCore's, numbered files per buffer, numbered
+// layered EXRs such as Blender's renderNNNN.exr, or a pattern render####.exr / render%04d.exr),
+// checks every frame's headers before anything is written, denoises each frame (temporal: with
+// the frames around it; svgf: with its history; a still method: on its own), and moves
+// OUTDIR/frame_NNNN.exr (+ .png previews, + preview.mp4 through ffmpeg when it is on PATH) into
+// place only when every frame is done. Bad input throws InputError naming the frame's file.
+#pragma once
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "atrous/denoise.h"
+#include "atrous/device.h"
+#include "atrous/learned.h"
+#include "atrous/svgf.h"
+#include "atrous/temporal.h"
+
+namespace atrous {
+
+struct SequenceDenoiseOptions {
+    // A sequence method (sequenceMethods(): temporal, svgf) or a still method (denoiseMethods(),
+    // each frame on its own; auto is resolved per frame by the buffers it has).
+    std::string method = "temporal";
+    Device device = Device::Cpu;
+    // The still method's options (its method field is overwritten by `method` for a still method;
+    // with temporal it is the still method run on the average, the CLI's --spatial).
+    DenoiseOptions frame;
+    TemporalParams temporal;      // method temporal
+    SvgfParams svgf;              // method svgf
+    LearnedWeights svgfWeights;   // svgf.learnedSpatial's network; empty = the built-in one
+    // Layered frames: "BUFFER=NAME" requests (the CLI's --pass) and the view layer (--layer),
+    // applied to every frame; a sequence of plain EXR folders refuses both.
+    std::vector<std::string> passes;
+    std::string viewLayer;
+    // Each output frame a copy of its layered input frame with this pass added (--add-pass).
+    std::string addPass;
+    // The frames start .. end (inclusive; -1 = the first / the last present), every step-th.
+    int start = -1, end = -1, step = 1;
+    float exposure = 1.0f;  // of the PNG previews
+    bool pngs = true;       // OUTDIR/frame_NNNN.png beside each EXR
+    bool preview = true;    // OUTDIR/preview.mp4 through ffmpeg when it is on PATH (needs pngs)
+};
+
+// One denoised frame, as it is done.
+struct SequenceFrameReport {
+    int index = 0;          // the frame's number in the input
+    std::string input;      // the frame's file or folder
+    std::string output;     // OUTDIR/frame_NNNN.exr (where it will be once the run is done)
+    std::string method;     // e.g. "temporal (+-3 frames, 3.8 averaged per pixel in 6 ms; then auto -> blend)"
+    std::string methodUsed; // the still method that ran (blend, sure, ...); "svgf" for SVGF
+    double milliseconds = 0;
+    double reprojected = -1;  // fraction of the frame that reprojects onto the previous one (-1: not tested)
+    bool hasReference = false;  // the frame has a reference.exr: then the MSEs below
+    double mse = 0, mseInput = 0;
+    std::string line;       // the line `atrous denoise --sequence` prints for it
+};
+
+struct SequenceReport {
+    int width = 0, height = 0;
+    std::vector<std::string> buffers;  // the buffers every frame has (color, albedo, ...)
+    std::vector<SequenceFrameReport> frames;
+    double filterMsPerFrame = 0, wallMsPerFrame = 0;
+    std::string preview;               // OUTDIR/preview.mp4 when written, else ""
+    std::vector<std::string> notes;    // what the run noticed (motion, ids, sign conventions, ffmpeg)
+};
+
+// Called as the run goes (a CLI's progress lines): each frame when it is denoised, each note when
+// it is made. Either may be empty.
+struct SequenceEvents {
+    std::function<void(const SequenceFrameReport&)> frame;
+    std::function<void(const std::string&)> note;
+};
+
+// Denoises every frame of `input` (a folder or a frame pattern) into the folder `outDir` (created;
+// an existing one keeps its other files, and this run's frame files replace those of an earlier
+// one). Throws InputError for bad input or options (nothing reaches outDir then) and
+// RuntimeError when the output cannot be moved into place.
+SequenceReport denoiseSequence(const std::string& input, const std::string& outDir,
+                               const SequenceDenoiseOptions& options, const SequenceEvents& events = {});
+
+}  // namespace atrous
