@@ -29,6 +29,7 @@ test: build setup-python
 	@cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 	@JOBS=$(JOBS) ./scripts/python_test.sh
 	@./scripts/corpus_check.sh $(BUILD)
+	@./scripts/blender_check.sh
 
 # The full third-party corpus (~40 min to render the first time) and its quality tables
 # (docs/quality.md, "Other renderers' output").

@@ -55,6 +55,7 @@ __all__ = [
     "SEQUENCE_METHODS",
     "WEIGHTED_METHODS",
     "denoise_methods",
+    "sequence_methods",
 ]
 
 __version__ = "0.1.0"
@@ -71,6 +72,11 @@ WEIGHTED_METHODS = tuple(str(r["name"]) for r in _core.denoise_methods() if r["u
 def denoise_methods() -> list:
     """The still methods, one dict per method: name, summary, uses_weights (the library's list)."""
     return [dict(r) for r in _core.denoise_methods()]
+
+
+def sequence_methods() -> list:
+    """The sequence methods, one dict per method: name, summary, causal (the library's list)."""
+    return [dict(r) for r in _core.sequence_methods()]
 
 
 def builtin_scenes() -> list:

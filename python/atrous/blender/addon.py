@@ -1,0 +1,182 @@
+"""The Blender classes of the atrous add-on (atrous.blender registers them): the settings
+(scene.atrous), the operator atrous.denoise_animation, the Output properties panel and the Render
+menu entry. Imported only inside Blender (or with the bpy module)."""
+from __future__ import annotations
+
+import os
+import re
+from typing import List, Optional, Tuple
+
+import bpy
+
+import atrous
+
+
+def _method_items() -> List[Tuple[str, str, str]]:
+    seq = [(r["name"], r["name"], r["summary"]) for r in atrous.sequence_methods()]
+    still = [(r["name"], f"{r['name']} (each frame alone)", r["summary"]) for r in atrous.denoise_methods()]
+    return seq + still
+
+
+def _still_items() -> List[Tuple[str, str, str]]:
+    return [(r["name"], r["name"], r["summary"]) for r in atrous.denoise_methods()]
+
+
+# Blender keeps the strings of an EnumProperty's items: made once, at import.
+_METHODS = _method_items()
+_STILL = _still_items()
+
+
+class AtrousSettings(bpy.types.PropertyGroup):
+    method: bpy.props.EnumProperty(
+        name="Method", items=_METHODS, default=atrous.SEQUENCE_METHODS[0],
+        description="temporal: each frame with the frames around it (the default); svgf: causal; a still "
+                    "method: each frame alone")
+    spatial: bpy.props.EnumProperty(
+        name="Spatial", items=_STILL, default="auto",
+        description="The still method the temporal method runs on its average (auto: by the passes given)")
+    output: bpy.props.StringProperty(
+        name="Output", subtype="DIR_PATH", default="",
+        description="Folder for frame_NNNN.exr (empty: a 'denoised' folder beside the rendered frames)")
+    preview: bpy.props.BoolProperty(
+        name="Preview video", default=True,
+        description="Also write PNG previews and preview.mp4 (when ffmpeg is on PATH)")
+    last_result: bpy.props.StringProperty(name="Last result", default="")
+
+
+def is_multilayer(scene) -> bool:
+    im = scene.render.image_settings
+    return getattr(im, "media_type", None) == "MULTI_LAYER_IMAGE" or im.file_format == "OPEN_EXR_MULTILAYER"
+
+
+def frame_pattern(scene) -> str:
+    """The rendered frames as a pattern the atrous reader takes (DIR/render####.exr), from the path
+    Blender writes frame_start to (render.frame_path: the output path with its '#' run or four
+    appended digits)."""
+    start = scene.frame_start
+    path = bpy.path.abspath(scene.render.frame_path(frame=start))
+    folder, name = os.path.split(path)
+    runs = [m for m in re.finditer(r"\d+", name) if int(m.group()) == start]
+    if not runs:
+        raise ValueError(f"cannot find the frame number {start} in the output file name {path}")
+    m = runs[-1]
+    return os.path.join(folder, name[:m.start()] + "#" * len(m.group()) + name[m.end():])
+
+
+def view_layer_of(context) -> str:
+    """The view layer to read when the frames hold several (the active one), else "" (the only one)."""
+    used = [v for v in context.scene.view_layers if v.use]
+    return context.view_layer.name if len(used) > 1 else ""
+
+
+def output_folder(scene, pattern: str) -> str:
+    s = scene.atrous
+    if s.output:
+        return bpy.path.abspath(s.output)
+    return os.path.join(os.path.dirname(pattern), "denoised")
+
+
+def denoise_animation(context, on_frame=None) -> dict:
+    """Denoises the scene's rendered animation (frame_start .. frame_end) as the operator does;
+    returns atrous.denoise_sequence's report. Raises ValueError for what the user must change."""
+    scene = context.scene
+    if not is_multilayer(scene):
+        raise ValueError("set Output > File Format to OpenEXR MultiLayer (with the Denoising Data and Vector "
+                         "passes of the view layer on), render the animation, then denoise it")
+    s = scene.atrous
+    pattern = frame_pattern(scene)
+    out = output_folder(scene, pattern)
+    return atrous.denoise_sequence(pattern, out, method=s.method, spatial=s.spatial, layer=view_layer_of(context),
+                                   start=scene.frame_start, end=scene.frame_end, step=scene.frame_step,
+                                   pngs=s.preview, preview=s.preview, device="auto", on_frame=on_frame)
+
+
+class ATROUS_OT_denoise_animation(bpy.types.Operator):
+    """Denoise the rendered animation (OpenEXR MultiLayer frames) with atrous"""
+
+    bl_idname = "atrous.denoise_animation"
+    bl_label = "Denoise Animation (atrous)"
+    bl_options = {"REGISTER"}
+
+    def execute(self, context):
+        wm = context.window_manager
+        scene = context.scene
+        total = max(1, (scene.frame_end - scene.frame_start) // max(1, scene.frame_step) + 1)
+        done = [0]
+
+        def progress(frame: dict) -> None:
+            done[0] += 1
+            wm.progress_update(done[0])
+            print("atrous:", frame["line"])
+
+        wm.progress_begin(0, total)
+        try:
+            report = denoise_animation(context, on_frame=progress)
+        except (ValueError, RuntimeError) as e:
+            scene.atrous.last_result = f"failed: {e}"
+            self.report({"ERROR"}, f"atrous: {e}")
+            return {"CANCELLED"}
+        finally:
+            wm.progress_end()
+        frames = report["frames"]
+        out = os.path.dirname(frames[0]["output"]) if frames else ""
+        used = scene.atrous.method
+        if frames and frames[0]["method_used"] != used:
+            used += f", then {frames[0]['method_used']}"
+        msg = f"{len(frames)} frames denoised ({used}) into {out}"
+        for note in report["notes"]:
+            print("atrous:", note)
+        scene.atrous.last_result = msg
+        self.report({"INFO"}, f"atrous: {msg}")
+        return {"FINISHED"}
+
+
+class ATROUS_PT_denoise(bpy.types.Panel):
+    bl_label = "Denoise Animation (atrous)"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "output"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        layout = self.layout
+        s = context.scene.atrous
+        layout.prop(s, "method")
+        if s.method == "temporal":
+            layout.prop(s, "spatial")
+        layout.prop(s, "output")
+        layout.prop(s, "preview")
+        if not is_multilayer(context.scene):
+            layout.label(text="Needs OpenEXR MultiLayer output", icon="ERROR")
+        layout.operator(ATROUS_OT_denoise_animation.bl_idname)
+        if s.last_result:
+            layout.label(text=s.last_result)
+
+
+def _menu(self, context):
+    self.layout.operator(ATROUS_OT_denoise_animation.bl_idname)
+
+
+_CLASSES = (AtrousSettings, ATROUS_OT_denoise_animation, ATROUS_PT_denoise)
+
+
+def _render_menu() -> Optional[type]:
+    return getattr(bpy.types, "TOPBAR_MT_render", None)
+
+
+def register() -> None:
+    for c in _CLASSES:
+        bpy.utils.register_class(c)
+    bpy.types.Scene.atrous = bpy.props.PointerProperty(type=AtrousSettings)
+    menu = _render_menu()
+    if menu is not None:
+        menu.append(_menu)
+
+
+def unregister() -> None:
+    menu = _render_menu()
+    if menu is not None:
+        menu.remove(_menu)
+    del bpy.types.Scene.atrous
+    for c in reversed(_CLASSES):
+        bpy.utils.unregister_class(c)
