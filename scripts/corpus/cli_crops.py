@@ -20,9 +20,7 @@ import numpy as np
 from PIL import Image
 
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
 from cli_quality import stills  # noqa: E402
-import quality  # noqa: E402,F401  (puts .venv-corpus's OpenEXR on the path)
 import OpenEXR  # noqa: E402
 
 

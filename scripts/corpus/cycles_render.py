@@ -14,7 +14,6 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import (SEED_SEQ, SEED_SEQ_REF, SEED_SEQ_SPP, seq_spp_folder, done, exr_channels, merged_render_seconds,  # noqa: E402
                     exr_read_all,
                     log, parse_render_args, still_jobs, write_manifest)

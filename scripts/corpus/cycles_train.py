@@ -16,7 +16,6 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import TRAIN, parse_train_args, done, exr_channels, log, merged_render_seconds, train_jobs, write_manifest  # noqa: E402
 import cycles_render as cr  # noqa: E402  (its main() does not run)
 

@@ -16,7 +16,6 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import TRAIN, parse_train_args, merged_render_seconds, train_jobs, write_manifest  # noqa: E402
 import mitsuba_render as mr  # noqa: E402  (sets the variant; its main() does not run)
 

@@ -24,12 +24,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[2]
 
-try:
-    import OpenEXR  # noqa: F401
-except ImportError:
-    for sp in sorted((ROOT / ".venv-corpus" / "lib").glob("python3*/site-packages")):
-        sys.path.append(str(sp))  # appended: .venv's numpy stays first
-    import OpenEXR  # noqa: F401
+import OpenEXR  # noqa: E402  (python/requirements.txt puts it in .venv, as in .venv-corpus)
 
 
 def read_exr(path):

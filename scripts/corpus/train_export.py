@@ -26,7 +26,6 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
-sys.path.insert(0, str(HERE))
 from common import TRAIN  # noqa: E402
 
 KEYS = ("color", "albedo", "normal", "depth", "emission")

@@ -80,7 +80,6 @@ def main() -> int:
                    help="withhold the variance buffer (every atrous method then estimates it, as for other renderers)")
     p.add_argument("--json")
     a = p.parse_args()
-    sys.path.append(str(ROOT / "python"))  # pyoidn, where it is a source tree (after the installed atrous)
     res = {}
     files = sorted(f for f in glob.glob(f"{a.data}/*.npz") if not f.endswith(".tmp.npz"))
     if not files:

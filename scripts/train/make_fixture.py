@@ -11,12 +11,11 @@ import struct
 import sys
 from pathlib import Path
 
+import jax
+import jax.numpy as jnp
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python" / "atrous"))
-import jax  # noqa: E402
-import jax.numpy as jnp  # noqa: E402
-from learn import context, features, model, weights  # noqa: E402
+from atrous.learn import context, features, model, weights
 
 PLANES = (("d", 3), ("var", 3), ("albedo", 3), ("normal", 3), ("depth", 1))
 VERSION = 4  # the fixture's own version: 4 holds a version-4 weight file and the v4 d_out

@@ -10,9 +10,8 @@ import json
 import sys
 from pathlib import Path
 
-# python/atrous/learn as the top-level package `learn`: atrous/__init__.py needs the built extension.
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python" / "atrous"))
-from learn import train, weights  # noqa: E402
+# The atrous package as installed into .venv-train (scripts/train/setup.sh installs the wheel).
+from atrous.learn import train, weights
 
 
 def main() -> int:

@@ -3,15 +3,13 @@ seeds never meet the test corpus's, and train_export.py turns a render into data
 format through `atrous inspect --export` (the CLI's reader and conventions)."""
 import json
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "scripts" / "corpus"))
-import common  # noqa: E402
+import common  # noqa: E402  (scripts/corpus: pytest's pythonpath, pyproject.toml)
 from atrous_cli import atrous_cli  # noqa: E402
 
 

@@ -4,7 +4,6 @@ room) are drawn from their own stream, so a scene without them is version 1's sc
 closed with the camera inside it; the held-out split never gets the extras; the CLI renders every kind
 of scene; a cached scene that the generator no longer draws is redrawn."""
 import json
-import sys
 import types
 from pathlib import Path
 
@@ -12,8 +11,7 @@ import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "scripts" / "train"))
-import dataset  # noqa: E402
+import dataset  # noqa: E402  (scripts/train: pytest's pythonpath, pyproject.toml)
 from atrous_cli import atrous_cli  # noqa: E402
 
 

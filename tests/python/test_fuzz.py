@@ -10,8 +10,7 @@ import os
 import random
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "fuzz"))
-import fuzz  # noqa: E402
+import fuzz  # noqa: E402  (tests/fuzz: pytest's pythonpath, pyproject.toml)
 
 
 def test_python_binding_cases(tmp_path):

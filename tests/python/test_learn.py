@@ -6,7 +6,6 @@ spec's formulas, and the weight file round-trips, reads version 3 as version 4 w
 rejects corruption and the retired versions 1 and 2. Skipped without
 jax (it lives in .venv-train: scripts/train/setup.sh)."""
 import struct
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -14,11 +13,9 @@ import pytest
 
 jax = pytest.importorskip("jax")
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "python" / "atrous"))
-sys.path.insert(0, str(ROOT / "scripts" / "train"))
-from learn import context, features, model, weights  # noqa: E402
+from atrous.learn import context, features, model, weights  # noqa: E402
 
-import make_fixture  # noqa: E402
+import make_fixture  # noqa: E402  (scripts/train: pytest's pythonpath, pyproject.toml)
 
 FIXTURE = ROOT / "tests" / "learned_fixture.bin"
 
