@@ -1,7 +1,7 @@
 """The Blender classes of the atrous add-on (atrous.blender registers them): the settings
 (scene.atrous), the operator atrous.denoise_animation, the Output properties panel and the Render
-menu entry. Imported only inside Blender (or with the bpy module)."""
-from __future__ import annotations
+menu entry. Imported only inside Blender (or with the bpy module). No `from __future__ import
+annotations` here: Blender reads the property annotations as objects."""
 
 import os
 import re
