@@ -13,10 +13,12 @@
 
 #include "atrous/error.h"
 #include "atrous/render.h"
+#include "atrous/temporal.h"
 #include "test_util.h"
 #include "view/buffer_view.h"
 #include "view/view_pipeline.h"
 
+using atrous::DenoiseMethod;
 using atrous::Device;
 using atrous::Image;
 using atrous::InputError;
@@ -34,7 +36,7 @@ const Scene& cornell() {
     return s;
 }
 
-PipelineSettings settings(Method a = Method::None, int spp = 1) {
+PipelineSettings settings(Method a = Method::none(), int spp = 1) {
     PipelineSettings s;
     s.methodA = a;
     s.sppPerFrame = spp;
@@ -95,7 +97,15 @@ pt::Camera turned(const ViewPipeline& pl, float yaw) {
 }  // namespace
 
 TEST(ViewPipeline, MethodNamesRoundTripAndUnknownOnesAreInputErrors) {
-    for (Method m : {Method::None, Method::Eaw, Method::Sure, Method::Svgf, Method::Learned}) EXPECT_EQ(parseMethod(methodName(m)), m);
+    for (const std::string& n : methodNames()) EXPECT_EQ(methodName(parseMethod(n)), n);
+    // The list is the library's: none, every still method, every causal sequence method.
+    std::vector<std::string> expected{"none"};
+    for (const auto& m : atrous::denoiseMethods()) expected.push_back(m.name);
+    for (const auto& m : atrous::sequenceMethods())
+        if (m.causal) expected.push_back(m.name);
+    EXPECT_EQ(methodNames(), expected);
+    EXPECT_EQ(parseMethod("svgf"), Method::svgf());
+    EXPECT_EQ(parseMethod("sure"), Method::of(DenoiseMethod::Sure));
     EXPECT_THROW(parseMethod("bilateral"), InputError);
     EXPECT_THROW(ViewPipeline(cornell(), 0, kH, Device::Cpu, 1), InputError);
 }
@@ -103,12 +113,12 @@ TEST(ViewPipeline, MethodNamesRoundTripAndUnknownOnesAreInputErrors) {
 TEST(ViewPipeline, StepsAccumulateFramesAndSamples) {
     ViewPipeline pl(cornell(), kW, kH, Device::Cpu, 1);
     EXPECT_EQ(pl.framesAccumulated(), 0);
-    pl.step(settings(Method::None, 2));
+    pl.step(settings(Method::none(), 2));
     EXPECT_EQ(pl.framesAccumulated(), 1);
     EXPECT_EQ(pl.samplesPerPixel(), 2);
     EXPECT_TRUE(pl.varianceValid());  // 2 samples: a variance estimate exists
-    pl.step(settings(Method::None, 2));
-    pl.step(settings(Method::None, 2));
+    pl.step(settings(Method::none(), 2));
+    pl.step(settings(Method::none(), 2));
     EXPECT_EQ(pl.framesAccumulated(), 3);
     EXPECT_EQ(pl.samplesPerPixel(), 6);
     for (const Image* img : {&pl.color(), &pl.variance(), &pl.albedo(), &pl.normal(), &pl.position(), &pl.depth(),
@@ -124,9 +134,9 @@ TEST(ViewPipeline, StepsAccumulateFramesAndSamples) {
 
 TEST(ViewPipeline, OneSamplePerPixelHasNoVarianceEstimate) {
     ViewPipeline pl(cornell(), kW, kH, Device::Cpu, 1);
-    pl.step(settings(Method::None, 1));
+    pl.step(settings(Method::none(), 1));
     EXPECT_FALSE(pl.varianceValid());
-    pl.step(settings(Method::None, 1));
+    pl.step(settings(Method::none(), 1));
     EXPECT_TRUE(pl.varianceValid());  // two frames of one sample
 }
 
@@ -198,23 +208,23 @@ TEST(ViewPipeline, ResetSppChangeAndAccumulationOffRestart) {
     EXPECT_EQ(pl.framesAccumulated(), 1);
     pl.step(settings());
     EXPECT_EQ(pl.framesAccumulated(), 2);
-    pl.step(settings(Method::None, 2));  // a running mean holds frames of one spp only
+    pl.step(settings(Method::none(), 2));  // a running mean holds frames of one spp only
     EXPECT_EQ(pl.framesAccumulated(), 1);
     EXPECT_EQ(pl.samplesPerPixel(), 2);
-    PipelineSettings off = settings(Method::None, 2);
+    PipelineSettings off = settings(Method::none(), 2);
     off.accumulate = false;
     pl.step(off);
     pl.step(off);
     EXPECT_EQ(pl.framesAccumulated(), 1);
     // Nothing reads the running mean: skipped, and restarted when needed again.
-    PipelineSettings skip = settings(Method::Svgf, 2);
+    PipelineSettings skip = settings(Method::svgf(), 2);
     skip.needAccumulated = false;
-    pl.step(settings(Method::None, 2));
-    pl.step(settings(Method::None, 2));
+    pl.step(settings(Method::none(), 2));
+    pl.step(settings(Method::none(), 2));
     ASSERT_EQ(pl.framesAccumulated(), 2);
     pl.step(skip);
     EXPECT_EQ(pl.framesAccumulated(), 1);
-    pl.step(settings(Method::None, 2));
+    pl.step(settings(Method::none(), 2));
     EXPECT_EQ(pl.framesAccumulated(), 1);  // not 3: the skipped frame broke the running mean
 }
 
@@ -228,40 +238,40 @@ TEST(ViewPipeline, TheSameSeedGivesTheSameFramesAndAnotherSeedOthers) {
 
 TEST(ViewPipeline, SlotsFollowTheMethodAndTheSplit) {
     ViewPipeline pl(cornell(), kW, kH, Device::Cpu, 1);
-    pl.step(settings(Method::None, 1));
-    EXPECT_EQ(pl.slot(0).method, Method::None);
+    pl.step(settings(Method::none(), 1));
+    EXPECT_EQ(pl.slot(0).method, Method::none());
     EXPECT_EQ(maxAbsDiff(pl.slot(0).image, pl.color()), 0.0f);  // none: the noisy input itself
     EXPECT_TRUE(pl.slot(1).image.empty());                       // no split: slot B not computed
 
-    PipelineSettings s = settings(Method::Eaw, 1);
+    PipelineSettings s = settings(Method::of(DenoiseMethod::Eaw), 1);
     s.split = true;
-    s.methodB = Method::None;
+    s.methodB = Method::none();
     pl.step(s);  // the method switch takes effect on the next step
     const SlotResult& a = pl.slot(0);
-    EXPECT_EQ(a.method, Method::Eaw);
+    EXPECT_EQ(a.method, Method::of(DenoiseMethod::Eaw));
     EXPECT_TRUE(a.error.empty()) << a.error;
     ASSERT_EQ(a.image.width(), kW);
     EXPECT_TRUE(allFinite(a.image));
     EXPECT_FALSE(a.stages.empty());
     EXPECT_GT(a.filterMs, 0.0);
-    EXPECT_EQ(pl.slot(1).method, Method::None);
+    EXPECT_EQ(pl.slot(1).method, Method::none());
     EXPECT_EQ(maxAbsDiff(pl.slot(1).image, pl.color()), 0.0f);
     // EAW brings the 2-spp mean closer to a 256-spp render (another seed): MSE ratio 0.65 measured
     // (0.55 to 0.8 over seeds); 1 when the filter does nothing.
     ViewPipeline ref(cornell(), kW, kH, Device::Cpu, 99);
-    for (int i = 0; i < 4; ++i) ref.step(settings(Method::None, 64));
+    for (int i = 0; i < 4; ++i) ref.step(settings(Method::none(), 64));
     EXPECT_LT(displayMse(a.image, ref.color()), 0.9 * displayMse(pl.color(), ref.color()));
     EXPECT_EQ(&pl.resultHost(0), &pl.slot(0).image);            // CPU: the result is on the host
 
     s.split = false;
     pl.step(s);
-    EXPECT_EQ(pl.slot(1).method, Method::None);
+    EXPECT_EQ(pl.slot(1).method, Method::none());
     EXPECT_TRUE(pl.slot(1).image.empty());
 }
 
 TEST(ViewPipeline, EverySlotMethodRunsAndSvgfTakesTheFramesOwnSamples) {
     ViewPipeline pl(cornell(), kW, kH, Device::Cpu, 1);
-    for (Method m : {Method::Sure, Method::Svgf, Method::Eaw, Method::Svgf, Method::Learned}) {
+    for (Method m : {Method::of(DenoiseMethod::Sure), Method::svgf(), Method::of(DenoiseMethod::Eaw), Method::svgf(), Method::of(DenoiseMethod::Learned)}) {
         pl.step(settings(m));
         const SlotResult& r = pl.slot(0);
         EXPECT_EQ(r.method, m);
@@ -279,7 +289,7 @@ TEST(ViewPipeline, EverySlotMethodRunsAndSvgfTakesTheFramesOwnSamples) {
 
 TEST(ViewPipeline, RejectedParametersLandInTheSlotAndTheInputIsShown) {
     ViewPipeline pl(cornell(), kW, kH, Device::Cpu, 1);
-    PipelineSettings s = settings(Method::Eaw);
+    PipelineSettings s = settings(Method::of(DenoiseMethod::Eaw));
     s.denoise.eaw.levels = 0;  // 1..10
     ASSERT_NO_THROW(pl.step(s));
     EXPECT_FALSE(pl.slot(0).error.empty());
@@ -288,7 +298,7 @@ TEST(ViewPipeline, RejectedParametersLandInTheSlotAndTheInputIsShown) {
     pl.step(s);
     EXPECT_TRUE(pl.slot(0).error.empty()) << pl.slot(0).error;
 
-    PipelineSettings v = settings(Method::Svgf);
+    PipelineSettings v = settings(Method::svgf());
     v.svgf.alpha = -1.0f;
     ASSERT_NO_THROW(pl.step(v));
     EXPECT_FALSE(pl.slot(0).error.empty());
@@ -297,7 +307,7 @@ TEST(ViewPipeline, RejectedParametersLandInTheSlotAndTheInputIsShown) {
 
 TEST(ViewPipeline, DebugBuffersOnlyWhenAsked) {
     ViewPipeline pl(cornell(), kW, kH, Device::Cpu, 1);
-    PipelineSettings s = settings(Method::Sure, 2);
+    PipelineSettings s = settings(Method::of(DenoiseMethod::Sure), 2);
     pl.step(s);
     EXPECT_TRUE(pl.detail().empty());
     EXPECT_EQ(pl.detailLevel(), -1);
@@ -327,9 +337,9 @@ TEST(ViewPipeline, DebugBuffersOnlyWhenAsked) {
 
 TEST(ViewPipeline, SvgfGetsMotionVectorsWhenTheCameraMoves) {
     ViewPipeline pl(cornell(), kW, kH, Device::Cpu, 1);
-    pl.step(settings(Method::Svgf));
+    pl.step(settings(Method::svgf()));
     pl.setCamera(turned(pl, 0.1f));
-    pl.step(settings(Method::Svgf));
+    pl.step(settings(Method::svgf()));
     const Image& m = pl.motion();
     int moving = 0;
     for (int y = 0; y < kH; ++y)
@@ -339,16 +349,16 @@ TEST(ViewPipeline, SvgfGetsMotionVectorsWhenTheCameraMoves) {
         }
     EXPECT_GT(moving, kW * kH / 2);
     EXPECT_TRUE(pl.slot(0).error.empty()) << pl.slot(0).error;
-    pl.step(settings(Method::Svgf));  // still again: no motion
+    pl.step(settings(Method::svgf()));  // still again: no motion
     for (size_t i = 0; i < pl.motion().size(); ++i) ASSERT_EQ(pl.motion().data()[i], 0.0f);
 }
 
 TEST(ViewPipeline, SaveBuffersWritesWhatTheStepComputed) {
     atrous::test::TempDir dir;
     ViewPipeline pl(cornell(), kW, kH, Device::Cpu, 1);
-    PipelineSettings s = settings(Method::Eaw, 2);
+    PipelineSettings s = settings(Method::of(DenoiseMethod::Eaw), 2);
     s.split = true;
-    s.methodB = Method::Svgf;
+    s.methodB = Method::svgf();
     s.detailLevel = 1;
     pl.step(s);
     const std::vector<std::string> names = pl.saveBuffers(dir / "out");
@@ -384,7 +394,7 @@ TEST(OrbitCamera, StartsAtTheCameraAndTurnsAboutItsPivot) {
 
 TEST(ViewTonemap, ViewsMapTheBuffersAndSayWhenThereIsNothingToShow) {
     ViewPipeline pl(cornell(), kW, kH, Device::Cpu, 1);
-    PipelineSettings s = settings(Method::None, 1);
+    PipelineSettings s = settings(Method::none(), 1);
     pl.step(s);
     std::vector<unsigned char> rgba(size_t(kW) * kH * 4, 7);
     auto px = [&](int x, int y, int c) { return rgba[(size_t(y) * kW + x) * 4 + c]; };

@@ -45,8 +45,8 @@ FrameTiming frameOf(double ms, double cpuMs, double renderMs) {
 TEST(ViewTiming, FrameStagesListThePipelineThenEachSlotThenTheDisplay) {
     ViewPipeline pl(Scene::builtin("cornell"), 24, 16, Device::Cpu, 1);
     PipelineSettings s;
-    s.methodA = Method::Eaw;
-    s.methodB = Method::None;
+    s.methodA = Method::of(atrous::DenoiseMethod::Eaw);
+    s.methodB = Method::none();
     s.split = true;
     s.maxDepth = 2;
     pl.step(s);
@@ -78,8 +78,8 @@ TEST(ViewTiming, JsonLineHasTheKeysInOrderAndLeavesTheWarmupOut) {
     run.scene = "box \"2\"";
     run.width = 64;
     run.height = 48;
-    run.settings.methodA = Method::Sure;
-    run.settings.methodB = Method::Svgf;
+    run.settings.methodA = Method::of(atrous::DenoiseMethod::Sure);
+    run.settings.methodB = Method::svgf();
     run.settings.split = true;
     run.settings.sppPerFrame = 2;
     run.display = "host upload";

@@ -7,12 +7,22 @@
 #if defined(ATROUS_HAVE_VIEWER)
 #include "atrous/params.h"
 #include "cli_flags.h"
+#include "view/view_pipeline.h"
 #include "view/viewer.h"
 #endif
 
 namespace atrous::cli {
 
 #if defined(ATROUS_HAVE_VIEWER)
+namespace {
+// "none | eaw | ... | svgf": the viewer's list, which is the library's (view::methodNames()).
+std::string methodList() {
+    std::string s;
+    for (const std::string& n : view::methodNames()) s += (s.empty() ? "" : " | ") + n;
+    return s;
+}
+}  // namespace
+
 void addViewCommand(CLI::App& app) {
     auto opt = std::make_shared<view::ViewerOptions>();
     CLI::App* cmd = app.add_subcommand("view",
@@ -30,7 +40,7 @@ void addViewCommand(CLI::App& app) {
                         const std::string n = f.name;
                         return n != "threads" && n != "light_sampling";
                     });
-    cmd->add_option("--method", o.method, "Denoiser of the main view: none | eaw | sure | svgf | learned | blend")
+    cmd->add_option("--method", o.method, "Denoiser of the main view: " + methodList())
         ->capture_default_str();
     cmd->add_option("--compare", o.compare, "Split screen: the method shown on the right half");
     cmd->add_flag("--no-accumulate", o.noAccumulate,

@@ -17,12 +17,17 @@
 namespace atrous::view {
 namespace {
 
-const char* const kMethodNames[] = {"none", "eaw", "sure", "svgf", "learned", "blend"};  // view::Method order
-
+// The library's methods (view::methodNames()) in a combo box.
 bool comboMethod(const char* label, Method& m) {
-    int i = int(m);
-    const bool changed = ImGui::Combo(label, &i, kMethodNames, int(sizeof kMethodNames / sizeof kMethodNames[0]));
-    m = Method(i);
+    const std::vector<std::string>& names = methodNames();
+    std::vector<const char*> items;
+    int i = 0;
+    for (const std::string& n : names) {
+        if (n == methodName(m)) i = int(items.size());
+        items.push_back(n.c_str());
+    }
+    const bool changed = ImGui::Combo(label, &i, items.data(), int(items.size()));
+    if (changed) m = parseMethod(names[size_t(i)]);
     return changed;
 }
 

@@ -17,6 +17,7 @@
 #include "filters/denoise_internal.h"
 #include "io/buffer_set.h"
 #include "io/image_io.h"
+#include "atrous/temporal.h"
 #include "render/accumulate.h"
 #include "render/bvh_render.h"
 #include "render/bvh_tracer.h"
@@ -24,32 +25,36 @@
 
 namespace atrous::view {
 
-const char* methodName(Method m) {
-    switch (m) {
-        case Method::None:
+const std::vector<std::string>& methodNames() {
+    static const std::vector<std::string> names = [] {
+        std::vector<std::string> n{"none"};
+        for (const DenoiseMethodInfo& m : denoiseMethods()) n.push_back(m.name);
+        for (const SequenceMethodInfo& m : sequenceMethods())
+            if (m.causal) n.push_back(m.name);
+        return n;
+    }();
+    return names;
+}
+
+const char* methodName(const Method& m) {
+    switch (m.kind) {
+        case Method::Kind::None:
             return "none";
-        case Method::Eaw:
-            return "eaw";
-        case Method::Sure:
-            return "sure";
-        case Method::Svgf:
+        case Method::Kind::Svgf:
             return "svgf";
-        case Method::Learned:
-            return "learned";
-        case Method::Blend:
-            return "blend";
+        case Method::Kind::Still:
+            return denoiseMethodName(m.still);
     }
     return "?";
 }
 
 Method parseMethod(const std::string& name) {
-    if (name == "none") return Method::None;
-    if (name == "eaw") return Method::Eaw;
-    if (name == "sure") return Method::Sure;
-    if (name == "svgf") return Method::Svgf;
-    if (name == "learned") return Method::Learned;
-    if (name == "blend") return Method::Blend;
-    throw InputError("unknown method \"" + name + "\" (expected none, eaw, sure, svgf, learned or blend)");
+    if (name == "none") return Method::none();
+    if (name == "svgf") return Method::svgf();
+    if (const DenoiseMethodInfo* m = findDenoiseMethod(name)) return Method::of(m->method);
+    std::string list;
+    for (const std::string& n : methodNames()) list += (list.empty() ? "" : ", ") + n;
+    throw InputError("unknown method \"" + name + "\" (expected " + list + ")");
 }
 
 namespace {
@@ -293,10 +298,7 @@ DenoiseInputs ViewPipeline::accumulatedInputs() const {
 
 DenoiseOptions ViewPipeline::denoiseOptions(Method m, const PipelineSettings& s) const {
     DenoiseOptions o = s.denoise;
-    o.method = m == Method::Sure      ? DenoiseMethod::Sure
-               : m == Method::Learned ? DenoiseMethod::Learned
-               : m == Method::Blend   ? DenoiseMethod::Blend
-                                      : DenoiseMethod::Eaw;
+    o.method = m.kind == Method::Kind::Still ? m.still : DenoiseMethod::Eaw;
     o.device = mDevice;
     o.report = nullptr;
     return o;
@@ -350,14 +352,14 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
     // (deviceResults) and is downloaded once here otherwise.
     const bool onDevice = s.deviceResults && mDevice == Device::Cuda;
     auto hostCopy = [](const Image& img) { return img.device() == Device::Cpu ? img.clone() : img.to(Device::Cpu); };
-    if (m == Method::None) {
+    if (m == Method::none()) {
         if (onDevice)
             r.deviceImage = mColor.clone();  // GPU to GPU
         else
             r.image = hostCopy(mColor);
         return;
     }
-    if (m == Method::Svgf) {
+    if (m == Method::svgf()) {
         try {
             if (!mSvgf[i] || !sameParams(mSvgfParams[i], s.svgf, svgfParams())) {
                 mSvgf[i] = std::make_unique<SvgfDenoiser>(s.svgf, mDevice);  // validates
@@ -392,7 +394,7 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
     o.report = &rep;
     Timer t;
     try {
-        if (m == Method::Sure && s.sureFractions && mDevice == Device::Cpu) {
+        if (m == Method::of(DenoiseMethod::Sure) && s.sureFractions && mDevice == Device::Cpu) {
             // The public denoise() has no debug outputs; the internal CPU entry fills s_i(p).
             filters::PreparedInputs prep = filters::prepareInputs(in, o, rep);
             filters::DriverDebug dbg;
@@ -434,7 +436,7 @@ void ViewPipeline::step(const PipelineSettings& s) {
         c = now;
         t.reset();
     };
-    const bool svgf = s.methodA == Method::Svgf || (s.split && s.methodB == Method::Svgf);
+    const bool svgf = s.methodA == Method::svgf() || (s.split && s.methodB == Method::svgf());
     renderFrame(s, svgf);
     lap(mTimes.render, mTimes.renderCpu);
 
@@ -474,7 +476,7 @@ void ViewPipeline::step(const PipelineSettings& s) {
         // both remodulated by the albedo. c_0 is taken as the colour before firefly suppression.
         try {
             const DenoiseInputs in = accumulatedInputs();
-            DenoiseOptions o = denoiseOptions(Method::Eaw, s);
+            DenoiseOptions o = denoiseOptions(Method::of(DenoiseMethod::Eaw), s);
             const int L = s.detailLevel;
             // A debug view: on CUDA both results are brought to the host (the view shows them
             // from there anyway).
@@ -519,14 +521,14 @@ std::vector<std::string> ViewPipeline::saveBuffers(const std::string& dir) const
     put("position.exr", position());
     put("depth.exr", depth());
     put("ids.exr", ids());
-    const bool svgf = mSlots[0].method == Method::Svgf || mSlots[1].method == Method::Svgf;
+    const bool svgf = mSlots[0].method == Method::svgf() || mSlots[1].method == Method::svgf();
     if (svgf) {
         put("motion.exr", motion());
         put("emission.exr", emission());
     }
     for (int i = 0; i < 2; ++i) {
         const SlotResult& r = mSlots[i];
-        if (r.method == Method::None) continue;
+        if (r.method == Method::none()) continue;
         const Image& img = resultHost(i);
         if (img.empty()) continue;
         put(std::string(i == 0 ? "denoised_a_" : "denoised_b_") + methodName(r.method) + ".exr",

@@ -23,9 +23,24 @@ class CudaBvhRenderer;  // render/bvh_render.h
 
 namespace atrous::view {
 
-enum class Method { None = 0, Eaw = 1, Sure = 2, Svgf = 3, Learned = 4, Blend = 5 };
-const char* methodName(Method m);
-Method parseMethod(const std::string& name);  // none | eaw | sure | svgf | learned | blend; InputError otherwise
+// A method of the viewer's list, which is the library's lists: "none" (the noisy input), each still
+// method (denoiseMethods(), include/atrous/denoise.h; auto included) and each causal sequence method
+// (sequenceMethods(), include/atrous/temporal.h: svgf). The offline temporal method needs the
+// frames after the one shown and is not in the list.
+struct Method {
+    enum class Kind : unsigned char { None, Still, Svgf };
+    Kind kind = Kind::None;
+    DenoiseMethod still = DenoiseMethod::Auto;  // Kind::Still: the still method
+    static Method none() { return {}; }
+    static Method svgf() { return {Kind::Svgf, DenoiseMethod::Auto}; }
+    static Method of(DenoiseMethod m) { return {Kind::Still, m}; }
+    bool operator==(const Method& o) const { return kind == o.kind && (kind != Kind::Still || still == o.still); }
+    bool operator!=(const Method& o) const { return !(*this == o); }
+};
+// The names of the list in order (the panel's combo boxes, `atrous view --method`'s help).
+const std::vector<std::string>& methodNames();
+const char* methodName(const Method& m);
+Method parseMethod(const std::string& name);  // a name of methodNames(); InputError otherwise
 
 // Everything the user can change between frames.
 struct PipelineSettings {
@@ -36,8 +51,8 @@ struct PipelineSettings {
     // 10% of an SVGF frame's CPU time at 256x256) and the running mean restarts when needed again.
     bool needAccumulated = true;
     int maxDepth = 8;
-    Method methodA = Method::Blend;  // what auto picks with the renderer's albedo and normal
-    Method methodB = Method::None;
+    Method methodA = Method::of(DenoiseMethod::Blend);  // what auto picks with the renderer's albedo and normal
+    Method methodB = Method::none();
     bool split = false;  // compute slot B too (split-screen comparison)
     // EAW's and SURE's parameters (SURE runs on the EAW cascade); the slot sets method, device
     // and report. The panel's controls are their tables' rows (params.h).
@@ -68,8 +83,8 @@ double processCpuMs();
 
 // One slot's result.
 struct SlotResult {
-    Method method = Method::None;
-    Image image;          // 3-channel linear HDR (the noisy input for Method::None)
+    Method method = Method::none();
+    Image image;          // 3-channel linear HDR (the noisy input for Method::none())
     // On the GPU when PipelineSettings::deviceResults asked for it (image is then empty until
     // ViewPipeline::resultHost() downloads it).
     Image deviceImage;
