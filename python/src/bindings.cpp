@@ -67,7 +67,8 @@ Image toImage(const Array& a, const char* what, int channels = 3) {
 // Hands an Image to Python as a C-contiguous H x W x C float32 array on the image's device.
 nb::object fromImage(Image&& img) {
     const Device dev = img.device();
-    Image* inter = new Image(img.width(), img.height(), img.channels(), dev);  // holds H x W x C floats
+    // Holds H x W x C floats, every one written by imageToInterleaved: no zero fill first.
+    Image* inter = new Image(Image::uninitialized(img.width(), img.height(), img.channels(), dev));
     imageToInterleaved(img, inter->data());
     nb::capsule owner(inter, [](void* p) noexcept { delete static_cast<Image*>(p); });
     const size_t shape[3] = {size_t(img.height()), size_t(img.width()), size_t(img.channels())};
@@ -87,6 +88,13 @@ struct Buffers {
     const Image& color;
     io::BufferRefs refs;
     explicit Buffers(const Image& c) : color(c) { refs.set(io::Buffer::Color, &c); }
+    // The binding's own copy of buffer b (toImage's), which denoise(DenoiseBuffers&) may filter in
+    // its storage; null when b was not given.
+    Image* ownedCopy(io::Buffer b) {
+        for (auto& o : owned)
+            if (o.get() == refs.get(b)) return o.get();
+        return nullptr;
+    }
     struct Arg {
         nb::handle obj;
         io::Buffer buffer;
@@ -235,10 +243,16 @@ nb::object pyDenoise(const Array& color, nb::handle albedo, nb::handle normal, n
     o.learnedWeights = learnedWeights;  // "" = the built-in weights
     o.device = c.device();
     for (auto [k, v] : params) applyParam(o, denoiseParams(), nb::cast<std::string>(k), v, "denoise");
+    // The colour, variance and emission are the binding's own copies (toImage): handed over, the
+    // filter works in their storage instead of copying them again (as the CLI does).
+    DenoiseBuffers db;
+    db.color = &c;
+    db.variance = b.ownedCopy(B::Variance), db.emission = b.ownedCopy(B::Emission);
+    db.albedo = in.albedo, db.normal = in.normal, db.position = in.position, db.depth = in.depth, db.ids = in.ids;
     Image out;
     {
         nb::gil_scoped_release release;
-        out = denoise(in, o);
+        out = denoise(db, o);
     }
     // denoise() ran on the colour's device and left its result there (o.device = c.device()).
     return fromImage(std::move(out));
