@@ -115,3 +115,43 @@ TEST(SequenceCompare, VideoSideBySide) {
     for (const auto& e : fs::directory_iterator(dir.str())) entries += e.path().filename().string().rfind(".atrous", 0) == 0;
     EXPECT_EQ(entries, 0);
 }
+
+// FLIP: with a `flip` command on PATH, the mean over frames of the "Mean: x" it prints per frame
+// (a stand-in here that checks its arguments name two written EXRs); --no-flip and a PATH without
+// `flip` give none (the latter with a note). Where `make python` installed the real one
+// (.venv/bin/flip), a sequence against itself has FLIP 0 and one off by 0.1 a FLIP in (0, 1).
+TEST(SequenceCompare, FlipColumnFromTheFlipCommandOnPath) {
+    TempDir dir;
+    writeSequence(dir / "ref", 3, 0.0f, false);
+    writeSequence(dir / "out", 3, 0.1f, false);
+    const std::string bin = dir / "bin";
+    fs::create_directories(bin);
+    std::ofstream(bin + "/flip") << "#!/bin/sh\n[ \"$1\" = -r ] && [ -s \"$2\" ] && [ \"$3\" = -t ] && [ -s \"$4\" ] || exit 3\n"
+                                    "echo 'FLIP between reference image and test image'\necho '     Mean: 0.250000'\n";
+    fs::permissions(bin + "/flip", fs::perms::owner_all);
+    const char* old = std::getenv("PATH");
+    const std::string oldPath = old ? old : "/usr/bin:/bin";
+    auto flipOf = [&](const std::string& path, const std::string& args, std::string* output = nullptr) {
+        setenv("PATH", path.c_str(), 1);
+        auto r = runCli("compare --json " + args + " --sequence " + dir / "ref" + " " + dir / "out");
+        setenv("PATH", oldPath.c_str(), 1);
+        EXPECT_EQ(r.exitCode, 0) << r.output;
+        if (output) *output = r.output;
+        return nlohmann::json::parse(r.output.substr(r.output.find('{')))["sequences"][0]["flip"];
+    };
+    EXPECT_DOUBLE_EQ(flipOf(bin + ":" + oldPath, "").get<double>(), 0.25);
+    EXPECT_TRUE(flipOf(bin + ":" + oldPath, "--no-flip").is_null());
+    std::string out;
+    EXPECT_TRUE(flipOf("/usr/bin:/bin", "", &out).is_null());
+    EXPECT_NE(out.find("note: no FLIP column"), std::string::npos) << out;
+    const std::string venv = std::string(ATROUS_SOURCE_DIR) + "/.venv/bin";
+    if (!fs::exists(venv + "/flip")) GTEST_SKIP() << "no .venv/bin/flip (make python): the real FLIP is not checked";
+    setenv("PATH", (venv + ":" + oldPath).c_str(), 1);
+    auto r = runCli("compare --json --sequence " + dir / "ref" + " " + dir / "ref" + " " + dir / "out");
+    setenv("PATH", oldPath.c_str(), 1);
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const nlohmann::json j = nlohmann::json::parse(r.output.substr(r.output.find('{')));
+    EXPECT_EQ(j["sequences"][0]["flip"].get<double>(), 0.0);
+    EXPECT_GT(j["sequences"][1]["flip"].get<double>(), 0.0);
+    EXPECT_LT(j["sequences"][1]["flip"].get<double>(), 1.0);
+}

@@ -1,9 +1,13 @@
 // `atrous compare`: MSE, relMSE, tonemapped PSNR and SSIM of images against a reference; with
-// --sequence, of denoised sequences against a reference sequence, with the temporal metrics.
+// --sequence, of denoised sequences against a reference sequence, with the temporal metrics and
+// (where the flip command is installed) HDR-FLIP.
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -29,6 +33,53 @@ struct CompareArgs {
     std::string ref, errorMaps, sequence, video;
     std::vector<std::string> images;
     bool json = false;
+    bool noFlip = false;
+};
+
+// HDR-FLIP (NVIDIA's FLIP, the `flip` command of PyPI's flip-evaluator, which `make python` puts in
+// .venv/bin) of a frame against the reference's, when `flip` is on PATH: both written as EXR into a
+// temporary folder (the reference's once per frame), `flip -r REF -t TEST -v 1` run, its
+// "Mean: x" read. Off (enabled() false) when there is no `flip`, or with --no-flip.
+class FlipRunner {
+public:
+    explicit FlipRunner(bool wanted) {
+        if (wanted) mExe = io::findOnPath("flip");
+        if (mExe.empty()) return;
+        mDir = fs::temp_directory_path() / ("atrous-flip-" + std::to_string(::getpid()));
+        std::error_code ec;
+        fs::remove_all(mDir, ec);
+        fs::create_directories(mDir, ec);
+        if (ec) throw RuntimeError(mDir.string() + ": cannot create (" + ec.message() + ")");
+    }
+    ~FlipRunner() {
+        std::error_code ec;
+        if (!mDir.empty()) fs::remove_all(mDir, ec);
+    }
+    FlipRunner(const FlipRunner&) = delete;
+    FlipRunner& operator=(const FlipRunner&) = delete;
+    bool enabled() const { return !mExe.empty(); }
+
+    double frame(int index, const Image& ref, const Image& test) {
+        const std::string refPath = (mDir / ("ref_" + std::to_string(index) + ".exr")).string();
+        if (!fs::exists(refPath)) io::writeImage(refPath, ref);
+        const std::string testPath = (mDir / "test.exr").string();
+        io::writeImage(testPath, test);
+        const std::string cmd = io::shellQuote(mExe) + " -r " + io::shellQuote(refPath) + " -t " + io::shellQuote(testPath) +
+                                " -v 1 -nerm -nexm -d " + io::shellQuote(mDir.string()) + " 2>&1";
+        std::string out;
+        if (FILE* f = ::popen(cmd.c_str(), "r")) {
+            char buf[512];
+            while (std::fgets(buf, sizeof buf, f)) out += buf;
+            const int rc = ::pclose(f);
+            const size_t at = out.find("Mean:");
+            if (rc == 0 && at != std::string::npos) return std::strtod(out.c_str() + at + 5, nullptr);
+        }
+        throw RuntimeError("FLIP (" + mExe + ") failed on frame " + std::to_string(index) + ": " + out.substr(0, 200));
+    }
+
+private:
+    std::string mExe;
+    fs::path mDir;
 };
 
 // The frames of a sequence by number: a reference frame's reference.exr when it has one (`atrous
@@ -110,9 +161,13 @@ void runSequence(const CompareArgs& a) {
     nlohmann::json j;
     j["reference"] = a.sequence;
     j["sequences"] = nlohmann::json::array();
+    FlipRunner flip(!a.noFlip);
+    if (!a.noFlip && !flip.enabled())
+        std::fprintf(stderr, "note: no FLIP column: the flip command (pip install flip-evaluator; make python puts it in "
+                             ".venv/bin) is not on PATH\n");
     if (!a.json)
-        std::printf("%-32s %7s %14s %10s %8s %14s %10s\n", "sequence", "frames", "relMSE", "PSNR(dB)", "SSIM", "temporal relMSE",
-                    "tPSNR(dB)");
+        std::printf("%-32s %7s %14s %10s %8s %14s %10s%s\n", "sequence", "frames", "relMSE", "PSNR(dB)", "SSIM", "temporal relMSE",
+                    "tPSNR(dB)", flip.enabled() ? "     FLIP" : "");
     for (const std::string& dir : a.images) {
         auto seq = sequenceImages(dir, false);
         // The frames are matched by number: the same numbers in both, or one line naming the first that is not.
@@ -124,7 +179,7 @@ void runSequence(const CompareArgs& a) {
                                                                              : " has no reference frame in " + a.sequence));
             }
         }
-        double rel = 0, psnr = 0, ssim = 0, trel = 0, tpsnr = 0;
+        double rel = 0, psnr = 0, ssim = 0, trel = 0, tpsnr = 0, flipSum = 0;
         for (size_t i = 0; i < seq.size(); ++i) {
             ImageMetrics m;
             try {
@@ -137,16 +192,21 @@ void runSequence(const CompareArgs& a) {
                 throw InputError(dir + ": frame " + std::to_string(seq[i].first) + " vs the reference's: " + e.what());
             }
             rel += m.relMse, psnr += m.psnr, ssim += m.ssim;
+            if (flip.enabled()) flipSum += flip.frame(seq[i].first, ref[i].second, seq[i].second);
         }
         const double n = double(seq.size()), steps = std::max(1.0, n - 1.0);
         nlohmann::json s = {{"path", dir},           {"frames", seq.size()},       {"relmse", rel / n},
                             {"psnr", psnr / n},      {"ssim", ssim / n},           {"temporal_relmse", trel / steps},
                             {"tpsnr", tpsnr / steps}};
-        if (a.json)
+        s["flip"] = flip.enabled() ? nlohmann::json(flipSum / n) : nlohmann::json(nullptr);
+        if (a.json) {
             j["sequences"].push_back(s);
-        else
-            std::printf("%-32s %7zu %14.6g %10.3f %8.4f %14.6g %10.3f\n", dir.c_str(), seq.size(), rel / n, psnr / n, ssim / n,
+        } else {
+            std::printf("%-32s %7zu %14.6g %10.3f %8.4f %14.6g %10.3f", dir.c_str(), seq.size(), rel / n, psnr / n, ssim / n,
                         trel / steps, tpsnr / steps);
+            if (flip.enabled()) std::printf(" %8.4f", flipSum / n);
+            std::printf("\n");
+        }
         if (!a.video.empty()) all.push_back(std::move(seq));  // every frame has the reference's size (computeMetrics)
     }
     if (!a.video.empty()) {
@@ -251,6 +311,9 @@ void addCompareCommand(CLI::App& app) {
                     "With --sequence: write an .mp4 of the sequences and the reference side by side, each labelled "
                     "with its folder's name (needs ffmpeg)");
     cmd->add_flag("--json", a->json, "Print JSON");
+    cmd->add_flag("--no-flip", a->noFlip,
+                  "With --sequence: no FLIP column (by default the mean HDR-FLIP over the frames when the flip command "
+                  "of pip's flip-evaluator is on PATH)");
     cmd->add_option("--error-maps", a->errorMaps, "Write <name>_se.exr and <name>_relse.exr error maps into DIR");
     cmd->callback([a] { run(*a); });
 }
