@@ -50,3 +50,29 @@ TEST(PublicIo, ErrorsNameTheFileAndAFailedWriteLeavesNothing) {
     EXPECT_EQ(readImage(dir / "keep.exr")(3, 3, 2), ramp(4, 4)(3, 3, 2));
     EXPECT_EQ(atrous::test::countEntries(dir.str()), 1);  // no temporary left behind
 }
+
+// readRenderFiles: a render folder as `atrous render` writes it, each buffer by name in the
+// filters' conventions (depth 1 channel, ids 2, the rest 3), the colour equal to color.exr; a
+// missing folder and a bad --pass request are InputErrors naming them.
+TEST(PublicIo, RenderFilesByNameInTheFiltersConventions) {
+    TempDir dir;
+    auto r = test::runCli("render --scene cornell --width 24 --height 16 --spp 2 --out " + dir / "render");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const RenderFiles f = readRenderFiles(dir / "render");
+    for (const char* name : {"color", "variance", "albedo", "normal", "position", "depth", "ids", "emission"})
+        ASSERT_NE(f.get(name), nullptr) << name;
+    EXPECT_EQ(f.get("motion"), nullptr);
+    EXPECT_EQ(f.get("depth")->channels(), 1);
+    EXPECT_EQ(f.get("ids")->channels(), 2);
+    EXPECT_EQ(f.get("albedo")->channels(), 3);
+    const Image color = readImage(dir / "render/color.exr");
+    for (size_t i = 0; i < color.size(); ++i) ASSERT_EQ(f.get("color")->data()[i], color.data()[i]) << i;
+    ASSERT_EQ(f.from.size(), f.buffers.size());
+    try {
+        readRenderFiles(dir / "nothing");
+        FAIL() << "no InputError";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("nothing"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(readRenderFiles(dir / "render", {"albedo"}), InputError);  // not BUFFER=NAME
+}

@@ -2,6 +2,8 @@
 // (docs/cpp.md). The same readers and writers as the CLI and the Python package use.
 #pragma once
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "atrous/image.h"
 
@@ -21,5 +23,23 @@ Image readImage(const std::string& path);
 // Throws InputError naming the file for an unknown extension, an unwritable directory or an
 // unsupported channel count.
 void writeImage(const std::string& path, const Image& img);
+
+// One render's buffers as a renderer wrote them (docs/inputs.md), the way `atrous denoise --in
+// PATH` reads them: `path` is a layered EXR (Blender's multilayer file, Mitsuba's AOV output) or a
+// render folder (atrous's file names, LuxCore's); `passes` are "BUFFER=NAME" requests
+// ("albedo=ViewLayer.Denoising Albedo") and `viewLayer` the view layer of a file with several, as
+// the CLI's --pass and --layer. Every buffer found, by name (color, variance, albedo, normal,
+// position, depth, ids, emission, motion), as host images in atrous's conventions: depth 1
+// channel (view depth), ids 2 (R object, G material id; -1 background), motion 2 (previous -
+// current, in pixels, y down), the others 3; `from` says which file (and pass) each came from and
+// `notes` which conventions were applied. Throws InputError naming the file and the problem.
+struct RenderFiles {
+    std::vector<std::pair<std::string, Image>> buffers;
+    std::vector<std::pair<std::string, std::string>> from;
+    std::vector<std::string> notes;
+    const Image* get(const std::string& name) const;  // null when absent
+};
+RenderFiles readRenderFiles(const std::string& path, const std::vector<std::string>& passes = {},
+                            const std::string& viewLayer = {});
 
 }  // namespace atrous

@@ -41,6 +41,7 @@ __all__ = [
     "render_sequence",
     "metrics",
     "read_image",
+    "read_buffers",
     "write_image",
     "Svgf",
     "builtin_scenes",
@@ -248,7 +249,7 @@ def denoise(
     weights = "" if learned_weights is None else os.fsdecode(os.fspath(learned_weights))
     c = _prepare(color, "color", allow_gray=False)
     bufs = {
-        name: _prepare(val, name)
+        name: _prepare(val, name, channels=(2, 3) if name == "ids" else (3,))
         for name, val in (("albedo", albedo), ("normal", normal), ("position", position),
                           ("depth", depth), ("variance", variance), ("ids", ids),
                           ("emission", emission))
@@ -370,6 +371,27 @@ def read_image(path: PathLike) -> np.ndarray:
     return _core.read_image(os.fsdecode(os.fspath(path)))
 
 
+def read_buffers(path: PathLike, *, passes: Optional[Dict[str, str]] = None, layer: str = "",
+                 motion: bool = False) -> Dict[str, Any]:
+    """One render's buffers as its renderer wrote them, the way `atrous denoise --in PATH` reads
+    them (docs/inputs.md): a layered EXR (Blender's multilayer file, Mitsuba's AOV output) or a
+    render folder (atrous's names, LuxCore's). passes: {buffer: pass name} where the automatic
+    mapping needs help ("albedo": "ViewLayer.Denoising Albedo"); layer: the view layer of a file
+    with several.
+
+    Returns {name: H x W x C float32 array} for each buffer found, ready for :func:`denoise`
+    (``atrous.denoise(**atrous.read_buffers(path))``): color, variance, albedo, normal, position
+    (3 channels), depth (1: view depth), ids (2: object, material id; -1 background), emission
+    (3); with motion=True also motion (2: previous - current, pixels, y down), for sequences.
+    Which file and pass each came from, and the conventions applied, are printed by
+    `atrous inspect PATH`. Raises ValueError naming the file for what cannot be read."""
+    d = _core.read_buffers(os.fsdecode(os.fspath(path)),
+                           [f"{k}={v}" for k, v in (passes or {}).items()], layer)
+    if not motion:
+        d.pop("motion", None)
+    return d
+
+
 def write_image(path: PathLike, image: Any) -> None:
     """Writes an H x W x 3 (or H x W / H x W x 1 grey) image by the file's extension.
 
@@ -475,7 +497,7 @@ class Svgf:
                       ids: Any = None, motion: Any = None, emission: Any = None) -> Any:
         """Denoises the next frame; motion is (dx, dy) in pixels, previous - current."""
         c = _prepare(color, "color", allow_gray=False)
-        b = [_prepare(v, n, channels=(2, 3) if n == "motion" else (3,))
+        b = [_prepare(v, n, channels=(2, 3) if n in ("motion", "ids") else (3,))
              for n, v in (("albedo", albedo), ("normal", normal), ("depth", depth), ("ids", ids),
                           ("motion", motion), ("emission", emission))]
         return _wrap_like(self._impl.denoise_frame(c, *b), color)

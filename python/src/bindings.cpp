@@ -18,6 +18,7 @@
 #include "atrous/device.h"
 #include "atrous/error.h"
 #include "atrous/interop.h"
+#include "atrous/io.h"
 #include "atrous/metrics.h"
 #include "atrous/params.h"
 #include "atrous/render.h"
@@ -107,8 +108,9 @@ struct Buffers {
     void add(const Arg& arg) {
         if (arg.obj.is_none()) return;
         Array a = nb::cast<Array>(arg.obj);
-        // Motion vectors keep the array's own channel count (2).
-        const int channels = arg.buffer == io::Buffer::Motion && a.ndim() == 3 ? int(a.shape(2)) : 3;
+        // Motion vectors and ids keep the array's own channel count (2: dx, dy; object, material id).
+        const bool ownCount = arg.buffer == io::Buffer::Motion || arg.buffer == io::Buffer::ObjectId;
+        const int channels = ownCount && a.ndim() == 3 ? int(a.shape(2)) : 3;
         owned.push_back(std::make_unique<Image>(toImage(a, arg.what, channels)));
         const Image& img = *owned.back();
         if (!img.view().sameSize(color.view()))
@@ -434,6 +436,18 @@ nb::dict pyDenoiseSequence(const std::string& input, const std::string& out, con
     return d;
 }
 
+// One render's files (readRenderFiles, include/atrous/io.h) as a dict of host arrays by buffer name.
+nb::dict pyReadBuffers(const std::string& path, const std::vector<std::string>& passes, const std::string& layer) {
+    RenderFiles r;
+    {
+        nb::gil_scoped_release release;
+        r = readRenderFiles(path, passes, layer);
+    }
+    nb::dict d;
+    for (auto& [name, img] : r.buffers) d[name.c_str()] = fromImage(std::move(img));
+    return d;
+}
+
 // Python's keywords are the render table's rows (params.h); the library validates the ranges.
 RenderSettings renderSettings(nb::dict params) {
     RenderSettings rs;
@@ -549,6 +563,7 @@ NB_MODULE(_core, m) {
           nb::arg("params"));
     m.def("metrics", &pyMetrics, nb::arg("image"), nb::arg("reference"));
     m.def("read_image", &pyReadImage, nb::arg("path"));
+    m.def("read_buffers", &pyReadBuffers, nb::arg("path"), nb::arg("passes"), nb::arg("layer"));
     m.def("write_image", &pyWriteImage, nb::arg("path"), nb::arg("image"));
     m.def("denoise_params", [] { return paramRows(denoiseParams()); });
     // The still methods (denoiseMethods(), include/atrous/denoise.h): atrous.METHODS and the rows of

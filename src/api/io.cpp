@@ -2,7 +2,9 @@
 // src/io so that the CLI, tests and Python keep using them unchanged.
 #include "atrous/io.h"
 
+#include "io/buffer_set.h"
 #include "io/image_io.h"
+#include "io/pass_map.h"
 
 namespace atrous {
 
@@ -17,6 +19,31 @@ void writeImage(const std::string& path, const Image& img) {
         return;
     }
     io::writeImage(path, img);
+}
+
+const Image* RenderFiles::get(const std::string& name) const {
+    for (const auto& [n, img] : buffers)
+        if (n == name) return &img;
+    return nullptr;
+}
+
+RenderFiles readRenderFiles(const std::string& path, const std::vector<std::string>& passes,
+                            const std::string& viewLayer) {
+    io::BufferFiles files;
+    files.in = path;
+    files.passes = io::parsePassRequests(passes);
+    files.viewLayer = viewLayer;
+    io::BufferSet set = io::loadBuffers(files);
+    RenderFiles out;
+    for (int i = 0; i < io::kBufferCount; ++i) {
+        const io::Buffer b = io::Buffer(i);
+        if (b == io::Buffer::MaterialId || set.image[i].empty()) continue;  // the ids live in the object_id slot
+        const std::string name = b == io::Buffer::ObjectId ? "ids" : io::bufferName(b);
+        out.from.emplace_back(name, set.from[i]);
+        out.buffers.emplace_back(name, std::move(set.image[i]));
+    }
+    out.notes = std::move(set.notes);
+    return out;
 }
 
 }  // namespace atrous
