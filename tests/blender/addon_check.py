@@ -173,6 +173,33 @@ def main():
         check(rc == {"CANCELLED"} and not os.path.exists(s.output) and "render0004.exr" in s.last_result,
               f"a missing frame is named and nothing written: {s.last_result!r}")
 
+        # A still: the Render Result of frame 3 (F12), with its passes, into the image "atrous denoised".
+        s.output = os.path.join(root, "still")
+        rc = bpy.ops.atrous.denoise_still()
+        check(rc in ({"CANCELLED"}, {"FINISHED"}) and "Render Result" in s.last_result,
+              "the still operator runs on the Render Result there is (the last reference frame) and says so")
+        sc.frame_set(3)
+        sc.render.filepath = os.path.join(root, "f12", "still")
+        bpy.ops.render.render()
+        try:
+            rc = bpy.ops.atrous.denoise_still()
+        except RuntimeError as e:
+            rc = {"CANCELLED"}
+            print("     (reported:", str(e).strip().splitlines()[-1], ")")
+        img = bpy.data.images.get("atrous denoised")
+        check(rc == {"FINISHED"} and img is not None and tuple(img.size) == (128, 96),
+              f"the Render Result is denoised into the image 'atrous denoised' ({s.last_result!r})")
+        if img is not None:
+            px = np.empty(128 * 96 * 4, np.float32)
+            img.pixels.foreach_get(px)
+            d = px.reshape(96, 128, 4)[::-1, :, :3]
+            ref = atrous.read_image(os.path.join(root, "ref", "ref0003.exr"))
+            noisy = combined(os.path.join(root, "render", "render0003.exr"))
+            e, e0 = rel_mse(d, ref), rel_mse(noisy, ref)
+            check(bool(np.isfinite(d).all()) and e < 0.6 * e0,
+                  f"the denoised still: relMSE {e:.4f} below 0.6x the noisy frame's {e0:.4f} (another seed)")
+            f = atrous.read_image(os.path.join(s.output, "still.exr"))
+            check(np.array_equal(f, d), "the still is also written to the Output folder, the same pixels")
         stub = atrous.blender.write_addon_file(os.path.join(root, "atrous_denoise.py"))
         text = open(stub).read()
         check("bl_info" in text and "from atrous.blender import register" in text, "the add-on file for Install from Disk")

@@ -1,6 +1,6 @@
 """The Blender classes of the atrous add-on (atrous.blender registers them): the settings
-(scene.atrous), the operator atrous.denoise_animation, the Output properties panel and the Render
-menu entry. Imported only inside Blender (or with the bpy module). No `from __future__ import
+(scene.atrous), the operators atrous.denoise_animation and atrous.denoise_still, the Output
+properties panel and the Render menu entries. Imported only inside Blender (or with the bpy module). No `from __future__ import
 annotations` here: Blender reads the property annotations as objects."""
 
 import os
@@ -34,7 +34,8 @@ class AtrousSettings(bpy.types.PropertyGroup):
                     "method: each frame alone")
     spatial: bpy.props.EnumProperty(
         name="Spatial", items=_STILL, default="auto",
-        description="The still method the temporal method runs on its average (auto: by the passes given)")
+        description="The still method: what the temporal method runs on its average, and what denoises the "
+                    "Render Result (auto: by the passes given)")
     output: bpy.props.StringProperty(
         name="Output", subtype="DIR_PATH", default="",
         description="Folder for frame_NNNN.exr (empty: a 'denoised' folder beside the rendered frames)")
@@ -131,6 +132,94 @@ class ATROUS_OT_denoise_animation(bpy.types.Operator):
         return {"FINISHED"}
 
 
+RESULT_IMAGE = "atrous denoised"
+
+
+def _set_multilayer(im) -> dict:
+    """Switches image settings to float OpenEXR MultiLayer; returns what to restore."""
+    old = {"file_format": im.file_format, "color_depth": im.color_depth}
+    if hasattr(im, "media_type"):  # Blender 5: MultiLayer is a media type
+        old["media_type"] = im.media_type
+        im.media_type = "MULTI_LAYER_IMAGE"
+    try:
+        im.file_format = "OPEN_EXR_MULTILAYER"
+    except TypeError:  # a Blender whose multilayer format is OPEN_EXR under the media type
+        im.file_format = "OPEN_EXR"
+    im.color_depth = "32"
+    return old
+
+
+def _restore(im, old: dict) -> None:
+    if "media_type" in old:
+        im.media_type = old["media_type"]
+    im.file_format = old["file_format"]
+    im.color_depth = old["color_depth"]
+
+
+def denoise_still(context) -> "bpy.types.Image":
+    """Denoises the Render Result (with its passes: Denoising Data for the albedo and normal) into
+    the image "atrous denoised" (and OUTPUT/still.exr when the Output folder is set); returns it.
+    Raises ValueError for what the user must change."""
+    import tempfile
+
+    import numpy as np
+
+    scene = context.scene
+    result = bpy.data.images.get("Render Result")
+    if result is None:
+        raise ValueError("render an image first (F12): there is no Render Result")
+    with tempfile.TemporaryDirectory(prefix="atrous_") as tmp:
+        path = os.path.join(tmp, "render.exr")
+        im = scene.render.image_settings
+        old = _set_multilayer(im)
+        try:
+            result.save_render(filepath=path, scene=scene)
+        except RuntimeError as e:  # no pixels yet
+            raise ValueError(f"render an image first (F12): the Render Result cannot be saved ({e})") from e
+        finally:
+            _restore(im, old)
+        if not os.path.isfile(path):
+            raise ValueError("the Render Result has no pixels: render an image first (F12)")
+        bufs = atrous.read_buffers(path, layer=view_layer_of(context))
+    s = scene.atrous
+    out = atrous.denoise(**bufs, method=s.spatial, device="auto")
+    h, w = out.shape[:2]
+    img = bpy.data.images.get(RESULT_IMAGE)
+    if img is None or tuple(img.size) != (w, h):
+        if img is not None:
+            bpy.data.images.remove(img)
+        img = bpy.data.images.new(RESULT_IMAGE, w, h, alpha=True, float_buffer=True)
+    rgba = np.ones((h, w, 4), np.float32)
+    rgba[..., :3] = out[::-1]  # Blender's rows go bottom-up
+    img.pixels.foreach_set(rgba.ravel())
+    img.update()
+    if s.output:
+        folder = bpy.path.abspath(s.output)
+        os.makedirs(folder, exist_ok=True)
+        atrous.write_image(os.path.join(folder, "still.exr"), out)
+    return img
+
+
+class ATROUS_OT_denoise_still(bpy.types.Operator):
+    """Denoise the Render Result (an F12 render with its Denoising Data passes) with atrous"""
+
+    bl_idname = "atrous.denoise_still"
+    bl_label = "Denoise Render Result (atrous)"
+    bl_options = {"REGISTER"}
+
+    def execute(self, context):
+        try:
+            img = denoise_still(context)
+        except (ValueError, RuntimeError) as e:
+            context.scene.atrous.last_result = f"failed: {e}"
+            self.report({"ERROR"}, f"atrous: {e}")
+            return {"CANCELLED"}
+        msg = f"Render Result denoised ({context.scene.atrous.spatial}) into the image '{img.name}'"
+        context.scene.atrous.last_result = msg
+        self.report({"INFO"}, f"atrous: {msg}")
+        return {"FINISHED"}
+
+
 class ATROUS_PT_denoise(bpy.types.Panel):
     bl_label = "Denoise Animation (atrous)"
     bl_space_type = "PROPERTIES"
@@ -142,22 +231,23 @@ class ATROUS_PT_denoise(bpy.types.Panel):
         layout = self.layout
         s = context.scene.atrous
         layout.prop(s, "method")
-        if s.method == "temporal":
-            layout.prop(s, "spatial")
+        layout.prop(s, "spatial")
         layout.prop(s, "output")
         layout.prop(s, "preview")
         if not is_multilayer(context.scene):
             layout.label(text="Needs OpenEXR MultiLayer output", icon="ERROR")
         layout.operator(ATROUS_OT_denoise_animation.bl_idname)
+        layout.operator(ATROUS_OT_denoise_still.bl_idname)
         if s.last_result:
             layout.label(text=s.last_result)
 
 
 def _menu(self, context):
     self.layout.operator(ATROUS_OT_denoise_animation.bl_idname)
+    self.layout.operator(ATROUS_OT_denoise_still.bl_idname)
 
 
-_CLASSES = (AtrousSettings, ATROUS_OT_denoise_animation, ATROUS_PT_denoise)
+_CLASSES = (AtrousSettings, ATROUS_OT_denoise_animation, ATROUS_OT_denoise_still, ATROUS_PT_denoise)
 
 
 def _render_menu() -> Optional[type]:
