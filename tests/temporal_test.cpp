@@ -309,3 +309,37 @@ TEST(TemporalCli, SequenceMethodsComeFromTheList) {
     EXPECT_EQ(findSequenceMethod("eaw"), nullptr);
     EXPECT_EQ(sequenceMethodNames(), "temporal, svgf");
 }
+
+// Causal: the frames after the centre are not used, whatever the window holds: the gather over
+// frames 0..6 centred on 3 is the gather over frames 0..3 (bit for bit), and it averages the
+// centre and the three before it (4 frames at falloff 0), where the two-sided one averages 7.
+TEST(TemporalGather, CausalUsesTheFramesBeforeOnly) {
+    SceneOptions o;
+    o.flat = true, o.withBox = false, o.noiseSigma = 0.1f;
+    const auto synth = makeFrames(o, 7);
+    const auto all = framesOf(synth);
+    TemporalParams p;
+    p.falloff = 0.0f;
+    p.causal = true;
+    const TemporalGather g = gatherTemporal(all, 3, p);
+    const std::vector<SvgfFrame> past(all.begin(), all.begin() + 4);
+    const TemporalGather h = gatherTemporal(past, 3, p);
+    EXPECT_TRUE(sameImages(g.color, h.color));
+    EXPECT_NEAR(meanOf(g.frames, 0), 4.0, 0.2);
+    p.causal = false;
+    EXPECT_NEAR(meanOf(gatherTemporal(all, 3, p).frames, 0), 7.0, 0.35);
+}
+
+// The CLI's causal mode denoises each frame from the ones before it: frame 0 alone (what radius 0
+// gives), and the line says so.
+TEST(TemporalCli, CausalFirstFrameIsThePerFrameMethod) {
+    TempDir dir;
+    const std::string seq = renderSequence(dir);
+    auto r = runCli("denoise --sequence " + seq + " --temporal-causal --spatial eaw --device cpu --out " + (dir / "c"));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("frame_0001: temporal (causal, -3 frames"), std::string::npos) << r.output;
+    r = runCli("denoise --sequence " + seq + " --method eaw --device cpu --out " + (dir / "e"));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_TRUE(sameImages(io::readImage(dir / "c/frame_0000.exr"), io::readImage(dir / "e/frame_0000.exr")));
+    EXPECT_FALSE(sameImages(io::readImage(dir / "c/frame_0002.exr"), io::readImage(dir / "e/frame_0002.exr")));
+}

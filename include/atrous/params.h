@@ -225,6 +225,8 @@ inline const ParamField<T> kTemporal[] = {
      "frame t+-k weighs exp(-k^2 / (2 falloff^2)) in the average (0 = all frames equal)"},
     {"firefly_k", &at<&T::fireflyK>, paramZeroOr(1e-6, "off"),
      "each frame's fireflies are clamped to k local standard deviations before averaging (0 = off)"},
+    {"causal", &at<&T::causal>, {},
+     "the frames before each one only (t-radius .. t): each frame as soon as it is rendered, as in a viewer"},
 };
 
 // threads: a ceiling, since tbb::task_arena aborts in its destructor from 65537 threads on

@@ -42,6 +42,10 @@ struct TemporalParams {
     // 16 keeps most of them and still takes the ceiling's fireflies out of a Cornell orbit
     // (docs/temporal.md).
     float fireflyK = 16.0f;
+    // Causal: frame t from t - radius .. t only (the frames after it are not used even when the
+    // window has them), so a frame can be denoised as soon as it is rendered (a viewer, a stream).
+    // The offline default uses both sides.
+    bool causal = false;
 };
 
 void validateTemporalParams(const TemporalParams& p);
@@ -76,7 +80,7 @@ public:
 };
 
 // Reprojects and averages window[center - r .. center + r] (r = params.radius, clipped to the
-// window) onto window[center]. Every frame must have the centre's buffers and size (SvgfFrame's
+// window; center - r .. center with params.causal) onto window[center]. Every frame must have the centre's buffers and size (SvgfFrame's
 // conventions: depth and ids in channel 0, motion previous - current in pixels). Frames without
 // motion are taken as still; what moved is then rejected by the depth, normal and id test.
 // Non-finite values of a neighbour are left out; the centre's own pass through. Host images.

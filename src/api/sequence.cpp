@@ -145,9 +145,11 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
     io::StagedDir staged("--out", outDir);
     const std::string stage = staged.stage();
 
-    // Frames are read in order; frame i is denoised once frames up to i + radius are in (temporal;
-    // the other methods: radius 0). `window` holds frames winFirst .. the last read.
+    // Frames are read in order; frame i is denoised once frames up to i + lookahead are in
+    // (temporal: its radius, 0 when causal; the other methods: 0). `window` holds frames winFirst
+    // .. the last read, at most radius behind the one denoised.
     const size_t radius = temporal ? size_t(args.temporal.radius) : 0;
+    const size_t lookahead = temporal && !args.temporal.causal ? radius : 0;
     std::deque<io::SequenceFrame> window;
     size_t winFirst = 0;
     int firstIndex = 0;
@@ -224,7 +226,8 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
         r.methodUsed = svgf ? "svgf" : denoiseMethodName(frameReport.methodUsed);
         r.method = args.method;
         if (temporal)
-            r.method += format(" (+-%zu frames, %.1f averaged per pixel in %.0f ms; then %s%s%s)", radius,
+            r.method += format(" (%s%zu frames, %.1f averaged per pixel in %.0f ms; then %s%s%s)",
+                               args.temporal.causal ? "causal, -" : "+-", radius,
                                temporalReport.meanFrames, temporalReport.gatherMs, denoiseMethodName(options.method),
                                resolved ? " -> " : "", resolved ? r.methodUsed.c_str() : "");
         else if (resolved)
@@ -299,7 +302,7 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
         }
         window.push_back(std::move(f));
         // Denoise every frame whose window is complete (at the end: all that are left).
-        for (; nextOut < frames.size() && (nextOut + radius <= i || i + 1 == frames.size()); ++nextOut) {
+        for (; nextOut < frames.size() && (nextOut + lookahead <= i || i + 1 == frames.size()); ++nextOut) {
             denoiseOne(nextOut);
             // Keep the frames the next one's window needs, and always the last read (the next check's).
             while (winFirst + radius < nextOut + 1 && window.size() > 1) {

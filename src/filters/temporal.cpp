@@ -122,7 +122,7 @@ TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t cente
     if (!c.color || c.color->empty()) svgf::checkFrame(c);  // throws: the colour is missing
     const int w = c.color->width(), h = c.color->height();
     const size_t r = size_t(params.radius);
-    const size_t lo = center > r ? center - r : 0, hi = std::min(window.size() - 1, center + r);
+    const size_t lo = center > r ? center - r : 0, hi = params.causal ? center : std::min(window.size() - 1, center + r);
     const bool stats = params.colorSigmas > 0.0f;
     // The cache holds what a frame's id was prepared into, for this size and these settings only.
     TemporalCache::Impl* cached = cache ? cache->mImpl.get() : nullptr;
