@@ -426,5 +426,26 @@ TEST(LearnedMethodCli, SequenceDenoisesEveryFrameAndChecksTheWeightsFirst) {
     EXPECT_FALSE(std::filesystem::exists(out2));
 }
 
+// DenoiseOptions::weights, the network loaded once: the same output as the file it came from; when
+// set, the path is not read (a missing file is then no error); the built-in weights by object
+// equal the built-in default.
+TEST(LearnedMethod, LoadedWeightsAreUsedAndThePathIsNotRead) {
+    test::TempDir dir;
+    const std::string wpath = writeFixtureWeights(dir);
+    const Synth sc;
+    const DenoiseInputs in = sc.inputs(true);
+    DenoiseOptions byPath = learnedOptions(wpath);
+    DenoiseOptions byObject = learnedOptions("");
+    byObject.weights = LearnedWeights::load(wpath);
+    EXPECT_TRUE(test::sameImages(denoise(in, byPath), denoise(in, byObject)));
+    byObject.learnedWeights = dir / "missing.bin";
+    EXPECT_TRUE(test::sameImages(denoise(in, byPath), denoise(in, byObject)));
+    DenoiseOptions builtin = learnedOptions("");
+    DenoiseOptions builtinObject = learnedOptions("");
+    builtinObject.weights = LearnedWeights::builtin();
+    EXPECT_TRUE(test::sameImages(denoise(in, builtin), denoise(in, builtinObject)));
+    EXPECT_FALSE(test::sameImages(denoise(in, builtin), denoise(in, byPath)));  // the fixture's are other weights
+}
+
 }  // namespace
 }  // namespace atrous

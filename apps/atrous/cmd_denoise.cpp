@@ -165,6 +165,7 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     LearnedWeights weights;
     if ((learnedMethod(still) || learnedSvgf) && !o.learnedWeights.empty())
         weights = withFlag("--learned-weights", [&] { return LearnedWeights::load(o.learnedWeights); });
+    o.weights = weights;  // loaded once: denoise() does not read the file again
     if (sequence) {
         if (!a.inDir.empty() || !a.color.empty())
             throw InputError("--sequence DIR denoises the frames of DIR: drop --in/--color");

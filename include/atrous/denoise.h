@@ -9,6 +9,7 @@
 
 #include "atrous/device.h"
 #include "atrous/image.h"
+#include "atrous/learned.h"
 #include "atrous/stage_time.h"
 
 namespace atrous {
@@ -133,8 +134,13 @@ struct DenoiseOptions {
     // Other renderers' albedo is 0 on glass, mirrors, emitters and the sky (docs/algorithms.md).
     // 0.05 is measured on the corpus (docs/quality.md): 0.1 half-demodulated dark texture.
     float albedoFloor = 0.05f;  // [0, 1]
-    // The learned method's weight file (version 2, docs/learned.md); empty = the built-in weights.
-    // Loaded by denoise() before any work: a bad file is an InputError naming it.
+    // The learned methods' network (learned, blend, auto), loaded once by the caller
+    // (LearnedWeights::load or ::builtin, include/atrous/learned.h) and shared between calls: a
+    // sequence or a batch reads its weight file once. When it holds none, learnedWeights below.
+    LearnedWeights weights;
+    // A weight file (version 4, or 3; docs/learned.md) that denoise() loads on each call when
+    // `weights` holds none; empty = the built-in weights. A bad file is an InputError naming it,
+    // before any work.
     std::string learnedWeights;
     DenoiseReport* report = nullptr;  // optional: filled with what the run did
 };

@@ -139,6 +139,9 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
         if (!temporal) options.method = parseDenoiseMethod(args.method);
         options.device = args.device;
         validateDenoiseOptions(options);
+        // A weight file is read once for the whole sequence (not by each frame's denoise()).
+        if (!options.weights.impl && !options.learnedWeights.empty())
+            options.weights = LearnedWeights::load(options.learnedWeights);
     }
     DenoiseReport frameReport;
     options.report = &frameReport;

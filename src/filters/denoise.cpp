@@ -491,7 +491,9 @@ Image denoiseWith(const DenoiseInputs& given, const DenoiseOptions& options, con
     // The weights before any work: a bad file is an InputError naming it, nothing computed.
     LearnedWeights weights;
     if (denoiseMethodInfo(o.method).usesWeights)
-        weights = o.learnedWeights.empty() ? LearnedWeights::builtin() : LearnedWeights::load(o.learnedWeights);
+        weights = o.weights.impl              ? o.weights
+                  : o.learnedWeights.empty() ? LearnedWeights::builtin()
+                                             : LearnedWeights::load(o.learnedWeights);
     filters::PreparedInputs prep = prepareCall(inputs, o, rep, true);
     prep.learned = weights;
     rep.methodUsed = o.method;
