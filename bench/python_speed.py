@@ -24,9 +24,9 @@ import subprocess
 import time
 from pathlib import Path
 
-import numpy as np
 
 from bench_machine import cpu_model, emit, git_commit  # bench/ (the script's own folder is on sys.path)
+from learned_speed import _oidn_filter  # an OIDN RT filter bound and committed once
 
 ROOT = Path(__file__).resolve().parents[1]
 BUFFERS = ("albedo", "normal", "position", "depth", "ids", "variance", "emission")
@@ -71,15 +71,7 @@ def main(argv=None) -> int:
         color, albedo, normal = oidn_inputs(b)
         dev = pyoidn.Device()
         dev.commit()
-        flt = pyoidn.Filter(dev, pyoidn.OIDN_FILTER_TYPE_RT)
-        result = np.zeros_like(color)
-        for name, img in ((pyoidn.OIDN_IMAGE_COLOR, color), (pyoidn.OIDN_IMAGE_ALBEDO, albedo),
-                          (pyoidn.OIDN_IMAGE_NORMAL, normal), (pyoidn.OIDN_IMAGE_OUTPUT, result)):
-            flt.set_image(name, img, pyoidn.OIDN_FORMAT_FLOAT3)
-        flt.set_bool("hdr", True)
-        flt.set_quality(pyoidn.OIDN_QUALITY_HIGH)
-        flt.commit()
-        oidn = flt
+        oidn, result = _oidn_filter(pyoidn, dev, color, albedo, normal, pyoidn.OIDN_QUALITY_HIGH)  # result: kept alive
     per = {m: {"cli": [], "python": []} for m in methods}
     oidn_ms, device_name = [], ""
     for _ in range(a.rounds):
