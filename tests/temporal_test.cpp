@@ -321,19 +321,24 @@ TEST(TemporalCli, SequenceMethodsComeFromTheList) {
 // Causal: the frames after the centre are not used, whatever the window holds: the gather over
 // frames 0..6 centred on 3 is the gather over frames 0..3 (bit for bit), and it averages the
 // centre and the three before it (4 frames at falloff 0), where the two-sided one averages 7.
+// The causal falloff is the one used then: at 1, frames t-1..t-3 weigh 0.61, 0.14, 0.011.
 TEST(TemporalGather, CausalUsesTheFramesBeforeOnly) {
     SceneOptions o;
     o.flat = true, o.withBox = false, o.noiseSigma = 0.1f;
     const auto synth = makeFrames(o, 7);
     const auto all = framesOf(synth);
     TemporalParams p;
-    p.falloff = 0.0f;
+    p.falloff = p.causalFalloff = 0.0f;
     p.causal = true;
     const TemporalGather g = gatherTemporal(all, 3, p);
     const std::vector<SvgfFrame> past(all.begin(), all.begin() + 4);
     const TemporalGather h = gatherTemporal(past, 3, p);
     EXPECT_TRUE(sameImages(g.color, h.color));
     EXPECT_NEAR(meanOf(g.frames, 0), 4.0, 0.2);
+    p.causalFalloff = 1.0f;
+    const double sw = 1 + std::exp(-0.5) + std::exp(-2.0) + std::exp(-4.5);
+    const double sw2 = 1 + std::exp(-1.0) + std::exp(-4.0) + std::exp(-9.0);
+    EXPECT_NEAR(meanOf(gatherTemporal(all, 3, p).frames, 0), sw * sw / sw2, 0.05 * sw * sw / sw2);
     p.causal = false;
     EXPECT_NEAR(meanOf(gatherTemporal(all, 3, p).frames, 0), 7.0, 0.35);
 }

@@ -227,6 +227,7 @@ inline const ParamField<T> kTemporal[] = {
      "each frame's fireflies are clamped to k local standard deviations before averaging (0 = off)"},
     {"causal", &at<&T::causal>, {},
      "the frames before each one only (t-radius .. t): each frame as soon as it is rendered, as in a viewer"},
+    {"causal_falloff", &at<&T::causalFalloff>, paramAtLeast(0), "the falloff in causal mode (in place of falloff)"},
 };
 
 // threads: a ceiling, since tbb::task_arena aborts in its destructor from 65537 threads on

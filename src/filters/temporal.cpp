@@ -213,7 +213,7 @@ TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t cente
             hop.from = prepared[from - lo]->views, hop.to = prepared[to - lo]->views, hop.centre = pc.views;
             hop.to.variance = viewOf(window[to].variance);
             hop.backward = dir < 0;
-            const float fo = params.falloff;
+            const float fo = params.causal ? params.causalFalloff : params.falloff;
             hop.weight = fo > 0.0f ? std::exp(-float(k * k) / (2.0f * fo * fo)) : 1.0f;
             hop.depthTolerance = params.depthTolerance, hop.normalCos = params.normalCos;
             hop.colorSigmas = params.colorSigmas;

@@ -38,10 +38,11 @@ def test_radius_zero_is_the_still_method(frames):
 
 def test_params_table_and_its_keywords(frames):
     names = [r["name"] for r in atrous.temporal_params()]
-    assert names == ["radius", "depth_tolerance", "normal_cos", "color_sigmas", "falloff", "firefly_k", "causal"]
-    # causal: the frames after the centre are not used (the window 0..4 centred on 2 is 0..2)
+    assert names == ["radius", "depth_tolerance", "normal_cos", "color_sigmas", "falloff", "firefly_k", "causal", "causal_falloff"]
+    # causal: the frames after the centre are not used (the window 0..4 centred on 2 is 0..2),
+    # with the causal falloff (1) in place of the two-sided one
     np.testing.assert_array_equal(atrous.denoise_temporal(frames, 2, temporal={"causal": True}),
-                                  atrous.denoise_temporal(frames[:3], 2))
+                                  atrous.denoise_temporal(frames[:3], 2, temporal={"falloff": 1.0}))
     with pytest.raises(ValueError, match="radius"):
         atrous.denoise_temporal(frames, 2, temporal={"radius": 99})
     with pytest.raises(ValueError, match="radios"):
