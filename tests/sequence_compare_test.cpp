@@ -116,36 +116,61 @@ TEST(SequenceCompare, VideoSideBySide) {
     EXPECT_EQ(entries, 0);
 }
 
-// FLIP: with a `flip` command on PATH, the mean over frames of the "Mean: x" it prints per frame
-// (a stand-in here that checks its arguments name two written EXRs); --no-flip and a PATH without
-// `flip` give none (the latter with a note). Where `make python` installed the real one
-// (.venv/bin/flip), a sequence against itself has FLIP 0 and one off by 0.1 a FLIP in (0, 1).
+// FLIP: with NVIDIA's `flip` on PATH, the mean over frames of the "Mean: x" it prints per frame
+// (a stand-in here that answers -h as FLIP does and checks its arguments name two written EXRs);
+// --no-flip and a PATH without `flip` give none (the latter with a note); another program called
+// flip (Debian's line-ending converter) is not taken for FLIP, and a FLIP that fails on a frame
+// leaves that sequence's FLIP out (null, one note) while the other metrics are printed, exit 0.
 TEST(SequenceCompare, FlipColumnFromTheFlipCommandOnPath) {
     TempDir dir;
     writeSequence(dir / "ref", 3, 0.0f, false);
     writeSequence(dir / "out", 3, 0.1f, false);
-    const std::string bin = dir / "bin";
-    fs::create_directories(bin);
-    std::ofstream(bin + "/flip") << "#!/bin/sh\n[ \"$1\" = -r ] && [ -s \"$2\" ] && [ \"$3\" = -t ] && [ -s \"$4\" ] || exit 3\n"
-                                    "echo 'FLIP between reference image and test image'\necho '     Mean: 0.250000'\n";
-    fs::permissions(bin + "/flip", fs::perms::owner_all);
+    auto standIn = [&](const std::string& name, const std::string& body) {
+        const std::string bin = dir / name;
+        fs::create_directories(bin);
+        std::ofstream(bin + "/flip") << "#!/bin/sh\n" << body;
+        fs::permissions(bin + "/flip", fs::perms::owner_all);
+        return bin;
+    };
+    const std::string good = standIn("good", "[ \"$1\" = -h ] && { echo 'FLIP v1.7.'; exit 0; }\n"
+                                             "[ \"$1\" = -r ] && [ -s \"$2\" ] && [ \"$3\" = -t ] && [ -s \"$4\" ] || exit 3\n"
+                                             "echo 'FLIP between reference image and test image'\necho '     Mean: 0.250000'\n");
+    const std::string other = standIn("other", "echo 'usage: flip [-t|-u|-m] file ...'\nexit 1\n");
+    const std::string failing = standIn("failing", "[ \"$1\" = -h ] && { echo 'FLIP v1.7.'; exit 0; }\necho 'boom'\nexit 1\n");
     const char* old = std::getenv("PATH");
     const std::string oldPath = old ? old : "/usr/bin:/bin";
-    auto flipOf = [&](const std::string& path, const std::string& args, std::string* output = nullptr) {
+    auto compare = [&](const std::string& path, const std::string& args) {
         setenv("PATH", path.c_str(), 1);
         auto r = runCli("compare --json " + args + " --sequence " + dir / "ref" + " " + dir / "out");
         setenv("PATH", oldPath.c_str(), 1);
         EXPECT_EQ(r.exitCode, 0) << r.output;
-        if (output) *output = r.output;
-        return nlohmann::json::parse(r.output.substr(r.output.find('{')))["sequences"][0]["flip"];
+        const auto s = nlohmann::json::parse(r.output.substr(r.output.find('{')))["sequences"][0];
+        EXPECT_GT(s["relmse"].get<double>(), 0.0) << r.output;  // the other metrics are there
+        return std::make_pair(s["flip"], r.output);
     };
-    EXPECT_DOUBLE_EQ(flipOf(bin + ":" + oldPath, "").get<double>(), 0.25);
-    EXPECT_TRUE(flipOf(bin + ":" + oldPath, "--no-flip").is_null());
-    std::string out;
-    EXPECT_TRUE(flipOf("/usr/bin:/bin", "", &out).is_null());
-    EXPECT_NE(out.find("note: no FLIP column"), std::string::npos) << out;
+    EXPECT_DOUBLE_EQ(compare(good + ":" + oldPath, "").first.get<double>(), 0.25);
+    EXPECT_TRUE(compare(good + ":" + oldPath, "--no-flip").first.is_null());
+    auto none = compare("/usr/bin:/bin", "");
+    EXPECT_TRUE(none.first.is_null());
+    EXPECT_NE(none.second.find("note: no FLIP column"), std::string::npos) << none.second;
+    auto notFlip = compare(other + ":/usr/bin:/bin", "");
+    EXPECT_TRUE(notFlip.first.is_null());
+    EXPECT_NE(notFlip.second.find("is not NVIDIA's FLIP"), std::string::npos) << notFlip.second;
+    auto failed = compare(failing + ":/usr/bin:/bin", "");
+    EXPECT_TRUE(failed.first.is_null());
+    EXPECT_NE(failed.second.find("failed on frame 1"), std::string::npos) << failed.second;
+}
+
+// The real FLIP, where `make python` installed it (.venv/bin/flip): a sequence against itself has
+// FLIP 0 and one off by 0.1 a FLIP in (0, 1).
+TEST(SequenceCompare, RealFlipWhereInstalled) {
     const std::string venv = std::string(ATROUS_SOURCE_DIR) + "/.venv/bin";
-    if (!fs::exists(venv + "/flip")) GTEST_SKIP() << "no .venv/bin/flip (make python): the real FLIP is not checked";
+    if (!fs::exists(venv + "/flip")) GTEST_SKIP() << "no .venv/bin/flip (make python)";
+    TempDir dir;
+    writeSequence(dir / "ref", 3, 0.0f, false);
+    writeSequence(dir / "out", 3, 0.1f, false);
+    const char* old = std::getenv("PATH");
+    const std::string oldPath = old ? old : "/usr/bin:/bin";
     setenv("PATH", (venv + ":" + oldPath).c_str(), 1);
     auto r = runCli("compare --json --sequence " + dir / "ref" + " " + dir / "ref" + " " + dir / "out");
     setenv("PATH", oldPath.c_str(), 1);

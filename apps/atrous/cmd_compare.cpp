@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,13 +38,21 @@ struct CompareArgs {
 };
 
 // HDR-FLIP (NVIDIA's FLIP, the `flip` command of PyPI's flip-evaluator, which `make python` puts in
-// .venv/bin) of a frame against the reference's, when `flip` is on PATH: both written as EXR into a
-// temporary folder (the reference's once per frame), `flip -r REF -t TEST -v 1` run, its
-// "Mean: x" read. Off (enabled() false) when there is no `flip`, or with --no-flip.
+// .venv/bin) of a frame against the reference's, when `flip` is on PATH and says it is FLIP (`flip
+// -h`; Debian has a line-ending converter of that name): both written as EXR into a temporary
+// folder (the reference's once per frame), `flip -r REF -t TEST -v 1` run, its "Mean: x" read.
+// Off (enabled() false) when there is no such `flip`, or with --no-flip; a frame it fails on
+// gives no value (nullopt) and one note on stderr, and the other metrics go on.
 class FlipRunner {
 public:
     explicit FlipRunner(bool wanted) {
         if (wanted) mExe = io::findOnPath("flip");
+        if (!mExe.empty() && run(io::shellQuote(mExe) + " -h 2>&1").find("FLIP") == std::string::npos) {
+            std::fprintf(stderr, "note: no FLIP column: %s is not NVIDIA's FLIP (pip install flip-evaluator)\n",
+                         mExe.c_str());
+            mExe.clear();
+            mNoted = true;
+        }
         if (mExe.empty()) return;
         mDir = fs::temp_directory_path() / ("atrous-flip-" + std::to_string(::getpid()));
         std::error_code ec;
@@ -58,28 +67,38 @@ public:
     FlipRunner(const FlipRunner&) = delete;
     FlipRunner& operator=(const FlipRunner&) = delete;
     bool enabled() const { return !mExe.empty(); }
+    bool noted() const { return mNoted; }
 
-    double frame(int index, const Image& ref, const Image& test) {
+    std::optional<double> frame(int index, const Image& ref, const Image& test) {
         const std::string refPath = (mDir / ("ref_" + std::to_string(index) + ".exr")).string();
         if (!fs::exists(refPath)) io::writeImage(refPath, ref);
         const std::string testPath = (mDir / "test.exr").string();
         io::writeImage(testPath, test);
-        const std::string cmd = io::shellQuote(mExe) + " -r " + io::shellQuote(refPath) + " -t " + io::shellQuote(testPath) +
-                                " -v 1 -nerm -nexm -d " + io::shellQuote(mDir.string()) + " 2>&1";
+        int rc = 0;
+        const std::string out = run(io::shellQuote(mExe) + " -r " + io::shellQuote(refPath) + " -t " + io::shellQuote(testPath) +
+                                    " -v 1 -nerm -nexm -d " + io::shellQuote(mDir.string()) + " 2>&1", &rc);
+        const size_t at = out.find("Mean:");
+        if (rc == 0 && at != std::string::npos) return std::strtod(out.c_str() + at + 5, nullptr);
+        std::fprintf(stderr, "note: FLIP (%s) failed on frame %d: %s\n", mExe.c_str(), index, out.substr(0, 200).c_str());
+        return std::nullopt;
+    }
+
+private:
+    static std::string run(const std::string& cmd, int* rc = nullptr) {
         std::string out;
         if (FILE* f = ::popen(cmd.c_str(), "r")) {
             char buf[512];
             while (std::fgets(buf, sizeof buf, f)) out += buf;
-            const int rc = ::pclose(f);
-            const size_t at = out.find("Mean:");
-            if (rc == 0 && at != std::string::npos) return std::strtod(out.c_str() + at + 5, nullptr);
+            const int status = ::pclose(f);
+            if (rc) *rc = status;
+        } else if (rc) {
+            *rc = -1;
         }
-        throw RuntimeError("FLIP (" + mExe + ") failed on frame " + std::to_string(index) + ": " + out.substr(0, 200));
+        return out;
     }
-
-private:
     std::string mExe;
     fs::path mDir;
+    bool mNoted = false;
 };
 
 // The frames of a sequence by number: a reference frame's reference.exr when it has one (`atrous
@@ -162,7 +181,7 @@ void runSequence(const CompareArgs& a) {
     j["reference"] = a.sequence;
     j["sequences"] = nlohmann::json::array();
     FlipRunner flip(!a.noFlip);
-    if (!a.noFlip && !flip.enabled())
+    if (!a.noFlip && !flip.enabled() && !flip.noted())
         std::fprintf(stderr, "note: no FLIP column: the flip command (pip install flip-evaluator; make python puts it in "
                              ".venv/bin) is not on PATH\n");
     if (!a.json)
@@ -180,6 +199,7 @@ void runSequence(const CompareArgs& a) {
             }
         }
         double rel = 0, psnr = 0, ssim = 0, trel = 0, tpsnr = 0, flipSum = 0;
+        bool flipOk = flip.enabled();
         for (size_t i = 0; i < seq.size(); ++i) {
             ImageMetrics m;
             try {
@@ -192,19 +212,23 @@ void runSequence(const CompareArgs& a) {
                 throw InputError(dir + ": frame " + std::to_string(seq[i].first) + " vs the reference's: " + e.what());
             }
             rel += m.relMse, psnr += m.psnr, ssim += m.ssim;
-            if (flip.enabled()) flipSum += flip.frame(seq[i].first, ref[i].second, seq[i].second);
+            if (flipOk) {
+                const std::optional<double> f = flip.frame(seq[i].first, ref[i].second, seq[i].second);
+                flipOk = f.has_value();
+                if (f) flipSum += *f;
+            }
         }
         const double n = double(seq.size()), steps = std::max(1.0, n - 1.0);
         nlohmann::json s = {{"path", dir},           {"frames", seq.size()},       {"relmse", rel / n},
                             {"psnr", psnr / n},      {"ssim", ssim / n},           {"temporal_relmse", trel / steps},
                             {"tpsnr", tpsnr / steps}};
-        s["flip"] = flip.enabled() ? nlohmann::json(flipSum / n) : nlohmann::json(nullptr);
+        s["flip"] = flipOk ? nlohmann::json(flipSum / n) : nlohmann::json(nullptr);
         if (a.json) {
             j["sequences"].push_back(s);
         } else {
             std::printf("%-32s %7zu %14.6g %10.3f %8.4f %14.6g %10.3f", dir.c_str(), seq.size(), rel / n, psnr / n, ssim / n,
                         trel / steps, tpsnr / steps);
-            if (flip.enabled()) std::printf(" %8.4f", flipSum / n);
+            if (flip.enabled()) flipOk ? std::printf(" %8.4f", flipSum / n) : std::printf(" %8s", "-");
             std::printf("\n");
         }
         if (!a.video.empty()) all.push_back(std::move(seq));  // every frame has the reference's size (computeMetrics)
