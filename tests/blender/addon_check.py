@@ -132,12 +132,13 @@ def main():
         s = sc.atrous
         check(s.method == "temporal" and "eaw" in [i.identifier for i in s.bl_rna.properties["method"].enum_items],
               "the method list is the library's (temporal first, the still methods too)")
-        s.output = os.path.join(root, "denoised")
-        rc = bpy.ops.atrous.denoise_animation()
-        check(rc == {"FINISHED"}, f"the operator finishes (got {rc})")
-        check("6 frames denoised (temporal, then" in s.last_result, f"the panel's summary names the method: {s.last_result!r}")
+        check(s.output == "", "the Output folder is empty by default")
+        rc = bpy.ops.atrous.denoise_animation()  # the default: RENDER_denoised beside the frames' folder
+        check(rc == {"FINISHED"}, f"the operator finishes with the default settings (got {rc})")
+        check("6 frames denoised (temporal, then" in s.last_result and "render_denoised" in s.last_result,
+              f"the panel's summary names the method and the folder: {s.last_result!r}")
         for f in range(1, 7):
-            out = os.path.join(root, "denoised", f"frame_{f:04d}.exr")
+            out = os.path.join(root, "render_denoised", f"frame_{f:04d}.exr")
             if not os.path.isfile(out) or not os.path.isfile(out[:-4] + ".png"):
                 check(False, f"frame {f} written (EXR and PNG)")
                 continue
@@ -176,8 +177,8 @@ def main():
         # A still: the Render Result of frame 3 (F12), with its passes, into the image "atrous denoised".
         s.output = os.path.join(root, "still")
         rc = bpy.ops.atrous.denoise_still()
-        check(rc in ({"CANCELLED"}, {"FINISHED"}) and "Render Result" in s.last_result,
-              "the still operator runs on the Render Result there is (the last reference frame) and says so")
+        check(rc == {"FINISHED"} and "Render Result denoised" in s.last_result,
+              "the still operator runs on the Render Result there is (the last reference frame's) and says so")
         sc.frame_set(3)
         sc.render.filepath = os.path.join(root, "f12", "still")
         bpy.ops.render.render()
@@ -200,6 +201,13 @@ def main():
                   f"the denoised still: relMSE {e:.4f} below 0.6x the noisy frame's {e0:.4f} (another seed)")
             f = atrous.read_image(os.path.join(s.output, "still.exr"))
             check(np.array_equal(f, d), "the still is also written to the Output folder, the same pixels")
+        sc.frame_step = 2
+        try:
+            rc = bpy.ops.atrous.denoise_animation()
+        except RuntimeError:
+            rc = {"CANCELLED"}
+        check(rc == {"CANCELLED"} and "Frame Step" in s.last_result, f"a Frame Step of 2 with temporal is refused: {s.last_result!r}")
+        sc.frame_step = 1
         stub = atrous.blender.write_addon_file(os.path.join(root, "atrous_denoise.py"))
         text = open(stub).read()
         check("bl_info" in text and "from atrous.blender import register" in text, "the add-on file for Install from Disk")

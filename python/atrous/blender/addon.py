@@ -38,7 +38,7 @@ class AtrousSettings(bpy.types.PropertyGroup):
                     "Render Result (auto: by the passes given)")
     output: bpy.props.StringProperty(
         name="Output", subtype="DIR_PATH", default="",
-        description="Folder for frame_NNNN.exr (empty: a 'denoised' folder beside the rendered frames)")
+        description="Folder for frame_NNNN.exr (empty: FRAMES_denoised beside the rendered frames' folder)")
     preview: bpy.props.BoolProperty(
         name="Preview video", default=True,
         description="Also write PNG previews and preview.mp4 (when ffmpeg is on PATH)")
@@ -71,10 +71,13 @@ def view_layer_of(context) -> str:
 
 
 def output_folder(scene, pattern: str) -> str:
+    """The Output folder, or beside the frames' folder: FRAMES_denoised (a folder inside the
+    frames' own is refused: its frame files would read as frames of the input next time)."""
     s = scene.atrous
     if s.output:
         return bpy.path.abspath(s.output)
-    return os.path.join(os.path.dirname(pattern), "denoised")
+    frames = os.path.normpath(os.path.dirname(pattern))
+    return frames + "_denoised"
 
 
 def denoise_animation(context, on_frame=None) -> dict:
@@ -85,6 +88,9 @@ def denoise_animation(context, on_frame=None) -> dict:
         raise ValueError("set Output > File Format to OpenEXR MultiLayer (with the Denoising Data and Vector "
                          "passes of the view layer on), render the animation, then denoise it")
     s = scene.atrous
+    if scene.frame_step > 1 and s.method in atrous.SEQUENCE_METHODS:
+        raise ValueError(f"Frame Step is {scene.frame_step}: the {s.method} method joins neighbouring frames, "
+                         "which needs every frame (set Frame Step to 1, or pick a still method)")
     pattern = frame_pattern(scene)
     out = output_folder(scene, pattern)
     return atrous.denoise_sequence(pattern, out, method=s.method, spatial=s.spatial, layer=view_layer_of(context),
@@ -137,7 +143,7 @@ RESULT_IMAGE = "atrous denoised"
 
 def _set_multilayer(im) -> dict:
     """Switches image settings to float OpenEXR MultiLayer; returns what to restore."""
-    old = {"file_format": im.file_format, "color_depth": im.color_depth}
+    old = {"file_format": im.file_format, "color_depth": im.color_depth, "exr_codec": im.exr_codec}
     if hasattr(im, "media_type"):  # Blender 5: MultiLayer is a media type
         old["media_type"] = im.media_type
         im.media_type = "MULTI_LAYER_IMAGE"
@@ -154,6 +160,8 @@ def _restore(im, old: dict) -> None:
         im.media_type = old["media_type"]
     im.file_format = old["file_format"]
     im.color_depth = old["color_depth"]
+    if old["file_format"].startswith("OPEN_EXR"):
+        im.exr_codec = old["exr_codec"]
 
 
 def denoise_still(context) -> "bpy.types.Image":
