@@ -320,7 +320,7 @@ void addDenoiseCommand(CLI::App& app) {
                     "Output file (.exr, .pfm or .png); with --sequence, an output directory, written only once every "
                     "frame is denoised (on error it is left as it was). An existing one keeps its other files; this "
                     "run's frame_NNNN.exr/.png replace the old ones, and those of an earlier run that this run does "
-                    "not write (and an old preview.mp4) are removed, named in a note")
+                    "not write (and an old preview.mp4) are removed, named in a note on stderr")
         ->required();
     std::string methodHelp;
     for (const DenoiseMethodInfo& m : denoiseMethods()) methodHelp += std::string(m.name) + ": " + m.summary + "; ";

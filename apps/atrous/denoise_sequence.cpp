@@ -22,6 +22,7 @@ int runSequenceDenoise(const SequenceDenoiseArgs& args) {
         std::printf("%s\n", line.c_str());
         std::fflush(stdout);
     };
+    events.warning = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
     if (!args.quiet)
         events.frame = [](const SequenceFrameReport& f) {
             std::printf("%s\n", f.line.c_str());

@@ -68,10 +68,12 @@ struct SequenceReport {
 };
 
 // Called as the run goes (a CLI's progress lines): each frame when it is denoised, each note when
-// it is made. Either may be empty.
+// it is made, and `warning` for what the run did beside its own files (the frame files of an
+// earlier run it removed from the output folder: the CLI's stderr). Any may be empty.
 struct SequenceEvents {
     std::function<void(const SequenceFrameReport&)> frame;
     std::function<void(const std::string&)> note;
+    std::function<void(const std::string&)> warning;
 };
 
 // Denoises every frame of `input` (a folder or a frame pattern) into the folder `outDir` (created;

@@ -5,7 +5,8 @@
 // and id agree with the frame it was reached from (SVGF's test, hop by hop) and, optionally,
 // where its local colour agrees with frame t's; the kept colour, albedo, normal and emission are
 // averaged, and the average is filtered by a still method (the default: auto). A film is
-// denoised after rendering, so unlike SVGF nothing here is causal: frame t uses its future too.
+// denoised after rendering, so by default frame t uses its future too; TemporalParams::causal
+// keeps to the frames before it (a viewer, a stream).
 #pragma once
 #include <memory>
 #include <string>

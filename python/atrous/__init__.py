@@ -464,8 +464,10 @@ def denoise_sequence(input: "PathLike", out: "PathLike", *, method: str = "tempo
     temporal, svgf: rows of :func:`temporal_params` / :func:`svgf_params`; params: the still
     method's rows (:func:`denoise_params`). on_frame(dict) is called as each frame is done.
     Writes out/frame_NNNN.exr (+ .png and preview.mp4 unless pngs/preview are False) only when
-    every frame is done. Returns the run's report: width, height, buffers, frames (one dict each:
-    index, input, output, method, method_used, ms, reprojected, mse, mse_input, line), notes.
+    every frame is done; `out` must not be inside the input's folder. Returns the run's report:
+    width, height, buffers (the names every frame has), frames (one dict each: index, input,
+    output, method, method_used, ms, reprojected, mse, mse_input, line), filter_ms_per_frame,
+    wall_ms_per_frame, preview (the video's path, or None) and notes.
     Raises ValueError for bad input (nothing is written then)."""
     pass_specs = [f"{k}={v}" for k, v in (passes or {}).items()]
     weights = "" if learned_weights is None else os.fsdecode(os.fspath(learned_weights))

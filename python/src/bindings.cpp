@@ -108,9 +108,10 @@ struct Buffers {
     void add(const Arg& arg) {
         if (arg.obj.is_none()) return;
         Array a = nb::cast<Array>(arg.obj);
-        // Motion vectors and ids keep the array's own channel count (2: dx, dy; object, material id).
+        // Motion vectors and ids of 2 or more channels keep them (dx, dy; object, material id); one
+        // channel is repeated into 3, as for every other buffer.
         const bool ownCount = arg.buffer == io::Buffer::Motion || arg.buffer == io::Buffer::ObjectId;
-        const int channels = ownCount && a.ndim() == 3 ? int(a.shape(2)) : 3;
+        const int channels = ownCount && a.ndim() == 3 && a.shape(2) >= 2 ? int(a.shape(2)) : 3;
         owned.push_back(std::make_unique<Image>(toImage(a, arg.what, channels)));
         const Image& img = *owned.back();
         if (!img.view().sameSize(color.view()))

@@ -140,7 +140,7 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
         options.device = args.device;
         validateDenoiseOptions(options);
         // A weight file is read once for the whole sequence (not by each frame's denoise()).
-        if (!options.weights.impl && !options.learnedWeights.empty())
+        if (!options.weights.impl && !options.learnedWeights.empty() && denoiseMethodInfo(options.method).usesWeights)
             options.weights = LearnedWeights::load(options.learnedWeights);
     }
     DenoiseReport frameReport;
@@ -324,7 +324,10 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
         if (wrote) report.preview = (fs::path(outDir) / "preview.mp4").string();
     }
     const std::string removed = staged.commit();
-    if (!removed.empty()) note("denoise: " + removed);
+    if (!removed.empty()) {
+        report.notes.push_back("denoise: " + removed);
+        if (events.warning) events.warning(report.notes.back());
+    }
     return report;
 }
 

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdlib>
 #include <sstream>
 
@@ -24,8 +25,11 @@ StagedDir::StagedDir(const std::string& flag, const std::string& outDir) {
     const fs::path parent = mOut.has_parent_path() ? mOut.parent_path() : fs::path(".");
     // Parents created here are removed again on failure (nothing is left behind).
     for (fs::path p = parent; !p.empty() && !fs::exists(p, ec); p = p.parent_path()) mCreatedParent = p;
-    mStage = parent / ("." + mOut.filename().string() + ".partial-" + std::to_string(::getpid()));
-    fs::remove_all(mStage, ec);  // a leftover of a killed run with the same pid
+    // One name per process and call: runs of one process (Python threads) never share a stage.
+    static std::atomic<unsigned> calls{0};
+    mStage = parent / ("." + mOut.filename().string() + ".partial-" + std::to_string(::getpid()) + "-" +
+                       std::to_string(calls.fetch_add(1)));
+    fs::remove_all(mStage, ec);  // a leftover of a killed run with the same pid and count
     if (!fs::create_directories(mStage, ec) || ec)
         throw InputError(flag + " '" + outDir + "': cannot create the output directory (" +
                          (ec ? ec.message() : std::string("it could not be made")) + ")");

@@ -66,3 +66,13 @@ def test_denoise_of_what_it_reads_is_the_clis_output(layered, tmp_path):
     subprocess.run([atrous_cli(), "denoise", "--in", str(path), "--out", str(tmp_path / "cli.exr")], check=True,
                    capture_output=True)
     np.testing.assert_array_equal(atrous.denoise(**atrous.read_buffers(path)), atrous.read_image(tmp_path / "cli.exr"))
+
+
+def test_ids_of_one_two_or_three_channels():
+    b = atrous.render("cornell", width=24, height=16, spp=2, seed=4)
+    ids = b["ids"]  # H x W x 3: object, material, 0
+    kw = dict(albedo=b["albedo"], normal=b["normal"], method="eaw")
+    three = atrous.denoise(b["color"], ids=ids, **kw)
+    np.testing.assert_array_equal(atrous.denoise(b["color"], ids=np.ascontiguousarray(ids[..., :2]), **kw), three)
+    one = atrous.denoise(b["color"], ids=np.ascontiguousarray(ids[..., :1]), **kw)  # repeated, as H x W
+    np.testing.assert_array_equal(one, atrous.denoise(b["color"], ids=np.ascontiguousarray(ids[..., 0]), **kw))

@@ -80,3 +80,35 @@ def test_bad_input_raises_and_writes_nothing(sequence, tmp_path):
     with pytest.raises(ValueError, match="frame_0003"):
         atrous.denoise_sequence(bad, out)
     assert not out.exists()
+
+
+def test_runs_of_one_process_do_not_share_a_stage(sequence, tmp_path):
+    # The library releases the GIL: two threads denoising into the same folder stage apart, both
+    # finish, and the folder holds one run's frames.
+    import threading
+
+    errors = []
+
+    def run():
+        try:
+            atrous.denoise_sequence(sequence, tmp_path / "out", method="eaw", preview=False, pngs=False)
+        except Exception as e:  # noqa: BLE001 - reported below
+            errors.append(e)
+
+    threads = [threading.Thread(target=run) for _ in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors, errors
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == [f"frame_{i:04d}.exr" for i in range(5)]
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".out.partial")]
+
+
+def test_a_weight_file_is_read_only_by_the_methods_that_use_it(sequence, tmp_path):
+    atrous.denoise_sequence(sequence, tmp_path / "eaw", method="eaw", learned_weights=tmp_path / "missing.bin",
+                            preview=False)
+    with pytest.raises(ValueError, match="missing.bin"):
+        atrous.denoise_sequence(sequence, tmp_path / "blend", method="blend", learned_weights=tmp_path / "missing.bin",
+                                preview=False)
+    assert not (tmp_path / "blend").exists()
