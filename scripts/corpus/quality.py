@@ -141,7 +141,10 @@ def load_frame(scene_dir, man, fr, ref=False):
 
 # ---------------------------------------------------------------- metrics and methods
 def relmse(x, ref):
-    return float(np.mean((x - ref) ** 2 / (ref ** 2 + 1e-2)))
+    """The library's relMSE (atrous.metrics, docs/eval.md), as `atrous compare` prints it."""
+    import atrous
+
+    return float(atrous.metrics(np.ascontiguousarray(x, np.float32), np.ascontiguousarray(ref, np.float32))["relmse"])
 
 
 def run_methods(b, oidn, want):

@@ -77,10 +77,6 @@ def temporal_window(count: int, index: int, radius: Optional[int] = None) -> Tup
     return max(0, index - int(radius)), min(count - 1, index + int(radius))
 
 
-def _relmse(x: np.ndarray, r: np.ndarray) -> float:
-    return float(np.mean((x.astype(np.float64) - r) ** 2 / (r.astype(np.float64) ** 2 + 0.01)))
-
-
 def evaluate_sequence(seq_dir: str, methods: Dict[str, Optional[Callable]],
                       log: Callable[[str], None] = print) -> Dict[str, Any]:
     """The temporal method (frames t-3..t+3, the CLI's --sequence default), SVGF (history carried
