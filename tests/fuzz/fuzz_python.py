@@ -1,7 +1,9 @@
 """The fuzz harness's Python-binding cases (fuzz.py, tests/python/test_fuzz.py): seeded calls of the
 atrous module (render, render_sequence, denoise keywords, read_image/write_image paths), and of
-everything in it that reads a file: read_image on layered, damaged, huge-window, offset-window,
-deep and tiled EXRs, directories and weight files; denoise(method='learned'|'auto',
+everything in it that reads a file: read_image and read_buffers on layered, damaged, huge-window,
+offset-window, deep and tiled EXRs, directories and weight files; denoise_sequence on a sequence
+whose second frame's colour is one of those files (a failed run must leave nothing behind);
+denoise(method='learned'|'auto',
 learned_weights=F) and Svgf(learned_spatial=True, learned_weights=F) with every kind of bad
 weight file; atrous.learn.weights.from_bytes. A driver interpreter imports atrous once and runs
 each case in a forked child: a crash marks that case only, and the child's own peak resident set
@@ -9,6 +11,7 @@ each case in a forked child: a crash marks that case only, and the child's own p
 import json
 import math
 import os
+import shutil
 import random
 import subprocess
 
@@ -54,6 +57,17 @@ def run(c):
     elif kind == "write_image":
         atrous.write_image(args["path"], np.zeros((2, 2, 3), np.float32))
         vals = []
+    elif kind == "read_buffers":
+        vals = list(atrous.read_buffers(args["path"], motion=True).values())
+    elif kind == "denoise_sequence":
+        out = args["out"]
+        try:
+            atrous.denoise_sequence(args["seq"], out, method=args["method"], preview=False, pngs=False)
+        except ValueError:
+            if os.path.exists(out) or any(n.startswith("." + os.path.basename(out)) for n in os.listdir(os.path.dirname(out))):
+                return ("wrong-code", "a failed run left files behind: " + out)
+            raise
+        vals = [atrous.read_image(os.path.join(out, n)) for n in sorted(os.listdir(out)) if n.endswith(".exr")]
     else:  # read_image
         vals = [atrous.read_image(args["path"])]
     finite = all(np.isfinite(np.asarray(v, dtype=np.float64)).all() for v in vals if isinstance(v, np.ndarray))
@@ -205,6 +219,19 @@ def _image_files(d, seeds):
     return out
 
 
+def colour_part():
+    """A float RGB part of the synthetic buffers' colour (the synthetic sequence's frames)."""
+    from fuzz_layered import make_part, seed_buffers
+    return make_part(seed_buffers(None), None, "RGB", "color", "", "float", 0)
+
+
+def _sequence_seed(work, seeds):
+    """A frame_NNNN sequence of the seeds (fuzz.py's rendered one), or None (synthetic frames)."""
+    if seeds and os.path.isdir(os.path.join(seeds, "seq")):
+        return os.path.join(seeds, "seq")
+    return None
+
+
 def python_cases(rng, n, work, seeds=None):
     """n cases; with seeds (the seed directory fuzz.py renders, or any directory holding
     render/*.exr and seq/frame_0001/motion.exr; None: synthetic buffers), a third read files."""
@@ -216,7 +243,8 @@ def python_cases(rng, n, work, seeds=None):
     kwn = ["sigma_color", "sigma_normal", "sigma_position", "sigma_depth", "albedo_epsilon", "color_scale",
            "position_scale", "emission_scale", "firefly_k", "albedo_floor", "color_level_factor"]
     vals = [1e-20, 1e-7, 1e-6, 0.0, -1.0, 0.5, 1e30, 3e38, float("nan"), float("inf"), 2, 10]
-    file_kinds = ["read_file", "learned", "svgf", "weights_py"]
+    file_kinds = ["read_file", "learned", "svgf", "weights_py", "read_buffers", "denoise_sequence"]
+    seq = _sequence_seed(work, seeds)
     for i in range(n):
         names, note = [], ""
         if i % 3 == 2:  # the file readers, in turn
@@ -271,6 +299,30 @@ def python_cases(rng, n, work, seeds=None):
             path, must_fail = images[note]
             args = {"path": path}
             names = [os.path.basename(path)]
+        elif k == "read_buffers":  # the reader of `denoise --in`: no oracle beyond what read_image must refuse
+            note = rng.choice(sorted(images))
+            path, must_fail = images[note]
+            must_fail = True if must_fail else None
+            args = {"path": path}
+            names = [os.path.basename(path)]
+        elif k == "denoise_sequence":  # a sequence with one frame's colour replaced by one of the images
+            note = rng.choice(sorted(images))
+            path, must_fail = images[note]
+            d = os.path.join(work, "pyseq_%d" % i)
+            shutil.rmtree(d, ignore_errors=True)
+            if seq:
+                shutil.copytree(seq, d)
+            else:  # synthetic: three frames of a flat colour
+                for f in range(3):
+                    os.makedirs(os.path.join(d, "frame_%04d" % f))
+                    E.write(os.path.join(d, "frame_%04d" % f, "color.exr"), [colour_part()], False)
+            frame = sorted(n for n in os.listdir(d) if n.startswith("frame_"))[1]
+            if os.path.isfile(path):
+                shutil.copyfile(path, os.path.join(d, frame, "color.exr"))
+            must_fail = True if must_fail else None
+            args = {"seq": d, "out": os.path.join(work, "pyseq_out_%d" % i),
+                    "method": rng.choice(["eaw", "temporal", "svgf"])}
+            names = [frame]
         else:
             note = rng.choice(sorted(weights))
             path, good = weights[note]
