@@ -112,3 +112,21 @@ def test_a_weight_file_is_read_only_by_the_methods_that_use_it(sequence, tmp_pat
         atrous.denoise_sequence(sequence, tmp_path / "blend", method="blend", learned_weights=tmp_path / "missing.bin",
                                 preview=False)
     assert not (tmp_path / "blend").exists()
+
+
+def test_a_frame_that_fails_to_decode_mid_run_leaves_nothing(sequence, tmp_path):
+    # frame 3's colour cut short: its header passes the up-front check, its pixels do not decode,
+    # after frames 0..2 were denoised and staged. Nothing reaches `out`, no staging folder stays.
+    bad = tmp_path / "seq"
+    for fd in sorted(sequence.iterdir()):
+        (bad / fd.name).mkdir(parents=True)
+        for p in fd.iterdir():
+            (bad / fd.name / p.name).write_bytes(p.read_bytes())
+    color = bad / "frame_0003" / "color.exr"
+    color.write_bytes(color.read_bytes()[: color.stat().st_size * 2 // 3])
+    for method in ("temporal", "eaw"):
+        out = tmp_path / f"out_{method}"
+        with pytest.raises(ValueError, match="frame_0003"):
+            atrous.denoise_sequence(bad, out, method=method, preview=False)
+        assert not out.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["seq"]
