@@ -7,11 +7,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "atrous/error.h"
+#include "atrous/metrics.h"
 #include "atrous/render.h"
 #include "atrous/temporal.h"
 #include "test_util.h"
@@ -102,7 +104,7 @@ TEST(ViewPipeline, MethodNamesRoundTripAndUnknownOnesAreInputErrors) {
     std::vector<std::string> expected{"none"};
     for (const auto& m : atrous::denoiseMethods()) expected.push_back(m.name);
     for (const auto& m : atrous::sequenceMethods())
-        if (m.causal) expected.push_back(m.name);
+        if (m.causal || m.causalMode) expected.push_back(m.name);
     EXPECT_EQ(methodNames(), expected);
     EXPECT_EQ(parseMethod("svgf"), Method::svgf());
     EXPECT_EQ(parseMethod("sure"), Method::of(DenoiseMethod::Sure));
@@ -271,7 +273,8 @@ TEST(ViewPipeline, SlotsFollowTheMethodAndTheSplit) {
 
 TEST(ViewPipeline, EverySlotMethodRunsAndSvgfTakesTheFramesOwnSamples) {
     ViewPipeline pl(cornell(), kW, kH, Device::Cpu, 1);
-    for (Method m : {Method::of(DenoiseMethod::Sure), Method::svgf(), Method::of(DenoiseMethod::Eaw), Method::svgf(), Method::of(DenoiseMethod::Learned)}) {
+    for (Method m : {Method::of(DenoiseMethod::Sure), Method::svgf(), Method::of(DenoiseMethod::Eaw), Method::svgf(),
+                     Method::of(DenoiseMethod::Learned), Method::temporal()}) {
         pl.step(settings(m));
         const SlotResult& r = pl.slot(0);
         EXPECT_EQ(r.method, m);
@@ -285,6 +288,40 @@ TEST(ViewPipeline, EverySlotMethodRunsAndSvgfTakesTheFramesOwnSamples) {
     const Image& m = pl.motion();
     for (size_t i = 0; i < m.size(); ++i) ASSERT_EQ(m.data()[i], 0.0f);
     EXPECT_EQ(pl.emission().width(), kW);
+}
+
+// The temporal method runs causal in the viewer, on each frame's own samples: with a still camera,
+// from the fourth frame on (frames t-3..t averaged) it is closer to a 512-spp render than the same
+// still method (auto) on each frame alone (the per-frame filter, accumulation off): measured 0.90x
+// on cornell-point at 32x24 (0.1047 against 0.1158; the library through Python: 0.0985 against
+// 0.1068 on its own frames); bound 0.97x. Its history restarts with the accumulation, and rejected parameters land in the slot.
+TEST(ViewPipeline, TemporalRunsCausalOnTheFramesOwnSamples) {
+    const Scene scene = Scene::builtin("cornell-point");
+    atrous::RenderSettings rs;
+    rs.width = kW, rs.height = kH, rs.spp = 512, rs.maxDepth = 3, rs.seed = 99;
+    const Image ref = atrous::render(scene, rs).color;
+    auto err = [&](const Image& img) { return atrous::computeMetrics(img, ref).relMse; };
+    PipelineSettings s = settings(Method::temporal());
+    PipelineSettings alone = settings(Method::of(DenoiseMethod::Auto));
+    alone.accumulate = false;
+    alone.split = true, alone.methodB = Method::temporal();  // the same frames through both
+    ViewPipeline pl(scene, kW, kH, Device::Cpu, 1);
+    double sumAlone = 0, sumTemporal = 0;
+    for (int k = 0; k < 8; ++k) {
+        pl.step(alone);
+        ASSERT_TRUE(pl.slot(1).error.empty()) << pl.slot(1).error;
+        ASSERT_TRUE(allFinite(pl.slot(1).image));
+        if (k >= 3) sumAlone += err(pl.slot(0).image), sumTemporal += err(pl.slot(1).image);
+    }
+    std::printf("temporal in the viewer: relMSE %.4f against %.4f per frame (frames 4-8)\n", sumTemporal / 5, sumAlone / 5);
+    EXPECT_LT(sumTemporal, 0.97 * sumAlone);
+    pl.resetAccumulation();
+    pl.step(s);
+    EXPECT_TRUE(pl.slot(0).error.empty()) << pl.slot(0).error;
+    s.temporal.radius = -1;
+    pl.step(s);
+    EXPECT_NE(pl.slot(0).error.find("radius"), std::string::npos) << pl.slot(0).error;
+    EXPECT_EQ(pl.slot(0).image.width(), kW);
 }
 
 TEST(ViewPipeline, RejectedParametersLandInTheSlotAndTheInputIsShown) {

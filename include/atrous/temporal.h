@@ -135,6 +135,8 @@ struct SequenceMethodInfo {
     const char* name;     // "temporal", "svgf": the CLI's --method
     const char* summary;  // one line: the CLI's help
     bool causal;          // each frame from the frames before it only (real time, the viewer)
+    bool causalMode;      // not causal itself, but has a causal mode (temporal's TemporalParams::causal),
+                          // which a viewer runs
 };
 const std::vector<SequenceMethodInfo>& sequenceMethods();  // temporal (the --sequence default) first
 const SequenceMethodInfo* findSequenceMethod(const std::string& name);  // null when unknown

@@ -31,9 +31,9 @@ const std::vector<SequenceMethodInfo>& sequenceMethods() {
         {"temporal",
          "the default with --sequence: frames t-3..t+3 reprojected onto t and averaged, then the still method "
          "--spatial (docs/temporal.md)",
-         false},
+         false, true},
         {"svgf", "spatiotemporal variance-guided filtering, causal: each frame from the ones before it (docs/svgf.md)",
-         true},
+         true, false},
     };
     return rows;
 }

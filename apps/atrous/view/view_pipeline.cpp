@@ -13,11 +13,11 @@
 
 #include "atrous/error.h"
 #include "atrous/params.h"
+#include "atrous/temporal.h"
 #include "core/timer.h"
 #include "filters/denoise_internal.h"
 #include "io/buffer_set.h"
 #include "io/image_io.h"
-#include "atrous/temporal.h"
 #include "render/accumulate.h"
 #include "render/bvh_render.h"
 #include "render/bvh_tracer.h"
@@ -30,7 +30,7 @@ const std::vector<std::string>& methodNames() {
         std::vector<std::string> n{"none"};
         for (const DenoiseMethodInfo& m : denoiseMethods()) n.push_back(m.name);
         for (const SequenceMethodInfo& m : sequenceMethods())
-            if (m.causal) n.push_back(m.name);
+            if (m.causal || m.causalMode) n.push_back(m.name);
         return n;
     }();
     return names;
@@ -42,6 +42,8 @@ const char* methodName(const Method& m) {
             return "none";
         case Method::Kind::Svgf:
             return "svgf";
+        case Method::Kind::Temporal:
+            return "temporal";
         case Method::Kind::Still:
             return denoiseMethodName(m.still);
     }
@@ -51,6 +53,7 @@ const char* methodName(const Method& m) {
 Method parseMethod(const std::string& name) {
     if (name == "none") return Method::none();
     if (name == "svgf") return Method::svgf();
+    if (name == "temporal") return Method::temporal();
     if (const DenoiseMethodInfo* m = findDenoiseMethod(name)) return Method::of(m->method);
     std::string list;
     for (const std::string& n : methodNames()) list += (list.empty() ? "" : ", ") + n;
@@ -388,6 +391,10 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
         }
         return;
     }
+    if (m == Method::temporal()) {
+        runTemporal(i, s, r);
+        return;
+    }
     DenoiseInputs in = accumulatedInputs();
     DenoiseOptions o = denoiseOptions(m, s);
     DenoiseReport rep;
@@ -420,6 +427,44 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
     }
 }
 
+// The temporal method in its causal mode: this frame and the last radius ones (their own samples,
+// kept on the host), reprojected through the motion and averaged, then the still method auto
+// (include/atrous/temporal.h). CPU only: the gather has no CUDA path yet.
+void ViewPipeline::runTemporal(int i, const PipelineSettings& s, SlotResult& r) {
+    std::deque<HistoryFrame>& h = mHistory[i];
+    try {
+        if (mDevice != Device::Cpu) throw InputError("temporal runs on the CPU in the viewer (its gather has no CUDA path)");
+        TemporalParams p = s.temporal;
+        p.causal = true;
+        validateTemporalParams(p);
+        if (mSvgfResetPending || (mCameraMoved && !s.svgfMotionVectors)) h.clear();
+        HistoryFrame f;
+        f.index = (long long)mFrameIndex;
+        for (const RenderBufferField& field : kRenderBufferFields)
+            if (!(frame().*field.image).empty()) f.b.*field.image = (frame().*field.image).clone();
+        f.b.motion = mMotion.clone();
+        f.b.emission = mEmission.clone();
+        h.push_back(std::move(f));
+        while (h.size() > size_t(p.radius) + 1) h.pop_front();
+        std::vector<SvgfFrame> window;
+        std::vector<long long> ids;
+        for (const HistoryFrame& x : h) {
+            window.push_back(io::svgfFrame(io::refsOf(x.b)));
+            ids.push_back(x.index);
+        }
+        DenoiseOptions o = denoiseOptions(Method::of(DenoiseMethod::Auto), s);
+        TemporalReport rep;
+        Timer t;
+        r.image = denoiseTemporal(window, window.size() - 1, p, o, &rep, &mTemporalCache[i], &ids);
+        r.filterMs = t.ms();
+        r.stages = rep.spatial.stages;
+    } catch (const InputError& e) {
+        h.clear();
+        r.error = e.what();
+        r.image = mDevice == Device::Cpu ? frame().color.clone() : frame().color.to(Device::Cpu);
+    }
+}
+
 void ViewPipeline::step(const PipelineSettings& s) {
     mTimes = StageTimes{};
     for (bool& v : mHostValid) v = false;  // this step rewrites the buffers
@@ -436,7 +481,9 @@ void ViewPipeline::step(const PipelineSettings& s) {
         c = now;
         t.reset();
     };
-    const bool svgf = s.methodA == Method::svgf() || (s.split && s.methodB == Method::svgf());
+    // SVGF and the temporal method take each frame's own samples, motion and emission.
+    auto perFrame = [](const Method& m) { return m == Method::svgf() || m == Method::temporal(); };
+    const bool svgf = perFrame(s.methodA) || (s.split && perFrame(s.methodB));
     renderFrame(s, svgf);
     lap(mTimes.render, mTimes.renderCpu);
 
@@ -521,8 +568,8 @@ std::vector<std::string> ViewPipeline::saveBuffers(const std::string& dir) const
     put("position.exr", position());
     put("depth.exr", depth());
     put("ids.exr", ids());
-    const bool svgf = mSlots[0].method == Method::svgf() || mSlots[1].method == Method::svgf();
-    if (svgf) {
+    auto perFrame = [](const Method& m) { return m == Method::svgf() || m == Method::temporal(); };
+    if (perFrame(mSlots[0].method) || perFrame(mSlots[1].method)) {
         put("motion.exr", motion());
         put("emission.exr", emission());
     }

@@ -5,6 +5,7 @@
 // (tests/view_pipeline_test.cpp, linking the library atrous_view_core).
 #pragma once
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <string>
 #include <vector>
@@ -14,6 +15,7 @@
 #include "atrous/render.h"
 #include "atrous/stage_time.h"
 #include "atrous/svgf.h"
+#include "atrous/temporal.h"
 #include "render/bvh_build.h"
 #include "render/scene_data.h"
 
@@ -24,15 +26,16 @@ class CudaBvhRenderer;  // render/bvh_render.h
 namespace atrous::view {
 
 // A method of the viewer's list, which is the library's lists: "none" (the noisy input), each still
-// method (denoiseMethods(), include/atrous/denoise.h; auto included) and each causal sequence method
-// (sequenceMethods(), include/atrous/temporal.h: svgf). The offline temporal method needs the
-// frames after the one shown and is not in the list.
+// method (denoiseMethods(), include/atrous/denoise.h; auto included), each causal sequence method
+// (sequenceMethods(), include/atrous/temporal.h: svgf) and each one with a causal mode, run in it
+// (temporal: frames t-3..t, since the viewer has no later frames).
 struct Method {
-    enum class Kind : unsigned char { None, Still, Svgf };
+    enum class Kind : unsigned char { None, Still, Svgf, Temporal };
     Kind kind = Kind::None;
     DenoiseMethod still = DenoiseMethod::Auto;  // Kind::Still: the still method
     static Method none() { return {}; }
     static Method svgf() { return {Kind::Svgf, DenoiseMethod::Auto}; }
+    static Method temporal() { return {Kind::Temporal, DenoiseMethod::Auto}; }
     static Method of(DenoiseMethod m) { return {Kind::Still, m}; }
     bool operator==(const Method& o) const { return kind == o.kind && (kind != Kind::Still || still == o.still); }
     bool operator!=(const Method& o) const { return !(*this == o); }
@@ -58,6 +61,8 @@ struct PipelineSettings {
     // and report. The panel's controls are their tables' rows (params.h).
     DenoiseOptions denoise;
     SvgfParams svgf;
+    // The temporal method (run causal: TemporalParams::causal is forced), its still method auto.
+    TemporalParams temporal;
     // SVGF on camera motion: true = feed reprojection motion vectors computed from the depth buffer
     // and the previous camera (history survives the move); false = reset the history instead.
     bool svgfMotionVectors = true;
@@ -203,6 +208,15 @@ class ViewPipeline {
     bool mVarianceValid = false;
     mutable SlotResult mSlots[2];  // mutable: resultHost() fills the host copy on demand
     std::unique_ptr<SvgfDenoiser> mSvgf[2];
+    // The temporal slots' last frames (their own samples, on the host), oldest first, with their
+    // frame numbers for the cache; cleared with the SVGF histories.
+    struct HistoryFrame {
+        long long index = 0;
+        RenderBuffers b;  // motion and emission: the pipeline's (mMotion, mEmission)
+    };
+    std::deque<HistoryFrame> mHistory[2];
+    TemporalCache mTemporalCache[2];
+    void runTemporal(int i, const PipelineSettings& s, SlotResult& r);
     SvgfParams mSvgfParams[2];
     SvgfReport mSvgfReport[2];
     bool mSvgfResetPending = false;
