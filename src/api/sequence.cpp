@@ -54,9 +54,9 @@ std::string format(const char* fmt, ...) {
     return buf;
 }
 
-// Encodes the staged PNGs into stage/preview.mp4 (24 fps). Returns a note when it could not.
-std::string writeAnimatedPreview(const std::string& stage, int firstIndex, const std::string& finalDir, bool& wrote) {
-    wrote = false;
+// Encodes the staged PNGs into stage/preview.mp4 (24 fps). Returns "" when it did, else a note
+// saying why not.
+std::string writeAnimatedPreview(const std::string& stage, int firstIndex, const std::string& finalDir) {
     const std::string ffmpeg = io::findOnPath("ffmpeg");
     if (ffmpeg.empty())
         return "ffmpeg is not on PATH: skipping the animated preview (the per-frame PNGs are in " + finalDir + ")";
@@ -79,7 +79,6 @@ std::string writeAnimatedPreview(const std::string& stage, int firstIndex, const
         fs::remove(tmpPath, ec);
         return "warning: could not rename the animated preview into place";
     }
-    wrote = true;
     return "";
 }
 
@@ -318,10 +317,11 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
     report.filterMsPerFrame = filterMs / double(frames.size());
     report.wallMsPerFrame = wall.ms() / double(frames.size());
     if (args.preview && args.pngs) {
-        bool wrote = false;
-        const std::string problem = writeAnimatedPreview(stage, firstIndex, outDir, wrote);
-        if (!problem.empty()) note(problem);
-        if (wrote) report.preview = (fs::path(outDir) / "preview.mp4").string();
+        const std::string problem = writeAnimatedPreview(stage, firstIndex, outDir);
+        if (problem.empty())
+            report.preview = (fs::path(outDir) / "preview.mp4").string();
+        else
+            note(problem);
     }
     const std::string removed = staged.commit();
     if (!removed.empty()) {
