@@ -211,15 +211,8 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     const bool albedoGiven = set.get(io::Buffer::Albedo) != nullptr;
     // The colour, variance and emission were read to be denoised: the filter works in their
     // storage (DenoiseBuffers) and they are not read afterwards.
-    DenoiseBuffers in;
-    in.color = &color;
-    if (!set.image[int(io::Buffer::Variance)].empty()) in.variance = &set.image[int(io::Buffer::Variance)];
-    if (!set.image[int(io::Buffer::Emission)].empty()) in.emission = &set.image[int(io::Buffer::Emission)];
-    in.albedo = set.get(io::Buffer::Albedo);
-    in.normal = set.get(io::Buffer::Normal);
-    in.position = set.get(io::Buffer::Position);
-    in.depth = set.get(io::Buffer::Depth);
-    in.ids = set.get(io::Buffer::ObjectId);
+    DenoiseBuffers in = io::handOver(io::refsOf(set), color, &set.image[int(io::Buffer::Variance)],
+                                     &set.image[int(io::Buffer::Emission)]);
     static constexpr io::Buffer kLabelled[] = {io::Buffer::Color,    io::Buffer::Variance, io::Buffer::Albedo,
                                               io::Buffer::Normal,   io::Buffer::Position, io::Buffer::Depth,
                                               io::Buffer::ObjectId, io::Buffer::Emission};

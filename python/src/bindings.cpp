@@ -240,7 +240,6 @@ nb::object pyDenoise(const Array& color, nb::handle albedo, nb::handle normal, n
     b.add({{albedo, B::Albedo, "albedo"}, {normal, B::Normal, "normal"}, {position, B::Position, "position"},
            {depth, B::Depth, "depth"}, {variance, B::Variance, "variance"}, {ids, B::ObjectId, "ids"},
            {emission, B::Emission, "emission"}});
-    const DenoiseInputs in = io::denoiseInputs(b.refs);
     DenoiseOptions o;
     o.method = parseDenoiseMethod(method);
     o.learnedWeights = learnedWeights;  // "" = the built-in weights
@@ -248,10 +247,7 @@ nb::object pyDenoise(const Array& color, nb::handle albedo, nb::handle normal, n
     for (auto [k, v] : params) applyParam(o, denoiseParams(), nb::cast<std::string>(k), v, "denoise");
     // The colour, variance and emission are the binding's own copies (toImage): handed over, the
     // filter works in their storage instead of copying them again (as the CLI does).
-    DenoiseBuffers db;
-    db.color = &c;
-    db.variance = b.ownedCopy(B::Variance), db.emission = b.ownedCopy(B::Emission);
-    db.albedo = in.albedo, db.normal = in.normal, db.position = in.position, db.depth = in.depth, db.ids = in.ids;
+    DenoiseBuffers db = io::handOver(b.refs, c, b.ownedCopy(B::Variance), b.ownedCopy(B::Emission));
     Image out;
     {
         nb::gil_scoped_release release;

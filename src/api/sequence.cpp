@@ -197,15 +197,8 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
                                       &ids);
                 frameReport.methodUsed = temporalReport.spatial.methodUsed;
             } else {
-                // The frame's colour, variance and emission are not read after this: the filter works
-                // in their storage.
-                const DenoiseInputs in = io::denoiseInputs(refsOf(f));
-                DenoiseBuffers bufs;
-                bufs.color = &f.color;
-                bufs.variance = f.variance.empty() ? nullptr : &f.variance;
-                bufs.emission = f.emission.empty() ? nullptr : &f.emission;
-                bufs.albedo = in.albedo, bufs.normal = in.normal, bufs.position = in.position;
-                bufs.depth = in.depth, bufs.ids = in.ids;
+                // The frame's colour, variance and emission are not read after this: handed over.
+                DenoiseBuffers bufs = io::handOver(refsOf(f), f.color, &f.variance, &f.emission);
                 out = denoise(bufs, options);
             }
         } catch (const InputError& e) {

@@ -66,6 +66,16 @@ DenoiseInputs denoiseInputs(const BufferRefs& r) {
     return in;
 }
 
+DenoiseBuffers handOver(const BufferRefs& r, Image& color, Image* variance, Image* emission) {
+    const DenoiseInputs in = denoiseInputs(r);
+    DenoiseBuffers b;
+    b.color = &color;
+    b.variance = variance && !variance->empty() ? variance : nullptr;
+    b.emission = emission && !emission->empty() ? emission : nullptr;
+    b.albedo = in.albedo, b.normal = in.normal, b.position = in.position, b.depth = in.depth, b.ids = in.ids;
+    return b;
+}
+
 // The same buffers as denoiseInputs() gives, plus motion (SvgfFrame's order).
 SvgfFrame svgfFrame(const BufferRefs& r) {
     const DenoiseInputs in = denoiseInputs(r);

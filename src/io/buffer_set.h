@@ -63,6 +63,10 @@ BufferRefs refsOf(const SequenceFrame& f);  // all but the reference
 // albedo, normal, depth, ids, motion and emission (its variance is its own, from the history).
 DenoiseInputs denoiseInputs(const BufferRefs& r);
 SvgfFrame svgfFrame(const BufferRefs& r);
+// The same for denoise(DenoiseBuffers&): the colour, variance and emission are the caller's own
+// images (those r points at), handed over, so the filter works in their storage and they are not
+// read afterwards; the features are read only. An empty (or null) variance or emission is absent.
+DenoiseBuffers handOver(const BufferRefs& r, Image& color, Image* variance, Image* emission);
 
 // Whether a still denoiser that reads `use` (denoiseBufferUse) reads buffer b (colour always;
 // motion never: it is for sequences).
