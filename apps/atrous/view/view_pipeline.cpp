@@ -157,7 +157,7 @@ void ViewPipeline::resetAccumulation() {
     mSvgfResetPending = true;
 }
 
-void ViewPipeline::renderFrame(const PipelineSettings& s, bool svgf) {
+void ViewPipeline::renderFrame(const PipelineSettings& s, bool ownSamples) {
     RenderSettings rs;
     rs.width = mWidth;
     rs.height = mHeight;
@@ -184,8 +184,8 @@ void ViewPipeline::renderFrame(const PipelineSettings& s, bool svgf) {
     pt::SceneView sv = data.view();
     sv.camera = mCamera;
     auto k = detail::makePathTraceKernel(sv, pt::makeBvhTracer(mBvh->view(), data), mFrame, rs);
-    if (svgf) {
-        // SVGF's extra inputs straight from the renderer: the emission of the primary hit, and the
+    if (ownSamples) {
+        // SVGF's and the temporal method's extra inputs straight from the renderer: the emission of the primary hit, and the
         // motion of each sample's primary hit reprojected into the previous camera (averaged over
         // the pixel's samples; the scene is static, so only the camera moves).
         k.out.motion = mMotion.view();
@@ -440,9 +440,11 @@ void ViewPipeline::runTemporal(int i, const PipelineSettings& s, SlotResult& r) 
         if (mSvgfResetPending || (mCameraMoved && !s.svgfMotionVectors)) h.clear();
         HistoryFrame f;
         f.index = (long long)mFrameIndex;
-        for (const RenderBufferField& field : kRenderBufferFields)
-            if (!(frame().*field.image).empty()) f.b.*field.image = (frame().*field.image).clone();
-        f.b.motion = mMotion.clone();
+        for (const RenderBufferField& field : kRenderBufferFields) {
+            const bool pipelines = field.image == &RenderBuffers::motion || field.image == &RenderBuffers::emission;
+            if (!pipelines && !(frame().*field.image).empty()) f.b.*field.image = (frame().*field.image).clone();
+        }
+        f.b.motion = mMotion.clone();  // the pipeline's, as SVGF reads them
         f.b.emission = mEmission.clone();
         h.push_back(std::move(f));
         while (h.size() > size_t(p.radius) + 1) h.pop_front();
@@ -481,10 +483,8 @@ void ViewPipeline::step(const PipelineSettings& s) {
         c = now;
         t.reset();
     };
-    // SVGF and the temporal method take each frame's own samples, motion and emission.
-    auto perFrame = [](const Method& m) { return m == Method::svgf() || m == Method::temporal(); };
-    const bool svgf = perFrame(s.methodA) || (s.split && perFrame(s.methodB));
-    renderFrame(s, svgf);
+    const bool ownSamples = s.methodA.ownSamples() || (s.split && s.methodB.ownSamples());
+    renderFrame(s, ownSamples);
     lap(mTimes.render, mTimes.renderCpu);
 
     if (s.needAccumulated) {
@@ -495,7 +495,7 @@ void ViewPipeline::step(const PipelineSettings& s) {
     }
     lap(mTimes.accumulate, mTimes.accumulateCpu);
 
-    if (svgf) {
+    if (ownSamples) {
         if (!mRendererMotion) computeMotion();  // the CUDA renderer: motion from the depth buffer
         if (!frame().emission.empty())
             mEmission.copyFrom(frame().emission);  // same device: a host or a GPU-to-GPU copy
@@ -568,8 +568,7 @@ std::vector<std::string> ViewPipeline::saveBuffers(const std::string& dir) const
     put("position.exr", position());
     put("depth.exr", depth());
     put("ids.exr", ids());
-    auto perFrame = [](const Method& m) { return m == Method::svgf() || m == Method::temporal(); };
-    if (perFrame(mSlots[0].method) || perFrame(mSlots[1].method)) {
+    if (mSlots[0].method.ownSamples() || mSlots[1].method.ownSamples()) {
         put("motion.exr", motion());
         put("emission.exr", emission());
     }

@@ -37,6 +37,9 @@ struct Method {
     static Method svgf() { return {Kind::Svgf, DenoiseMethod::Auto}; }
     static Method temporal() { return {Kind::Temporal, DenoiseMethod::Auto}; }
     static Method of(DenoiseMethod m) { return {Kind::Still, m}; }
+    // SVGF and the temporal method take each frame's own samples (with motion and emission), not
+    // the running mean the still methods filter.
+    bool ownSamples() const { return kind == Kind::Svgf || kind == Kind::Temporal; }
     bool operator==(const Method& o) const { return kind == o.kind && (kind != Kind::Still || still == o.still); }
     bool operator!=(const Method& o) const { return !(*this == o); }
 };
@@ -167,7 +170,7 @@ class ViewPipeline {
     const Image& hostBuffer(Buffer b) const;
     // This frame's render: mFrame on the CPU, the CUDA renderer's device buffers on the GPU.
     const RenderBuffers& frame() const { return *mCur; }
-    void renderFrame(const PipelineSettings& s, bool svgf);
+    void renderFrame(const PipelineSettings& s, bool ownSamples);
     void accumulateFrame(bool accumulate);
     void computeMotion();
     void computeEmission();

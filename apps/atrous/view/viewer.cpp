@@ -71,8 +71,7 @@ ViewerState checkOptions(const ViewerOptions& opt) {
 void prepareStep(PipelineSettings& ps, BufferView view, int level, bool snapshot, bool finalDump, Device device) {
     ps.detailLevel = view == BufferView::Detail ? level : -1;
     ps.sureFractions = view == BufferView::SureFractions;
-    auto onRunningMean = [](Method m) { return m != Method::svgf() && m != Method::temporal(); };
-    ps.needAccumulated = onRunningMean(ps.methodA) || (ps.split && onRunningMean(ps.methodB)) ||
+    ps.needAccumulated = !ps.methodA.ownSamples() || (ps.split && !ps.methodB.ownSamples()) ||
                          !(view == BufferView::Result || view == BufferView::Motion) || snapshot || finalDump;
     // CUDA: results stay on the GPU; the host path downloads them only when it shows them
     // (resultHost), the interop path never.
