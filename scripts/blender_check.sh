@@ -7,8 +7,5 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/corpus/setup.sh
-WHEEL=$(ls build-py/wheel/atrous-*.whl 2>/dev/null | head -1 || true)
-[ -n "$WHEEL" ] || ./scripts/python_install.sh
-WHEEL=$(ls build-py/wheel/atrous-*.whl | head -1)
-.venv-corpus/bin/python -m pip install -q --no-deps --force-reinstall "$WHEEL"
+./scripts/install_wheel.sh .venv-corpus
 .venv-corpus/bin/python tests/blender/addon_check.py

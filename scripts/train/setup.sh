@@ -15,8 +15,4 @@ if ! { [ -x "$VENV/bin/python" ] && "$VENV/bin/python" -c "import jax, optax, nu
     "$VENV/bin/pip" install --quiet -r scripts/train/requirements.txt
     "$VENV/bin/python" -c "import jax, optax; print('jax', jax.__version__, 'optax', optax.__version__)"
 fi
-if ! ls build-py/wheel/atrous-*.whl >/dev/null 2>&1; then
-    ./scripts/setup.sh --python
-    ./scripts/python_install.sh
-fi
-"$VENV/bin/pip" install --quiet --no-deps --force-reinstall build-py/wheel/atrous-*.whl
+./scripts/install_wheel.sh "$VENV"
