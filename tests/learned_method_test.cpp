@@ -80,14 +80,8 @@ long firstDifference(const Image& a, const Image& b) {
 }
 
 // cornell-point at 8 spp, every buffer the filter reads.
-struct Rendered {
-    RenderBuffers b = render(Scene::builtin("cornell-point"), test::smallRender(48, 40, 8, 3));
-    DenoiseInputs inputs() const {
-        DenoiseInputs in;
-        in.color = &b.color, in.variance = &b.variance, in.albedo = &b.albedo, in.normal = &b.normal;
-        in.depth = &b.depth, in.emission = &b.emission;
-        return in;
-    }
+struct Rendered : test::RenderedInputs {
+    Rendered() : RenderedInputs("cornell-point", 48, 40, 8, 3) {}
 };
 
 double mse(const Image& a, const Image& ref) {

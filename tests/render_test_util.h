@@ -3,6 +3,7 @@
 #pragma once
 #include <cstdint>
 
+#include "atrous/denoise.h"
 #include "atrous/render.h"
 
 namespace atrous::test {
@@ -15,5 +16,19 @@ inline RenderSettings smallRender(int w, int h, int spp, uint32_t seed) {
     s.seed = seed;
     return s;
 }
+
+// A small render of a built-in scene with the buffers the still filters read (colour, variance,
+// albedo, normal, depth, emission), as DenoiseInputs.
+struct RenderedInputs {
+    RenderBuffers b;
+    RenderedInputs(const char* scene, int w, int h, int spp, uint32_t seed)
+        : b(render(Scene::builtin(scene), smallRender(w, h, spp, seed))) {}
+    DenoiseInputs inputs() const {
+        DenoiseInputs in;
+        in.color = &b.color, in.variance = &b.variance, in.albedo = &b.albedo, in.normal = &b.normal;
+        in.depth = &b.depth, in.emission = &b.emission;
+        return in;
+    }
+};
 
 }  // namespace atrous::test

@@ -4,6 +4,8 @@
 // (`atrous denoise`) and the benchmarks. The math is docs/denoising.md; the
 // parameters and how their defaults are derived are documented in docs/denoising.md.
 #pragma once
+#include <deque>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -24,7 +26,8 @@ namespace atrous {
 // every case measured and below the better of the two on the geometric mean at 16 spp
 // (docs/quality.md, "The default method"). Auto (the default): resolved by denoise() to Blend when
 // an albedo and a normal buffer are given, else Sure (DenoiseReport::methodUsed says which).
-enum class DenoiseMethod { Eaw, Sure, Learned, Auto, Blend };
+// Registered methods (registerDenoiseMethod, below) take the values after Blend.
+enum class DenoiseMethod : int { Eaw, Sure, Learned, Auto, Blend };
 
 // Per-pixel buffers, planar Images of the colour's size (see docs/rendering.md, "The buffers"):
 // 3 channels each (more are ignored), but depth (1: channel 0 is read) and ids (2: R and G).
@@ -211,17 +214,45 @@ struct DenoiseBufferUse {
 };
 DenoiseBufferUse denoiseBufferUse(const DenoiseOptions& options, DenoiseMethod resolved);
 
+// A registered method's own cascade (registerDenoiseMethod): given the planes every still method
+// is prepared with, it writes the filtered colour, in the same demodulated units, to `out` (3
+// planes of the colour's size on the planes' device); denoise() then applies the safety net (when
+// on), remodulates and adds the filtered emission back, as for the built-in methods.
+struct StillPlanes {
+    Device device = Device::Cpu;
+    ImageView color;     // c_0: sanitised, emission taken out, fireflies clamped, demodulated (3)
+    ImageView variance;  // its per-channel variance, given or estimated (3)
+    // The features, sanitised; invalid when not given (albedo also when demodulation is off).
+    ImageView albedo, normal, position;  // 3 channels each
+    ImageView depth;                     // 1
+    ImageView ids;                       // 2: R object, G material
+};
+using StillCascade = std::function<void(const StillPlanes& planes, const DenoiseOptions& options, const ImageView& out)>;
+
 // The still methods, one row each: the one list the CLI (--method, its help and messages, the
-// sequence check), `atrous bench`, and Python (atrous.METHODS, the farm, the evaluation) read, so
-// a new still method is a row here, an enum value and its branch in the driver
-// (docs/architecture.md, "A new denoising method").
+// sequence check), `atrous bench`, the viewer and Python (atrous.methods(), the farm, the
+// evaluation) read. The built-in methods' rows run the driver's own stages; a registered method
+// is a row with a cascade per device (registerDenoiseMethod), and nothing else needs an edit
+// (docs/architecture.md, "A new denoising method"; tests/toy_method.cpp is one).
 struct DenoiseMethodInfo {
     DenoiseMethod method;
     const char* name;     // "eaw", ...: the CLI's --method, Python's method=, the report's column
     const char* summary;  // one line for --help
     bool usesWeights;     // reads the learned filter's weights (DenoiseOptions::learnedWeights)
+    // A registered method's cascade on the CPU and on CUDA (empty: not on that device); empty
+    // for the built-in methods.
+    StillCascade cpu = {}, cuda = {};
+    bool registered() const { return bool(cpu) || bool(cuda); }
 };
-const std::vector<DenoiseMethodInfo>& denoiseMethods();  // eaw, sure, learned, blend, auto
+// The rows in order: eaw, sure, learned, blend, auto, then the registered methods. The references
+// stay valid while the program runs.
+const std::deque<DenoiseMethodInfo>& denoiseMethods();
+// Adds a still method: `info.name` (a new name of letters, digits, '_' or '-'), its summary and
+// at least one cascade; `info.method` is ignored, and the method's new value returned (pass it as
+// DenoiseOptions::method, or the name to the CLI and Python). Call it before any denoise() of the
+// program runs (it is not synchronised with them). InputError for a taken or malformed name, or
+// no cascade.
+DenoiseMethod registerDenoiseMethod(DenoiseMethodInfo info);
 const DenoiseMethodInfo* findDenoiseMethod(const std::string& name);  // null when unknown
 const DenoiseMethodInfo& denoiseMethodInfo(DenoiseMethod m);          // the method's row
 // The names in order, "eaw, sure, learned, blend or auto".

@@ -57,21 +57,57 @@ __all__ = [
     "WEIGHTED_METHODS",
     "denoise_methods",
     "sequence_methods",
+    "methods",
+    "register_method",
 ]
 
 __version__ = "0.1.0"
 
-# The still methods, from the library's one list (denoiseMethods(), include/atrous/denoise.h).
-METHODS = tuple(str(r["name"]) for r in _core.denoise_methods())
-# The methods that denoise a sequence as a sequence (sequenceMethods(), include/atrous/temporal.h):
-# temporal (denoise_temporal, the CLI's --sequence default) and svgf (Svgf).
-SEQUENCE_METHODS = tuple(str(r["name"]) for r in _core.sequence_methods())
-# Those that read the learned filter's weights (learned_weights= applies to them).
-WEIGHTED_METHODS = tuple(str(r["name"]) for r in _core.denoise_methods() if r["uses_weights"])
+# METHODS (the still methods), SEQUENCE_METHODS (those that denoise a sequence as a sequence:
+# temporal, svgf) and WEIGHTED_METHODS (those that read the learned filter's weights) are read from
+# the library's registry when asked for (module __getattr__), so a method added with
+# register_method is in them from then on.
+def __getattr__(name: str) -> Any:
+    if name == "METHODS":
+        return tuple(str(r["name"]) for r in _core.denoise_methods())
+    if name == "SEQUENCE_METHODS":
+        return tuple(str(r["name"]) for r in _core.sequence_methods())
+    if name == "WEIGHTED_METHODS":
+        return tuple(str(r["name"]) for r in _core.denoise_methods() if r["uses_weights"])
+    raise AttributeError(f"module 'atrous' has no attribute '{name}'")
+
+
+def methods() -> list:
+    """Every method, one dict each, from the library's registry: name, kind ("still": a method of
+    :func:`denoise`; "sequence": of :func:`denoise_sequence` / :class:`Svgf`), summary and
+    registered (added with :func:`register_method`). The still methods come first, in the order of
+    the CLI's ``--method`` help."""
+    rows = [dict(name=str(r["name"]), kind="still", summary=str(r["summary"]), registered=bool(r["registered"]))
+            for r in _core.denoise_methods()]
+    rows += [dict(name=str(r["name"]), kind="sequence", summary=str(r["summary"]), registered=False)
+             for r in _core.sequence_methods()]
+    return rows
+
+
+def register_method(name: str, cascade: Any, summary: str = "") -> None:
+    """Adds a still method to the library's registry: from then on it is a `method=` of
+    :func:`denoise` (and of the farm's denoise job, docs/farm.md "Plugins"), and in
+    :func:`methods`. `cascade(planes, out)` filters: `planes` is a dict of H x W x C float32 arrays,
+    read-only views of the filter's own planes, prepared as for every method (sanitised, the
+    emission taken out, fireflies clamped, demodulated by the albedo): color and variance (3
+    channels), albedo, normal, position (3), depth (1) and ids (2; R object, G material), None when
+    not given; `out` (H x W x 3, writable) receives the filtered colour in the same units. The
+    library then applies the safety net (when on), remodulates and adds the filtered emission
+    back. The views are valid during the call only. The CPU only; the name must be new (letters,
+    digits, '_', '-'), else ValueError. An exception in `cascade` reaches the caller of denoise
+    as RuntimeError naming it. docs/python.md has an example."""
+    if not callable(cascade):
+        raise ValueError(f"register_method: cascade must be callable (got {type(cascade).__name__})")
+    _core.register_method(str(name), str(summary), cascade)
 
 
 def denoise_methods() -> list:
-    """The still methods, one dict per method: name, summary, uses_weights (the library's list)."""
+    """The still methods, one dict per method: name, summary, uses_weights, registered (the library's list)."""
     return [dict(r) for r in _core.denoise_methods()]
 
 
@@ -242,8 +278,9 @@ def denoise(
 
     Returns the denoised H x W x 3 float32 image as the same kind of array as `color`.
     """
-    if method not in METHODS:
-        raise ValueError(f"unknown method '{method}' (expected one of {', '.join(METHODS)})")
+    known = __getattr__("METHODS")
+    if method not in known:
+        raise ValueError(f"unknown method '{method}' (expected one of {', '.join(known)})")
     if device not in ("auto", "cpu", "cuda"):
         raise ValueError(f"unknown device '{device}' (expected auto, cpu or cuda)")
     weights = "" if learned_weights is None else os.fsdecode(os.fspath(learned_weights))

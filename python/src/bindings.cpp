@@ -32,6 +32,10 @@
 namespace nb = nanobind;
 using namespace atrous;
 
+namespace atrous::python {
+void bindMethods(nb::module_& m);  // methods.cpp: register_method
+}
+
 namespace {
 
 using Array = nb::ndarray<nb::ro>;  // any dtype, shape, strides and device: checked below
@@ -188,14 +192,15 @@ nb::dict resolveParams(const ParamTable<S>& t, nb::dict params, const char* what
 
 // A method registry for Python (atrous.denoise_methods(), atrous.sequence_methods()): one dict per
 // row, its name, summary and the registry's one flag under `flagName`.
-template <class Info>
-nb::list methodRows(const std::vector<Info>& infos, const char* flagName, bool Info::*flag) {
+template <class Rows, class Info>
+nb::list methodRows(const Rows& infos, const char* flagName, bool Info::*flag) {
     nb::list rows;
     for (const Info& i : infos) {
         nb::dict d;
         d["name"] = i.name;
         d["summary"] = i.summary;
         d[flagName] = i.*flag;
+        if constexpr (std::is_same_v<Info, DenoiseMethodInfo>) d["registered"] = i.registered();
         rows.append(d);
     }
     return rows;
@@ -540,6 +545,7 @@ void pyWriteImage(const std::string& path, const Array& image) {
 }  // namespace
 
 NB_MODULE(_core, m) {
+    atrous::python::bindMethods(m);
     m.doc() = "atrous native core (use the `atrous` package, not this module)";
     nb::register_exception_translator([](const std::exception_ptr& p, void*) {
         try {

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -28,8 +29,12 @@
 
 namespace atrous {
 
-const std::vector<DenoiseMethodInfo>& denoiseMethods() {
-    static const std::vector<DenoiseMethodInfo> kMethods = {
+namespace {
+
+// The registry: the built-in rows, then the registered ones (a deque: rows never move, so the
+// references and names handed out stay valid), with the registered names' storage beside them.
+struct MethodRegistry {
+    std::deque<DenoiseMethodInfo> rows = {
         {DenoiseMethod::Eaw, "eaw", "the edge-avoiding a-trous wavelet filter (Dammertz et al. 2010)", false},
         {DenoiseMethod::Sure, "sure", "EAW's cascade keeping part of each detail, chosen by SURE (Kim, Moon, Yoon 2016)", false},
         {DenoiseMethod::Learned, "learned", "a small network steering the a-trous cascade (docs/learned.md)", true},
@@ -37,7 +42,35 @@ const std::vector<DenoiseMethodInfo>& denoiseMethods() {
         {DenoiseMethod::Auto, "auto", "blend with an albedo and a normal, else sure: the method measured best for the buffers given",
          true},
     };
-    return kMethods;
+    std::deque<std::string> strings;
+};
+
+MethodRegistry& registry() {
+    static MethodRegistry r;
+    return r;
+}
+
+}  // namespace
+
+const std::deque<DenoiseMethodInfo>& denoiseMethods() { return registry().rows; }
+
+DenoiseMethod registerDenoiseMethod(DenoiseMethodInfo info) {
+    const std::string name = info.name ? info.name : "";
+    bool ok = !name.empty() && name.size() <= 64;
+    for (char ch : name) ok = ok && (std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-');
+    if (!ok) throw InputError("registerDenoiseMethod: '" + name + "' is not a method name (letters, digits, '_', '-')");
+    if (findDenoiseMethod(name)) throw InputError("registerDenoiseMethod: there is already a method '" + name + "'");
+    if (!info.registered()) throw InputError("registerDenoiseMethod: method '" + name + "' has no cascade (cpu or cuda)");
+    if (info.usesWeights)
+        throw InputError("registerDenoiseMethod: method '" + name + "': a registered cascade cannot read the learned weights");
+    MethodRegistry& r = registry();
+    info.method = static_cast<DenoiseMethod>(r.rows.size());  // the built-ins are 0..4
+    r.strings.push_back(name);
+    info.name = r.strings.back().c_str();
+    r.strings.push_back(info.summary ? info.summary : "");
+    info.summary = r.strings.back().c_str();
+    r.rows.push_back(std::move(info));
+    return r.rows.back().method;
 }
 
 const DenoiseMethodInfo* findDenoiseMethod(const std::string& name) {
@@ -49,7 +82,7 @@ const DenoiseMethodInfo* findDenoiseMethod(const std::string& name) {
 const DenoiseMethodInfo& denoiseMethodInfo(DenoiseMethod m) {
     for (const DenoiseMethodInfo& i : denoiseMethods())
         if (i.method == m) return i;
-    throw std::logic_error("denoiseMethodInfo: a DenoiseMethod without a row in denoiseMethods()");
+    throw InputError("unknown denoise method (value " + std::to_string(static_cast<int>(m)) + ", not in denoiseMethods())");
 }
 
 std::string denoiseMethodNames() {
@@ -343,13 +376,14 @@ PreparedInputs prepareInputsDropping(const DenoiseInputs& given, const DenoiseOp
     }
     const DenoiseBufferUse use = denoiseBufferUse(o, o.method);
     const bool learned = o.method == DenoiseMethod::Learned;
-    const bool network = denoiseMethodInfo(o.method).usesWeights;  // the learned cascade runs
+    const DenoiseMethodInfo& info = denoiseMethodInfo(o.method);
+    const bool network = info.usesWeights;  // the learned cascade runs
     if (in.albedo) used += use.albedo ? ",albedo" : ",albedo(unused: demodulation off)";
     if (in.normal) used += ",normal";
     if (in.position) used += use.position ? ",position" : ",position(unused by learned)";
     // Depth steers the depth stop (sigma-depth > 0), the learned network, and, without a usable
     // variance, the noise estimate's geometric edges.
-    if (in.depth) used += network || o.eaw.sigmaDepth > 0 || rep.noiseEstimated ? ",depth" : ",depth(unused: sigma-depth 0)";
+    if (in.depth) used += network || info.registered() || o.eaw.sigmaDepth > 0 || rep.noiseEstimated ? ",depth" : ",depth(unused: sigma-depth 0)";
     if (in.ids) used += use.ids ? ",ids" : learned ? ",ids(unused by learned)" : ",ids(unused)";
     if (in.emission) used += ",emission";
     rep.buffersUsed = used;
@@ -488,9 +522,13 @@ Image denoiseWith(const DenoiseInputs& given, const DenoiseOptions& options, con
     DenoiseInputs inputs = given;
     DenoiseOptions o = options;
     o.method = resolveDenoiseMethod(options.method, inputs);
+    const DenoiseMethodInfo& info = denoiseMethodInfo(o.method);
+    if (info.registered() && !(o.device == Device::Cuda ? info.cuda : info.cpu))
+        throw InputError(std::string("method '") + info.name + "' has no cascade for " +
+                         (o.device == Device::Cuda ? "CUDA" : "the CPU"));
     // The weights before any work: a bad file is an InputError naming it, nothing computed.
     LearnedWeights weights;
-    if (denoiseMethodInfo(o.method).usesWeights)
+    if (info.usesWeights)
         weights = o.weights.impl              ? o.weights
                   : o.learnedWeights.empty() ? LearnedWeights::builtin()
                                              : LearnedWeights::load(o.learnedWeights);

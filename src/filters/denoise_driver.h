@@ -191,9 +191,14 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     const bool blend = o.method == DenoiseMethod::Blend;
     const bool sure = o.method == DenoiseMethod::Sure || blend;
     const bool learned = o.method == DenoiseMethod::Learned;  // the learned method alone
-    const bool network = denoiseMethodInfo(o.method).usesWeights;  // the learned cascade runs
+    const DenoiseMethodInfo& info = denoiseMethodInfo(o.method);
+    const bool network = info.usesWeights;  // the learned cascade runs
     const int levels = o.eaw.levels;
     constexpr bool kHost = std::is_same<Exec, CpuExec>::value;
+    // A registered method's cascade (registerDenoiseMethod) in place of stages 4-5 (denoise()
+    // has checked that it has one for this device). It reads every feature given, and no zeros.
+    const StillCascade* own = info.registered() ? (kHost ? &info.cpu : &info.cuda) : nullptr;
+    const bool givenOnly = learned || own;  // the features as given (invalid when absent)
     // The CPU row engine compiles the depth and id terms out when they are off: their planes are
     // then never read (the functor path, CUDA's and the tests' reference, reads them whatever).
     bool rowEngine = false;
@@ -254,18 +259,19 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     }
     // (The learned method reads no position, and a normal only when given: no zero planes for it.)
     Image normalStore, positionStore, depthStore, idsStore;
-    const ImageView normal = learned && !in.normal.valid() ? ImageView{} : sanitizedFeature(exec, in.normal, w, h, 3, normalStore);
-    const ImageView position = learned ? ImageView{} : sanitizedFeature(exec, in.position, w, h, 3, positionStore);
-    // Depth: for the learned network, the depth stop, and the noise estimate's edge test.
-    const bool depthStop = !learned && o.eaw.sigmaDepth > 0 && in.depth.valid();
-    const bool needDepth = network || depthStop || noise || out.planes;
+    const ImageView normal = givenOnly && !in.normal.valid() ? ImageView{} : sanitizedFeature(exec, in.normal, w, h, 3, normalStore);
+    const ImageView position = learned || (own && !in.position.valid()) ? ImageView{}
+                                                                         : sanitizedFeature(exec, in.position, w, h, 3, positionStore);
+    // Depth: for the learned network, the depth stop, the noise estimate's edge test, a registered cascade.
+    const bool depthStop = !givenOnly && o.eaw.sigmaDepth > 0 && in.depth.valid();
+    const bool needDepth = network || own || depthStop || noise || out.planes;
     ImageView depth;
     if (needDepth && in.depth.valid()) depth = sanitizedFeature(exec, in.depth, w, h, 1, depthStore);
-    else if (!rowEngine && !learned) depth = sanitizedFeature(exec, ImageView{}, w, h, 1, depthStore);  // zeros
-    const bool idStop = !learned && o.eaw.useIds && in.ids.valid();
+    else if (!rowEngine && !givenOnly) depth = sanitizedFeature(exec, ImageView{}, w, h, 1, depthStore);  // zeros
+    const bool idStop = !learned && o.eaw.useIds && in.ids.valid();  // (a registered cascade: the ids given)
     ImageView ids;
     if (idStop) ids = sanitizedFeature(exec, in.ids, w, h, 2, idsStore);
-    else if (!rowEngine && !learned) ids = sanitizedFeature(exec, ImageView{}, w, h, 2, idsStore);  // zeros
+    else if (!rowEngine && !givenOnly) ids = sanitizedFeature(exec, ImageView{}, w, h, 2, idsStore);  // zeros
     markStage(out.clock, "sanitize");
 
     // 2. Fireflies (before demodulation: the outlier is in radiance), into new planes: c_0 and
@@ -334,7 +340,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     // The safety net's input y and its summed variance, kept before the cascade overwrites them.
     // The albedo give-back reads the same y. With the learned cascade, after it (it only reads y),
     // when its own temporaries are gone: Blend's peak is then SURE's plus one plane set.
-    const bool giveBack = cfg.albedoGiveBack && !learned && albedo.valid();
+    const bool giveBack = cfg.albedoGiveBack && !givenOnly && albedo.valid();
     Image safetyIn, safetyVar;
     auto keepInput = [&] {
         if (o.safety.enabled || giveBack) {
@@ -364,7 +370,23 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         keepInput();
         if (o.safety.enabled || giveBack) markStage(out.clock, "keep input");
     }
-    if (!learned) {
+    if (own) {
+        // 4-5. A registered method's cascade, into learnedOut's planes.
+        learnedOut = spareC.empty() ? planes(3) : std::move(spareC);
+        // (A clean feature may be the caller's own image, with more channels than it stands for.)
+        auto first = [](ImageView v, int n) { return v.valid() ? ImageView{v.data, v.width, v.height, n} : v; };
+        StillPlanes P;
+        P.device = dev;
+        P.color = cA.view(), P.variance = vA.view(), P.albedo = first(albedo, 3);
+        P.normal = first(in.normal.valid() ? normal : ImageView{}, 3);
+        P.position = first(in.position.valid() ? position : ImageView{}, 3);
+        P.depth = first(in.depth.valid() ? depth : ImageView{}, 1);
+        P.ids = first(ids, 2);
+        (*own)(P, o, learnedOut.view());
+        cur = &learnedOut;
+        markStage(out.clock, info.name);
+    }
+    if (!givenOnly) {
         // 4. Per-pixel scales of the automatic σ_c and σ_x (1/σ_z only for the depth stop). The
         // colour scale S, 1/σ_x² and each level's 1/σ_c² factors (EawLevel::rS) are the three planes
         // of `sigmas`, var(c_0)'s buffer when the firefly pass freed it.

@@ -312,6 +312,20 @@ def test_evaluate_sweep_dataset_and_denoise_jobs(cluster, tmp_path):
     want = [f"scene_00000{i}/spp_{n}/denoised_eaw.{ext}" for i in (0, 1) for n in (1, 2) for ext in ("exr", "png")]
     assert files_of(dn) == [".farm.lock", "manifest.json"] + want
 
+    # A method a plugin registers (tests/python/toy_plugin.py, atrous.register_method): the driver
+    # and every worker load it, and the workers' output is the library's in this process.
+    tn = tmp_path / "toy"
+    plugin = Path(__file__).with_name("toy_plugin.py")
+    r = farm(["denoise", "--in", str(ds / "scene_000000" / "spp_2"), "--method", "toy", "--plugin", str(plugin),
+              "--address", cluster.address, "--out", str(tn), "--quiet"], env=env)
+    assert r.returncode == 0, r.stderr
+    import toy_plugin  # noqa: F401 (registers toy here too)
+    from atrous.farm.tasks import denoise_buffers, read_buffers
+
+    want_toy = denoise_buffers(read_buffers(ds / "scene_000000" / "spp_2"), "toy", {}, "cpu")
+    np.testing.assert_array_equal(atrous.read_image(tn / "spp_2" / "denoised_toy.exr"), want_toy)
+    assert manifest(tn)["spec"]["plugins"] == [str(plugin.resolve())]
+
 
 @pytest.mark.parametrize("args,needle", [
     (["render", "--scenes", "no-such-scene", "--spp", "2"], "no-such-scene"),
@@ -322,6 +336,8 @@ def test_evaluate_sweep_dataset_and_denoise_jobs(cluster, tmp_path):
     (["render", "--scenes", "cornell", "--address", "127.0.0.1:1"], "no Ray head answers"),
     (["render", "--dataset", "SPEC"], "SPEC"),
     (["denoise", "--in", "IN", "--method", "bilateral"], "bilateral"),
+    (["denoise", "--in", "IN", "--method", "toy", "--plugin", "no_such_plugin.py"], "no_such_plugin.py"),
+    (["denoise", "--in", "IN", "--plugin", "no_such_module_xyz"], "no_such_module_xyz"),
     (["denoise", "--in", "IN", "--param", "sigma_colour=1"], "sigma_colour"),
     (["denoise", "--in", "IN", "--method", "temporal", "--param", "temporal_radios=1"], "radios"),
     (["denoise", "--in", "IN", "--method", "temporal", "--param", "spatial=nope"], "nope"),

@@ -194,7 +194,7 @@ def test_eval_takes_learned_and_auto(tmp_path):
     # The report compares the best atrous method (learned among them) with OIDN.
     from atrous.eval import report
 
-    assert "learned" in report.ATROUS_METHODS and "learned" in report.COLORS
+    assert "learned" in atrous.METHODS and "learned" in report.COLORS
 
 
 def test_svgf_learned_spatial_takes_the_given_weights(tmp_path):

@@ -32,7 +32,13 @@ import atrous
 
 __all__ = ["EvalConfig", "run_eval", "main", "load_oidn", "oidn_inputs", "time_call", "score"]
 
-ALL_METHODS = ("noisy",) + atrous.METHODS + ("oidn",)
+
+
+def all_methods() -> tuple:
+    """What --methods may name: noisy, the library's still methods (as registered now), oidn."""
+    return ("noisy",) + atrous.METHODS + ("oidn",)
+
+
 # The default set (--methods not given). learned (the learned à-trous filter, docs/learned.md) and
 # auto (learned with an albedo and a normal, which every render here has: the same as learned) are
 # taken when asked for: --methods noisy,eaw,sure,learned,oidn.
@@ -143,7 +149,7 @@ def build_methods(names: Sequence[str], notes: List[str],
             else:
                 out[name] = fn
         else:
-            raise ValueError(f"--methods: unknown method '{name}' (expected {', '.join(ALL_METHODS)})")
+            raise ValueError(f"--methods: unknown method '{name}' (expected {', '.join(all_methods())})")
     return out
 
 
@@ -496,7 +502,7 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> EvalConfig:
     p.add_argument("--spp", help="comma list of input samples per pixel (default 4,16,64)")
     p.add_argument("--size", help="image size, N or WxH (default 256)")
     p.add_argument("--ref-spp", type=int, help="samples per pixel of the references (default 1024)")
-    p.add_argument("--methods", help=f"comma list from {','.join(ALL_METHODS)} "
+    p.add_argument("--methods", help=f"comma list from {','.join(all_methods())} "
                    f"(default: {','.join(DEFAULT_METHODS)})")
     p.add_argument("--learned-weights", metavar="FILE",
                    help="weight file of the learned filter for learned/auto (default: the built-in weights)")
@@ -534,10 +540,10 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> EvalConfig:
         cfg.ref_spp = a.ref_spp
     if a.methods is not None:
         cfg.methods = [m.strip() for m in a.methods.split(",") if m.strip()]
-        bad = [m for m in cfg.methods if m not in ALL_METHODS]
+        bad = [m for m in cfg.methods if m not in all_methods()]
         if bad or not cfg.methods:
             raise UsageError(f"--methods: unknown {', '.join(bad) or repr(a.methods)} "
-                             f"(expected {', '.join(ALL_METHODS)})")
+                             f"(expected {', '.join(all_methods())})")
     if a.learned_weights is not None:
         if not os.path.isfile(a.learned_weights):
             raise UsageError(f"--learned-weights: '{a.learned_weights}' is not a file")

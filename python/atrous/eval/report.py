@@ -12,7 +12,6 @@ import numpy as np
 
 import atrous
 
-ATROUS_METHODS = atrous.METHODS
 COLORS = {"noisy": "#7f7f7f", "eaw": "#1f77b4", "sure": "#2ca02c", "learned": "#ff7f0e", "blend": "#17becf", "auto": "#8c564b",
           "oidn": "#d62728", "svgf": "#9467bd", "temporal": "#e377c2",
           "render 1 spp": "#000000"}
@@ -54,7 +53,7 @@ def summarise(data: Dict[str, Any]) -> Dict[str, Any]:
             pm["db_per_10ms"] = pm["psnr_gain_mean_db"] / pm["median_ms"] * 10.0
     findings: List[str] = []
     versus: List[Dict[str, Any]] = []
-    present = [m for m in ATROUS_METHODS if m in data["methods"]]
+    present = [m for m in atrous.METHODS if m in data["methods"]]
     if "oidn" in data["methods"] and present:
         for sc, spp in cases:
             o = by.get((sc, spp, "oidn"))

@@ -12,7 +12,7 @@ import sys
 from typing import Any, Dict, List, Optional, Sequence
 
 from . import jobs
-from .items import DENOISE_METHODS, EVAL_CHOICES, EVAL_METHODS, FarmInputError, parse_assignments
+from .items import EVAL_METHODS, FarmInputError, denoise_choices, eval_choices, parse_assignments
 from .runner import JobResult, print_summary
 
 PROG = "python -m atrous.farm"
@@ -68,15 +68,18 @@ def _parser() -> argparse.ArgumentParser:
                    help="a render directory (color.exr, ...), a frame sequence (frame_NNNN/) or a directory of "
                         "them, such as a render job's --out; repeat or comma-separate")
     d.add_argument("--method", default="auto",
-                   help=f"{', '.join(DENOISE_METHODS)} (default auto: blend with an albedo and a normal, else sure)")
+                   help=f"{', '.join(denoise_choices())} (default auto: blend with an albedo and a normal, else sure)")
     d.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                    help="a filter parameter, named as atrous.denoise's keywords (levels=4, sigma_color=0.5)")
+    d.add_argument("--plugin", action="append", default=[], metavar="FILE.py|MODULE",
+                   help="a Python file or module that adds still methods (atrous.register_method), loaded "
+                        "here and in every worker; repeat for more (docs/farm.md, 'Plugins')")
     _run_flags(d)
 
     e = sub.add_parser("evaluate", help="the quality benchmark: methods x scenes x spp against references")
     e.add_argument("--scenes", default="cornell,cornell-spheres")
     e.add_argument("--spp", default="4,16")
-    e.add_argument("--methods", default=",".join(EVAL_METHODS), help=f"comma list from {','.join(EVAL_CHOICES)} (default {','.join(EVAL_METHODS)})")
+    e.add_argument("--methods", default=",".join(EVAL_METHODS), help=f"comma list from {','.join(eval_choices())} (default {','.join(EVAL_METHODS)})")
     _eval_flags(e)
     e.add_argument("--runs", type=int, default=3, help="timed denoise runs per item after a warm-up (median kept)")
     _run_flags(e)
@@ -124,7 +127,8 @@ def run(argv: Optional[Sequence[str]] = None) -> JobResult:
                            camera_path=a.camera_path, reference_spp=a.reference_spp, **kw)
     if a.job == "denoise":
         inputs: List[str] = [p for v in a.inputs for p in v.split(",") if p]
-        return jobs.denoise(a.out, inputs, a.method, parse_assignments(a.param, "--param", lists=False), **kw)
+        return jobs.denoise(a.out, inputs, a.method, parse_assignments(a.param, "--param", lists=False),
+                            plugins=a.plugin, **kw)
     if a.job == "evaluate":
         return jobs.evaluate(a.out, a.scenes, a.spp, a.methods, width=a.width, height=a.height, ref_spp=a.ref_spp,
                              seed=a.seed, ref_seed=a.ref_seed, runs=a.runs, max_depth=a.max_depth, **kw)

@@ -20,15 +20,26 @@ import numpy as np
 import atrous
 
 __all__ = ["Item", "FarmInputError", "scene_label", "check_scenes", "parse_value", "check_denoise_params",
-           "discover_inputs", "DENOISE_METHODS", "EVAL_METHODS", "EVAL_CHOICES", "split_temporal_params"]
+           "discover_inputs", "denoise_choices", "EVAL_METHODS", "eval_choices", "split_temporal_params"]
 
-# The still methods, OIDN, and the sequence methods (temporal, svgf: the library's lists).
-DENOISE_METHODS = atrous.METHODS + ("oidn",) + atrous.SEQUENCE_METHODS
+
+def denoise_choices() -> tuple:
+    """The still methods, OIDN, and the sequence methods (temporal, svgf): the library's lists as
+    they are now (with the methods a plugin registered)."""
+    return atrous.METHODS + ("oidn",) + atrous.SEQUENCE_METHODS
+
+
 # The temporal method's own parameters travel as temporal_<name> (the CLI's --temporal-<name>), and
 # its still method as spatial=...; the rest are the still method's.
 TEMPORAL_PREFIX = "temporal_"
 EVAL_METHODS = ("noisy", "eaw", "sure", "oidn")  # the default set
-EVAL_CHOICES = EVAL_METHODS + tuple(m for m in atrous.METHODS if m not in EVAL_METHODS)  # what an evaluation may ask for
+
+
+def eval_choices() -> tuple:
+    """What an evaluation may ask for: the default set, then the library's other still methods."""
+    return EVAL_METHODS + tuple(m for m in atrous.METHODS if m not in EVAL_METHODS)
+
+
 _FRAME = re.compile(r"^frame_(\d{4,})$")
 _SEED_MAX = 2 ** 32 - 1
 

@@ -10,9 +10,10 @@ from typing import Any, Dict, List, Optional, Sequence, Union
 import atrous
 
 from . import dataset as _dataset
-from .items import (DENOISE_METHODS, EVAL_CHOICES, EVAL_METHODS, FarmInputError, Item, check_denoise_params, check_scenes,
-                    discover_inputs, grid_points, int_list, name_list, params_label, positive_int, scene_label)
+from .items import (EVAL_METHODS, FarmInputError, Item, check_denoise_params, check_scenes, denoise_choices,
+                    discover_inputs, eval_choices, grid_points, int_list, name_list, params_label, positive_int, scene_label)
 from .manifest import Manifest
+from .plugins import load_plugins, resolve_plugins
 from .runner import JobResult, run_job
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -80,20 +81,24 @@ def render_dataset(out: PathLike, spec: Union[Dict[str, Any], PathLike], **run: 
 
 
 def denoise(out: PathLike, inputs: Any, method: str = "auto", params: Optional[Dict[str, Any]] = None,
-            **run: Any) -> JobResult:
+            plugins: Any = None, **run: Any) -> JobResult:
     """Render directories and frame sequences through one method: OUT/<name>/denoised_<method>.exr
     and .png per render directory, OUT/<sequence>/frame_NNNN.exr and .png per frame (svgf: one
     item per sequence, its frames in order; temporal: one item per frame, which reads the frames
-    around it: params temporal_<name> are its own, spatial=METHOD its still method)."""
-    if method not in DENOISE_METHODS:
-        raise FarmInputError(f"method: unknown '{method}' (expected {', '.join(DENOISE_METHODS)})")
+    around it: params temporal_<name> are its own, spatial=METHOD its still method). plugins: Python
+    files or modules that register still methods (atrous.register_method), loaded here and in every
+    worker (plugins.py)."""
+    plugins = resolve_plugins(plugins)
+    load_plugins(plugins)
+    if method not in denoise_choices():
+        raise FarmInputError(f"method: unknown '{method}' (expected {', '.join(denoise_choices())})")
     params = dict(params or {})
     check_denoise_params(method, params, "params")
     found = discover_inputs([str(p) for p in ([inputs] if isinstance(inputs, (str, os.PathLike)) else inputs)],
                             "inputs")
     items = []
     for f in found:
-        base = {"method": method, "params": params}
+        base = {"method": method, "params": params, **({"plugins": plugins} if plugins else {})}
         if method in atrous.SEQUENCE_METHODS and f["kind"] != "sequence":
             raise FarmInputError(f"inputs: {f['path']}: {method} denoises frame sequences (frame_NNNN/), "
                                  "this is a single render")
@@ -112,7 +117,8 @@ def denoise(out: PathLike, inputs: Any, method: str = "auto", params: Optional[D
                 iid = f"{f['name']}/{fr}"
                 items.append(Item(iid, "denoise", dict(base, input=str(Path(f["path"]) / fr)),
                                   [iid + ".exr", iid + ".png"]))
-    spec = {"inputs": [f["path"] for f in found], "method": method, "params": params}
+    spec = {"inputs": [f["path"] for f in found], "method": method, "params": params,
+            **({"plugins": plugins} if plugins else {})}
     return run_job("denoise", spec, items, Path(out), **run)
 
 
@@ -193,8 +199,8 @@ def evaluate(out: PathLike, scenes: Any = ("cornell", "cornell-spheres"), spp: A
         raise FarmInputError("ref_seed: must differ from seed (the reference would share the input's noise)")
     methods = name_list(methods, "methods")
     for m in methods:
-        if m not in EVAL_CHOICES:
-            raise FarmInputError(f"methods: unknown '{m}' (expected {', '.join(EVAL_CHOICES)})")
+        if m not in eval_choices():
+            raise FarmInputError(f"methods: unknown '{m}' (expected {', '.join(eval_choices())})")
     runs = positive_int(runs, "runs", 1, 1000)
     items = _references(scenes, size, ref_spp, ref_seed, max_depth)
     items += _scored("evaluate", scenes, spp, size, seed, max_depth, None, methods, runs)

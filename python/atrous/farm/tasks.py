@@ -22,6 +22,8 @@ import numpy as np
 
 import atrous
 
+from .plugins import load_plugins
+
 BUFFERS = ("color", "variance", "albedo", "normal", "position", "depth", "ids", "emission")
 PARTIAL = ".partial"
 REFERENCE_SEED_OFFSET = 0x9E3779B9  # `atrous render --frames --reference-spp`: references use seed + this
@@ -314,6 +316,7 @@ def run_item(item: Dict[str, Any], out_root: str, threads: int, device: str, tra
             res.update(status="failed", error=f"needs {failed_dep.get('id')}, which failed: {failed_dep.get('error')}",
                        error_kind=failed_dep.get("error_kind") or "runtime")
         else:
+            load_plugins(item["params"].get("plugins") or [])  # the methods a plugin registers
             res["result"] = RUNNERS[item["kind"]](item, Path(out_root), threads, device)
     except ValueError as e:  # bad input: the library's InputError, a missing buffer
         res.update(status="failed", error=str(e), error_kind="input")

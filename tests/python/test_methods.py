@@ -1,0 +1,83 @@
+"""A still method added from Python is one registry row plus its policy (issue 31): the toy of
+toy_plugin.py registered with atrous.register_method is in atrous.methods(), METHODS and the
+evaluation's and farm's method lists, and denoise(method="toy") is its cascade on the prepared
+planes, then the remodulation. The farm's workers load it with --plugin (test_farm.py). Errors:
+a taken name, a non-callable, a cascade that raises or writes where it may not."""
+import numpy as np
+import pytest
+
+import atrous
+import toy_plugin
+from atrous.eval import all_methods
+from atrous.farm.items import denoise_choices, eval_choices
+
+
+def _render():
+    return atrous.render("cornell", width=24, height=20, spp=4, seed=3, max_depth=3)
+
+
+def test_the_toy_is_in_every_list():
+    rows = {r["name"]: r for r in atrous.methods()}
+    assert rows["toy"]["kind"] == "still" and rows["toy"]["registered"]
+    assert rows["eaw"]["registered"] is False and rows["svgf"]["kind"] == "sequence"
+    assert [r["name"] for r in atrous.methods()][:5] == ["eaw", "sure", "learned", "blend", "auto"]
+    assert "toy" in atrous.METHODS and "toy" not in atrous.WEIGHTED_METHODS
+    assert "toy" in all_methods() and "toy" in denoise_choices() and "toy" in eval_choices()
+
+
+def test_denoise_is_the_cascade_on_the_prepared_planes_then_remodulation():
+    b = _render()
+    for albedo in (b["albedo"], None):
+        got = atrous.denoise(b["color"], albedo=albedo, normal=b["normal"], variance=b["variance"],
+                             emission=b["emission"], method="toy")
+        p = atrous.learned_planes(b["color"], variance=b["variance"], albedo=albedo, normal=b["normal"],
+                                  emission=b["emission"])
+        f = np.empty_like(p["d"])
+        toy_plugin.toy_cascade({"color": p["d"], "albedo": p.get("albedo")}, f)
+        want = f * p["mod"] + p["emission"]
+        # The library's remodulation is one float32 multiply-add per sample, as numpy's here.
+        np.testing.assert_allclose(got, want, rtol=1e-6, atol=1e-7)
+        assert not np.array_equal(got, b["color"])
+
+
+def test_planes_are_views_of_the_right_shape_and_read_only():
+    b = _render()
+    seen = {}
+
+    def spy(planes, out):
+        seen.update({k: (None if v is None else (v.shape, v.flags.writeable)) for k, v in planes.items()})
+        seen["out"] = (out.shape, out.flags.writeable)
+        out[...] = planes["color"]
+
+    atrous.register_method("spy", spy)
+    got = atrous.denoise(b["color"], albedo=b["albedo"], normal=b["normal"], depth=b["depth"], ids=b["ids"],
+                         method="spy", firefly=False)
+    assert seen["color"] == ((20, 24, 3), False) and seen["variance"] == ((20, 24, 3), False)
+    assert seen["depth"] == ((20, 24, 1), False) and seen["ids"] == ((20, 24, 2), False)
+    assert seen["position"] is None and seen["out"] == ((20, 24, 3), True)
+    assert np.isfinite(got).all()
+
+
+def test_bad_registrations_and_cascades():
+    with pytest.raises(ValueError, match="already a method 'toy'"):
+        atrous.register_method("toy", toy_plugin.toy_cascade)
+    with pytest.raises(ValueError, match="already a method 'sure'"):
+        atrous.register_method("sure", toy_plugin.toy_cascade)
+    with pytest.raises(ValueError, match="not a method name"):
+        atrous.register_method("no good", toy_plugin.toy_cascade)
+    with pytest.raises(ValueError, match="callable"):
+        atrous.register_method("notcallable", 3)
+    b = _render()
+
+    def boom(planes, out):
+        raise KeyError("nope")
+
+    def writes_input(planes, out):
+        planes["color"][0, 0, 0] = 1.0
+
+    atrous.register_method("boom", boom)
+    atrous.register_method("writes-input", writes_input)
+    with pytest.raises(RuntimeError, match="KeyError"):
+        atrous.denoise(b["color"], method="boom")
+    with pytest.raises(RuntimeError, match="read-only"):
+        atrous.denoise(b["color"], method="writes-input")

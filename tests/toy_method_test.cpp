@@ -1,0 +1,149 @@
+// A new still method is one registry row plus its policy (issue 31): tests/toy_method.cpp registers
+// "toy" (the toy edge-stop policy of tests/toy_policy.h as a three-level cascade) and nothing else
+// is edited. Linked into this test, the viewer's pipeline lists and runs it; linked with the CLI's
+// objects (atrous_toy), `denoise --help` lists it and `denoise --method toy` runs it, while the
+// CLI without it refuses the name. denoise() with it is the cascade on the prepared planes, then
+// the remodulation, bit for bit. Python's registry (atrous.register_method) and the farm's
+// --plugin are tests/python/test_methods.py.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "atrous/denoise.h"
+#include "atrous/error.h"
+#include "atrous/render.h"
+#include "filters/denoise_internal.h"
+#include "io/image_io.h"
+#include "render_test_util.h"
+#include "test_util.h"
+#include "toy_method.h"
+#include "view/view_pipeline.h"
+
+namespace atrous {
+namespace {
+
+struct Rendered : test::RenderedInputs {
+    Rendered() : RenderedInputs("cornell", 32, 24, 4, 3) {}
+};
+
+TEST(ToyMethod, IsARowOfTheRegistry) {
+    const DenoiseMethodInfo* m = findDenoiseMethod("toy");
+    ASSERT_NE(m, nullptr);
+    EXPECT_EQ(m->method, toy::toyMethod());
+    EXPECT_TRUE(m->registered());
+    EXPECT_FALSE(m->usesWeights);
+    EXPECT_EQ(parseDenoiseMethod("toy"), toy::toyMethod());
+    EXPECT_STREQ(denoiseMethodName(toy::toyMethod()), "toy");
+    EXPECT_NE(denoiseMethodNames().find("toy"), std::string::npos);
+    // The built-in rows keep their order and come first.
+    EXPECT_STREQ(denoiseMethods().front().name, "eaw");
+    EXPECT_EQ(&denoiseMethodInfo(toy::toyMethod()), m);
+    // A taken or malformed name, no cascade, or the weights: an InputError, nothing added.
+    const size_t n = denoiseMethods().size();
+    EXPECT_THROW(registerDenoiseMethod({DenoiseMethod::Eaw, "toy", "again", false, toy::toyCascade}), InputError);
+    EXPECT_THROW(registerDenoiseMethod({DenoiseMethod::Eaw, "sure", "again", false, toy::toyCascade}), InputError);
+    EXPECT_THROW(registerDenoiseMethod({DenoiseMethod::Eaw, "a b", "", false, toy::toyCascade}), InputError);
+    EXPECT_THROW(registerDenoiseMethod({DenoiseMethod::Eaw, "", "", false, toy::toyCascade}), InputError);
+    EXPECT_THROW(registerDenoiseMethod({DenoiseMethod::Eaw, "bare", "", false}), InputError);
+    EXPECT_THROW(registerDenoiseMethod({DenoiseMethod::Eaw, "weighted", "", true, toy::toyCascade}), InputError);
+    EXPECT_EQ(denoiseMethods().size(), n);
+    // A value no row has is an InputError, not undefined behaviour.
+    DenoiseOptions o;
+    o.method = static_cast<DenoiseMethod>(999);
+    const Rendered r;
+    EXPECT_THROW(denoise(r.inputs(), o), InputError);
+}
+
+TEST(ToyMethod, IsItsCascadeOnThePreparedPlanesThenRemodulate) {
+    const Rendered r;
+    for (bool albedo : {true, false}) {
+        DenoiseInputs in = r.inputs();
+        if (!albedo) in.albedo = nullptr;
+        DenoiseOptions o;
+        o.method = toy::toyMethod();
+        DenoiseReport rep;
+        o.report = &rep;
+        const Image out = denoise(in, o);
+        EXPECT_EQ(rep.methodUsed, toy::toyMethod());
+        bool staged = false;
+        for (const StageTime& s : rep.stages) staged = staged || s.name == "toy";
+        EXPECT_TRUE(staged) << "no stage 'toy'";
+        o.report = nullptr;
+        const filters::PreparedPlanes p = filters::learnedPlanes(in, o);
+        StillPlanes P;
+        P.color = p.d.view(), P.variance = p.var.view();
+        if (!p.albedo.empty()) P.albedo = p.albedo.view();
+        Image f(32, 24, 3);
+        toy::toyCascade(P, o, f.view());
+        long differ = -1, changed = -1;
+        for (int y = 0; y < 24 && differ < 0; ++y)
+            for (int x = 0; x < 32; ++x)
+                for (int c = 0; c < 3; ++c) {
+                    if (!(out(x, y, c) == f(x, y, c) * p.mod(x, y, c) + p.emission(x, y, c))) differ = long(c) * 1000 + y * 32 + x;
+                    if (out(x, y, c) != r.b.color(x, y, c)) changed = 1;
+                }
+        EXPECT_EQ(differ, -1) << "albedo " << albedo;
+        EXPECT_EQ(changed, 1) << "it filtered";
+    }
+    // No CUDA cascade: on CUDA an InputError naming the method (whether or not a GPU is present).
+    DenoiseOptions o;
+    o.method = toy::toyMethod();
+    o.device = Device::Cuda;
+    try {
+        denoise(r.inputs(), o);
+        ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("'toy' has no cascade for CUDA"), std::string::npos) << e.what();
+    }
+}
+
+TEST(ToyMethod, TheViewerListsAndRunsIt) {
+    using namespace view;
+    const auto& names = methodNames();
+    EXPECT_NE(std::find(names.begin(), names.end(), "toy"), names.end());
+    const Method m = parseMethod("toy");
+    EXPECT_EQ(m, Method::of(toy::toyMethod()));
+    EXPECT_STREQ(methodName(m), "toy");
+    ViewPipeline pl(Scene::builtin("cornell"), 32, 24, Device::Cpu, 1);
+    PipelineSettings s;
+    s.methodA = m;
+    s.maxDepth = 3;
+    for (int i = 0; i < 2; ++i) pl.step(s);
+    const SlotResult& r = pl.slot(0);
+    EXPECT_TRUE(r.error.empty()) << r.error;
+    ASSERT_EQ(r.image.width(), 32);
+    EXPECT_EQ(r.method, m);
+}
+
+#ifdef ATROUS_TOY_CLI
+TEST(ToyMethod, TheCliWithItListsAndRunsItAndTheOneWithoutRefusesIt) {
+    const std::string toyCli = ATROUS_TOY_CLI;
+    test::CliResult h = test::runShell(toyCli + " denoise --help");
+    EXPECT_EQ(h.exitCode, 0) << h.output;
+    EXPECT_NE(h.output.find("toy: a toy"), std::string::npos) << h.output;
+    test::TempDir dir;
+    const Rendered r;
+    const std::string in = dir / "r";
+    std::filesystem::create_directories(in);
+    io::writeImage(in + "/color.exr", r.b.color);
+    io::writeImage(in + "/albedo.exr", r.b.albedo);
+    io::writeImage(in + "/normal.exr", r.b.normal);
+    const std::string out = dir / "o.exr";
+    test::CliResult run = test::runShell(toyCli + " denoise --in " + in + " --out " + out + " --method toy");
+    EXPECT_EQ(run.exitCode, 0) << run.output;
+    EXPECT_NE(run.output.find("method toy"), std::string::npos) << run.output;
+    EXPECT_TRUE(std::filesystem::exists(out));
+    // The project's own CLI has no such method: one line, exit 2, nothing written.
+    const std::string out2 = dir / "o2.exr";
+    test::CliResult plain = test::runCli("denoise --in " + in + " --out " + out2 + " --method toy");
+    EXPECT_EQ(plain.exitCode, 2) << plain.output;
+    EXPECT_NE(plain.output.find("toy"), std::string::npos) << plain.output;
+    EXPECT_FALSE(std::filesystem::exists(out2));
+    test::CliResult plainHelp = test::runCli("denoise --help");
+    EXPECT_EQ(plainHelp.output.find("toy: a toy"), std::string::npos);
+}
+#endif
+
+}  // namespace
+}  // namespace atrous
