@@ -22,7 +22,7 @@
 #include "atrous/device.h"
 #include "bench_cli.h"
 #include "core/math.h"
-#include "core/timer.h"
+#include "atrous/timer.h"
 #include "render/bvh.h"
 #include "render/bvh_build.h"
 

@@ -20,7 +20,7 @@
 #include "atrous/denoise.h"
 #include "../tests/denoise_test_util.h"  // inputsOf
 #include "bench_cli.h"
-#include "core/timer.h"
+#include "atrous/timer.h"
 
 using namespace atrous;
 

@@ -24,8 +24,8 @@
 #include "atrous/denoise.h"
 #include "atrous/error.h"
 #include "bench_cli.h"
-#include "core/timer.h"
-#include "io/buffer_set.h"
+#include "atrous/timer.h"
+#include "atrous/io/buffer_set.h"
 
 using namespace atrous;
 

@@ -14,7 +14,7 @@
 #include "atrous/device.h"
 #include "bench_cli.h"
 #include "atrous/render.h"
-#include "core/timer.h"
+#include "atrous/timer.h"
 #include "render/bvh_render.h"
 
 using namespace atrous;

@@ -20,7 +20,7 @@
 #include "atrous/learned.h"
 #include "bench_cli.h"
 #include "core/parallel.h"
-#include "core/timer.h"
+#include "atrous/timer.h"
 #include "filters/learned.h"
 
 using namespace atrous;

@@ -14,7 +14,7 @@
 #include "atrous/device.h"
 #include "bench_cli.h"
 #include "atrous/render.h"
-#include "core/timer.h"
+#include "atrous/timer.h"
 
 // CPU seconds (user + system) this process has used: on a shared machine, samples per CPU-second
 // is a figure the other tenants do not distort as much as wall-clock throughput.

@@ -25,7 +25,7 @@
 #include "atrous/device.h"
 #include "atrous/error.h"
 #include "atrous/svgf.h"
-#include "core/timer.h"
+#include "atrous/timer.h"
 #include "filters/svgf_atrous.h"
 #include "bench_cli.h"
 

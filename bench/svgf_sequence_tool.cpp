@@ -34,8 +34,8 @@
 #include "../apps/atrous/denoise_sequence.cpp"  // runSequenceDenoise and the SVGF flags without the CLI wiring
 #include "atrous/error.h"
 #include "atrous/metrics.h"
-#include "io/image_io.h"
-#include "io/sequence.h"
+#include "atrous/io/image_io.h"
+#include "atrous/io/sequence.h"
 
 namespace {
 

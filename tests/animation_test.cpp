@@ -10,7 +10,7 @@
 #include "atrous/error.h"
 #include "atrous/render.h"
 #include "core/sampler.h"
-#include "io/image_io.h"
+#include "atrous/io/image_io.h"
 #include "render/animation.h"
 #include "render/camera.h"
 #include "render/scene_data.h"

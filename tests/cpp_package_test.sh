@@ -17,14 +17,14 @@ step() { echo "== $*"; }
 
 step "install into $prefix"
 "$cmake" --install "$build" --prefix "$prefix" > "$tmp/install.log" || { cat "$tmp/install.log"; fail "cmake --install"; }
-for f in include/atrous/denoise.h include/atrous/io.h bin/atrous; do
+for f in include/atrous/denoise.h include/atrous/io.h include/atrous/io/buffer_set.h bin/atrous; do
   [ -e "$prefix/$f" ] || fail "$f was not installed"
 done
 config=$(find "$prefix" -name atrousConfig.cmake)
 [ -n "$config" ] || fail "no atrousConfig.cmake under the prefix"
 [ -e "$(dirname "$config")/atrousConfigVersion.cmake" ] || fail "no atrousConfigVersion.cmake"
 # The installed headers must stand alone: none may include an internal (src/) header.
-if grep -l '#include "\(core\|io\|render\|filters\|cpu\|cuda\)/' "$prefix"/include/atrous/*.h; then
+if grep -rl --include='*.h' '#include "\(core\|io\|render\|filters\|cpu\|cuda\)/' "$prefix"/include/atrous; then
   fail "an installed header includes an internal header"
 fi
 

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "denoise_test_util.h"
-#include "io/image_io.h"
+#include "atrous/io/image_io.h"
 #include "test_util.h"
 
 using namespace atrous;

@@ -20,9 +20,9 @@
 
 #include "atrous/error.h"
 #include "exr_fixture.h"
-#include "io/exr_layers.h"
-#include "io/image_io.h"
-#include "io/pass_map.h"
+#include "atrous/io/exr_layers.h"
+#include "atrous/io/image_io.h"
+#include "atrous/io/pass_map.h"
 
 using namespace atrous;
 using namespace atrous::test;

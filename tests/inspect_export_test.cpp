@@ -9,9 +9,9 @@
 #include <string>
 
 #include "denoise_test_util.h"
-#include "io/buffer_set.h"
-#include "io/exr_layers.h"
-#include "io/image_io.h"
+#include "atrous/io/buffer_set.h"
+#include "atrous/io/exr_layers.h"
+#include "atrous/io/image_io.h"
 #include "test_util.h"
 
 using namespace atrous;

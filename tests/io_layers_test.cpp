@@ -14,10 +14,10 @@
 
 #include "atrous/error.h"
 #include "denoise_test_util.h"
-#include "io/buffer_set.h"
-#include "io/exr_layers.h"
-#include "io/image_io.h"
-#include "io/pass_map.h"
+#include "atrous/io/buffer_set.h"
+#include "atrous/io/exr_layers.h"
+#include "atrous/io/image_io.h"
+#include "atrous/io/pass_map.h"
 #include "test_util.h"
 
 using namespace atrous;

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "atrous/error.h"
-#include "io/image_io.h"
+#include "atrous/io/image_io.h"
 #include "test_util.h"
 
 using namespace atrous;

@@ -24,7 +24,7 @@
 #include "denoise_test_util.h"
 #include "filters/denoise_internal.h"
 #include "filters/learned.h"
-#include "io/image_io.h"
+#include "atrous/io/image_io.h"
 #include "learned_fixture.h"
 #include "render_test_util.h"
 #include "test_util.h"
@@ -113,7 +113,7 @@ TEST(LearnedMethod, IsRunLearnedOnThePreparedPlanesThenRemodulate) {
         if (!k.depth) in.depth = nullptr;
         const DenoiseOptions o = learnedOptions(wpath);
         const Image out = denoise(in, o);
-        filters::PreparedPlanes p = filters::learnedPlanes(in, o);
+        PreparedPlanes p = learnedPlanes(in, o);
         ASSERT_EQ(p.albedo.empty(), !k.albedo);
         ASSERT_EQ(p.normal.empty(), !k.normal);
         ASSERT_EQ(p.depth.empty(), !k.depth);
@@ -176,7 +176,7 @@ TEST(LearnedMethod, RunsOnARenderedSceneWithinTheRangeOfItsPlanes) {
     const DenoiseOptions o = learnedOptions(wpath);
     const Image out = denoise(r.inputs(), o);
     ASSERT_TRUE(allFinite(out));
-    const filters::PreparedPlanes p = filters::learnedPlanes(r.inputs(), o);
+    const PreparedPlanes p = learnedPlanes(r.inputs(), o);
     for (int c = 0; c < 3; ++c) {
         float lo = INFINITY, hi = -INFINITY;
         for (size_t i = 0; i < p.d.plane(); ++i) lo = std::fmin(lo, p.d.view().channel(c)[i]), hi = std::fmax(hi, p.d.view().channel(c)[i]);

@@ -22,7 +22,7 @@
 #include "atrous/error.h"
 #include "atrous/render.h"
 #include "atrous/svgf.h"
-#include "io/image_io.h"
+#include "atrous/io/image_io.h"
 #include "denoise_test_util.h"
 #include "test_util.h"
 

@@ -11,7 +11,7 @@
 #include "atrous/error.h"
 #include "atrous/render.h"
 #include "core/rng.h"
-#include "io/image_io.h"
+#include "atrous/io/image_io.h"
 #include "render/bsdf.h"
 #include "render/camera.h"
 #include "render/lights.h"

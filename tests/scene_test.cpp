@@ -7,7 +7,7 @@
 
 #include "atrous/error.h"
 #include "atrous/render.h"
-#include "io/image_io.h"
+#include "atrous/io/image_io.h"
 #include "render/scene_data.h"
 #include "test_util.h"
 

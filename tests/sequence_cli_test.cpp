@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "io/image_io.h"
+#include "atrous/io/image_io.h"
 #include "test_util.h"
 
 using atrous::test::countEntries;

@@ -13,7 +13,7 @@
 
 #include "atrous/image.h"
 #include "atrous/metrics.h"
-#include "io/image_io.h"
+#include "atrous/io/image_io.h"
 #include "test_util.h"
 
 using atrous::test::runCli;

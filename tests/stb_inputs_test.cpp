@@ -12,7 +12,7 @@
 
 #include "atrous/error.h"
 #include "exr_fixture.h"
-#include "io/image_io.h"
+#include "atrous/io/image_io.h"
 
 using namespace atrous;
 using namespace atrous::test;

@@ -17,8 +17,8 @@
 #include "atrous/svgf.h"
 #include "core/parallel.h"
 #include "filters/svgf_pipeline.h"
-#include "io/image_io.h"
-#include "io/sequence.h"
+#include "atrous/io/image_io.h"
+#include "atrous/io/sequence.h"
 #include "learned_fixture.h"
 #include "svgf_test_util.h"
 #include "test_util.h"
@@ -27,7 +27,7 @@
 // compile its translation unit into this test so they can be tested as functions. The session
 // itself is the library's (include/atrous/sequence.h).
 #include "../apps/atrous/denoise_sequence.cpp"
-#include "io/staged_dir.h"
+#include "atrous/io/staged_dir.h"
 
 using namespace atrous;
 using namespace atrous::svgf_test;

@@ -15,8 +15,8 @@
 #include "atrous/svgf.h"
 #include "core/parallel.h"
 #include "filters/svgf_pipeline.h"
-#include "io/image_io.h"
-#include "io/sequence.h"
+#include "atrous/io/image_io.h"
+#include "atrous/io/sequence.h"
 #include "svgf_test_util.h"
 #include "test_util.h"
 

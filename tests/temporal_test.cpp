@@ -12,7 +12,7 @@
 #include "atrous/error.h"
 #include "atrous/params.h"
 #include "atrous/temporal.h"
-#include "io/image_io.h"
+#include "atrous/io/image_io.h"
 #include "svgf_test_util.h"
 #include "test_util.h"
 

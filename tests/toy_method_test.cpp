@@ -14,7 +14,7 @@
 #include "atrous/error.h"
 #include "atrous/render.h"
 #include "filters/denoise_internal.h"
-#include "io/image_io.h"
+#include "atrous/io/image_io.h"
 #include "render_test_util.h"
 #include "test_util.h"
 #include "toy_method.h"
@@ -70,7 +70,7 @@ TEST(ToyMethod, IsItsCascadeOnThePreparedPlanesThenRemodulate) {
         for (const StageTime& s : rep.stages) staged = staged || s.name == "toy";
         EXPECT_TRUE(staged) << "no stage 'toy'";
         o.report = nullptr;
-        const filters::PreparedPlanes p = filters::learnedPlanes(in, o);
+        const PreparedPlanes p = learnedPlanes(in, o);
         StillPlanes P;
         P.color = p.d.view(), P.variance = p.var.view();
         if (!p.albedo.empty()) P.albedo = p.albedo.view();

@@ -15,7 +15,7 @@
 
 #include "atrous/device.h"
 #include "atrous/image.h"
-#include "io/image_io.h"
+#include "atrous/io/image_io.h"
 #include "test_util.h"
 
 using atrous::Image;

@@ -21,9 +21,7 @@
 #include "atrous/render.h"
 #include "atrous/svgf.h"
 #include "commands.h"
-#include "core/memory.h"
-#include "core/timer.h"
-#include "render/bvh_render.h"
+#include "atrous/timer.h"
 
 namespace atrous::cli {
 namespace {
@@ -151,7 +149,7 @@ void run(const BenchArgs& a) {
     for (auto& s : split(a.sizes)) sizes.push_back(parseSize(s));
     if (sizes.empty()) throw InputError("--sizes: no size given");
     Scene scene = Scene::loadByNameOrFile(a.scene);
-    std::unique_ptr<CudaBvhRenderer> cudaRenderer;  // made on first use (--device cuda)
+    std::unique_ptr<SceneRenderer> cudaRenderer;  // made on first use (--device cuda)
 
     nlohmann::json doc;
     doc["device"] = deviceToString(device);
@@ -191,11 +189,11 @@ void run(const BenchArgs& a) {
             if (device == Device::Cuda) {
                 // The CUDA path tracer as the viewer runs it: one persistent renderer (scene and BVH
                 // uploaded once, outside the timing), 1 spp into its device buffers, no download.
-                // renderOnDevice returns after the kernel has finished, so the wall clock covers it.
-                if (!cudaRenderer) cudaRenderer = std::make_unique<CudaBvhRenderer>(scene);
+                // renderInPlace returns after the kernel has finished, so the wall clock covers it.
+                if (!cudaRenderer) cudaRenderer = std::make_unique<SceneRenderer>(scene, Device::Cuda);
                 auto tc = repeat(a.warmup, runs, [&] {
                     Timer tt;
-                    cudaRenderer->renderOnDevice(one);
+                    cudaRenderer->renderInPlace(one);
                     return tt.ms();
                 });
                 nlohmann::json rc = renderRow(tc, "cuda");
@@ -254,7 +252,7 @@ void run(const BenchArgs& a) {
             if (device == Device::Cuda && !learned) {
                 // Achieved bandwidth of the compulsory traffic, against the GPU's peak.
                 const double bytes = cudaDenoiseTrafficBytes(o, in, w, h);
-                const double peak = detail::cudaPeakBandwidthGBs();
+                const double peak = cudaPeakBandwidthGBs();
                 const double achieved = bytes / (median(t) * 1e-3) / 1e9;
                 r["model_dram_mb"] = bytes / 1e6;
                 r["achieved_gb_s"] = achieved;

@@ -19,10 +19,10 @@
 #include "atrous/error.h"
 #include "atrous/metrics.h"
 #include "commands.h"
-#include "io/staged_dir.h"
-#include "io/image_io.h"
-#include "io/paths.h"
-#include "io/sequence.h"
+#include "atrous/io/staged_dir.h"
+#include "atrous/io/image_io.h"
+#include "atrous/io/paths.h"
+#include "atrous/io/sequence.h"
 
 namespace atrous::cli {
 

@@ -11,12 +11,12 @@
 #include "atrous/learned.h"
 #include "cli_flags.h"
 #include "commands.h"
-#include "core/timer.h"
+#include "atrous/timer.h"
 #include "denoise_sequence.h"
-#include "core/srgb.h"
-#include "io/buffer_set.h"
-#include "io/image_io.h"
-#include "io/paths.h"
+#include "atrous/srgb.h"
+#include "atrous/io/buffer_set.h"
+#include "atrous/io/image_io.h"
+#include "atrous/io/paths.h"
 
 namespace atrous::cli {
 

@@ -14,12 +14,12 @@
 #include "atrous/error.h"
 #include "cli_flags.h"
 #include "commands.h"
-#include "io/buffer_set.h"
-#include "io/exr_layers.h"
-#include "io/image_io.h"
-#include "io/pass_map.h"
-#include "io/paths.h"
-#include "io/sequence.h"
+#include "atrous/io/buffer_set.h"
+#include "atrous/io/exr_layers.h"
+#include "atrous/io/image_io.h"
+#include "atrous/io/pass_map.h"
+#include "atrous/io/paths.h"
+#include "atrous/io/sequence.h"
 
 namespace atrous::cli {
 

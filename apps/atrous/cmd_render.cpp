@@ -14,10 +14,9 @@
 #include "atrous/render.h"
 #include "cli_flags.h"
 #include "commands.h"
-#include "core/timer.h"
-#include "io/image_io.h"
-#include "render/bvh_render.h"
-#include "io/sequence.h"
+#include "atrous/timer.h"
+#include "atrous/io/image_io.h"
+#include "atrous/io/sequence.h"
 #include "progress.h"
 
 namespace atrous::cli {
@@ -163,7 +162,7 @@ void run(const RenderArgs& a) {
     ProgressLine progress(!a.quiet && stderrIsTerminal() && device == Device::Cpu, "render",
                           uint64_t(s.width) * uint64_t(s.height) * uint64_t(s.spp));
     rs.samplesDone = progress.counter();
-    RenderBuffers b = device == Device::Cuda ? renderBvhCuda(scene, s) : render(scene, rs);
+    RenderBuffers b = render(scene, device == Device::Cuda ? s : rs, device);
     progress.finish();
     double seconds = timer.seconds();
 

@@ -14,7 +14,7 @@
 #include <string>
 #include <thread>
 
-#include "core/timer.h"
+#include "atrous/timer.h"
 
 namespace atrous::cli {
 

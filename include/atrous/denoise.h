@@ -202,6 +202,22 @@ struct DenoiseBuffers {
 };
 Image denoise(DenoiseBuffers& buffers, const DenoiseOptions& options);
 
+// The planes every still method is prepared with, as host images: what denoise() does before any
+// filter (validation, noise estimate, sanitise, the emission split and filter, fireflies,
+// demodulation), on the CPU. For training (atrous.learned_planes) and for checking a registered
+// method against its cascade: with the safety net off, denoise()'s output is
+// filtered(d) * mod + emission. albedo (none given, or demodulation off), normal and depth are
+// empty when absent; mod and emission are always there (1 and 0 without an albedo or an emission).
+struct PreparedPlanes {
+    Image d, var, albedo, normal, depth, mod, emission;
+};
+PreparedPlanes learnedPlanes(const DenoiseInputs& inputs, const DenoiseOptions& options);
+
+// denoise() with method Sure on the CPU, and SURE's kept fraction s_i(p) of each level's detail in
+// `fractions` (one channel per level; levels below sure.firstLevel are 0): the viewer's debug view.
+// InputError for another method or device.
+Image denoiseWithSureFractions(const DenoiseInputs& inputs, const DenoiseOptions& options, Image& fractions);
+
 // Throws ParamError (atrous/params.h: an InputError naming the field, `sigma_normal`) when a
 // parameter is out of range; the ranges are the rows of denoiseParams().
 void validateDenoiseOptions(const DenoiseOptions& options);

@@ -25,5 +25,8 @@ void requireCuda();
 // instruction set its row loops run (ATROUS_CPU_ISA, docs/development.md), or the GPU's name.
 // Used in benchmark JSON.
 std::string deviceName(Device d);
+// The GPU's theoretical peak DRAM bandwidth in GB/s (memory clock x bus width x 2, from its device
+// attributes), for benchmarks that compare achieved traffic with it; 0 without a GPU.
+double cudaPeakBandwidthGBs();
 
 }  // namespace atrous

@@ -135,6 +135,33 @@ void validateRenderSettings(const RenderSettings& settings);
 // Renders `scene` on the CPU (validates the settings first). motion stays empty; emission is filled.
 RenderBuffers render(const Scene& scene, const RenderSettings& settings);
 
+// Renders `scene` on `device`: Device::Cpu is render() above (Embree); Device::Cuda the CUDA path
+// tracer (the same per-pixel kernel over atrous's BVH), whose buffers come back to the host.
+// InputError (a ParamError naming `device`) for CUDA without the backend or a GPU.
+RenderBuffers render(const Scene& scene, const RenderSettings& settings, Device device);
+
+// Repeated renders of one scene (benchmarks, interactive loops): on CUDA the BVH is built and the
+// scene uploaded once, and the buffers stay on the GPU between calls; on the CPU each call is
+// render(). Construction on CUDA throws as render(..., Device::Cuda) does.
+class SceneRenderer {
+public:
+    SceneRenderer(const Scene& scene, Device device);
+    ~SceneRenderer();
+    SceneRenderer(SceneRenderer&&) noexcept;
+    SceneRenderer& operator=(SceneRenderer&&) noexcept;
+    Device device() const { return mDevice; }
+    // Host buffers, equal to render(scene, settings, device)'s.
+    RenderBuffers render(const RenderSettings& settings);
+    // The render where it was made, owned by the renderer and valid until its next call: on CUDA
+    // its device buffers (the kernel has finished when it returns), on the CPU a host render.
+    const RenderBuffers& renderInPlace(const RenderSettings& settings);
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> mImpl;
+    Device mDevice;
+};
+
 // Renders frame time t of the animated `scene` (as loaded) on the CPU, with motion vectors against
 // time tPrev (pass tPrev = t for a first frame: then every motion vector is 0 up to rounding).
 RenderBuffers renderFrame(const Scene& scene, CameraPath path, float t, float tPrev, const RenderSettings& settings);

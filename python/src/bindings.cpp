@@ -25,9 +25,8 @@
 #include "atrous/sequence.h"
 #include "atrous/svgf.h"
 #include "atrous/temporal.h"
-#include "filters/denoise_internal.h"
-#include "io/buffer_set.h"
-#include "io/image_io.h"
+#include "atrous/io/buffer_set.h"
+#include "atrous/io/image_io.h"
 
 namespace nb = nanobind;
 using namespace atrous;
@@ -262,7 +261,7 @@ nb::object pyDenoise(const Array& color, nb::handle albedo, nb::handle normal, n
     return fromImage(std::move(out));
 }
 
-// The learned filter's prepared planes (filters::learnedPlanes): d, var, albedo, normal, depth
+// The learned filter's prepared planes (learnedPlanes): d, var, albedo, normal, depth
 // (the last three only when given), mod and emission, on the host, for training.
 nb::dict pyLearnedPlanes(const Array& color, nb::handle variance, nb::handle albedo, nb::handle normal,
                          nb::handle depth, nb::handle emission, nb::dict params) {
@@ -275,10 +274,10 @@ nb::dict pyLearnedPlanes(const Array& color, nb::handle variance, nb::handle alb
     const DenoiseInputs in = io::denoiseInputs(b.refs);
     DenoiseOptions o;
     for (auto [k, v] : params) applyParam(o, denoiseParams(), nb::cast<std::string>(k), v, "denoise");
-    filters::PreparedPlanes p;
+    PreparedPlanes p;
     {
         nb::gil_scoped_release release;
-        p = filters::learnedPlanes(in, o);
+        p = learnedPlanes(in, o);
     }
     nb::dict d;
     const std::pair<const char*, Image*> planes[] = {{"d", &p.d},           {"var", &p.var},   {"albedo", &p.albedo},

@@ -2,9 +2,9 @@
 // src/io so that the CLI, tests and Python keep using them unchanged.
 #include "atrous/io.h"
 
-#include "io/buffer_set.h"
-#include "io/image_io.h"
-#include "io/pass_map.h"
+#include "atrous/io/buffer_set.h"
+#include "atrous/io/image_io.h"
+#include "atrous/io/pass_map.h"
 
 namespace atrous {
 

@@ -16,13 +16,13 @@
 #include <memory>
 
 #include "atrous/error.h"
-#include "core/timer.h"
-#include "io/buffer_set.h"
-#include "io/image_io.h"
-#include "io/paths.h"
+#include "atrous/timer.h"
+#include "atrous/io/buffer_set.h"
+#include "atrous/io/image_io.h"
+#include "atrous/io/paths.h"
 #include "io/reprojection_check.h"
-#include "io/sequence.h"
-#include "io/staged_dir.h"
+#include "atrous/io/sequence.h"
+#include "atrous/io/staged_dir.h"
 
 namespace fs = std::filesystem;
 

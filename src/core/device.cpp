@@ -49,6 +49,8 @@ static std::string cpuModel() {
     return "unknown CPU";
 }
 
+double cudaPeakBandwidthGBs() { return detail::cudaPeakBandwidthGBs(); }
+
 std::string deviceName(Device d) {
     if (d == Device::Cuda) return detail::cudaDeviceName();
     return cpuModel() + " (" + std::to_string(tbb::info::default_concurrency()) + " threads, " + cpu::isaDescription() + ")";

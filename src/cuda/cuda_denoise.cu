@@ -18,7 +18,7 @@
 #include "atrous/denoise.h"
 #include "atrous/error.h"
 #include "core/math.h"
-#include "core/timer.h"
+#include "atrous/timer.h"
 #include "cuda/cuda_check.cuh"
 #include "cuda/cuda_exec.cuh"
 #include "filters/denoise_internal.h"

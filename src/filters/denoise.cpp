@@ -20,7 +20,7 @@
 #include "atrous/learned.h"
 #include "atrous/params.h"
 #include "core/parallel.h"
-#include "core/timer.h"
+#include "atrous/timer.h"
 #include "cpu/isa_dispatch.h"
 #include "filters/denoise_driver.h"
 #include "filters/denoise_internal.h"
@@ -516,7 +516,8 @@ void requireHostInputs(const DenoiseInputs& inputs) {
 }
 
 // denoise() with, optionally, the caller's images handed over (used on the CPU only).
-Image denoiseWith(const DenoiseInputs& given, const DenoiseOptions& options, const filters::HandedOver* stores) {
+Image denoiseWith(const DenoiseInputs& given, const DenoiseOptions& options, const filters::HandedOver* stores,
+                  filters::DriverDebug* debug = nullptr) {
     DenoiseReport local;
     DenoiseReport& rep = options.report ? *options.report : local;
     DenoiseInputs inputs = given;
@@ -540,7 +541,7 @@ Image denoiseWith(const DenoiseInputs& given, const DenoiseOptions& options, con
         return filters::denoiseCuda(inputs, o, prep, rep);
     }
     requireHostInputs(inputs);
-    return filters::denoiseCpu(inputs, o, prep, rep, nullptr, stores);
+    return filters::denoiseCpu(inputs, o, prep, rep, debug, stores);
 }
 
 }  // namespace
@@ -555,13 +556,22 @@ Image denoise(DenoiseBuffers& buffers, const DenoiseOptions& options) {
     return denoiseWith(in, options, &stores);
 }
 
-namespace filters {
+Image denoiseWithSureFractions(const DenoiseInputs& inputs, const DenoiseOptions& options, Image& fractions) {
+    if (options.method != DenoiseMethod::Sure || options.device != Device::Cpu)
+        throw InputError("SURE's fractions: the method must be sure and the device the CPU");
+    if (!inputs.color || inputs.color->empty()) throw InputError("missing color buffer");
+    filters::DriverDebug dbg;
+    dbg.sureS = Image(inputs.color->width(), inputs.color->height(), options.eaw.levels);
+    Image out = denoiseWith(inputs, options, nullptr, &dbg);
+    fractions = std::move(dbg.sureS);
+    return out;
+}
 
 PreparedPlanes learnedPlanes(const DenoiseInputs& given, const DenoiseOptions& options) {
     DenoiseReport local;
     DenoiseReport& rep = options.report ? *options.report : local;
     DenoiseInputs in = given;
-    const PreparedInputs prep = prepareCall(in, options, rep);
+    const filters::PreparedInputs prep = prepareCall(in, options, rep);
     requireHostInputs(in);
     const int w = in.color->width(), h = in.color->height();
     PreparedPlanes p;
@@ -569,22 +579,20 @@ PreparedPlanes learnedPlanes(const DenoiseInputs& given, const DenoiseOptions& o
     if (in.albedo && options.demodulate) p.albedo = Image(w, h, 3);
     if (in.normal) p.normal = Image(w, h, 3);
     if (in.depth) p.depth = Image(w, h, 1);
-    DriverPlanes views;
+    filters::DriverPlanes views;
     views.d = p.d.view(), views.var = p.var.view(), views.mod = p.mod.view(), views.emission = p.emission.view();
-    views.albedo = viewOf(p.albedo.empty() ? nullptr : &p.albedo);
-    views.normal = viewOf(p.normal.empty() ? nullptr : &p.normal);
-    views.depth = viewOf(p.depth.empty() ? nullptr : &p.depth);
-    DriverOutputs dout;
+    views.albedo = filters::viewOf(p.albedo.empty() ? nullptr : &p.albedo);
+    views.normal = filters::viewOf(p.normal.empty() ? nullptr : &p.normal);
+    views.depth = filters::viewOf(p.depth.empty() ? nullptr : &p.depth);
+    filters::DriverOutputs dout;
     dout.planes = &views;
-    DriverConfig cfg{options};
+    filters::DriverConfig cfg{options};
     cfg.opts.method = DenoiseMethod::Learned;  // the planes of the learned method, whatever options.method says
     cfg.varianceGiven = in.variance != nullptr;
-    setNoiseEstimate(cfg, rep);
-    runDenoise(CpuExec{}, driverInputsOf(in, prep), cfg, dout);
+    filters::setNoiseEstimate(cfg, rep);
+    filters::runDenoise(CpuExec{}, filters::driverInputsOf(in, prep), cfg, dout);
     return p;
 }
-
-}  // namespace filters
 
 }  // namespace atrous
 

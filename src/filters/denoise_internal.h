@@ -58,15 +58,6 @@ void estimateNoiseSigma(const Image& color, const Image* albedo, float eps, floa
 // The same estimate of a colour on the GPU, computed there (src/cuda/cuda_denoise.cu): the same
 // MadDetail functor, so the same medians. A host albedo is uploaded for it.
 void estimateNoiseSigmaCuda(const Image& color, const Image* albedo, float eps, float floor, float sigma[3]);
-// The learned filter's prepared planes (DriverPlanes, denoise_driver.h) as host images: what
-// denoise() does up to step 3 of the driver (validation, noise estimate, sanitise, emission split
-// and filter, fireflies, demodulation), on the CPU, for training (atrous.learned_planes). albedo
-// (none given or demodulation off), normal and depth are empty when absent; mod and emission are
-// always there (1 and 0 without an albedo or an emission).
-struct PreparedPlanes {
-    Image d, var, albedo, normal, depth, mod, emission;
-};
-PreparedPlanes learnedPlanes(const DenoiseInputs& in, const DenoiseOptions& o);
 // stores (optional): the caller's colour, variance and emission images, handed over (denoise() on
 // DenoiseBuffers, DriverInputs::colorStore): the filter works in them and returns its result in
 // one of them.

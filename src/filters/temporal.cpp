@@ -11,7 +11,7 @@
 #include "atrous/error.h"
 #include "atrous/params.h"
 #include "core/parallel.h"
-#include "core/timer.h"
+#include "atrous/timer.h"
 #include "filters/prepass.h"
 #include "filters/svgf_gbuffer.h"
 #include "filters/temporal_window.h"

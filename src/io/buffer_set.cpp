@@ -1,11 +1,11 @@
-#include "io/buffer_set.h"
+#include "atrous/io/buffer_set.h"
 
 #include <algorithm>
 #include <filesystem>
 #include <iterator>
 
 #include "atrous/error.h"
-#include "io/image_io.h"
+#include "atrous/io/image_io.h"
 
 namespace fs = std::filesystem;
 

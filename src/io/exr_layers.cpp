@@ -1,4 +1,4 @@
-#include "io/exr_layers.h"
+#include "atrous/io/exr_layers.h"
 
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
@@ -22,7 +22,7 @@
 #include "atrous/error.h"
 #include "io/exr_core.h"
 #include "io/exr_limits.h"
-#include "io/image_io.h"
+#include "atrous/io/image_io.h"
 
 namespace atrous::io {
 

@@ -1,4 +1,4 @@
-#include "io/image_io.h"
+#include "atrous/io/image_io.h"
 
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
@@ -24,11 +24,11 @@
 #include <vector>
 
 #include "atrous/error.h"
-#include "core/srgb.h"
-#include "io/exr_layers.h"
+#include "atrous/srgb.h"
+#include "atrous/io/exr_layers.h"
 #include "io/exr_core.h"
 #include "io/exr_limits.h"
-#include "io/pass_map.h"
+#include "atrous/io/pass_map.h"
 #include "io/stb_checks.h"
 
 namespace fs = std::filesystem;

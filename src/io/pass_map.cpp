@@ -1,4 +1,4 @@
-#include "io/pass_map.h"
+#include "atrous/io/pass_map.h"
 
 #include <algorithm>
 #include <cctype>

@@ -1,4 +1,4 @@
-#include "io/paths.h"
+#include "atrous/io/paths.h"
 
 #include <filesystem>
 

@@ -1,4 +1,4 @@
-#include "io/sequence.h"
+#include "atrous/io/sequence.h"
 
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
@@ -12,10 +12,10 @@
 #include <utility>
 
 #include "atrous/error.h"
-#include "io/buffer_set.h"
-#include "io/exr_layers.h"
+#include "atrous/io/buffer_set.h"
+#include "atrous/io/exr_layers.h"
 #include "io/exr_limits.h"
-#include "io/image_io.h"
+#include "atrous/io/image_io.h"
 
 namespace fs = std::filesystem;
 

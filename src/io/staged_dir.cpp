@@ -1,4 +1,4 @@
-#include "io/staged_dir.h"
+#include "atrous/io/staged_dir.h"
 
 #include <unistd.h>
 
@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "atrous/error.h"
-#include "io/sequence.h"
+#include "atrous/io/sequence.h"
 
 namespace fs = std::filesystem;
 

@@ -11,7 +11,7 @@
 
 #include "atrous/error.h"
 #include "atrous/image.h"
-#include "io/image_io.h"
+#include "atrous/io/image_io.h"
 
 namespace atrous::io {
 

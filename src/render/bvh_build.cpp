@@ -11,7 +11,7 @@
 #include <string>
 
 #include "atrous/error.h"
-#include "core/timer.h"
+#include "atrous/timer.h"
 
 namespace atrous {
 namespace {

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "atrous/error.h"
-#include "io/image_io.h"
+#include "atrous/io/image_io.h"
 #include "render/scene_limits.h"
 
 namespace atrous::pt {

@@ -9,7 +9,7 @@
 #include <thread>
 
 #include "atrous/device.h"
-#include "core/timer.h"
+#include "atrous/timer.h"
 
 namespace atrous::view {
 namespace {

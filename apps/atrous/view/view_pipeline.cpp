@@ -14,10 +14,9 @@
 #include "atrous/error.h"
 #include "atrous/params.h"
 #include "atrous/temporal.h"
-#include "core/timer.h"
-#include "filters/denoise_internal.h"
-#include "io/buffer_set.h"
-#include "io/image_io.h"
+#include "atrous/timer.h"
+#include "atrous/io/buffer_set.h"
+#include "atrous/io/image_io.h"
 #include "render/accumulate.h"
 #include "render/bvh_render.h"
 #include "render/bvh_tracer.h"
@@ -402,12 +401,7 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
     Timer t;
     try {
         if (m == Method::of(DenoiseMethod::Sure) && s.sureFractions && mDevice == Device::Cpu) {
-            // The public denoise() has no debug outputs; the internal CPU entry fills s_i(p).
-            filters::PreparedInputs prep = filters::prepareInputs(in, o, rep);
-            filters::DriverDebug dbg;
-            dbg.sureS = Image(mWidth, mHeight, s.denoise.eaw.levels);
-            r.image = filters::denoiseCpu(in, o, prep, rep, &dbg);
-            mSureS = std::move(dbg.sureS);
+            r.image = denoiseWithSureFractions(in, o, mSureS);
         } else if (mDevice == Device::Cuda) {
             // The inputs are the running means on the GPU: denoise() reads them in place and
             // leaves its result there.

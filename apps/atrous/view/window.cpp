@@ -9,7 +9,7 @@
 
 #include "atrous/error.h"
 #include "atrous/image.h"
-#include "io/image_io.h"
+#include "atrous/io/image_io.h"
 #include "view/buffer_view.h"
 
 namespace atrous::view {

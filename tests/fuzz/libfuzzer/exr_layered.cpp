@@ -12,10 +12,10 @@
 // EXR without channels given for one buffer (37f271e: SIGSEGV), 4-channel half parts in the
 // OpenEXR Core reader (7244261: SIGSEGV). Their inputs are seeds (corpus/*/finding_*.exr).
 #include "fuzz_common.h"
-#include "io/buffer_set.h"
-#include "io/exr_layers.h"
-#include "io/image_io.h"
-#include "io/pass_map.h"
+#include "atrous/io/buffer_set.h"
+#include "atrous/io/exr_layers.h"
+#include "atrous/io/image_io.h"
+#include "atrous/io/pass_map.h"
 
 using namespace atrous_fuzz;
 using namespace atrous::io;

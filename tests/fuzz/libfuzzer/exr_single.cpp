@@ -6,7 +6,7 @@
 // most the reader allows, docs/reliability.md) plus 64 KiB, at 2 bytes (one half channel) per
 // pixel. NaN/Inf pixels are allowed (colour: the filters repair them).
 #include "fuzz_common.h"
-#include "io/image_io.h"
+#include "atrous/io/image_io.h"
 
 using namespace atrous_fuzz;
 

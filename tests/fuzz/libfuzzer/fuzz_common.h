@@ -28,8 +28,8 @@
 
 #include "atrous/error.h"
 #include "atrous/image.h"
-#include "io/exr_layers.h"
-#include "io/pass_map.h"
+#include "atrous/io/exr_layers.h"
+#include "atrous/io/pass_map.h"
 #include "render/scene_data.h"
 #include "render/scene_limits.h"
 

@@ -31,8 +31,8 @@
 #include <vector>
 
 #include "atrous/image.h"
-#include "io/exr_layers.h"
-#include "io/image_io.h"
+#include "atrous/io/exr_layers.h"
+#include "atrous/io/image_io.h"
 
 namespace atrous::filters {
 extern const std::uint8_t kLearnedDefaultWeights[];

@@ -20,8 +20,8 @@
 #include <sstream>
 
 #include "fuzz_common.h"
-#include "io/exr_layers.h"
-#include "io/pass_map.h"
+#include "atrous/io/exr_layers.h"
+#include "atrous/io/pass_map.h"
 
 using namespace atrous_fuzz;
 using namespace atrous::io;

@@ -7,7 +7,7 @@
 #include <cstring>
 
 #include "fuzz_common.h"
-#include "io/image_io.h"
+#include "atrous/io/image_io.h"
 
 using namespace atrous_fuzz;
 

@@ -12,7 +12,7 @@
 // (and a '\' escape could spell a '/').
 #include "atrous/render.h"
 #include "fuzz_common.h"
-#include "io/image_io.h"
+#include "atrous/io/image_io.h"
 
 using namespace atrous_fuzz;
 

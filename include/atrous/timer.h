@@ -1,3 +1,5 @@
+// A steady-clock stopwatch and the median of a sample: what the library, the CLI and the benchmarks
+// time with.
 #pragma once
 #include <algorithm>
 #include <chrono>

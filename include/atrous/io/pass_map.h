@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "atrous/image.h"
-#include "io/exr_layers.h"
+#include "atrous/io/exr_layers.h"
 
 namespace atrous::io {
 

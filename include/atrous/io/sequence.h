@@ -26,8 +26,8 @@
 #include <vector>
 
 #include "atrous/image.h"
-#include "io/exr_layers.h"
-#include "io/pass_map.h"
+#include "atrous/io/exr_layers.h"
+#include "atrous/io/pass_map.h"
 
 namespace atrous::io {
 

@@ -11,9 +11,9 @@
 #include "atrous/image.h"
 #include "atrous/render.h"
 #include "atrous/svgf.h"
-#include "io/exr_layers.h"
-#include "io/pass_map.h"
-#include "io/sequence.h"
+#include "atrous/io/exr_layers.h"
+#include "atrous/io/pass_map.h"
+#include "atrous/io/sequence.h"
 
 namespace atrous::io {
 
