@@ -21,7 +21,7 @@
 
 #include "atrous/device.h"
 #include "bench_cli.h"
-#include "core/math.h"
+#include "atrous/math.h"
 #include "atrous/timer.h"
 #include "render/bvh.h"
 #include "render/bvh_build.h"

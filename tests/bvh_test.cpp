@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "atrous/error.h"
-#include "core/math.h"
+#include "atrous/math.h"
 
 // The traversal is compiled here for FMA hardware (x86-64-v3: what the library, which this test
 // links and so needs anyway, and the benchmarks are built for), so that gcc may fuse a*b - c*d

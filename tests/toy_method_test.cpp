@@ -18,7 +18,7 @@
 #include "render_test_util.h"
 #include "test_util.h"
 #include "toy_method.h"
-#include "view/view_pipeline.h"
+#include "atrous/view_pipeline.h"
 
 namespace atrous {
 namespace {

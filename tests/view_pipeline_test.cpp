@@ -18,7 +18,8 @@
 #include "atrous/temporal.h"
 #include "test_util.h"
 #include "view/buffer_view.h"
-#include "view/view_pipeline.h"
+#include "atrous/view_pipeline.h"
+#include "render/scene_data.h"  // the scene's camera (white-box)
 
 using atrous::DenoiseMethod;
 using atrous::Device;

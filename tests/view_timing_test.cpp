@@ -14,7 +14,7 @@
 #include "atrous/render.h"
 #include "view/frame_timing.h"
 #include "view/stage_history.h"
-#include "view/view_pipeline.h"
+#include "atrous/view_pipeline.h"
 
 using atrous::Device;
 using atrous::Scene;

@@ -7,7 +7,7 @@
 #if defined(ATROUS_HAVE_VIEWER)
 #include "atrous/params.h"
 #include "cli_flags.h"
-#include "view/view_pipeline.h"
+#include "atrous/view_pipeline.h"
 #include "view/viewer.h"
 #endif
 

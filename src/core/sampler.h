@@ -18,7 +18,7 @@
 #include <cstdint>
 
 #include "atrous/platform.h"
-#include "core/math.h"
+#include "atrous/math.h"
 #include "core/rng.h"
 
 namespace atrous {

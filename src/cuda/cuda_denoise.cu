@@ -17,9 +17,9 @@
 
 #include "atrous/denoise.h"
 #include "atrous/error.h"
-#include "core/math.h"
+#include "atrous/math.h"
 #include "atrous/timer.h"
-#include "cuda/cuda_check.cuh"
+#include "atrous/cuda_check.cuh"
 #include "cuda/cuda_exec.cuh"
 #include "filters/denoise_internal.h"
 #include "filters/stage_clock.h"

@@ -4,7 +4,7 @@
 #include <cuda_runtime.h>
 
 #include "atrous/device.h"
-#include "cuda/cuda_check.cuh"
+#include "atrous/cuda_check.cuh"
 
 namespace atrous::cuda {
 

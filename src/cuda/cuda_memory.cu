@@ -5,7 +5,7 @@
 
 #include "atrous/device.h"
 #include "core/memory.h"
-#include "cuda/cuda_check.cuh"
+#include "atrous/cuda_check.cuh"
 
 namespace atrous {
 

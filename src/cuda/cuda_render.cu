@@ -7,7 +7,7 @@
 #include "atrous/device.h"
 #include "atrous/error.h"
 #include "cuda/cuda_bvh.cuh"
-#include "cuda/cuda_check.cuh"
+#include "atrous/cuda_check.cuh"
 #include "cuda/cuda_exec.cuh"
 #include "cuda/device_buffer.cuh"
 #include "render/bvh_render.h"

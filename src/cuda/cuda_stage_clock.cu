@@ -6,7 +6,7 @@
 
 #include <string>
 
-#include "cuda/cuda_check.cuh"
+#include "atrous/cuda_check.cuh"
 #include "filters/stage_clock.h"
 
 namespace atrous::filters {

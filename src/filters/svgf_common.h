@@ -4,7 +4,7 @@
 #include <cstring>
 
 #include "atrous/image.h"
-#include "core/math.h"
+#include "atrous/math.h"
 #include "filters/modulation.h"  // AlbedoRule, Demodulate, Remodulate; atrous_math.h: b3, fastExp, lum, selectF
 
 namespace atrous::svgf {

@@ -26,7 +26,7 @@
 #include "atrous/device.h"
 #include "atrous/image.h"
 #include "atrous/platform.h"
-#include "core/math.h"
+#include "atrous/math.h"
 #include "render/camera.h"
 
 namespace atrous {

@@ -3,7 +3,7 @@
 // Values returned by eval are f(wo, wi) (without the cosine); sample returns the weight
 // f * |cos(wi)| / pdf and the pdf in solid angle.
 #pragma once
-#include "core/math.h"
+#include "atrous/math.h"
 #include "render/sampling.h"
 #include "render/scene_data.h"
 

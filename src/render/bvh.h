@@ -40,7 +40,7 @@
 #include <cstdint>
 
 #include "atrous/platform.h"
-#include "core/math.h"
+#include "atrous/math.h"
 
 namespace atrous {
 

@@ -1,6 +1,6 @@
 // Pinhole camera (look-at, vertical field of view), shared by host and device.
 #pragma once
-#include "core/math.h"
+#include "atrous/math.h"
 #include "render/scene_data.h"
 
 namespace atrous::pt {

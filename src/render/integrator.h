@@ -9,7 +9,7 @@
 //   bool occluded(Vec3 o, Vec3 d, float tmax) const;              // any hit in (0, tmax)
 #pragma once
 #include "atrous/image.h"
-#include "core/math.h"
+#include "atrous/math.h"
 #include "core/rng.h"
 #include "core/sampler.h"
 #include "render/bsdf.h"

@@ -1,7 +1,7 @@
 // Geometry queries and light sampling shared by host and device: analytic sphere intersection,
 // surface interactions from a hit record, ray-origin offsets, area / point / environment lights.
 #pragma once
-#include "core/math.h"
+#include "atrous/math.h"
 #include "render/sampling.h"
 #include "render/scene_data.h"
 

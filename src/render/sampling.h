@@ -1,7 +1,7 @@
 // Sampling building blocks shared by host and device: warps from [0,1)^2, piecewise-constant 1D
 // and 2D distributions stored as flat CDF arrays, the power heuristic, texture lookups.
 #pragma once
-#include "core/math.h"
+#include "atrous/math.h"
 #include "render/scene_data.h"
 
 namespace atrous::pt {

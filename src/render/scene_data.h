@@ -7,7 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "core/math.h"
+#include "atrous/camera.h"
+#include "atrous/math.h"
 
 namespace atrous::pt {
 
@@ -70,13 +71,6 @@ struct Environment {
     float margInt = 0.0f;
 };
 
-struct Camera {
-    Vec3 position = Vec3(0.0f, 0.0f, 5.0f);
-    Vec3 forward = Vec3(0.0f, 0.0f, -1.0f);  // unit
-    Vec3 right = Vec3(1.0f, 0.0f, 0.0f);     // unit
-    Vec3 up = Vec3(0.0f, 1.0f, 0.0f);        // unit
-    float tanHalfFov = 0.4f;                 // tan(vertical fov / 2)
-};
 
 // Non-owning view of the whole scene: what the shading code (host or device) reads.
 struct SceneView {

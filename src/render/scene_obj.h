@@ -4,7 +4,7 @@
 #include <cmath>
 #include <string>
 
-#include "core/math.h"
+#include "atrous/math.h"
 #include "render/scene_builder.h"
 
 namespace atrous::pt {

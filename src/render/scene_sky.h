@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "atrous/image.h"
-#include "core/math.h"
+#include "atrous/math.h"
 #include "render/sampling.h"
 
 namespace atrous::pt {

@@ -12,7 +12,7 @@
 #include "../bvh_scenes.h"
 #include "atrous/device.h"
 #include "cuda/cuda_bvh.cuh"
-#include "cuda/cuda_check.cuh"
+#include "atrous/cuda_check.cuh"
 #include "cuda/device_buffer.cuh"
 
 using namespace atrous;

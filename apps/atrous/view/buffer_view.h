@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "atrous/image.h"
-#include "view/view_pipeline.h"
+#include "atrous/view_pipeline.h"
 
 namespace atrous::view {
 

@@ -4,8 +4,8 @@
 #pragma once
 #include <GLFW/glfw3.h>
 
-#include "render/scene_data.h"
-#include "view/view_pipeline.h"
+#include "atrous/camera.h"
+#include "atrous/view_pipeline.h"
 
 namespace atrous::view {
 

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <string>
 
-#include "cuda/cuda_check.cuh"
+#include "atrous/cuda_check.cuh"
 #include "view/cuda_display.h"
 
 namespace atrous::view {

@@ -10,7 +10,7 @@
 
 #include "atrous/device.h"
 #include "view/buffer_view.h"
-#include "view/view_pipeline.h"
+#include "atrous/view_pipeline.h"
 #include "view/window.h"
 
 namespace atrous::view {

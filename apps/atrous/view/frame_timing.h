@@ -6,7 +6,7 @@
 
 #include "atrous/stage_time.h"
 #include "view/stage_history.h"
-#include "view/view_pipeline.h"
+#include "atrous/view_pipeline.h"
 
 namespace atrous::view {
 

@@ -8,7 +8,7 @@
 #include "view/buffer_view.h"
 #include "view/camera_input.h"
 #include "view/stage_history.h"
-#include "view/view_pipeline.h"
+#include "atrous/view_pipeline.h"
 
 namespace atrous::view {
 

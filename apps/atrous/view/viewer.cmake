@@ -4,12 +4,11 @@
 # exists and says how to get it.
 option(ATROUS_BUILD_VIEWER "Build the interactive viewer when GLFW, OpenGL and imgui are found" ON)
 
-# The viewer's parts without GL: the frame pipeline (view_pipeline.h: rendering with a movable
-# camera, accumulation, motion, the filter slots, debug buffers), the buffer views' tonemapping
-# (buffer_view.h) and the timings with their JSON line (frame_timing.h). A library of its own,
-# built with or without the viewer, which the viewer and the tests (view_pipeline_test.cpp,
-# view_timing_test.cpp) link.
-set(ATROUS_VIEW_CORE_SOURCES ${CMAKE_CURRENT_LIST_DIR}/view_pipeline.cpp ${CMAKE_CURRENT_LIST_DIR}/buffer_view.cpp
+# The viewer's parts without GL: the buffer views' tonemapping (buffer_view.h) and the timings with
+# their JSON line (frame_timing.h), over the library's session (include/atrous/view_pipeline.h). A
+# library of its own, built with or without the viewer, which the viewer and the tests
+# (view_pipeline_test.cpp, view_timing_test.cpp) link.
+set(ATROUS_VIEW_CORE_SOURCES ${CMAKE_CURRENT_LIST_DIR}/buffer_view.cpp
     ${CMAKE_CURRENT_LIST_DIR}/frame_timing.cpp)
 add_library(atrous_view_core STATIC ${ATROUS_VIEW_CORE_SOURCES})
 target_include_directories(atrous_view_core PUBLIC ${CMAKE_CURRENT_LIST_DIR}/..)

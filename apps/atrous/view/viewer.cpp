@@ -28,7 +28,7 @@
 #include "view/frame_timing.h"
 #include "view/panel.h"
 #include "view/stage_history.h"
-#include "view/view_pipeline.h"
+#include "atrous/view_pipeline.h"
 #include "view/window.h"
 
 namespace atrous::view {

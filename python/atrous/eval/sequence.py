@@ -1,6 +1,6 @@
 """Frame sequences for the evaluation: SVGF (temporal) next to the per-frame methods.
 
-Layout (the one src/io/sequence.h reads): DIR/frame_0000/, frame_0001/, ... each holding
+Layout (the one include/atrous/io/sequence.h reads): DIR/frame_0000/, frame_0001/, ... each holding
 color.exr albedo.exr normal.exr position.exr depth.exr ids.exr motion.exr and optionally
 reference.exr, variance.exr, emission.exr. EXRs are read and written by the library's OpenEXR
 code (atrous.read_image / atrous.write_image), the same that `atrous render` writes with.

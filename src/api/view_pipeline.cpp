@@ -1,5 +1,5 @@
 // The viewer's frame pipeline (see view_pipeline.h).
-#include "view/view_pipeline.h"
+#include "atrous/view_pipeline.h"
 
 #include <sys/resource.h>
 #include <tbb/blocked_range2d.h>

@@ -1,8 +1,9 @@
-// The viewer's frame pipeline without any windowing: progressive path tracing with a movable
-// camera, accumulation of the buffers over frames, screen-space motion vectors for SVGF, the
-// denoisers of the two comparison slots, and the debug buffers (per-level detail, SURE's s_i).
-// Kept apart from the GLFW/ImGui code so its logic reads and is tested on its own
-// (tests/view_pipeline_test.cpp, linking the library atrous_view_core).
+// The interactive session behind `atrous view`, without any windowing: progressive path tracing
+// with a movable camera, accumulation of the buffers over frames, screen-space motion vectors for
+// SVGF, the denoisers of the two comparison slots, and the debug buffers (per-level detail, SURE's
+// s_i). A session of the library (src/api/view_pipeline.cpp), so that the viewer's GLFW/ImGui code
+// (apps/atrous/view) only shows it and another front-end can drive it; tests/view_pipeline_test.cpp
+// tests it on its own.
 #pragma once
 #include <cstdint>
 #include <deque>
@@ -16,11 +17,12 @@
 #include "atrous/stage_time.h"
 #include "atrous/svgf.h"
 #include "atrous/temporal.h"
-#include "render/bvh_build.h"
-#include "render/scene_data.h"
+#include "atrous/camera.h"
+#include "atrous/math.h"
 
 namespace atrous {
-class CudaBvhRenderer;  // render/bvh_render.h
+class CudaBvhRenderer;  // src/render/bvh_render.h
+struct BvhData;         // src/render/bvh_build.h
 }
 
 namespace atrous::view {

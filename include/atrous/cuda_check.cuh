@@ -1,4 +1,6 @@
-// Every CUDA call is checked (docs/architecture.md, principle 3).
+// Every CUDA call is checked (docs/architecture.md, principle 3): ATROUS_CUDA_CHECK(call) throws the
+// library's RuntimeError naming the call (out of memory said as such). For CUDA code of the library and
+// its front-ends (the viewer's OpenGL interop); it includes cuda_runtime.h.
 #pragma once
 #include <cuda_runtime.h>
 
