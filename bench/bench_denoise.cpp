@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "atrous/denoise.h"
-#include "../tests/denoise_test_util.h"  // inputsOf
 #include "bench_cli.h"
+#include "bench_scene.h"
 #include "atrous/timer.h"
 
 using namespace atrous;
@@ -34,36 +34,6 @@ double cpuMs() {
     return (ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) * 1e3 + (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec) * 1e-3;
 }
 
-struct Buffers {
-    Image color, variance, albedo, normal, position, depth, ids;
-    Buffers(int w, int h)
-        : color(w, h, 3), variance(w, h, 3), albedo(w, h, 3), normal(w, h, 3), position(w, h, 3), depth(w, h, 3),
-          ids(w, h, 3) {
-        // A box-like scene: a few planar regions with smooth shading and MC-like noise.
-        std::mt19937 rng(1);
-        std::normal_distribution<float> g(0.0f, 1.0f);
-        for (int y = 0; y < h; ++y)
-            for (int x = 0; x < w; ++x) {
-                const float u = float(x) / w, v = float(y) / h;
-                const int region = (u > 0.3f && u < 0.7f && v > 0.4f) ? 1 : (u < 0.15f ? 2 : 0);
-                const float z = region == 1 ? 3.0f : 5.0f;
-                for (int c = 0; c < 3; ++c) {
-                    const float t = (0.3f + 0.5f * v) * (region == 2 ? (c == 0 ? 0.8f : 0.2f) : 0.7f);
-                    const float var = 0.05f * (0.02f + t);
-                    color(x, y, c) = t + std::sqrt(var) * g(rng);
-                    variance(x, y, c) = var;
-                    albedo(x, y, c) = region == 2 ? (c == 0 ? 0.8f : 0.2f) : 0.7f;
-                    normal(x, y, c) = region == 2 ? (c == 0 ? 1.0f : 0.0f) : (c == 2 ? 1.0f : 0.0f);
-                    depth(x, y, c) = z;
-                    ids(x, y, c) = c < 2 ? float(region) : 0.0f;
-                }
-                position(x, y, 0) = (u - 0.5f) * z;
-                position(x, y, 1) = (v - 0.5f) * z;
-                position(x, y, 2) = z;
-            }
-    }
-    DenoiseInputs inputs() const { return test::inputsOf(color, variance, albedo, normal, position, depth, ids); }
-};
 
 }  // namespace
 
@@ -98,21 +68,21 @@ int main(int argc, char** argv) {
                 deviceName(device).c_str(), concurrency, runs);
     bool first = true;
     for (auto& sz : sizes) {
-        Buffers b(sz.first, sz.second);
+        const bench::BoxScene b(sz.first, sz.second, false);
         for (DenoiseMethod m : methods) {
             DenoiseOptions o;
             o.method = m;
             o.device = device;
             DenoiseReport rep;
             o.report = &rep;
-            for (int i = 0; i < 3; ++i) denoise(b.inputs(), o);  // warm-up
+            for (int i = 0; i < 3; ++i) denoise(b.allInputs(), o);  // warm-up
             std::vector<double> filterMs, totalMs;
             std::vector<std::string> stageNames;
             std::vector<std::vector<double>> stageMs;  // [stage][run]
             const double cpu0 = cpuMs();
             for (int i = 0; i < runs; ++i) {
                 Timer t;
-                denoise(b.inputs(), o);
+                denoise(b.allInputs(), o);
                 totalMs.push_back(t.ms());
                 filterMs.push_back(rep.milliseconds);
                 if (i == 0)

@@ -19,6 +19,7 @@
 #include "atrous/denoise.h"
 #include "atrous/learned.h"
 #include "bench_cli.h"
+#include "bench_scene.h"
 #include "core/parallel.h"
 #include "atrous/timer.h"
 #include "filters/learned.h"
@@ -27,33 +28,6 @@ using namespace atrous;
 
 namespace {
 
-// A box-like scene (as bench_denoise): planar regions, smooth shading, Monte Carlo-like noise.
-struct Scene {
-    Image color, variance, albedo, normal, depth;
-    Scene(int w, int h) : color(w, h, 3), variance(w, h, 3), albedo(w, h, 3), normal(w, h, 3), depth(w, h, 3) {
-        std::mt19937 rng(1);
-        std::normal_distribution<float> g(0.0f, 1.0f);
-        for (int y = 0; y < h; ++y)
-            for (int x = 0; x < w; ++x) {
-                const float u = float(x) / w, v = float(y) / h;
-                const int region = (u > 0.3f && u < 0.7f && v > 0.4f) ? 1 : (u < 0.15f ? 2 : 0);
-                for (int c = 0; c < 3; ++c) depth(x, y, c) = region == 1 ? 3.0f : (v < 0.1f ? 1e30f : 5.0f);
-                for (int c = 0; c < 3; ++c) {
-                    const float a = region == 2 ? (c == 0 ? 0.8f : 0.2f) : 0.7f;
-                    const float t = (0.3f + 0.5f * v) * a, var = 0.05f * (0.02f + t);
-                    color(x, y, c) = std::max(t + std::sqrt(var) * g(rng), 0.0f);
-                    variance(x, y, c) = var;
-                    albedo(x, y, c) = a;
-                    normal(x, y, c) = region == 2 ? (c == 0 ? 1.0f : 0.0f) : (c == 2 ? 1.0f : 0.0f);
-                }
-            }
-    }
-    DenoiseInputs inputs() const {
-        DenoiseInputs in;
-        in.color = &color, in.variance = &variance, in.albedo = &albedo, in.normal = &normal, in.depth = &depth;
-        return in;
-    }
-};
 
 double minOf(const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); }
 
@@ -93,7 +67,7 @@ int main(int argc, char** argv) {
                 weightsPath.empty() ? "built-in" : weightsPath.c_str());
     bool first = true;
     for (auto [w, h] : sizes) {
-        const Scene s(w, h);
+        const bench::BoxScene s(w, h, true);
         // The cascade alone, on the scene's colour as d (the driver's preparation is timed below).
         Image out(w, h, 3);
         const filters::LearnedPlanes P{s.color.view(), s.variance.view(), s.albedo.view(), s.normal.view(),
@@ -134,7 +108,7 @@ int main(int argc, char** argv) {
         std::vector<std::vector<double>> stageMs;
         for (int i = 0; i < 3 + runs; ++i) {
             Timer timer;
-            denoise(s.inputs(), o);
+            denoise(s.learnedInputs(), o);
             if (i < 3) continue;
             whole.push_back(timer.ms());
             if (names.empty())

@@ -288,20 +288,22 @@ export -f info bandwidth gtest bench_size bench_render oidn sanitize_prep saniti
 
 # ---------------------------------------------------------------- run
 say "$([ "$DRY" = 1 ] && echo "dry run (no GPU)" || echo "GPU run"); pack $PACK; out $OUTDIR; budget ${BUDGET}s"
-t0=$(date +%s.%N)
-setup > "$LOGS/setup.log" 2>&1
-rc=$?
-record setup "$([ $rc = 0 ] && echo ok || echo failed)" $rc "$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN{printf "%.1f", b-a}')" \
-  "$LOGS/setup.log" "$([ $rc = 0 ] || grep -v '^\s*$' "$LOGS/setup.log" | head -1 | cut -c1-160)"
-[ $rc = 0 ] || cat "$LOGS/setup.log"
-if [ "$DRY" = 1 ]; then
+# inshell NAME FUNCTION [NOTE_PATTERN]: a step run in this shell (setup sets the environment), output
+# in logs/NAME.log and shown when it fails; the note is the log's line matching NOTE_PATTERN when
+# it succeeds, else its first line.
+inshell() {
+  local name=$1 fn=$2 pattern=${3:-} t0 rc note
   t0=$(date +%s.%N)
-  check_pack > "$LOGS/pack.log" 2>&1
+  "$fn" > "$LOGS/$name.log" 2>&1
   rc=$?
-  record pack "$([ $rc = 0 ] && echo ok || echo failed)" $rc "$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN{printf "%.1f", b-a}')" \
-    "$LOGS/pack.log" "$(grep '^pack size' "$LOGS/pack.log")"
-  [ $rc = 0 ] || cat "$LOGS/pack.log"
-fi
+  if [ $rc = 0 ]; then note=$([ -n "$pattern" ] && grep "$pattern" "$LOGS/$name.log")
+  else note=$(grep -v '^\s*$' "$LOGS/$name.log" | head -1 | cut -c1-160); fi
+  record "$name" "$([ $rc = 0 ] && echo ok || echo failed)" $rc \
+    "$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN{printf "%.1f", b-a}')" "$LOGS/$name.log" "$note"
+  [ $rc = 0 ] || cat "$LOGS/$name.log"
+}
+inshell setup setup
+[ "$DRY" = 1 ] && inshell pack check_pack '^pack size'
 if [ -x "$WORK/atrous" ]; then
   wants info && step info 30 info
   wants bandwidth && step bandwidth 30 bandwidth

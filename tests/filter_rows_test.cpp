@@ -20,6 +20,7 @@
 #include "filters/noise_estimate.h"
 #include "filters/prepass.h"
 #include "filters/sure.h"
+#include "test_util.h"
 
 using namespace atrous;
 using namespace atrous::filters;
@@ -40,13 +41,7 @@ long firstBitDifference(const Image& a, const Image& b) {
     return -1;
 }
 
-Image randomImage(int w, int h, int c, unsigned seed, float lo, float hi) {
-    Image img(w, h, c);
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> u(lo, hi);
-    for (size_t i = 0; i < img.size(); ++i) img.data()[i] = u(rng);
-    return img;
-}
+using test::randomImage;
 
 // An albedo with every case of the modulation rule: black, below a tenth of the floor, between
 // the floor and twice it (the rim test), ordinary, above 1, NaN and Inf, in patches so that rims

@@ -20,13 +20,7 @@ using namespace atrous::test;
 
 namespace {
 
-Image ramp(int w, int h, int channels, float base) {
-    Image img(w, h, channels);
-    for (int c = 0; c < channels; ++c)
-        for (int y = 0; y < h; ++y)
-            for (int x = 0; x < w; ++x) img(x, y, c) = base + 0.1f * c + 0.01f * float(x + w * y);
-    return img;
-}
+Image ramp(int w, int h, int channels, float base) { return channelRamp(w, h, channels, base, 0.01f); }
 
 int lines(const std::string& s) {
     int n = 0;

@@ -26,13 +26,7 @@ using namespace atrous::test;
 
 namespace {
 
-Image constant(int w, int h, int channels, float base) {
-    Image img(w, h, channels);
-    for (int c = 0; c < channels; ++c)
-        for (int y = 0; y < h; ++y)
-            for (int x = 0; x < w; ++x) img(x, y, c) = base + 0.1f * c + 0.001f * float(x + w * y);
-    return img;
-}
+Image constant(int w, int h, int channels, float base) { return channelRamp(w, h, channels, base, 0.001f); }
 
 // A Blender-like render: every pass Blender 5 writes for the denoiser, under one view layer.
 struct BlenderLike {

@@ -8,19 +8,14 @@
 
 #include "core/parallel.h"
 #include "filters/prepass.h"
+#include "test_util.h"
 
 using namespace atrous;
 using namespace atrous::filters;
 
 namespace {
 
-Image randomImage(int w, int h, int channels, unsigned seed, float lo, float hi) {
-    Image img(w, h, channels);
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> u(lo, hi);
-    for (size_t i = 0; i < img.size(); ++i) img.data()[i] = u(rng);
-    return img;
-}
+using test::randomImage;
 
 // Largest |a - b| / max(|b|, 1e-30); identical non-finite values count as equal.
 double maxRelDiff(const Image& a, const Image& b) {

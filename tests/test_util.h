@@ -26,6 +26,25 @@ inline Image rampImage(int w, int h, float dx, float dy, float dc) {
     return img;
 }
 
+// Any channel count: img(x, y, c) = base + 0.1·c + step·(x + w·y) (the layered-file tests' passes:
+// each pass, channel and pixel its own value).
+inline Image channelRamp(int w, int h, int channels, float base, float step) {
+    Image img(w, h, channels);
+    for (int c = 0; c < channels; ++c)
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) img(x, y, c) = base + 0.1f * c + step * float(x + w * y);
+    return img;
+}
+
+// Values drawn uniformly from [lo, hi) with a seeded generator (the row-loop equality tests).
+inline Image randomImage(int w, int h, int channels, unsigned seed, float lo, float hi) {
+    Image img(w, h, channels);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(lo, hi);
+    for (size_t i = 0; i < img.size(); ++i) img.data()[i] = u(rng);
+    return img;
+}
+
 // Equal size, channels and values bit for bit (the CLI paths that must give the same image).
 inline bool sameImages(const Image& a, const Image& b) {
     return a.width() == b.width() && a.height() == b.height() && a.channels() == b.channels() &&

@@ -4,6 +4,7 @@
 
 #include "core/parallel.h"
 #include "cpu/isa_dispatch.h"
+#include "cpu/row_sums.h"
 #include "filters/denoise_driver.h"
 
 namespace atrous::filters {
@@ -14,18 +15,8 @@ void reportLuminance(const CpuExec&, const ImageView& c, DriverReport& report) {
     cpu::parallelForIsa(cpu::activeIsa(), 0, h, 16, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             const size_t o = size_t(y) * size_t(w);
-            const float* r = c.channel(0) + o;
-            const float* g = c.channel(1) + o;
-            const float* b = c.channel(2) + o;
-            double s = 0, n = 0;
-#pragma omp simd reduction(+ : s, n)
-            for (int x = 0; x < w; ++x) {
-                const float l = lum(r[x], g[x], b[x]);
-                const bool ok = finite(l);
-                s += ok ? double(l) : 0.0;
-                n += ok ? 1.0 : 0.0;
-            }
-            sum[size_t(y)] = s, count[size_t(y)] = n;
+            cpu::finiteLuminanceRow(c.channel(0) + o, c.channel(1) + o, c.channel(2) + o, w, sum[size_t(y)],
+                                    count[size_t(y)]);
         }
     });
     double s = 0, n = 0;

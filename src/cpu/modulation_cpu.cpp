@@ -8,6 +8,7 @@
 #include "atrous/platform.h"
 ATROUS_NO_TRAPPING_MATH
 
+#include <type_traits>
 #include <vector>
 
 #include "core/parallel.h"
@@ -47,24 +48,19 @@ void runDemodulate(const CpuExec&, const Demodulate& f) {
                 const float* ATROUS_RESTRICT e = hasE ? g.emission.channel(k) + o : in;
                 float* var = hasVar ? g.var.channel(k) + o : nullptr;
                 const float* ATROUS_RESTRICT ak = a[k];
-                if (hasVar) {
+                // One loop body, compiled with and without the variance update (each vectorised).
+                auto row = [&](auto withVar) {
 #pragma omp simd
                     for (int x = 0; x < w; ++x) {
                         const float u = hasE ? e[x] : 0.0f;
                         const float ev = hasE ? (finite(u) ? u : 0.0f) : 0.0f;
                         const float ia = 1.0f / ak[x];
                         out[x] = (in[x] - ev) * ia;
-                        var[x] *= ia * ia;
+                        if constexpr (decltype(withVar)::value) var[x] *= ia * ia;
                     }
-                } else {
-#pragma omp simd
-                    for (int x = 0; x < w; ++x) {
-                        const float u = hasE ? e[x] : 0.0f;
-                        const float ev = hasE ? (finite(u) ? u : 0.0f) : 0.0f;
-                        const float ia = 1.0f / ak[x];
-                        out[x] = (in[x] - ev) * ia;
-                    }
-                }
+                };
+                if (hasVar) row(std::true_type{});
+                else row(std::false_type{});
             }
         });
     });

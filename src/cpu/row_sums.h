@@ -92,4 +92,19 @@ ATROUS_FORCE_INLINE inline void sumRowRanges(const float* const* rows, const int
     if (i < n) sumRowRangesChunk<G>(rows, lo, hi, first, last, out, n - 32);
 }
 
+// The sum (in double) and count of the finite luminances of one row of planes r, g, b: the
+// reports' mean luminance (the input scan of denoise(), the driver's after the firefly pass).
+ATROUS_FORCE_INLINE inline void finiteLuminanceRow(const float* ATROUS_RESTRICT r, const float* ATROUS_RESTRICT g,
+                                                   const float* ATROUS_RESTRICT b, int w, double& sum, double& count) {
+    double s = 0, n = 0;
+#pragma omp simd reduction(+ : s, n)
+    for (int x = 0; x < w; ++x) {
+        const float l = filters::lum(r[x], g[x], b[x]);
+        const bool ok = filters::finite(l);
+        s += ok ? double(l) : 0.0;
+        n += ok ? 1.0 : 0.0;
+    }
+    sum = s, count = n;
+}
+
 }  // namespace atrous::cpu

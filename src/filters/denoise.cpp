@@ -22,6 +22,7 @@
 #include "core/parallel.h"
 #include "atrous/timer.h"
 #include "cpu/isa_dispatch.h"
+#include "cpu/row_sums.h"
 #include "filters/denoise_driver.h"
 #include "filters/denoise_internal.h"
 #include "filters/noise_estimate.h"
@@ -160,17 +161,8 @@ InputScan scanInputs(const Image& color, const Image* variance, const Image* emi
                                 }
                     }
                 if (e.valid()) {
-                    const float* ATROUS_RESTRICT er = e.channel(0) + o;
-                    const float* ATROUS_RESTRICT eg = e.channel(1) + o;
-                    const float* ATROUS_RESTRICT eb = e.channel(2) + o;
                     double es = 0, en = 0;
-#pragma omp simd reduction(+ : es, en)
-                    for (int x = 0; x < w; ++x) {
-                        const float l = lum(er[x], eg[x], eb[x]);
-                        const bool ok = finite(l);
-                        es += ok ? double(l) : 0.0;
-                        en += ok ? 1.0 : 0.0;
-                    }
+                    cpu::finiteLuminanceRow(e.channel(0) + o, e.channel(1) + o, e.channel(2) + o, w, es, en);
                     r.emissionLumSum += es, r.emissionLumCount += en;
                 }
             }
