@@ -22,9 +22,7 @@ namespace atrous {
 // the albedo rule (demodulate, albedoEpsilon, albedoFloor) and the safety net apply; levels, the
 // σ's and scales of the EAW stops and SureParams do not. Blend: the mean of the learned and the
 // SURE outputs, both from the same prepared planes (one preparation, the two cascades): their
-// errors are partly independent, and on other renderers' stills the mean is below SURE's error in
-// every case measured and below the better of the two on the geometric mean at 16 spp
-// (docs/quality.md, "The default method"). Auto (the default): resolved by denoise() to Blend when
+// errors are partly independent (docs/decisions.md; docs/quality.md, "The default method"). Auto (the default): resolved by denoise() to Blend when
 // an albedo and a normal buffer are given, else Sure (DenoiseReport::methodUsed says which).
 // Registered methods (registerDenoiseMethod, below) take the values after Blend.
 enum class DenoiseMethod : int { Eaw, Sure, Learned, Auto, Blend };
@@ -89,10 +87,8 @@ struct SureParams {
     // (per-level factors computed exactly for the unweighted B3 cascade on white noise).
     bool correlatedVariance = true;
     // Levels i < firstLevel keep none of their detail (s_i = 0); 0 is the paper's form. The default
-    // 2 is measured (docs/quality.md "SURE"): fine levels' detail noise is strongly correlated
-    // across levels, which the per-level risk ignores, and an oracle keeps ~0% of them anyway.
-    // On other renderers' output 1 wins on fine texture and loses on the geometric mean
-    // (docs/quality.md, "Other renderers' output").
+    // 2: fine levels' detail noise is strongly correlated across levels, which the per-level risk
+    // ignores (docs/decisions.md).
     int firstLevel = 2;
 };
 
@@ -107,10 +103,9 @@ struct FireflyParams {
 // The safety net after either filter (docs/algorithms.md, "The safety net"), off by default: per
 // pixel, SURE on the residual between the input and the filter's output chooses how much of the
 // residual to give back, where that residual's energy is above `trigger` times the input's
-// variance (the filter is then estimated worse than its input). Measured on the corpus
-// (docs/quality.md): with a rendered variance it changes little (±1%); with an estimated one
-// (other renderers' output) the local variance is too uncertain for it, and it costs more than it
-// saves, so it is a choice for inputs whose variance is trusted.
+// variance (the filter is then estimated worse than its input). With an estimated variance (other
+// renderers' output) the local variance is too uncertain for it, so it is a choice for inputs
+// whose variance is trusted (docs/decisions.md).
 struct SafetyNetParams {
     bool enabled = false;
     int windowRadius = 3;  // the window is (2r+1)², 1..10
@@ -135,7 +130,7 @@ struct DenoiseOptions {
     // Where a pixel's largest albedo channel m is below this, demodulation fades out: the divisor
     // is 1 + t (max(a, ε) - 1) with t = min(m / albedoFloor, 1)² (0 = off: max(a, ε) everywhere).
     // Other renderers' albedo is 0 on glass, mirrors, emitters and the sky (docs/algorithms.md).
-    // 0.05 is measured on the corpus (docs/quality.md): 0.1 half-demodulated dark texture.
+    // 0.05: 0.1 half-demodulated dark texture (docs/decisions.md).
     float albedoFloor = 0.05f;  // [0, 1]
     // The learned methods' network (learned, blend, auto), loaded once by the caller
     // (LearnedWeights::load or ::builtin, include/atrous/learned.h) and shared between calls: a

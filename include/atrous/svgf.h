@@ -16,9 +16,9 @@ namespace atrous {
 // changes the output (tests/svgf_test.cpp checks that).
 struct SvgfParams {
     // À-trous edge stops (paper's σ_l, σ_n, σ_z).
-    // luminance: exp(-|l_p - l_q| / (σ_l sqrt(g3x3(var_p)) + ε)). 2 with historyClip 0.5, measured
-    // together (docs/quality.md, "Other renderers' output"): the paper's 4 with a clip of 2 kept
-    // cornell's orbit 4% lower but lost to per-frame EAW on Mitsuba's and Cycles' orbits by 1.4x.
+    // luminance: exp(-|l_p - l_q| / (σ_l sqrt(g3x3(var_p)) + ε)). 2 with historyClip 0.5, chosen
+    // together on other renderers' orbits, where the paper's 4 lost to per-frame EAW
+    // (docs/decisions.md).
     float sigmaL = 2.0f;
     float sigmaN = 128.0f;  // normal: max(0, n_p·n_q)^σ_n
     float sigmaZ = 1.0f;    // depth: exp(-|z_p - z_q| / (σ_z |∇z_p·(p - q)| + ε))
@@ -29,9 +29,7 @@ struct SvgfParams {
     int historyCap = 32;   // history length saturates here (>= 1)
     // History clipping: the reprojected illumination is scaled into m ± historyClip·s of the
     // current frame's 3x3 luminance samples before the blend, so a moving highlight leaves no
-    // trail (other renderers' glossy metals). >= 0; 0 = off. Measured with σ_l (docs/quality.md):
-    // 0.5 and σ_l 2 against the former 2 and 4: Mitsuba's orbit 0.088 -> 0.054, Cycles' 0.027 ->
-    // 0.018 (per-frame EAW 0.061, 0.019), cornell's 256^2 orbit 0.0160 -> 0.0166.
+    // trail (other renderers' glossy metals). >= 0; 0 = off. Chosen with σ_l (docs/decisions.md).
     float historyClip = 0.5f;
     int levels = 5;        // à-trous levels, step 2^i (0..10; 0 = temporal accumulation only)
     // Which à-trous level's output becomes next frame's colour history: 0 = after the first level

@@ -48,9 +48,8 @@ struct TemporalParams {
     // The offline default uses both sides.
     bool causal = false;
     // The falloff in causal mode (in place of `falloff`): one-sided averaging lags a moving
-    // highlight in one direction only, and the far frames must weigh less. 1 is at most the
-    // per-frame filter's error on all eleven sequences measured, where 1.5 was 1.36x worse on
-    // Cycles' orbit at 16 spp (docs/temporal.md, "A causal mode"). 0 = all frames equal.
+    // highlight in one direction only, and the far frames must weigh less (docs/decisions.md;
+    // docs/temporal.md, "A causal mode"). 0 = all frames equal.
     float causalFalloff = 1.0f;
 };
 

@@ -12,7 +12,7 @@
 // compiled for), AVX2 (x86-64-v3) and AVX-512, chosen at run time (parallelForIsa, cpu_isa.h):
 // EAW's tap loop needs ~30 live vectors (16 ymm
 // registers spilled to the stack on every tap) and 16 lanes halve the instruction count where the
-// core has 512-bit units (measured 27% less CPU time for the level loop on an AMD EPYC).
+// core has 512-bit units (docs/decisions.md, "Speed").
 //
 // Plain floats and small structs only in the loop bodies; everything they call is force-inlined.
 #pragma once

@@ -45,9 +45,8 @@ void requireColorInRange(const Image& color);
 // The InputError for a negative variance value at planar index `pixel` (of one plane).
 InputError negativeVarianceError(float value, size_t pixel, int width);
 // Without a variance buffer: the driver's local noise estimate (noise_estimate.h), floored at
-// kNoiseFloorFraction of the global estimate in `rep`. Nothing when cfg.varianceGiven. Measured
-// on the Mitsuba corpus (docs/quality.md): radius 5 beat 2, 3, 7 and 10; the floor at the
-// global estimate (fraction 1) beat 0.1 and 0.25 on 9 of 10 scene/spp pairs.
+// kNoiseFloorFraction of the global estimate in `rep`. Nothing when cfg.varianceGiven. The radius
+// and the floor: docs/decisions.md.
 constexpr int kNoiseRadius = 5;
 constexpr float kNoiseFloorFraction = 1.0f;
 void setNoiseEstimate(DriverConfig& cfg, const DenoiseReport& rep);

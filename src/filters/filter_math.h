@@ -16,15 +16,14 @@ namespace atrous::filters {
 // Other renderers write albedo 0 on glass, mirrors, emitters and the sky; dividing there by ~eps
 // multiplied the noise by 1000 and the filter spread it into the rims ("dotted bright rims").
 // The same a'_c on both sides keeps the pair an exact inverse. floor = 0: the plain max(a_c, eps).
-// SVGF's floor. The still filters' default (DenoiseOptions::albedoFloor) is 0.05: on the corpus
-// a floor of 0.1 half-demodulated a 40x checker's dark squares (albedo ~0.09), so the filter saw
-// the texture as signal to smooth (Cycles textures at 16 spp, SURE: 0.021 -> 0.011; docs/quality.md).
+// SVGF's floor. The still filters' default (DenoiseOptions::albedoFloor) is 0.05: a floor of 0.1
+// half-demodulated a checker's dark squares, so the filter saw the texture as signal to smooth
+// (docs/decisions.md).
 constexpr float kDefaultAlbedoFloor = 0.1f;
 // Beside a black-albedo pixel (max channel below kBlackAlbedoFraction · floor) the floor is
 // kRimFloorMul times higher: such a pixel is on the rim of glass or a mirror, partly covered by the
 // surface behind, so its small albedo explains little of its colour (dividing by it amplified the
-// reflection into a bright rim). Measured on the corpus (docs/quality.md): the quick set's mirror
-// scene at 4 spp 0.058 -> 0.043 (floor 0.05 alone had lost 32% there against 0.1); 2 and 4 equal.
+// reflection into a bright rim; docs/decisions.md).
 constexpr float kRimFloorMul = 2.0f;
 constexpr float kBlackAlbedoFraction = 0.1f;
 ATROUS_INLINE float modulationTerm(float m, float floor) {

@@ -30,7 +30,7 @@ struct AlbedoRule {
 // emission (non-finite reads 0), var. kSample (SVGF): a pixel whose input has a non-finite
 // channel is no sample, out = 0 and valid = 0 (SVGF keeps its history there), else valid = 1, and
 // |out| is clamped to maxAbs. The still filters' input is sanitised before (prepass.h), so their
-// instance skips those tests (measured: they cost Demodulate 6.7 -> 10 ms at 1080p). `out` may be `in`.
+// instance skips those tests (they cost half again its time: docs/decisions.md). `out` may be `in`.
 template <bool kSample>
 struct DemodulateT {
     AlbedoRule rule;

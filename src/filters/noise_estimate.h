@@ -30,25 +30,20 @@ float medianFinite(const CudaExec& exec, const ImageView& v, float none);
 
 // The local estimate is capped at this many times the global one. A visible light's edge or a
 // sun's rim reads as noise thousands of times the image's, and the colour stop then opened across
-// it. Measured on the corpus (docs/quality.md): 128 beat 4, 16, 32, 64, 512 and no cap on the
-// geometric mean (Mitsuba glass, box filter: 0.0249 -> 0.0115 at 16 spp; Cycles glass at 4 spp
-// alone lost, 0.0248 -> 0.0319).
+// it. 128: the best cap on the corpus's geometric mean (docs/decisions.md).
 constexpr float kNoiseCapMul = 128.0f;
 // DetailEnergy leaves out a tap whose colour differs from p's by more than sqrt(kNoiseEdgeSigmas2
 // · kNoiseCapMul) global standard deviations (68: 6 times the largest local deviation the cap
 // allows): an edge in the colour itself, such as a visible light in a wall of the same normal and
 // depth, whose B3 detail otherwise raised the estimate on both sides and opened the colour stop
-// across the light's edge (RobustInputs.VisibleLightWithoutEmissionBufferKeepsItsEdge). Measured on
-// the corpus (docs/quality.md): 16 spp best/OIDN geomean 1.041 -> 1.020 with 36, 1.024 with 64;
-// 9 lost glass caustics at 4 spp (1.009 -> 1.119), 100 no longer keeps the test's light edge.
+// across the light's edge (RobustInputs.VisibleLightWithoutEmissionBufferKeepsItsEdge). A smaller
+// bound loses glass caustics, a larger one that light edge (docs/decisions.md).
 constexpr float kNoiseEdgeSigmas2 = 36.0f;
 // The variance of a background pixel (a zero normal), as a fraction of the global estimate, in
 // place of the local estimate. The global estimate is of the image's surfaces, and the local one
 // reads a sky's gradient toward the horizon as noise: with either, the filter smoothed the sky
-// and, on Cycles' sky below the horizon, pulled the horizon's bright rows into the dark ones (the
-// quick corpus's 64^2 Cycles sun-sky scene at 16 spp: 0.0277, worse than its input's 0.0190,
-// -> 0.0123). Measured on the full corpus (docs/quality.md): 16 spp best/OIDN geomean 1.020 ->
-// 1.005, 4 spp 1.019 -> 1.009 (as a floor under the local estimate only: 1.009 and 1.003).
+// and, on Cycles' sky below the horizon, pulled the horizon's bright rows into the dark ones
+// (docs/decisions.md).
 constexpr float kNoiseBackgroundFloor = 0.01f;
 
 // var(d_0) = σ² (1 + Σ h² - 2 h(0)) for white noise under the 5×5 B3 kernel (see estimateNoiseSigma).
@@ -137,17 +132,10 @@ struct DetailEnergy {
     // the detail that the albedo's own detail explains (a least-squares fit of c on a, per
     // channel, over the same taps) is signal, not noise: a component the albedo does not multiply
     // (a dielectric's specular layer over a fine texture) leaves the demodulation c / a' with the
-    // texture's pattern, and read as noise it opened the colour stop across the texture. Measured
-    // with the driver setting it (docs/quality.md has the default's table; cli_quality.py on
-    // out/corpus/full, 2026-12-02): 16 spp best/OIDN geomean 1.005 -> 0.976, cy_textures_box 16 spp
-    // EAW 0.01329 -> 0.01138, SURE 0.01097 -> 0.00946 (noisy 0.00954), cy_sunsky_thin 16 spp -11%;
-    // 4 spp 1.009 -> 1.013 (cy_interior +6%, mi_glass +3%: the fit also takes pure noise's energy
-    // where the albedo varies, p's leverage: up to 27% on a 1-pixel checker, tests/noise_fit_test.cpp;
-    // a fit shrunk by its significance, 1 - s / (R^2 n_eff), gave s = 1: 0.982 / 1.011, s = 2:
-    // 0.988 / 1.010; the energy divided by the fit residual's exact white-noise variance, so that
-    // pure noise keeps all of it: 0.987 / 1.011, cy_interior 4 spp still +6%). The quick set's 16
-    // cases are all better with it (worst filter/noisy 0.736 -> 0.654). Off until the whole table
-    // says it pays (and the learned filter's training planes, which use this estimate, agree).
+    // texture's pattern, and read as noise it opened the colour stop across the texture. It wins at
+    // 16 spp and loses at 4 (the fit also takes pure noise's energy where the albedo varies:
+    // tests/noise_fit_test.cpp), so it is off until the whole table says it pays (and the learned
+    // filter's training planes, which use this estimate, agree): docs/decisions.md.
     ImageView albedo;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         const int w = color.width, h = color.height;

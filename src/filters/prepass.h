@@ -108,9 +108,8 @@ void runCopy3(const CpuExec& exec, const ImageView& in, const ImageView& out);
 // E·sqrt((1 - j/n)/j): 0.66 for 2 of 16, 0.58 for 2 of 4). A bright pixel whose own standard
 // deviation is below half its excess over m (the sun seen directly, partly covering the pixel at
 // 16 spp: ~0.2) is signal, not a firefly, and is kept. The two overlap at very low spp: at 4 spp
-// the directly seen sun in sphere-env (2 of 4 samples) is clamped; 0.75 would keep it but then
-// keeps 2-sample fireflies at 16 spp, which multiplied sphere-env's relMSE by 2500. Measured
-// trade-off in docs/quality.md. With an estimated (constant)
+// the directly seen sun in sphere-env (2 of 4 samples) is clamped; a looser bound that keeps it
+// keeps 2-sample fireflies at 16 spp (docs/decisions.md). With an estimated (constant)
 // variance this test is off (ownVariance = 0).
 constexpr float kFireflyOwnStd = 0.5f;  // see FireflyClamp
 
@@ -122,9 +121,8 @@ ATROUS_INLINE float lumVariance(float vr, float vg, float vb) {
     const float s = lum(sqrtf(maxSel(vr, 0.0f)), sqrtf(maxSel(vg, 0.0f)), sqrtf(maxSel(vb, 0.0f)));
     return s * s;
 }
-// Σ w_c² v_c: the neighbours' v̄ of the bound keeps this form. Measured on the built-in scenes
-// (docs/quality.md): the correlated form there raised the bound, clamped 1-9% fewer fireflies and
-// made cornell-spheres' MSE 3-4% and sphere-env's relMSE 0.4-1.4% worse.
+// Σ w_c² v_c: the neighbours' v̄ of the bound keeps this form; the correlated form there raised the
+// bound and clamped fewer fireflies (docs/decisions.md).
 ATROUS_INLINE float lumVarianceIndependent(float vr, float vg, float vb) {
     return lum(lum(1, 0, 0) * vr, lum(0, 1, 0) * vg, lum(0, 0, 1) * vb);
 }

@@ -81,12 +81,8 @@ struct SafetyBlend {
 //     A = cov_W(a, r) / var_W(a), shrunk by its significance: A · max(0, 1 - k / (n R²)),
 // R² = cov² / (var(a) var(r)) (n R² is the fit's χ² statistic, about 1 on pure noise); then, as a
 // guided filter, F' = F + mean_W(A) a(p) + mean_W(b), b = -A mean_W(a): the slope's part only, not
-// the residual's mean (giving that back too returned the filter's low-frequency noise: 16-spp
-// best/OIDN geomean 1.18 in a prototype). Measured on out/corpus/full (cli_quality.py, docs/quality.md):
-// 16 spp best/OIDN geomean 1.005 -> 0.946, 4 spp 1.009 -> 0.972; cy_textures_box 16 spp EAW
-// 0.0133 -> 0.00934 and SURE 0.0110 -> 0.00834 (input 0.00954), cy_sunsky_thin -24%; no case
-// worse by more than 0.6%. R 4, k 4 (R 3..8, k 1..16 tried; k below 4 let noise back on
-// cy_interior at 4 spp, larger k or R kept less of the texture).
+// the residual's mean (giving that back too returned the filter's low-frequency noise). R 4, k 4:
+// a smaller k let noise back, a larger k or R kept less of the texture (docs/decisions.md).
 constexpr int kGiveBackRadius = 4;
 constexpr float kGiveBackSignificance = 4.0f;
 // The albedo must vary over the window by this much (a standard deviation of 0.003, as the noise

@@ -15,8 +15,8 @@
 // Blend: e_out = lerp(clamp(e_hist), e, α), α = max(alpha, 1/n, κ|m·ĝ|): n the capped history
 // length (the colour's rule, docs/svgf.md, "Stages"); the last term raises α where the light's edge
 // moves across pixels (m the motion, ĝ the direction of the history's emission gradient), since
-// there the resampled history lags (measured on cornell orbit: a halo on the ceiling beside the
-// light's edge without it). alpha = 1 reproduces the raw emission.
+// there the resampled history lags (a halo on the ceiling beside the light's edge without it,
+// docs/decisions.md). alpha = 1 reproduces the raw emission.
 #pragma once
 #include "filters/svgf_common.h"
 
@@ -58,8 +58,7 @@ struct AccumulateEmission {
         // History at p + motion (integer pixel centres, as Reproject), resampled with a 4x4
         // Catmull-Rom filter rather than bilinearly: a light's edge moving a fraction of a pixel
         // per frame would otherwise be blurred by every frame's bilinear resampling, and the
-        // clamp below keeps that blur on the edge (measured: a halo on the ceiling next to the
-        // light). Its negative lobes are removed by the same clamp. Taps beyond the image border
+        // clamp below keeps that blur on the edge (a halo next to the light). Its negative lobes are removed by the same clamp. Taps beyond the image border
         // repeat the border; a position more than half a pixel outside the image is a reset.
         float px = float(x) + mx, py = float(y) + my;
         if (!(px >= -0.5f && py >= -0.5f && px <= float(w) - 0.5f && py <= float(h) - 0.5f)) {
