@@ -36,7 +36,7 @@ test: build setup-python
 quality: build setup-python
 	@python3 scripts/corpus/render.py --full
 	@python3 scripts/corpus/cli_quality.py --corpus out/corpus/full --atrous $(BUILD)/atrous --json out/corpus/full/cli_quality.json
-	@.venv/bin/python scripts/corpus/quality.py --corpus out/corpus/full --crops
+	@.venv/bin/python -m atrous.eval corpus --corpus out/corpus/full --crops
 
 python: setup-python
 	@JOBS=$(JOBS) ./scripts/python_install.sh

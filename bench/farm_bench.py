@@ -29,7 +29,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from bench_machine import cpu_model  # bench/ (the script's own folder is on sys.path)
+from atrous.eval.machine import cpu_model
 
 REPO = Path(__file__).resolve().parents[1]
 SIZES = {"tiny": {"width": 32, "height": 32, "spp": 2}, "medium": {"width": 128, "height": 128, "spp": 64}}

@@ -34,7 +34,7 @@ import sys
 import time
 from pathlib import Path
 
-from bench_machine import cpu_model, emit, git_commit  # bench/ (the script's own folder is on sys.path)
+from atrous.eval.machine import cpu_model, emit, git_commit
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -25,7 +25,7 @@ import time
 from pathlib import Path
 
 
-from bench_machine import cpu_model, emit, git_commit  # bench/ (the script's own folder is on sys.path)
+from atrous.eval.machine import cpu_model, emit, git_commit
 from learned_speed import _oidn_filter  # an OIDN RT filter bound and committed once
 
 ROOT = Path(__file__).resolve().parents[1]

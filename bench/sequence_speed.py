@@ -23,7 +23,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from bench_machine import cpu_model, emit, git_commit  # bench/ (the script's own folder is on sys.path)
+from atrous.eval.machine import cpu_model, emit, git_commit
 
 ROOT = Path(__file__).resolve().parents[1]
 VARIANTS = {"temporal": [], "per_frame_auto": ["--method", "auto"]}

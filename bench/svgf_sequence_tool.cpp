@@ -1,4 +1,4 @@
-// Helper of bench/svgf_quality.py (not a timing benchmark):
+// Helper of atrous.eval sequences (python/atrous/eval/sequences.py) (not a timing benchmark):
 //   svgf_sequence_tool denoise --method svgf|eaw|sure --sequence DIR --out OUTDIR
 //       the body of `atrous denoise --sequence` (runSequenceDenoise), for builds where the CLI
 //       does not have --sequence wired in yet;

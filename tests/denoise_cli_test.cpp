@@ -161,7 +161,7 @@ TEST(CompareCli, MetricsJsonAndErrorMaps) {
 
 TEST(DenoiseCli, QualityOnRenderedScenes) {
     // 64×64 renders at 16 spp against 1024-spp references, both rendered here through the CLI: the
-    // CI-sized version of bench/quality.py (docs/quality.md). cornell-point (point light: diffuse
+    // CI-sized version of atrous.eval cli-scenes (python/atrous/eval/cli_scenes.py) (docs/quality.md). cornell-point (point light: diffuse
     // interreflection noise) and cornell-spheres (a visible area light, a mirror and a glass
     // sphere: emission and delta-chain features). Bounds: EAW and SURE cut the noisy MSE at least
     // 2.5× (measured 3.7× / 4.4× and 3.4× / 3.4× here; 38× and 9.2× at 512×512), and SURE is not

@@ -9,7 +9,7 @@ stills, per case and as geometric means per renderer and spp over OIDN fast and 
 Each VARIANT=FLAGS runs `atrous denoise --in FILE --out X.exr FLAGS` on the file (or folder) as the
 renderer wrote it, so `default=""` is what a user gets without --method. OIDN (pyoidn, colour +
 albedo + normal as atrous.eval passes them, HDR; quality fast, balanced and high) runs on the
-buffers scripts/corpus/quality.py's loaders read; its outputs are cached in <corpus>/oidn_cache/
+buffers atrous.eval corpus (python/atrous/eval/corpus.py)'s loaders read; its outputs are cached in <corpus>/oidn_cache/
 (delete it after re-rendering). --crops DIR writes, for each --crop-cases scene/spp, a strip
 noisy | --crop-variant | OIDN fast | OIDN high | reference (the window with the most reference
 detail, 2x), DIR/<scene>_<spp>spp_oidn.png.
@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-import quality as Q  # noqa: E402  (the corpus loaders, relmse, read_exr)
+from atrous.eval import corpus as Q  # the corpus loaders, relmse, read_exr
 
 
 def oidn_output(cache: Path, key: str, b, quality: str):

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Quality per second (docs/quality.md, "Quality per second"): relMSE on the third-party corpus
 (scripts/corpus/method_quality.py's JSON: geometric mean per renderer of relMSE / OIDN fast's)
-against time per frame at 512² and 1080p (bench/learned_speed.py's JSON: `atrous bench` medians for
+against time per frame at 512² and 1080p (atrous.eval speed (python/atrous/eval/speed.py)'s JSON: `atrous bench` medians for
 EAW, SURE, learned and blend, OIDN fast/balanced/high alternating in one process), for every atrous
 method and OIDN's three quality modes. Writes a PNG and prints the points.
 

@@ -19,7 +19,7 @@ renderer wrote it ("" is what a user gets without --method). Corpus sequences ar
     atrous render --scene cornell-spheres --camera-path orbit --frames 20 --spp 1 --reference-spp 256 --width 128 --height 128 --out out/heldout_seq/spheres_orbit
 
 OIDN (pyoidn, HDR, colour + albedo + normal) runs per frame on the buffers the corpus loaders read
-(scripts/corpus/quality.py) or on the frame's color/albedo/normal.exr. The metrics are `atrous
+(atrous.eval corpus (python/atrous/eval/corpus.py)) or on the frame's color/albedo/normal.exr. The metrics are `atrous
 compare --sequence`'s, over all pixels and again with the pixels that show a light (reference
 luminance above LIGHT_LUM in any frame, grown by a pixel) left out. Runs in the project venv
 (.venv: numpy, pyoidn, atrous).
@@ -35,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-import quality as Q  # noqa: E402  (the corpus loaders)
+from atrous.eval import corpus as Q  # the corpus loaders
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -63,7 +63,7 @@ def own_sequences(own: Path):
 
 def frame_buffers(scene: Path, folder: Path, ref: bool = False):
     """(name, buffers) per frame in order: the noisy frame's color, albedo and normal at `folder`'s
-    spp through the corpus loaders (scripts/corpus/quality.py), or an own sequence's files; with
+    spp through the corpus loaders (atrous.eval corpus (python/atrous/eval/corpus.py)), or an own sequence's files; with
     ref=True the reference's color. name: the frame_NNNN that `atrous denoise --sequence` writes."""
     import atrous
 

@@ -209,3 +209,26 @@ def test_static_sequence_adds_temporal_and_svgf_columns(tmp_path):
     assert res["summary"]["temporal"]["relmse"] < res["summary"]["eaw"]["relmse"]
     with pytest.raises(ValueError, match="frame_"):
         sequence.list_frames(str(tmp_path))  # no frame directories at the top level
+
+
+def test_one_entry_point_for_every_evaluation(capsys):
+    """python -m atrous.eval (atrous-eval) is the one entry point: its subcommands are the built-in
+    scenes (the default), the corpus, the held-out scenes, sequences, the CLI's scenes and speed,
+    each with its own --help under its own name; an unknown first word is the scenes' (bad) flag."""
+    import subprocess
+
+    from atrous.eval.__main__ import SUBCOMMANDS, run
+
+    assert set(SUBCOMMANDS) == {"scenes", "corpus", "held-out", "sequences", "cli-scenes", "speed"}
+    assert run(["--help"]) == 0
+    out = capsys.readouterr().out
+    assert all(name in out for name in SUBCOMMANDS)
+    for name in SUBCOMMANDS:
+        r = subprocess.run([sys.executable, "-m", "atrous.eval", name, "--help"], capture_output=True, text=True,
+                           timeout=120)
+        assert r.returncode == 0, (name, r.stderr)
+        if name != "scenes":
+            assert f"python -m atrous.eval {name}" in r.stdout, name
+    r = subprocess.run([sys.executable, "-m", "atrous.eval", "--scenes", "nope", "--quick"], capture_output=True,
+                       text=True, timeout=120)
+    assert r.returncode == 2 and "nope" in r.stderr

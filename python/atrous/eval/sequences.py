@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """SVGF quality benchmark: SVGF vs per-frame EAW and SURE on animated scenes (docs/quality.md).
 
 For each scene (NAME:CAMERA_PATH) it renders a 1-spp sequence with per-frame references
@@ -111,8 +110,8 @@ def markdown(result, plots_rel):
     return "\n".join(out)
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+def main(argv=None):
+    ap = argparse.ArgumentParser(prog="python -m atrous.eval sequences", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--atrous", default="build/atrous", help="atrous CLI (default build/atrous)")
     ap.add_argument("--tool", default="build/bench/svgf_sequence_tool", help="bench/svgf_sequence_tool binary")
     ap.add_argument("--scenes", default="cornell:orbit,cornell-moving:static", help="NAME:CAMERA_PATH,...")
@@ -131,7 +130,7 @@ def main():
     ap.add_argument("--json", help="also write the JSON here")
     ap.add_argument("--plots", help="write svgf_<scene>_<path>_{relmse,temporal_no_emitters}.svg into this directory")
     ap.add_argument("--markdown", help="write the tables (Markdown) to this file")
-    a = ap.parse_args()
+    a = ap.parse_args(argv)
 
     use_cli = not a.use_tool and has_sequence_flag(a.atrous)
     result = {"benchmark": "svgf_quality", "date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime()),
@@ -216,6 +215,3 @@ def main():
             f.write(text + "\n")
     print(text)
 
-
-if __name__ == "__main__":
-    main()

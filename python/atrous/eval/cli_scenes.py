@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Quality benchmark of the denoisers (run by hand; results go to docs/quality.md).
 
 For each built-in scene, renders a high-spp reference (cached under OUT/refs/), noisy images at
@@ -6,8 +5,8 @@ the given spp, denoises them with EAW and SURE, and compares all against the ref
 `atrous compare --json`. Prints a markdown table (MSE, relMSE, MSE reduction over noisy, SURE vs
 EAW) and writes it to OUT/quality.md. Python 3 standard library only.
 
-  python3 bench/quality.py                      # 512x512, 4 and 16 spp, 4096-spp references
-  nice -n 19 python3 bench/quality.py --size 256 --ref-spp 1024   # quicker, for development
+  .venv/bin/python -m atrous.eval cli-scenes                      # 512x512, 4 and 16 spp, 4096-spp references
+  nice -n 19 .venv/bin/python -m atrous.eval cli-scenes --size 256 --ref-spp 1024   # quicker, for development
 """
 import argparse
 import datetime
@@ -17,7 +16,7 @@ import subprocess
 import sys
 import time
 
-from bench_machine import cpu_model  # bench/ (the script's own folder is on sys.path)
+from atrous.eval.machine import cpu_model
 
 SCENES = ["cornell", "cornell-point", "cornell-spheres", "sphere-env"]
 
@@ -30,8 +29,8 @@ def run(cmd):
     return r.stdout, time.time() - t
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+def main(argv=None):
+    ap = argparse.ArgumentParser(prog="python -m atrous.eval cli-scenes", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--atrous", default="build/atrous", help="path of the atrous CLI")
     ap.add_argument("--out", default="out/quality", help="work directory (references cached in OUT/refs)")
     ap.add_argument("--size", type=int, default=512)
@@ -39,7 +38,7 @@ def main():
     ap.add_argument("--ref-spp", type=int, default=4096)
     ap.add_argument("--scenes", default=",".join(SCENES))
     ap.add_argument("--denoise-args", default="", help="extra flags for atrous denoise")
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
     spps = [int(s) for s in args.spp.split(",")]
     scenes = args.scenes.split(",")
     os.makedirs(os.path.join(args.out, "refs"), exist_ok=True)
@@ -97,6 +96,3 @@ def main():
     print()
     print(table)
 
-
-if __name__ == "__main__":
-    main()

@@ -1,9 +1,8 @@
-#!/usr/bin/env python3
 """Denoising quality on the third-party corpus (scripts/corpus/render.py): noisy vs OIDN vs atrous.
 
-    .venv/bin/python scripts/corpus/quality.py                      # out/corpus/full if it has scenes, else quick
-    .venv/bin/python scripts/corpus/quality.py --corpus out/corpus/quick --crops
-    .venv/bin/python scripts/corpus/quality.py --preview            # also tonemapped PNGs of every reference
+    .venv/bin/python -m atrous.eval corpus                      # out/corpus/full if it has scenes, else quick
+    .venv/bin/python -m atrous.eval corpus --corpus out/corpus/quick --crops
+    .venv/bin/python -m atrous.eval corpus --preview            # also tonemapped PNGs of every reference
 
 Runs in the project venv (.venv: numpy, pyoidn, atrous). The EXRs are read with the OpenEXR Python
 bindings: from .venv if installed there, else from .venv-corpus's site-packages (same Python 3.11).
@@ -22,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path.cwd()  # the repository root: run from it (its out/ and build/ are the defaults)
 
 import OpenEXR  # noqa: E402  (python/requirements.txt puts it in .venv, as in .venv-corpus)
 
@@ -196,8 +195,8 @@ def crop_strip(images, ref, size):
 
 
 # ---------------------------------------------------------------- main
-def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+def main(argv=None):
+    ap = argparse.ArgumentParser(prog="python -m atrous.eval corpus", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--corpus", default=None, help="corpus root (default out/corpus/full, else out/corpus/quick)")
     ap.add_argument("--methods", default="noisy,oidn,eaw,sure")
     ap.add_argument("--crops", action="store_true", help="write side-by-side PNG crops")
@@ -206,7 +205,7 @@ def main():
     ap.add_argument("--scenes", default="", help="comma-separated scene names")
     ap.add_argument("--no-sequences", action="store_true")
     ap.add_argument("--out", default=None, help="JSON path (default <corpus>/quality.json)")
-    a = ap.parse_args()
+    a = ap.parse_args(argv)
     corpus = Path(a.corpus) if a.corpus else None
     if corpus is None:
         full = ROOT / "out" / "corpus" / "full"
@@ -305,6 +304,3 @@ def table(results, cols):
     lines += [fmt_row(r, allc) for r in results]
     return "\n".join(lines)
 
-
-if __name__ == "__main__":
-    main()

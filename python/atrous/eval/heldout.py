@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """relMSE of the learned filter on the held-out scenes (out/train/data/test) against the noisy input,
 atrous's EAW and SURE and OIDN (pyoidn, when importable), at 4 and 16 spp, per scene and geometric
 mean; prints a Markdown table and writes JSON (docs/learned.md, "Results"). Every atrous method runs
@@ -6,7 +5,7 @@ through the library as it ships (atrous.denoise with all buffers, the learned fi
 method="learned" and the given or built-in weights), so the table measures the C++ inference, not
 the JAX model. Runs in the project venv (.venv: the atrous module, pyoidn):
 
-  .venv/bin/python scripts/train/evaluate.py --weights out/train/run/weights.bin --json out/train/eval.json
+  .venv/bin/python -m atrous.eval held-out --weights out/train/run/weights.bin --json out/train/eval.json
 """
 import argparse
 import glob
@@ -17,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path.cwd()  # the repository root: run from it (its out/ and build/ are the defaults)
 BUFS = ("color", "variance", "albedo", "normal", "depth", "emission")
 METHODS = ("noisy", "eaw", "sure", "learned", "blend", "oidn")
 
@@ -71,15 +70,15 @@ def summary(res: dict, spps=(4, 16)) -> dict:
     return out
 
 
-def main() -> int:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(prog="python -m atrous.eval held-out", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--data", default="out/train/data/test")
     p.add_argument("--weights", default=None, help="a weight file (version 4, or 3) (default: the built-in weights)")
     p.add_argument("--methods", nargs="+", default=list(METHODS), choices=METHODS)
     p.add_argument("--no-variance", action="store_true",
                    help="withhold the variance buffer (every atrous method then estimates it, as for other renderers)")
     p.add_argument("--json")
-    a = p.parse_args()
+    a = p.parse_args(argv)
     res = {}
     files = sorted(f for f in glob.glob(f"{a.data}/*.npz") if not f.endswith(".tmp.npz"))
     if not files:
@@ -104,6 +103,3 @@ def main() -> int:
         print({k: (round(x, 3) if isinstance(x, float) else x) for k, x in v.items() if k not in METHODS})
     return 0
 
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -1,8 +1,7 @@
-#!/usr/bin/env python3
 """The learned filter's speed against EAW, SURE and Intel Open Image Denoise, in one run.
 
-    .venv/bin/python bench/learned_speed.py --atrous build/atrous            # 512x512 and 1920x1080
-    .venv/bin/python bench/learned_speed.py --atrous build/atrous --runs 20 --out learned_speed.json
+    .venv/bin/python -m atrous.eval speed --atrous build/atrous            # 512x512 and 1920x1080
+    .venv/bin/python -m atrous.eval speed --atrous build/atrous --runs 20 --out learned_speed.json
 
 It calls `atrous bench --json --what eaw,sure,learned` (the filter alone, inputs in place: the
 median of --runs runs after --warmup; docs/benchmarks.md) and, in the same run, times OIDN on the
@@ -35,11 +34,11 @@ import sys
 import time
 from pathlib import Path
 
-from bench_machine import cpu_model, emit, git_commit  # bench/ (the script's own folder is on sys.path)
+from atrous.eval.machine import cpu_model, emit, git_commit
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path.cwd()  # the repository root: run from it (its out/ and build/ are the defaults)
 
 
 def _oidn_filter(pyoidn, dev, color, albedo, normal, quality):
@@ -126,7 +125,7 @@ def time_default_alternating(b, runs: int, warmup: int) -> dict:
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p = argparse.ArgumentParser(prog="python -m atrous.eval speed", description=__doc__.split("\n\n")[0])
     p.add_argument("--atrous", default=str(ROOT / "build" / "atrous"), help="the atrous CLI (default build/atrous)")
     p.add_argument("--sizes", default="512x512,1920x1080", help="comma list of WxH (default 512x512,1920x1080)")
     p.add_argument("--runs", type=int, default=10, help="timed runs per figure (default 10)")
@@ -176,7 +175,7 @@ def main(argv=None) -> int:
         rows.append(row)
 
     doc = {
-        "what": "learned filter speed vs EAW, SURE and OIDN (bench/learned_speed.py)",
+        "what": "learned filter speed vs EAW, SURE and OIDN (python -m atrous.eval speed)",
         "date_utc": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M:%S"),
         "commit": git_commit(),
         "machine": {"host": platform.node(), "cpu": cpu_model(), "cpu_count": os.cpu_count(),
@@ -195,6 +194,3 @@ def main(argv=None) -> int:
     emit(doc, a.out)
     return 0
 
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -8,7 +8,7 @@ import subprocess
 from pathlib import Path
 from typing import Optional
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path.cwd()  # the repository root: run from it (its out/ and build/ are the defaults)
 
 
 def cpu_model(unknown: str = "unknown") -> str:
