@@ -48,6 +48,13 @@ TEST(ToyMethod, IsARowOfTheRegistry) {
     EXPECT_THROW(registerDenoiseMethod({DenoiseMethod::Eaw, "bare", "", false}), InputError);
     EXPECT_THROW(registerDenoiseMethod({DenoiseMethod::Eaw, "weighted", "", true, toy::toyCascade}), InputError);
     EXPECT_EQ(denoiseMethods().size(), n);
+    // What a row reads tells a reader what to decode (the preparation's buffers always).
+    DenoiseMethodInfo normalOnly{DenoiseMethod::Eaw, "toy-normal-only", "", false, toy::toyCascade};
+    normalOnly.reads = DenoiseBufferUse{false, false, true, false, false, false, false};
+    const DenoiseBufferUse use = denoiseBufferUse(DenoiseOptions{}, registerDenoiseMethod(normalOnly));
+    EXPECT_TRUE(use.normal && use.variance && use.emission && use.albedo && use.depth);
+    EXPECT_FALSE(use.position || use.ids);
+    EXPECT_TRUE(denoiseBufferUse(DenoiseOptions{}, toy::toyMethod()).position);
     // A value no row has is an InputError, not undefined behaviour.
     DenoiseOptions o;
     o.method = static_cast<DenoiseMethod>(999);

@@ -253,6 +253,12 @@ struct DenoiseMethodInfo {
     // A registered method's cascade on the CPU and on CUDA (empty: not on that device); empty
     // for the built-in methods.
     StillCascade cpu = {}, cuda = {};
+    // The feature buffers a registered method's cascade reads: the planes of the others are
+    // invalid, and denoiseBufferUse tells a reader it need not decode them (the preparation reads
+    // the variance, the emission, the albedo for demodulation and depth for the noise estimate
+    // whatever this says). The built-in methods'
+    // use is denoiseBufferUse's own rule.
+    DenoiseBufferUse reads = {};
     bool registered() const { return bool(cpu) || bool(cuda); }
 };
 // The rows in order: eaw, sure, learned, blend, auto, then the registered methods. The references

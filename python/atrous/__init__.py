@@ -89,7 +89,8 @@ def methods() -> list:
     return rows
 
 
-def register_method(name: str, cascade: Any, summary: str = "") -> None:
+def register_method(name: str, cascade: Any, summary: str = "",
+                    reads: Sequence[str] = ("variance", "albedo", "normal", "position", "depth", "ids", "emission")) -> None:
     """Adds a still method to the library's registry: from then on it is a `method=` of
     :func:`denoise` (and of the farm's denoise job, docs/farm.md "Plugins"), and in
     :func:`methods`. `cascade(planes, out)` filters: `planes` is a dict of H x W x C float32 arrays,
@@ -98,12 +99,14 @@ def register_method(name: str, cascade: Any, summary: str = "") -> None:
     channels), albedo, normal, position (3), depth (1) and ids (2; R object, G material), None when
     not given; `out` (H x W x 3, writable) receives the filtered colour in the same units. The
     library then applies the safety net (when on), remodulates and adds the filtered emission
-    back. The views are valid during the call only. The CPU only; the name must be new (letters,
+    back. The views are valid during the call only. `reads`: the buffers the cascade reads (the
+    others' planes are None, and a reader need not decode them); the albedo still demodulates
+    the colour. The CPU only; the name must be new (letters,
     digits, '_', '-'), else ValueError. An exception in `cascade` reaches the caller of denoise
     as RuntimeError naming it. docs/python.md has an example."""
     if not callable(cascade):
         raise ValueError(f"register_method: cascade must be callable (got {type(cascade).__name__})")
-    _core.register_method(str(name), str(summary), cascade)
+    _core.register_method(str(name), str(summary), cascade, [str(r) for r in reads])
 
 
 def denoise_methods() -> list:

@@ -5,8 +5,10 @@
 #include <nanobind/nanobind.h>
 #include <nanobind/ndarray.h>
 #include <nanobind/stl/string.h>
+#include <nanobind/stl/vector.h>
 
 #include <string>
+#include <vector>
 
 #include "atrous/denoise.h"
 #include "atrous/error.h"
@@ -58,8 +60,19 @@ struct PyCascade {
 }  // namespace
 
 void bindMethods(nb::module_& m) {
-    m.def("register_method", [](const std::string& name, const std::string& summary, nb::callable cascade) {
+    m.def("register_method", [](const std::string& name, const std::string& summary, nb::callable cascade,
+                                std::vector<std::string> reads) {
         DenoiseMethodInfo info{DenoiseMethod::Eaw, name.c_str(), summary.c_str(), false};
+        info.reads = DenoiseBufferUse{false, false, false, false, false, false, false};
+        for (const std::string& b : reads) {
+            bool* f = b == "variance" ? &info.reads.variance : b == "albedo" ? &info.reads.albedo
+                      : b == "normal" ? &info.reads.normal : b == "position" ? &info.reads.position
+                      : b == "depth" ? &info.reads.depth : b == "ids" ? &info.reads.ids
+                      : b == "emission" ? &info.reads.emission : nullptr;
+            if (!f) throw InputError("register_method: reads: unknown buffer '" + b +
+                                     "' (variance, albedo, normal, position, depth, ids, emission)");
+            *f = true;
+        }
         PyObject* fn = cascade.ptr();
         info.cpu = PyCascade{fn};
         const DenoiseMethod added = registerDenoiseMethod(std::move(info));

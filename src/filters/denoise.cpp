@@ -289,13 +289,14 @@ PreparedInputs prepareInputsDropping(const DenoiseInputs& given, const DenoiseOp
     const bool learned = o.method == DenoiseMethod::Learned;
     const DenoiseMethodInfo& info = denoiseMethodInfo(o.method);
     const bool network = info.usesWeights;  // the learned cascade runs
+    const std::string by = std::string(" by ") + info.name + ")";
     if (in.albedo) used += use.albedo ? ",albedo" : ",albedo(unused: demodulation off)";
-    if (in.normal) used += ",normal";
-    if (in.position) used += use.position ? ",position" : ",position(unused by learned)";
+    if (in.normal) used += use.normal ? ",normal" : ",normal(unused" + by;
+    if (in.position) used += use.position ? ",position" : ",position(unused" + by;
     // Depth steers the depth stop (sigma-depth > 0), the learned network, and, without a usable
     // variance, the noise estimate's geometric edges.
     if (in.depth) used += network || info.registered() || o.eaw.sigmaDepth > 0 || rep.noiseEstimated ? ",depth" : ",depth(unused: sigma-depth 0)";
-    if (in.ids) used += use.ids ? ",ids" : learned ? ",ids(unused by learned)" : ",ids(unused)";
+    if (in.ids) used += use.ids ? ",ids" : learned || info.registered() ? ",ids(unused" + by : ",ids(unused)";
     if (in.emission) used += ",emission";
     rep.buffersUsed = used;
     return p;
@@ -306,6 +307,14 @@ PreparedInputs prepareInputsDropping(const DenoiseInputs& given, const DenoiseOp
 // The learned filter's network reads depth (and no position or ids); EAW/SURE the reverse by
 // default; Blend what both read.
 DenoiseBufferUse denoiseBufferUse(const DenoiseOptions& o, DenoiseMethod resolved) {
+    const DenoiseMethodInfo& info = denoiseMethodInfo(resolved);
+    if (info.registered()) {
+        DenoiseBufferUse u = info.reads;
+        u.albedo = o.demodulate;  // the preparation demodulates by it, whether the cascade reads it or not
+        u.depth = true;           // the noise estimate's edges (below)
+        u.variance = u.emission = true;  // the preparation's (the planes' variance, the emission split)
+        return u;
+    }
     const bool learned = resolved == DenoiseMethod::Learned;
     DenoiseBufferUse u;
     u.albedo = o.demodulate;

@@ -377,11 +377,12 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         auto first = [](ImageView v, int n) { return v.valid() ? ImageView{v.data, v.width, v.height, n} : v; };
         StillPlanes P;
         P.device = dev;
-        P.color = cA.view(), P.variance = vA.view(), P.albedo = first(albedo, 3);
-        P.normal = first(in.normal.valid() ? normal : ImageView{}, 3);
-        P.position = first(in.position.valid() ? position : ImageView{}, 3);
-        P.depth = first(in.depth.valid() ? depth : ImageView{}, 1);
-        P.ids = first(ids, 2);
+        const DenoiseBufferUse& reads = info.reads;  // what the method reads of what was given
+        P.color = cA.view(), P.variance = vA.view(), P.albedo = reads.albedo ? first(albedo, 3) : ImageView{};
+        P.normal = reads.normal ? first(in.normal.valid() ? normal : ImageView{}, 3) : ImageView{};
+        P.position = reads.position ? first(in.position.valid() ? position : ImageView{}, 3) : ImageView{};
+        P.depth = reads.depth ? first(in.depth.valid() ? depth : ImageView{}, 1) : ImageView{};
+        P.ids = reads.ids ? first(ids, 2) : ImageView{};
         (*own)(P, o, learnedOut.view());
         cur = &learnedOut;
         markStage(out.clock, info.name);

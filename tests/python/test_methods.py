@@ -81,3 +81,21 @@ def test_bad_registrations_and_cascades():
         atrous.denoise(b["color"], method="boom")
     with pytest.raises(RuntimeError, match="read-only"):
         atrous.denoise(b["color"], method="writes-input")
+
+
+def test_reads_says_which_planes_the_cascade_gets():
+    b = _render()
+    seen = {}
+
+    def spy(planes, out):
+        seen.update({k: v is not None for k, v in planes.items()})
+        out[...] = planes["color"]
+
+    atrous.register_method("normal-only", spy, reads=("normal",))
+    atrous.denoise(b["color"], albedo=b["albedo"], normal=b["normal"], position=b["position"], depth=b["depth"],
+                   ids=b["ids"], method="normal-only")
+    assert seen == {"color": True, "variance": True, "normal": True, "albedo": False, "position": False,
+                    "depth": False, "ids": False}
+    with pytest.raises(ValueError, match="unknown buffer 'motion'"):
+        atrous.register_method("bad-reads", spy, reads=("motion",))
+    assert "bad-reads" not in atrous.METHODS
