@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 
 #include "atrous/device.h"
 #include "atrous/image.h"
@@ -105,26 +106,30 @@ TEST(RenderCli, BadInputIsOneLineExitTwoNothingWritten) {
     std::ofstream(tmp / "badtex.json")
         << R"({"camera": {"position": [0,0,3], "lookAt": [0,0,0]}, "materials": {"m": {"texture": "badtex.png"}}, "objects": []})";
     const std::string ok = " --width 8 --height 8 --spp 1";
-    expectBadInput("--scene " + d + "/nothere.json" + ok, "nothere.json", tmp);
-    expectBadInput("--scene " + d + "/malformed.json" + ok, "malformed.json", tmp);
-    expectBadInput("--scene " + d + "/objscene.json" + ok, "bad.obj", tmp);
-    expectBadInput("--scene " + d + "/missingobj.json" + ok, "gone.obj", tmp);
-    expectBadInput("--scene " + d + "/tex.json" + ok, "gone.png", tmp);
-    expectBadInput("--scene " + d + "/badtex.json" + ok, "badtex.png", tmp);
-    expectBadInput("--scene kitchen" + ok, "kitchen", tmp);
-    expectBadInput("--scene cornell --spp 0 --width 8 --height 8", "--spp", tmp);
-    expectBadInput("--scene cornell --spp -4 --width 8 --height 8", "--spp", tmp);
-    expectBadInput("--scene cornell --width 0 --height 8 --spp 1", "--width", tmp);
-    expectBadInput("--scene cornell --width 8 --height -1 --spp 1", "--height", tmp);
-    expectBadInput("--scene cornell --width 20000 --height 8 --spp 1", "--width", tmp);
-    expectBadInput("--scene cornell --width 8 --height 16385 --spp 1", "--height", tmp);
-    expectBadInput("--scene cornell --width 8 --height 8 --spp 1 --denoise blur", "blur", tmp);
-    expectBadInput("--scene cornell --width 8 --height 8 --spp 1 --max-depth -1", "--max-depth", tmp);
-    expectBadInput("--scene cornell --width 8 --height 8 --spp 1 --threads -1", "--threads", tmp);
-    // The render table's rules, the flag named from the library's field (no message parsing).
-    expectBadInput("--scene cornell --width 0 --height 8 --spp 1", "--width: must be in 1..16384 (got 0)", tmp);
-    expectBadInput("--scene cornell --width 8 --height 8 --spp 1 --max-depth 2000", "--max-depth: must be in 0..1024 (got 2000)", tmp);
-    expectBadInput("--scene cornell --width 8 --height 8 --spp ''", "--spp", tmp);
+    // Each case: the command line's arguments and what its one error line must name.
+    const std::pair<std::string, std::string> cases[] = {
+        {"--scene " + d + "/nothere.json" + ok, "nothere.json"},
+        {"--scene " + d + "/malformed.json" + ok, "malformed.json"},
+        {"--scene " + d + "/objscene.json" + ok, "bad.obj"},
+        {"--scene " + d + "/missingobj.json" + ok, "gone.obj"},
+        {"--scene " + d + "/tex.json" + ok, "gone.png"},
+        {"--scene " + d + "/badtex.json" + ok, "badtex.png"},
+        {"--scene kitchen" + ok, "kitchen"},
+        {"--scene cornell --spp 0 --width 8 --height 8", "--spp"},
+        {"--scene cornell --spp -4 --width 8 --height 8", "--spp"},
+        {"--scene cornell --width 0 --height 8 --spp 1", "--width"},
+        {"--scene cornell --width 8 --height -1 --spp 1", "--height"},
+        {"--scene cornell --width 20000 --height 8 --spp 1", "--width"},
+        {"--scene cornell --width 8 --height 16385 --spp 1", "--height"},
+        {"--scene cornell --width 8 --height 8 --spp 1 --denoise blur", "blur"},
+        {"--scene cornell --width 8 --height 8 --spp 1 --max-depth -1", "--max-depth"},
+        {"--scene cornell --width 8 --height 8 --spp 1 --threads -1", "--threads"},
+        // The render table's rules, the flag named from the library's field (no message parsing).
+        {"--scene cornell --width 0 --height 8 --spp 1", "--width: must be in 1..16384 (got 0)"},
+        {"--scene cornell --width 8 --height 8 --spp 1 --max-depth 2000", "--max-depth: must be in 0..1024 (got 2000)"},
+        {"--scene cornell --width 8 --height 8 --spp ''", "--spp"},
+    };
+    for (const auto& [args, needle] : cases) expectBadInput(args, needle, tmp);
 }
 
 // render --denoise and denoise of the buffers it wrote take their inputs from the one assembly

@@ -64,7 +64,7 @@ std::string benchmarkJson(const BenchmarkRun& run, const std::vector<FrameTiming
     // The first frame (BVH already built, but first allocations, ImGui font atlas upload) is a
     // warm-up and left out when there are more.
     const size_t skip = frames.size() > 1 ? 1 : 0;
-    auto med = [&](double (*field)(const FrameTiming&)) {
+    auto med = [&](auto field) {
         std::vector<double> v;
         for (size_t i = skip; i < frames.size(); ++i) v.push_back(field(frames[i]));
         return median(v);
@@ -89,24 +89,27 @@ std::string benchmarkJson(const BenchmarkRun& run, const std::vector<FrameTiming
     j["frame_ms_mean"] = sig6(mean);
     j["frame_ms_median"] = sig6(frameMed);
     j["fps"] = sig6(frameMed > 0 ? 1000.0 / frameMed : 0.0);
-    j["render_ms"] = sig6(med([](const FrameTiming& f) { return f.stages.render; }));
-    j["accumulate_ms"] = sig6(med([](const FrameTiming& f) { return f.stages.accumulate; }));
-    j["motion_ms"] = sig6(med([](const FrameTiming& f) { return f.stages.motion; }));
-    j["denoise_a_ms"] = sig6(med([](const FrameTiming& f) { return f.stages.denoiseA; }));
-    j["denoise_b_ms"] = sig6(med([](const FrameTiming& f) { return f.stages.denoiseB; }));
-    j["debug_ms"] = sig6(med([](const FrameTiming& f) { return f.stages.debug; }));
+    // Each stage's median wall-clock and CPU milliseconds, under its JSON names.
+    struct StageField {
+        const char *wall, *cpu;
+        double StageTimes::*wallMs, StageTimes::*cpuMs;
+    };
+    static const StageField kStages[] = {
+        {"render_ms", "render_cpu_ms", &StageTimes::render, &StageTimes::renderCpu},
+        {"accumulate_ms", "accumulate_cpu_ms", &StageTimes::accumulate, &StageTimes::accumulateCpu},
+        {"motion_ms", "motion_cpu_ms", &StageTimes::motion, &StageTimes::motionCpu},
+        {"denoise_a_ms", "denoise_a_cpu_ms", &StageTimes::denoiseA, &StageTimes::denoiseACpu},
+        {"denoise_b_ms", "denoise_b_cpu_ms", &StageTimes::denoiseB, &StageTimes::denoiseBCpu},
+        {"debug_ms", "debug_cpu_ms", &StageTimes::debug, &StageTimes::debugCpu},
+    };
+    for (const StageField& st : kStages) j[st.wall] = sig6(med([&](const FrameTiming& f) { return f.stages.*st.wallMs; }));
     j["display_ms"] = sig6(med([](const FrameTiming& f) { return f.displayMs; }));
     // CPU time (user + system, all threads) per frame: on a shared machine the wall-clock
     // figures above depend on the other tenants; frame CPU time / cores bounds the frame time
     // on an idle machine from below (exact when every stage keeps all cores busy).
     const double cpuMed = med([](const FrameTiming& f) { return f.frameCpuMs; });
     j["cpu_ms_per_frame_median"] = sig6(cpuMed);
-    j["render_cpu_ms"] = sig6(med([](const FrameTiming& f) { return f.stages.renderCpu; }));
-    j["accumulate_cpu_ms"] = sig6(med([](const FrameTiming& f) { return f.stages.accumulateCpu; }));
-    j["motion_cpu_ms"] = sig6(med([](const FrameTiming& f) { return f.stages.motionCpu; }));
-    j["denoise_a_cpu_ms"] = sig6(med([](const FrameTiming& f) { return f.stages.denoiseACpu; }));
-    j["denoise_b_cpu_ms"] = sig6(med([](const FrameTiming& f) { return f.stages.denoiseBCpu; }));
-    j["debug_cpu_ms"] = sig6(med([](const FrameTiming& f) { return f.stages.debugCpu; }));
+    for (const StageField& st : kStages) j[st.cpu] = sig6(med([&](const FrameTiming& f) { return f.stages.*st.cpuMs; }));
     const int cores = int(std::thread::hardware_concurrency());
     j["hardware_threads"] = cores;
     j["fps_idle_estimate"] = sig6(cpuMed > 0 ? 1000.0 * std::max(1, cores) / cpuMed : 0.0);
