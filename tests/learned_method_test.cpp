@@ -133,11 +133,16 @@ TEST(LearnedMethod, IsRunLearnedOnThePreparedPlanesThenRemodulate) {
     }
 }
 
-TEST(LearnedMethod, IgnoresLevelsAndTheEawParametersButNotTheSafetyNet) {
+// The fixture's weights in a file, the synthetic scene and a report to fill.
+class LearnedSynth : public ::testing::Test {
+protected:
     test::TempDir dir;
     const std::string wpath = writeFixtureWeights(dir);
-    const Synth sc;
+    Synth sc;
     DenoiseReport rep;
+};
+
+TEST_F(LearnedSynth, IgnoresLevelsAndTheEawParametersButNotTheSafetyNet) {
     DenoiseOptions o = learnedOptions(wpath);
     o.report = &rep;
     const Image base = denoise(sc.inputs(), o);
@@ -189,10 +194,7 @@ TEST(LearnedMethod, RunsOnARenderedSceneWithinTheRangeOfItsPlanes) {
     }
 }
 
-TEST(LearnedMethod, OutputIsFiniteWithNanAndInfInEveryBuffer) {
-    test::TempDir dir;
-    const std::string wpath = writeFixtureWeights(dir);
-    Synth sc;
+TEST_F(LearnedSynth, OutputIsFiniteWithNanAndInfInEveryBuffer) {
     sc.s.noisy(3, 3, 0) = NAN, sc.s.noisy(5, 9, 1) = INFINITY, sc.s.noisy(20, 20, 2) = -INFINITY;
     sc.s.albedo(7, 7, 0) = NAN, sc.s.normal(8, 8, 1) = INFINITY, sc.s.depth(9, 9, 0) = NAN;
     sc.s.depth(10, 10, 0) = 1e30f, sc.emission(11, 11, 0) = INFINITY, sc.s.variance(12, 12, 0) = NAN;
@@ -202,11 +204,7 @@ TEST(LearnedMethod, OutputIsFiniteWithNanAndInfInEveryBuffer) {
     }
 }
 
-TEST(LearnedMethod, AutoPicksBlendWithAlbedoAndNormalElseSure) {
-    test::TempDir dir;
-    const std::string wpath = writeFixtureWeights(dir);
-    const Synth sc;
-    DenoiseReport rep;
+TEST_F(LearnedSynth, AutoPicksBlendWithAlbedoAndNormalElseSure) {
     DenoiseOptions autoO = learnedOptions(wpath);
     autoO.method = DenoiseMethod::Auto;
     autoO.report = &rep;

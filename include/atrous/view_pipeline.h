@@ -46,7 +46,8 @@ struct Method {
     bool operator!=(const Method& o) const { return !(*this == o); }
 };
 // The names of the list in order (the panel's combo boxes, `atrous view --method`'s help).
-const std::vector<std::string>& methodNames();
+// Read from the registries on each call: a method registered later is in it.
+std::vector<std::string> methodNames();
 const char* methodName(const Method& m);
 Method parseMethod(const std::string& name);  // a name of methodNames(); InputError otherwise
 

@@ -24,15 +24,12 @@
 
 namespace atrous::view {
 
-const std::vector<std::string>& methodNames() {
-    static const std::vector<std::string> names = [] {
-        std::vector<std::string> n{"none"};
-        for (const DenoiseMethodInfo& m : denoiseMethods()) n.push_back(m.name);
-        for (const SequenceMethodInfo& m : sequenceMethods())
-            if (m.causal || m.causalMode) n.push_back(m.name);
-        return n;
-    }();
-    return names;
+std::vector<std::string> methodNames() {
+    std::vector<std::string> n{"none"};
+    for (const DenoiseMethodInfo& m : denoiseMethods()) n.push_back(m.name);
+    for (const SequenceMethodInfo& m : sequenceMethods())
+        if (m.causal || m.causalMode) n.push_back(m.name);
+    return n;
 }
 
 const char* methodName(const Method& m) {

@@ -19,7 +19,7 @@ namespace {
 
 // The library's methods (view::methodNames()) in a combo box.
 bool comboMethod(const char* label, Method& m) {
-    const std::vector<std::string>& names = methodNames();
+    const std::vector<std::string> names = methodNames();
     std::vector<const char*> items;
     int i = 0;
     for (const std::string& n : names) {

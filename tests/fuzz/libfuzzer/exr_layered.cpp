@@ -44,13 +44,7 @@ void checkImage(Buffer b, const Image& img, const ExrInfo& info, const std::stri
 
 }  // namespace
 
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-    targetName() = "exr_layered";
-    return 0;
-}
-
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-    const std::string path = writeScratch("in.exr", data, size);
+ATROUS_FUZZ_FILE_TARGET("exr_layered", "in.exr") {
     ExrInfo info;
     if (!returnsOrInputError("inspectExr", [&] { info = inspectExr(path); })) return 0;
     checkExrInfo(info, "inspectExr");

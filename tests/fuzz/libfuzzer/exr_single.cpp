@@ -10,13 +10,7 @@
 
 using namespace atrous_fuzz;
 
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-    targetName() = "exr_single";
-    return 0;
-}
-
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-    const std::string path = writeScratch("in.exr", data, size);
+ATROUS_FUZZ_FILE_TARGET("exr_single", "in.exr") {
     Image img;
     if (!returnsOrInputError("readImage(.exr)", [&] { img = atrous::io::readImage(path); })) return 0;
     checkShape("readImage(.exr)", img);

@@ -122,6 +122,22 @@ inline std::string writeScratch(const std::string& name, const std::string& text
     return writeScratch(name, text.data(), text.size());
 }
 
+// The libFuzzer entry points of a target that reads its input as a file: the target's name for
+// findings, and the input's bytes written to scratchDir()/file; the body that follows is the
+// check, with `path` (that file), `data` and `size`, returning 0:
+//   ATROUS_FUZZ_FILE_TARGET("pfm", "in.pfm") { ...; return 0; }
+#define ATROUS_FUZZ_FILE_TARGET(name, file)                                                       \
+    static int fuzzFileTarget(const std::string& path, const uint8_t* data, size_t size);         \
+    extern "C" int LLVMFuzzerInitialize(int*, char***) {                                          \
+        ::atrous_fuzz::targetName() = name;                                                       \
+        return 0;                                                                                 \
+    }                                                                                             \
+    extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {                     \
+        return fuzzFileTarget(::atrous_fuzz::writeScratch(file, data, size), data, size);         \
+    }                                                                                             \
+    static int fuzzFileTarget(const std::string& path, [[maybe_unused]] const uint8_t* data,     \
+                              [[maybe_unused]] size_t size)
+
 // The input cut at each `sep` into at most `maxParts` parts (the last keeps the rest): how the
 // targets with several files (a scene JSON and an image; an OBJ, its MTL and a texture) take them
 // from one input.

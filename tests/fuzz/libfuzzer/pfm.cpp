@@ -11,13 +11,7 @@
 
 using namespace atrous_fuzz;
 
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-    targetName() = "pfm";
-    return 0;
-}
-
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-    const std::string path = writeScratch("in.pfm", data, size);
+ATROUS_FUZZ_FILE_TARGET("pfm", "in.pfm") {
     Image img;
     if (!returnsOrInputError("readImage(.pfm)", [&] { img = atrous::io::readImage(path); })) return 0;
     checkShape("readImage(.pfm)", img);
