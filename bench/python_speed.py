@@ -26,7 +26,7 @@ from pathlib import Path
 
 
 from atrous.eval.machine import cpu_model, emit, git_commit
-from learned_speed import _oidn_filter  # an OIDN RT filter bound and committed once
+from atrous.eval.speed import _oidn_filter  # an OIDN RT filter bound and committed once
 
 ROOT = Path(__file__).resolve().parents[1]
 BUFFERS = ("albedo", "normal", "position", "depth", "ids", "variance", "emission")
