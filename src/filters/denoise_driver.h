@@ -174,6 +174,16 @@ struct BlendMean {
     }
 };
 
+// After a registered method's cascade: a sample it left non-finite is the prepared input's (NaN
+// and Inf never reach an output, whatever a plug-in computes).
+struct FiniteOr {
+    ImageView out, fallback;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        for (int k = 0; k < 3; ++k)
+            if (!finite(out(x, y, k))) out(x, y, k) = fallback(x, y, k);
+    }
+};
+
 // Memory (docs/architecture.md, "Memory"): every temporary is allocated without a zero fill
 // (each is written whole before it is read), once per call (the cascade's planes live through it:
 // nothing is allocated per level), and dead planes are reused: the variance's buffer becomes EAW's
@@ -384,6 +394,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         P.depth = reads.depth ? first(in.depth.valid() ? depth : ImageView{}, 1) : ImageView{};
         P.ids = reads.ids ? first(ids, 2) : ImageView{};
         (*own)(P, o, learnedOut.view());
+        exec.forEachPixel(w, h, FiniteOr{learnedOut.view(), cA.view()});
         cur = &learnedOut;
         markStage(out.clock, info.name);
     }

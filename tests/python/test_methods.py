@@ -99,3 +99,20 @@ def test_reads_says_which_planes_the_cascade_gets():
     with pytest.raises(ValueError, match="unknown buffer 'motion'"):
         atrous.register_method("bad-reads", spy, reads=("motion",))
     assert "bad-reads" not in atrous.METHODS
+
+
+def test_a_cascade_that_leaves_nan_or_inf_never_reaches_the_output():
+    b = _render()
+
+    def holes(planes, out):
+        out[...] = planes["color"]
+        out[::3, ::2, 0] = np.nan
+        out[1::4, :, 2] = np.inf
+
+    atrous.register_method("holes", holes)
+    got = atrous.denoise(b["color"], albedo=b["albedo"], normal=b["normal"], method="holes")
+    assert np.isfinite(got).all()
+    # Where the cascade was finite its value is kept (an identity cascade: the prepared colour,
+    # remodulated; the replaced samples are the prepared colour too, so the whole is that).
+    p = atrous.learned_planes(b["color"], albedo=b["albedo"], normal=b["normal"])
+    np.testing.assert_allclose(got, p["d"] * p["mod"] + p["emission"], rtol=1e-6, atol=1e-7)
