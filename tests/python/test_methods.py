@@ -116,3 +116,28 @@ def test_a_cascade_that_leaves_nan_or_inf_never_reaches_the_output():
     # remodulated; the replaced samples are the prepared colour too, so the whole is that).
     p = atrous.learned_planes(b["color"], albedo=b["albedo"], normal=b["normal"])
     np.testing.assert_allclose(got, p["d"] * p["mod"] + p["emission"], rtol=1e-6, atol=1e-7)
+
+
+def test_the_evaluation_takes_a_plugins_method(tmp_path):
+    """python -m atrous.eval --plugin FILE --methods ...,toy scores the plugin's method beside the
+    built-in ones; a plugin that cannot be loaded is one line and exit 2, nothing written."""
+    import json
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    plugin = str(Path(__file__).with_name("toy_plugin.py"))
+    small = ["--scenes", "cornell", "--spp", "4", "--size", "24", "--ref-spp", "16", "--runs", "1",
+             "--resolutions", "0", "--no-equal-time"]
+    out = tmp_path / "ev"
+    r = subprocess.run([sys.executable, "-m", "atrous.eval", *small, "--methods", "noisy,eaw,toy", "--plugin", plugin,
+                        "--out", str(out)], capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr
+    rows = json.loads((out / "results.json").read_text())["results"]
+    by = {x["method"]: x["relmse"] for x in rows}
+    assert set(by) == {"noisy", "eaw", "toy"} and by["toy"] < by["noisy"]
+    bad = tmp_path / "bad"
+    r = subprocess.run([sys.executable, "-m", "atrous.eval", *small, "--plugin", str(tmp_path / "nope.py"),
+                        "--out", str(bad)], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2 and "nope.py" in r.stderr and len(r.stderr.strip().splitlines()) == 1
+    assert not bad.exists()

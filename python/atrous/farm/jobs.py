@@ -13,7 +13,7 @@ from . import dataset as _dataset
 from .items import (EVAL_METHODS, FarmInputError, Item, check_denoise_params, check_scenes, denoise_choices,
                     discover_inputs, eval_choices, grid_points, int_list, name_list, params_label, positive_int, scene_label)
 from .manifest import Manifest
-from .plugins import load_plugins, resolve_plugins
+from ..plugins import PluginError, load_plugins, resolve_plugins
 from .runner import JobResult, run_job
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -87,9 +87,12 @@ def denoise(out: PathLike, inputs: Any, method: str = "auto", params: Optional[D
     item per sequence, its frames in order; temporal: one item per frame, which reads the frames
     around it: params temporal_<name> are its own, spatial=METHOD its still method). plugins: Python
     files or modules that register still methods (atrous.register_method), loaded here and in every
-    worker (plugins.py)."""
-    plugins = resolve_plugins(plugins)
-    load_plugins(plugins)
+    worker (atrous/plugins.py)."""
+    try:
+        plugins = resolve_plugins(plugins)
+        load_plugins(plugins)
+    except PluginError as e:
+        raise FarmInputError(str(e)) from None
     if method not in denoise_choices():
         raise FarmInputError(f"method: unknown '{method}' (expected {', '.join(denoise_choices())})")
     params = dict(params or {})

@@ -22,7 +22,7 @@ import numpy as np
 
 import atrous
 
-from .plugins import load_plugins
+from ..plugins import load_plugins
 
 BUFFERS = ("color", "variance", "albedo", "normal", "position", "depth", "ids", "emission")
 PARTIAL = ".partial"

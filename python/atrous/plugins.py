@@ -1,8 +1,10 @@
-"""Plugins: Python modules or files that add still methods with atrous.register_method. A farm
-job loads them on the driver (so that their methods pass its checks) and in every worker before
-it runs an item of that job (a worker is another process: the registry is per process). A file
-is loaded once per process under a name made from its absolute path; on a cluster it must be at
-that path on every node (a shared file system), a module importable on every node.
+"""Plugins: Python modules or files that add still methods with atrous.register_method, loaded by
+the front-ends that take --plugin (python -m atrous.eval, the farm). A farm job loads them on the
+driver (so that their methods pass its checks) and in every worker before it runs an item of that
+job (a worker is another process: the registry is per process). A file is loaded once per process
+under a name made from its absolute path; on a cluster it must be at that path on every node (a
+shared file system), a module importable on every node. A plugin that cannot be loaded is a
+ValueError naming it.
 """
 from __future__ import annotations
 
@@ -13,9 +15,12 @@ import sys
 from pathlib import Path
 from typing import Any, List
 
-from .items import FarmInputError
 
-__all__ = ["resolve_plugins", "load_plugins"]
+__all__ = ["resolve_plugins", "load_plugins", "PluginError"]
+
+
+class PluginError(ValueError):
+    """A plugin that cannot be found or loaded."""
 
 
 def resolve_plugins(plugins: Any) -> List[str]:
@@ -27,7 +32,7 @@ def resolve_plugins(plugins: Any) -> List[str]:
     for p in items:
         p = str(p)
         if not p:
-            raise FarmInputError("--plugin: empty")
+            raise PluginError("--plugin: empty")
         out.append(str(Path(p).resolve()) if p.endswith(".py") or "/" in p else p)
     return out
 
@@ -38,17 +43,17 @@ def _load_file(spec: str) -> None:
     if name in sys.modules:
         return
     if not path.is_file():
-        raise FarmInputError(f"--plugin {spec}: no such file")
+        raise PluginError(f"--plugin {spec}: no such file")
     loader = importlib.util.spec_from_file_location(name, path)
     if loader is None or loader.loader is None:
-        raise FarmInputError(f"--plugin {spec}: not a Python file")
+        raise PluginError(f"--plugin {spec}: not a Python file")
     mod = importlib.util.module_from_spec(loader)
     sys.modules[name] = mod
     try:
         loader.loader.exec_module(mod)
     except Exception as e:
         del sys.modules[name]
-        raise FarmInputError(f"--plugin {spec}: {type(e).__name__}: {e}") from None
+        raise PluginError(f"--plugin {spec}: {type(e).__name__}: {e}") from None
 
 
 def load_plugins(plugins: List[str]) -> None:
@@ -60,4 +65,4 @@ def load_plugins(plugins: List[str]) -> None:
         try:
             importlib.import_module(spec)
         except Exception as e:
-            raise FarmInputError(f"--plugin {spec}: {type(e).__name__}: {e}") from None
+            raise PluginError(f"--plugin {spec}: {type(e).__name__}: {e}") from None
