@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,15 @@ std::string renderFrames(const TempDir& dir, const std::string& scene, int frame
     auto r = runCli("render --scene " + scene + " --frames " + std::to_string(frames) + " --spp 1 --width 24 --height 16 --out " + seq);
     EXPECT_EQ(r.exitCode, 0) << r.output;
     return seq;
+}
+
+// Copies `buffer`.exr of each of the first `frames` frames of `seq` (frame_000F/) into the folder
+// `dst` (created) as name(F + 1): the layouts other tools leave.
+void copyFrames(const std::string& seq, int frames, const std::string& buffer, const std::string& dst,
+                const std::function<std::string(int)>& name) {
+    fs::create_directories(dst);
+    for (int f = 0; f < frames; ++f)
+        fs::copy_file(seq + "/frame_000" + std::to_string(f) + "/" + buffer + ".exr", dst + "/" + name(f + 1));
 }
 
 }  // namespace
@@ -128,11 +138,8 @@ TEST(RendererLayouts, NumberedFilesPerBufferAreASequence) {
     atrous::test::CliResult r;
     // One folder, one file per buffer and frame, as compositors and some renderers write them.
     const std::string per = dir / "per";
-    fs::create_directories(per);
-    for (int f = 0; f < 3; ++f)
-        for (const char* b : {"color", "albedo", "normal", "depth"})
-            fs::copy_file(seq + "/frame_000" + std::to_string(f) + "/" + b + ".exr",
-                          per + "/" + b + "_000" + std::to_string(f + 1) + ".exr");
+    for (const std::string b : {"color", "albedo", "normal", "depth"})
+        copyFrames(seq, 3, b, per, [&](int n) { return b + "_000" + std::to_string(n) + ".exr"; });
     const std::string out = dir / "out";
     r = runCli("denoise --sequence " + per + " --method sure --out " + out);
     ASSERT_EQ(r.exitCode, 0) << r.output;
@@ -164,11 +171,8 @@ TEST(RendererLayouts, PatternsWithStartEndAndStep) {
     atrous::test::CliResult r;
     // Two sequences in one folder, as a compositor leaves them: a pattern picks one.
     const std::string src = dir / "src";
-    fs::create_directories(src);
-    for (int f = 0; f < 5; ++f)
-        for (const char* stem : {"render", "other"})
-            fs::copy_file(seq + "/frame_000" + std::to_string(f) + "/color.exr",
-                          src + "/" + stem + "000" + std::to_string(f + 1) + ".exr");
+    for (const std::string stem : {"render", "other"})
+        copyFrames(seq, 5, "color", src, [&](int n) { return stem + "000" + std::to_string(n) + ".exr"; });
     r = runCli("denoise --sequence " + src + " --method eaw --out " + dir / "all");
     EXPECT_EQ(r.exitCode, 2) << r.output;  // two prefixes in the folder: refused without a pattern
     struct Case {

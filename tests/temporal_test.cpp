@@ -244,14 +244,10 @@ TEST(TemporalGather, BadWindowsThrow) {
 TEST(TemporalCli, IsTheSequenceDefaultAndSaysSo) {
     TempDir dir;
     const std::string seq = renderSequence(dir);
-    auto r = runCli("denoise --sequence " + seq + " --out " + (dir / "out"));
-    ASSERT_EQ(r.exitCode, 0) << r.output;
-    EXPECT_NE(r.output.find("frame_0001: temporal (+-3 frames"), std::string::npos) << r.output;
-    EXPECT_NE(r.output.find("then auto -> blend)"), std::string::npos) << r.output;
+    test::expectCli("denoise --sequence " + seq + " --out " + (dir / "out"), 0,
+                    {"frame_0001: temporal (+-3 frames", "then auto -> blend)"});
     for (int f = 0; f < 3; ++f) EXPECT_TRUE(fs::exists(dir / ("out/frame_000" + std::to_string(f) + ".exr")));
-    r = runCli("denoise --sequence " + seq + " --spatial eaw --out " + (dir / "eaw"));
-    ASSERT_EQ(r.exitCode, 0) << r.output;
-    EXPECT_NE(r.output.find("then eaw)"), std::string::npos) << r.output;
+    test::expectCli("denoise --sequence " + seq + " --spatial eaw --out " + (dir / "eaw"), 0, {"then eaw)"});
 }
 
 // Radius 0 with --spatial eaw writes what --method eaw writes, bit for bit. The causal mode

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <initializer_list>
 #include <random>
 #include <string>
 
@@ -103,6 +104,14 @@ inline std::string cliPath() {
 
 // Runs `build/atrous <args>` through the shell and captures its output and exit code.
 inline CliResult runCli(const std::string& args) { return runShell(cliPath() + " " + args); }
+
+// runCli, checking the exit code and that the output holds each of `needles`; the result for more.
+inline CliResult expectCli(const std::string& args, int exitCode, std::initializer_list<std::string> needles = {}) {
+    CliResult r = runCli(args);
+    EXPECT_EQ(r.exitCode, exitCode) << args << "\n" << r.output;
+    for (const std::string& n : needles) EXPECT_NE(r.output.find(n), std::string::npos) << n << " in\n" << r.output;
+    return r;
+}
 
 // Counts the entries of a directory (to check that a failed command wrote nothing).
 inline int countEntries(const std::string& dir) {
