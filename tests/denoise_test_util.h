@@ -4,7 +4,10 @@
 #include <cmath>
 #include <random>
 
+#include <string>
+
 #include "atrous/denoise.h"
+#include "atrous/error.h"
 #include "atrous/image.h"
 
 namespace atrous::test {
@@ -21,6 +24,16 @@ inline DenoiseInputs inputsOf(const Image& color, const Image& variance, const I
     in.depth = &depth;
     in.ids = &ids;
     return in;
+}
+
+// The message of the InputError that denoise(in, o) throws, or "" when it returns.
+inline std::string inputErrorOf(const DenoiseInputs& in, const DenoiseOptions& o) {
+    try {
+        denoise(in, o);
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "";
 }
 
 // DenoiseInputs of a colour and its variance only (no feature buffers).

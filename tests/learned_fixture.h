@@ -56,4 +56,19 @@ inline const Fixture& fixture() {
     return fx;
 }
 
+// Weight files a reader must refuse, written into `dir`: the path of one that is not there, one that
+// is not a weight file ("junk.atrl"), and the fixture relabelled version 2 with its checksum fixed
+// ("v2.atrl": only the version is wrong), in that order.
+inline std::vector<std::string> badWeightFiles(const std::string& dir) {
+    const std::string junk = dir + "/junk.atrl", v2 = dir + "/v2.atrl";
+    std::ofstream(junk) << "ATRL but not really";
+    std::vector<std::uint8_t> w = fixture().weights;
+    w[4] = 2;
+    std::uint32_t h = 0x811C9DC5u;
+    for (size_t i = 0; i + 4 < w.size(); ++i) h = (h ^ w[i]) * 0x01000193u;
+    std::memcpy(&w[w.size() - 4], &h, 4);
+    std::ofstream(v2, std::ios::binary).write(reinterpret_cast<const char*>(w.data()), std::streamsize(w.size()));
+    return {dir + "/missing.atrl", junk, v2};
+}
+
 }  // namespace atrous::test

@@ -293,14 +293,7 @@ TEST(LearnedMethod, BlendIsTheMeanOfLearnedAndSure) {
     }
 }
 
-std::string inputErrorOf(const DenoiseInputs& in, const DenoiseOptions& o) {
-    try {
-        denoise(in, o);
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "";
-}
+using test::inputErrorOf;
 
 TEST(LearnedMethod, ABadWeightFileIsAnInputErrorNamingIt) {
     test::TempDir dir;
@@ -364,19 +357,10 @@ TEST(LearnedMethodCli, MethodsWeightsAndExitCodes) {
     EXPECT_NE(r.output.find("method auto -> sure"), std::string::npos) << r.output;
     std::filesystem::remove(out);
     // A missing or corrupt weight file: exit 2, one line naming the file, nothing written.
-    const std::string junk = dir / "junk.atrl";
-    std::ofstream(junk) << "ATRL but not really";
-    // A retired version-2 file (the fixture's bytes relabelled, checksum fixed).
-    const std::string v2 = dir / "v2.atrl";
-    {
-        std::vector<std::uint8_t> w = test::fixture().weights;
-        w[4] = 2;
-        std::uint32_t h = 0x811C9DC5u;
-        for (size_t i = 0; i + 4 < w.size(); ++i) h = (h ^ w[i]) * 0x01000193u;
-        std::memcpy(&w[w.size() - 4], &h, 4);
-        std::ofstream(v2, std::ios::binary).write(reinterpret_cast<const char*>(w.data()), std::streamsize(w.size()));
-    }
-    for (const std::string& bad : {dir / "missing.atrl", junk, v2}) {
+    // Missing, not a weight file, and a retired version-2 file (tests/learned_fixture.h).
+    const std::vector<std::string> bads = test::badWeightFiles(dir.path().string());
+    const std::string v2 = bads[2];
+    for (const std::string& bad : bads) {
         r = test::runCli("denoise --in " + in + " --out " + out + " --method learned --learned-weights " + bad);
         EXPECT_EQ(r.exitCode, 2) << r.output;
         EXPECT_NE(r.output.find(bad), std::string::npos) << r.output;

@@ -224,7 +224,7 @@ TEST(SvgfSequence, LearnedWeightsReachTheLearnedSpatialFilter) {
     sequenceArgs(dir, 32, 24, 0.2f, 3);  // writes dir/seq
     const std::string seq = dir / "seq";
     const std::string wpath = dir / "fixture.atrl";
-    std::vector<std::uint8_t> w = test::fixture().weights;
+    const std::vector<std::uint8_t>& w = test::fixture().weights;
     std::ofstream(wpath, std::ios::binary).write(reinterpret_cast<const char*>(w.data()), std::streamsize(w.size()));
     const std::string base = "denoise --sequence " + seq + " --method svgf --svgf-learned-spatial --out ";
     test::CliResult r = test::runCli(base + dir / "builtin");
@@ -239,15 +239,10 @@ TEST(SvgfSequence, LearnedWeightsReachTheLearnedSpatialFilter) {
         // Outputs are O(1); random weights against trained ones differ far above rounding.
         EXPECT_GT(maxAbsDiff(a, b), 1e-2f) << name;
     }
-    const std::string junk = dir / "junk.atrl";
-    std::ofstream(junk) << "ATRL but not really";
-    const std::string v2 = dir / "v2.atrl";  // the fixture relabelled version 2, checksum fixed
-    w[4] = 2;
-    std::uint32_t hash = 0x811C9DC5u;
-    for (size_t i = 0; i + 4 < w.size(); ++i) hash = (hash ^ w[i]) * 0x01000193u;
-    std::memcpy(&w[w.size() - 4], &hash, 4);
-    std::ofstream(v2, std::ios::binary).write(reinterpret_cast<const char*>(w.data()), std::streamsize(w.size()));
-    for (const std::string& bad : {dir / "missing.atrl", junk, v2}) {
+    // Missing, not a weight file, the fixture relabelled version 2 (tests/learned_fixture.h).
+    const std::vector<std::string> bads = test::badWeightFiles(dir.path().string());
+    const std::string junk = bads[1];
+    for (const std::string& bad : bads) {
         r = test::runCli(base + dir / "bad" + " --learned-weights " + bad);
         EXPECT_EQ(r.exitCode, 2) << r.output;
         EXPECT_NE(r.output.find(bad), std::string::npos) << r.output;
