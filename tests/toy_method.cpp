@@ -1,5 +1,6 @@
 // The toy still method: the whole of what a new method is, one registry row plus its policy
-// (tests/toy_policy.h). Registered when the program starts, before main.
+// (tests/toy_policy.h). Linked into a program it is registered when the program starts; built as
+// a plugin (ATROUS_TOY_PLUGIN) when the plugin is loaded.
 #include "toy_method.h"
 
 #include "core/parallel.h"
@@ -24,12 +25,23 @@ void toyCascade(const StillPlanes& p, const DenoiseOptions&, const ImageView& ou
     }
 }
 
-namespace {
-const DenoiseMethod kToy =
+void registerToy() {
     registerDenoiseMethod({DenoiseMethod::Eaw, "toy", "a toy: three levels of a cross-bilateral a-trous on the albedo (tests/toy_method.cpp)",
                            false, toyCascade});
-}  // namespace
+}
 
-DenoiseMethod toyMethod() { return kToy; }
+DenoiseMethod toyMethod() { return parseDenoiseMethod("toy"); }
+
+#if !defined(ATROUS_TOY_PLUGIN)
+namespace {
+// Linked into a program (atrous_toy, toy_method_test): registered when it starts.
+const bool kRegistered = (registerToy(), true);
+}  // namespace
+#endif
 
 }  // namespace atrous::toy
+
+#if defined(ATROUS_TOY_PLUGIN)
+// Built as a plugin (libatrous_toy_plugin.so): registered when loaded (atrous::loadPlugin).
+extern "C" void atrous_plugin_register() { atrous::toy::registerToy(); }
+#endif

@@ -11,7 +11,8 @@ namespace atrous::toy {
 // channel (σ² = 0.01) when an albedo is given, else the plain B3 à-trous.
 void toyCascade(const StillPlanes& planes, const DenoiseOptions& options, const ImageView& out);
 
-// The method's value, registered when the program starts.
+// Adds the "toy" row (registerDenoiseMethod); the method's value once it is there.
+void registerToy();
 DenoiseMethod toyMethod();
 
 }  // namespace atrous::toy

@@ -7,7 +7,9 @@
 // --plugin are tests/python/test_methods.py.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "atrous/denoise.h"
@@ -149,6 +151,32 @@ TEST(ToyMethod, TheCliWithItListsAndRunsItAndTheOneWithoutRefusesIt) {
     EXPECT_FALSE(std::filesystem::exists(out2));
     test::CliResult plainHelp = test::runCli("denoise --help");
     EXPECT_EQ(plainHelp.output.find("toy: a toy"), std::string::npos);
+}
+#endif
+
+#ifdef ATROUS_TOY_PLUGIN_FILE
+// The same file built as a plugin: `atrous --plugin` lists it in denoise's help and the viewer's
+// method list and runs it with the same output as atrous_toy; a plugin that is not there, or a
+// library that is no plugin, is one line and exit 2.
+TEST(ToyMethod, AsAPluginTheCliListsAndRunsIt) {
+    const std::string plugin = std::string(" --plugin ") + ATROUS_TOY_PLUGIN_FILE + " ";
+    test::expectCli(plugin + "denoise --help", 0, {"toy: a toy"});
+    test::expectCli(plugin + "view --help", 0, {"| toy |"});
+    test::TempDir dir;
+    const Rendered r;
+    const std::string in = dir / "r";
+    std::filesystem::create_directories(in);
+    io::writeImage(in + "/color.exr", r.b.color);
+    io::writeImage(in + "/albedo.exr", r.b.albedo);
+    test::expectCli(plugin + "denoise --in " + in + " --method toy --out " + (dir / "plugin.exr"), 0, {"method toy"});
+#ifdef ATROUS_TOY_CLI
+    test::runShell(std::string(ATROUS_TOY_CLI) + " denoise --in " + in + " --method toy --out " + (dir / "linked.exr"));
+    EXPECT_TRUE(test::sameImages(io::readImage(dir / "plugin.exr"), io::readImage(dir / "linked.exr")));
+#endif
+    const test::CliResult missing = test::expectCli(" --plugin " + (dir / "nope.so") + " denoise --help", 2, {"nope.so"});
+    EXPECT_EQ(std::count(missing.output.begin(), missing.output.end(), '\n'), 1) << missing.output;
+    std::ofstream(dir / "junk.so") << "not a library";
+    test::expectCli(" --plugin " + (dir / "junk.so") + " denoise --help", 2, {"junk.so: cannot load the plugin"});
 }
 #endif
 

@@ -4,9 +4,11 @@
 #include <cstdio>
 #include <exception>
 #include <string>
+#include <vector>
 
 #include "atrous/error.h"
 #include "atrous/params.h"
+#include "atrous/plugins.h"
 #include "cli_flags.h"
 #include "commands.h"
 
@@ -20,12 +22,35 @@ std::string oneLine(std::string s) {
     return s;
 }
 
+// `--plugin FILE.so` before the command (include/atrous/plugins.h): loaded before the commands are
+// made, so that the methods it registers are in their choices and help.
+std::vector<std::string> pluginArgs(int argc, char** argv) {
+    std::vector<std::string> files;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        if (a == "--plugin" && i + 1 < argc) files.push_back(argv[++i]);
+        else if (a.rfind("--plugin=", 0) == 0) files.push_back(a.substr(9));
+        else if (!a.empty() && a[0] != '-') break;  // the command: its own flags follow
+    }
+    return files;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+    try {
+        for (const std::string& f : pluginArgs(argc, argv)) atrous::loadPlugin(f);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "atrous: error: --plugin %s\n", oneLine(e.what()).c_str());
+        return 2;
+    }
     CLI::App app{"atrous: Monte Carlo path tracing and fast wavelet denoising (EAW, SURE, SVGF)"};
     app.require_subcommand(1);
     app.set_version_flag("--version", "atrous 0.1.0");
+    std::vector<std::string> plugins;  // loaded above; declared here for --help and parsing
+    app.add_option("--plugin", plugins,
+                   "A shared library that adds denoising methods (include/atrous/plugins.h), before the command; "
+                   "repeat for more");
     atrous::cli::addRenderCommand(app);
     atrous::cli::addDenoiseCommand(app);
     atrous::cli::addCompareCommand(app);

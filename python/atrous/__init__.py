@@ -59,6 +59,7 @@ __all__ = [
     "sequence_methods",
     "methods",
     "register_method",
+    "load_plugin",
 ]
 
 __version__ = "0.1.0"
@@ -107,6 +108,14 @@ def register_method(name: str, cascade: Any, summary: str = "",
     if not callable(cascade):
         raise ValueError(f"register_method: cascade must be callable (got {type(cascade).__name__})")
     _core.register_method(str(name), str(summary), cascade, [str(r) for r in reads])
+
+
+def load_plugin(path: "PathLike") -> None:
+    """Loads a C++ plugin, a shared library built against include/atrous whose entry point
+    registers still methods (include/atrous/plugins.h): they are then in :func:`methods` and run
+    through :func:`denoise`, as in the CLI with ``atrous --plugin FILE.so``. Loading one twice does
+    nothing; a missing or unloadable file, or a name already taken, raises ValueError."""
+    _core.load_plugin(os.fsdecode(os.fspath(path)))
 
 
 def denoise_methods() -> list:

@@ -33,7 +33,7 @@ def resolve_plugins(plugins: Any) -> List[str]:
         p = str(p)
         if not p:
             raise PluginError("--plugin: empty")
-        out.append(str(Path(p).resolve()) if p.endswith(".py") or "/" in p else p)
+        out.append(str(Path(p).resolve()) if p.endswith((".py", ".so")) or "/" in p else p)
     return out
 
 
@@ -57,8 +57,17 @@ def _load_file(spec: str) -> None:
 
 
 def load_plugins(plugins: List[str]) -> None:
-    """Loads each plugin once per process (a second load of the same one does nothing)."""
+    """Loads each plugin once per process (a second load of the same one does nothing): a C++
+    plugin (a shared library, .so: atrous.load_plugin), a Python file or a module."""
+    import atrous
+
     for spec in plugins:
+        if spec.endswith(".so"):
+            try:
+                atrous.load_plugin(spec)
+            except ValueError as e:
+                raise PluginError(str(e)) from None
+            continue
         if spec.endswith(".py") or "/" in spec:
             _load_file(spec)
             continue

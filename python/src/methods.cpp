@@ -12,6 +12,7 @@
 
 #include "atrous/denoise.h"
 #include "atrous/error.h"
+#include "atrous/plugins.h"
 
 namespace nb = nanobind;
 
@@ -60,6 +61,10 @@ struct PyCascade {
 }  // namespace
 
 void bindMethods(nb::module_& m) {
+    m.def("load_plugin", [](const std::string& path) {
+        nb::gil_scoped_release release;
+        loadPlugin(path);
+    });
     m.def("register_method", [](const std::string& name, const std::string& summary, nb::callable cascade,
                                 std::vector<std::string> reads) {
         DenoiseMethodInfo info{DenoiseMethod::Eaw, name.c_str(), summary.c_str(), false};

@@ -15,3 +15,10 @@ def atrous_cli() -> Optional[str]:
         if cand and os.path.isfile(cand) and os.access(cand, os.X_OK):
             return cand
     return None
+
+
+def toy_plugin_so() -> Optional[str]:
+    """The C++ toy method built as a plugin (tests/toy_method.cpp): beside the CLI's build, or None."""
+    cli = atrous_cli()
+    cand = Path(cli).parent / "tests" / "libatrous_toy_plugin.so" if cli else None
+    return str(cand) if cand is not None and cand.is_file() else None

@@ -17,7 +17,7 @@ from atrous.eval import score
 from atrous.farm.dataset import random_scene
 
 from farm_cluster import LocalCluster
-from atrous_cli import atrous_cli
+from atrous_cli import atrous_cli, toy_plugin_so
 
 
 @pytest.fixture(scope="module")
@@ -316,15 +316,27 @@ def test_evaluate_sweep_dataset_and_denoise_jobs(cluster, tmp_path):
     # and every worker load it, and the workers' output is the library's in this process.
     tn = tmp_path / "toy"
     plugin = Path(__file__).with_name("toy_plugin.py")
-    r = farm(["denoise", "--in", str(ds / "scene_000000" / "spp_2"), "--method", "toy", "--plugin", str(plugin),
+    r = farm(["denoise", "--in", str(ds / "scene_000000" / "spp_2"), "--method", "pytoy", "--plugin", str(plugin),
               "--address", cluster.address, "--out", str(tn), "--quiet"], env=env)
     assert r.returncode == 0, r.stderr
     import toy_plugin  # noqa: F401 (registers toy here too)
     from atrous.farm.tasks import denoise_buffers, read_buffers
 
-    want_toy = denoise_buffers(read_buffers(ds / "scene_000000" / "spp_2"), "toy", {}, "cpu")
-    np.testing.assert_array_equal(atrous.read_image(tn / "spp_2" / "denoised_toy.exr"), want_toy)
+    want_toy = denoise_buffers(read_buffers(ds / "scene_000000" / "spp_2"), "pytoy", {}, "cpu")
+    np.testing.assert_array_equal(atrous.read_image(tn / "spp_2" / "denoised_pytoy.exr"), want_toy)
     assert manifest(tn)["spec"]["plugins"] == [str(plugin.resolve())]
+    # The C++ toy (tests/toy_method.cpp) as a plugin library: the same bytes as the CLI with it.
+    so = toy_plugin_so()
+    if so is not None and cli is not None:
+        cn = tmp_path / "toy_cpp"
+        r = farm(["denoise", "--in", str(ds / "scene_000000" / "spp_2"), "--method", "toy", "--plugin", so,
+                  "--address", cluster.address, "--out", str(cn), "--quiet"], env=env)
+        assert r.returncode == 0, r.stderr
+        c = subprocess.run([cli, "--plugin", so, "denoise", "--in", str(ds / "scene_000000" / "spp_2"), "--method",
+                            "toy", "--device", "cpu", "--out", str(tmp_path / "cli_toy.exr")],
+                           capture_output=True, text=True, timeout=60)
+        assert c.returncode == 0, c.stderr
+        assert (cn / "spp_2" / "denoised_toy.exr").read_bytes() == (tmp_path / "cli_toy.exr").read_bytes()
 
 
 @pytest.mark.parametrize("args,needle", [
@@ -336,7 +348,8 @@ def test_evaluate_sweep_dataset_and_denoise_jobs(cluster, tmp_path):
     (["render", "--scenes", "cornell", "--address", "127.0.0.1:1"], "no Ray head answers"),
     (["render", "--dataset", "SPEC"], "SPEC"),
     (["denoise", "--in", "IN", "--method", "bilateral"], "bilateral"),
-    (["denoise", "--in", "IN", "--method", "toy", "--plugin", "no_such_plugin.py"], "no_such_plugin.py"),
+    (["denoise", "--in", "IN", "--method", "pytoy", "--plugin", "no_such_plugin.py"], "no_such_plugin.py"),
+    (["denoise", "--in", "IN", "--plugin", "no_such_plugin.so"], "no_such_plugin.so"),
     (["denoise", "--in", "IN", "--plugin", "no_such_module_xyz"], "no_such_module_xyz"),
     (["denoise", "--in", "IN", "--param", "sigma_colour=1"], "sigma_colour"),
     (["denoise", "--in", "IN", "--method", "temporal", "--param", "temporal_radios=1"], "radios"),

@@ -1,6 +1,6 @@
 """A still method added from Python is one registry row plus its policy (issue 31): the toy of
 toy_plugin.py registered with atrous.register_method is in atrous.methods(), METHODS and the
-evaluation's and farm's method lists, and denoise(method="toy") is its cascade on the prepared
+evaluation's and farm's method lists, and denoise(method="pytoy") is its cascade on the prepared
 planes, then the remodulation. The farm's workers load it with --plugin (test_farm.py). Errors:
 a taken name, a non-callable, a cascade that raises or writes where it may not."""
 import numpy as np
@@ -18,18 +18,18 @@ def _render():
 
 def test_the_toy_is_in_every_list():
     rows = {r["name"]: r for r in atrous.methods()}
-    assert rows["toy"]["kind"] == "still" and rows["toy"]["registered"]
+    assert rows["pytoy"]["kind"] == "still" and rows["pytoy"]["registered"]
     assert rows["eaw"]["registered"] is False and rows["svgf"]["kind"] == "sequence"
     assert [r["name"] for r in atrous.methods()][:5] == ["eaw", "sure", "learned", "blend", "auto"]
-    assert "toy" in atrous.METHODS and "toy" not in atrous.WEIGHTED_METHODS
-    assert "toy" in all_methods() and "toy" in denoise_choices() and "toy" in eval_choices()
+    assert "pytoy" in atrous.METHODS and "pytoy" not in atrous.WEIGHTED_METHODS
+    assert "pytoy" in all_methods() and "pytoy" in denoise_choices() and "pytoy" in eval_choices()
 
 
 def test_denoise_is_the_cascade_on_the_prepared_planes_then_remodulation():
     b = _render()
     for albedo in (b["albedo"], None):
         got = atrous.denoise(b["color"], albedo=albedo, normal=b["normal"], variance=b["variance"],
-                             emission=b["emission"], method="toy")
+                             emission=b["emission"], method="pytoy")
         p = atrous.learned_planes(b["color"], variance=b["variance"], albedo=albedo, normal=b["normal"],
                                   emission=b["emission"])
         f = np.empty_like(p["d"])
@@ -59,8 +59,8 @@ def test_planes_are_views_of_the_right_shape_and_read_only():
 
 
 def test_bad_registrations_and_cascades():
-    with pytest.raises(ValueError, match="already a method 'toy'"):
-        atrous.register_method("toy", toy_plugin.toy_cascade)
+    with pytest.raises(ValueError, match="already a method 'pytoy'"):
+        atrous.register_method("pytoy", toy_plugin.toy_cascade)
     with pytest.raises(ValueError, match="already a method 'sure'"):
         atrous.register_method("sure", toy_plugin.toy_cascade)
     with pytest.raises(ValueError, match="not a method name"):
@@ -119,7 +119,7 @@ def test_a_cascade_that_leaves_nan_or_inf_never_reaches_the_output():
 
 
 def test_the_evaluation_takes_a_plugins_method(tmp_path):
-    """python -m atrous.eval --plugin FILE --methods ...,toy scores the plugin's method beside the
+    """python -m atrous.eval --plugin FILE --methods ...,pytoy scores the plugin's method beside the
     built-in ones; a plugin that cannot be loaded is one line and exit 2, nothing written."""
     import json
     import subprocess
@@ -130,14 +130,46 @@ def test_the_evaluation_takes_a_plugins_method(tmp_path):
     small = ["--scenes", "cornell", "--spp", "4", "--size", "24", "--ref-spp", "16", "--runs", "1",
              "--resolutions", "0", "--no-equal-time"]
     out = tmp_path / "ev"
-    r = subprocess.run([sys.executable, "-m", "atrous.eval", *small, "--methods", "noisy,eaw,toy", "--plugin", plugin,
+    r = subprocess.run([sys.executable, "-m", "atrous.eval", *small, "--methods", "noisy,eaw,pytoy", "--plugin", plugin,
                         "--out", str(out)], capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stderr
     rows = json.loads((out / "results.json").read_text())["results"]
     by = {x["method"]: x["relmse"] for x in rows}
-    assert set(by) == {"noisy", "eaw", "toy"} and by["toy"] < by["noisy"]
+    assert set(by) == {"noisy", "eaw", "pytoy"} and by["pytoy"] < by["noisy"]
     bad = tmp_path / "bad"
     r = subprocess.run([sys.executable, "-m", "atrous.eval", *small, "--plugin", str(tmp_path / "nope.py"),
                         "--out", str(bad)], capture_output=True, text=True, timeout=120)
     assert r.returncode == 2 and "nope.py" in r.stderr and len(r.stderr.strip().splitlines()) == 1
     assert not bad.exists()
+
+
+def test_the_cpp_toy_plugin_is_one_method_for_the_cli_and_python(tmp_path):
+    """tests/toy_method.cpp built as a plugin: `atrous --plugin` lists and runs it, and in another
+    Python process atrous.load_plugin puts the same row in atrous.methods(); both give the same
+    image from the same files (the farm runs it too: test_farm.py)."""
+    import subprocess
+    import sys
+
+    from atrous_cli import atrous_cli, toy_plugin_so
+
+    so, cli = toy_plugin_so(), atrous_cli()
+    if so is None or cli is None:
+        pytest.skip("no C++ build with the toy plugin")
+    b = _render()
+    d = tmp_path / "in"
+    d.mkdir()
+    for name in ("color", "albedo", "normal"):
+        atrous.write_image(d / f"{name}.exr", b[name])
+    r = subprocess.run([cli, "--plugin", so, "denoise", "--in", str(d), "--method", "toy", "--out",
+                        str(tmp_path / "cli.exr")], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    code = ("import sys, atrous; atrous.load_plugin(sys.argv[1]); "
+            "rows = {m['name']: m for m in atrous.methods()}; assert rows['toy']['registered']; "
+            "bufs = atrous.read_buffers(sys.argv[2]); "
+            "atrous.write_image(sys.argv[3], atrous.denoise(method='toy', device='cpu', **bufs))")
+    r = subprocess.run([sys.executable, "-c", code, so, str(d), str(tmp_path / "py.exr")], capture_output=True,
+                       text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    np.testing.assert_array_equal(atrous.read_image(tmp_path / "py.exr"), atrous.read_image(tmp_path / "cli.exr"))
+    with pytest.raises(ValueError, match="no such plugin file"):
+        atrous.load_plugin(tmp_path / "nope.so")

@@ -24,5 +24,6 @@ def toy_cascade(planes, out):
     out[...] = acc / ws[..., None]
 
 
-if "toy" not in atrous.METHODS:
-    atrous.register_method("toy", toy_cascade, "a toy: a 3x3 cross-bilateral box on the albedo (tests/python/toy_plugin.py)")
+# "pytoy": the C++ toy (tests/toy_method.cpp, a plugin) is "toy", and a farm's workers may hold both.
+if "pytoy" not in atrous.METHODS:
+    atrous.register_method("pytoy", toy_cascade, "a toy: a 3x3 cross-bilateral box on the albedo (tests/python/toy_plugin.py)")

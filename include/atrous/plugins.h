@@ -1,0 +1,19 @@
+// Methods from shared libraries: a plugin is a library built against include/atrous with an
+// entry point `extern "C" void atrous_plugin_register()` that calls registerDenoiseMethod
+// (atrous/denoise.h); loading it adds its methods to this process's registry, so every front-end lists and runs them (`atrous --plugin FILE.so ...`,
+// Python's atrous.load_plugin, the farm's and the evaluation's --plugin). tests/toy_method.cpp is
+// one (build/tests/libatrous_toy_plugin.so). Linux (dlopen); same compiler and atrous version.
+#pragma once
+#include <string>
+
+namespace atrous {
+
+constexpr const char* kPluginEntry = "atrous_plugin_register";
+
+// Loads the plugin at `path` and calls its entry point (once per process: loading it again does
+// nothing). InputError naming the file when it is missing, cannot be loaded (undefined symbols,
+// another architecture) or has no entry point; a method it registers under a taken name is the
+// InputError of registerDenoiseMethod.
+void loadPlugin(const std::string& path);
+
+}  // namespace atrous
