@@ -29,6 +29,17 @@ struct Rendered : test::RenderedInputs {
     Rendered() : RenderedInputs("cornell", 32, 24, 4, 3) {}
 };
 
+// The render's colour, albedo and normal as a render folder dir/r (what `denoise --in` reads).
+std::string renderFolder(const test::TempDir& dir) {
+    const Rendered r;
+    const std::string in = dir / "r";
+    std::filesystem::create_directories(in);
+    io::writeImage(in + "/color.exr", r.b.color);
+    io::writeImage(in + "/albedo.exr", r.b.albedo);
+    io::writeImage(in + "/normal.exr", r.b.normal);
+    return in;
+}
+
 TEST(ToyMethod, IsARowOfTheRegistry) {
     const DenoiseMethodInfo* m = findDenoiseMethod("toy");
     ASSERT_NE(m, nullptr);
@@ -132,12 +143,7 @@ TEST(ToyMethod, TheCliWithItListsAndRunsItAndTheOneWithoutRefusesIt) {
     EXPECT_EQ(h.exitCode, 0) << h.output;
     EXPECT_NE(h.output.find("toy: a toy"), std::string::npos) << h.output;
     test::TempDir dir;
-    const Rendered r;
-    const std::string in = dir / "r";
-    std::filesystem::create_directories(in);
-    io::writeImage(in + "/color.exr", r.b.color);
-    io::writeImage(in + "/albedo.exr", r.b.albedo);
-    io::writeImage(in + "/normal.exr", r.b.normal);
+    const std::string in = renderFolder(dir);
     const std::string out = dir / "o.exr";
     test::CliResult run = test::runShell(toyCli + " denoise --in " + in + " --out " + out + " --method toy");
     EXPECT_EQ(run.exitCode, 0) << run.output;
@@ -163,11 +169,7 @@ TEST(ToyMethod, AsAPluginTheCliListsAndRunsIt) {
     test::expectCli(plugin + "denoise --help", 0, {"toy: a toy"});
     test::expectCli(plugin + "view --help", 0, {"| toy |"});
     test::TempDir dir;
-    const Rendered r;
-    const std::string in = dir / "r";
-    std::filesystem::create_directories(in);
-    io::writeImage(in + "/color.exr", r.b.color);
-    io::writeImage(in + "/albedo.exr", r.b.albedo);
+    const std::string in = renderFolder(dir);
     test::expectCli(plugin + "denoise --in " + in + " --method toy --out " + (dir / "plugin.exr"), 0, {"method toy"});
 #ifdef ATROUS_TOY_CLI
     test::runShell(std::string(ATROUS_TOY_CLI) + " denoise --in " + in + " --method toy --out " + (dir / "linked.exr"));
