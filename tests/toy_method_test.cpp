@@ -139,6 +139,7 @@ TEST(ToyMethod, TheViewerListsAndRunsIt) {
 #ifdef ATROUS_TOY_CLI
 TEST(ToyMethod, TheCliWithItListsAndRunsItAndTheOneWithoutRefusesIt) {
     const std::string toyCli = ATROUS_TOY_CLI;
+    if (!std::filesystem::exists(toyCli)) GTEST_SKIP() << toyCli << " is not there (a test pack moved elsewhere)";
     test::CliResult h = test::runShell(toyCli + " denoise --help");
     EXPECT_EQ(h.exitCode, 0) << h.output;
     EXPECT_NE(h.output.find("toy: a toy"), std::string::npos) << h.output;
@@ -165,6 +166,7 @@ TEST(ToyMethod, TheCliWithItListsAndRunsItAndTheOneWithoutRefusesIt) {
 // method list and runs it with the same output as atrous_toy; a plugin that is not there, or a
 // library that is no plugin, is one line and exit 2.
 TEST(ToyMethod, AsAPluginTheCliListsAndRunsIt) {
+    if (!std::filesystem::exists(ATROUS_TOY_PLUGIN_FILE)) GTEST_SKIP() << ATROUS_TOY_PLUGIN_FILE << " is not there";
     const std::string plugin = std::string(" --plugin ") + ATROUS_TOY_PLUGIN_FILE + " ";
     test::expectCli(plugin + "denoise --help", 0, {"toy: a toy"});
     test::expectCli(plugin + "view --help", 0, {"| toy |"});
@@ -172,8 +174,10 @@ TEST(ToyMethod, AsAPluginTheCliListsAndRunsIt) {
     const std::string in = renderFolder(dir);
     test::expectCli(plugin + "denoise --in " + in + " --method toy --out " + (dir / "plugin.exr"), 0, {"method toy"});
 #ifdef ATROUS_TOY_CLI
-    test::runShell(std::string(ATROUS_TOY_CLI) + " denoise --in " + in + " --method toy --out " + (dir / "linked.exr"));
-    EXPECT_TRUE(test::sameImages(io::readImage(dir / "plugin.exr"), io::readImage(dir / "linked.exr")));
+    if (std::filesystem::exists(ATROUS_TOY_CLI)) {
+        test::runShell(std::string(ATROUS_TOY_CLI) + " denoise --in " + in + " --method toy --out " + (dir / "linked.exr"));
+        EXPECT_TRUE(test::sameImages(io::readImage(dir / "plugin.exr"), io::readImage(dir / "linked.exr")));
+    }
 #endif
     const test::CliResult missing = test::expectCli(" --plugin " + (dir / "nope.so") + " denoise --help", 2, {"nope.so"});
     EXPECT_EQ(std::count(missing.output.begin(), missing.output.end(), '\n'), 1) << missing.output;
