@@ -17,6 +17,7 @@
 #include "atrous/render.h"
 #include "filters/denoise_internal.h"
 #include "atrous/io/image_io.h"
+#include "denoise_test_util.h"
 #include "render_test_util.h"
 #include "test_util.h"
 #include "toy_method.h"
@@ -60,6 +61,9 @@ TEST(ToyMethod, IsARowOfTheRegistry) {
     EXPECT_THROW(registerDenoiseMethod({DenoiseMethod::Eaw, "", "", false, toy::toyCascade}), InputError);
     EXPECT_THROW(registerDenoiseMethod({DenoiseMethod::Eaw, "bare", "", false}), InputError);
     EXPECT_THROW(registerDenoiseMethod({DenoiseMethod::Eaw, "weighted", "", true, toy::toyCascade}), InputError);
+    for (const char* reserved : {"temporal", "svgf", "none", "noisy", "oidn"})
+        EXPECT_THROW(registerDenoiseMethod({DenoiseMethod::Eaw, reserved, "", false, toy::toyCascade}), InputError)
+            << reserved;
     EXPECT_EQ(denoiseMethods().size(), n);
     // What a row reads tells a reader what to decode (the preparation's buffers always).
     DenoiseMethodInfo normalOnly{DenoiseMethod::Eaw, "toy-normal-only", "", false, toy::toyCascade};
@@ -116,6 +120,25 @@ TEST(ToyMethod, IsItsCascadeOnThePreparedPlanesThenRemodulate) {
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("'toy' has no cascade for CUDA"), std::string::npos) << e.what();
     }
+}
+
+// A cascade's exception reaches the caller naming the method, whatever it threw.
+TEST(ToyMethod, ACascadesErrorsNameTheMethod) {
+    registerDenoiseMethod({DenoiseMethod::Eaw, "throws-int", "", false,
+                           [](const StillPlanes&, const DenoiseOptions&, const ImageView&) { throw 42; }});
+    registerDenoiseMethod({DenoiseMethod::Eaw, "throws-input", "", false,
+                           [](const StillPlanes&, const DenoiseOptions&, const ImageView&) { throw InputError("bad"); }});
+    const Rendered r;
+    DenoiseOptions o;
+    o.method = parseDenoiseMethod("throws-int");
+    try {
+        denoise(r.inputs(), o);
+        ADD_FAILURE() << "no error";
+    } catch (const RuntimeError& e) {
+        EXPECT_NE(std::string(e.what()).find("method 'throws-int': "), std::string::npos) << e.what();
+    }
+    o.method = parseDenoiseMethod("throws-input");
+    EXPECT_NE(test::inputErrorOf(r.inputs(), o).find("method 'throws-input': bad"), std::string::npos);
 }
 
 TEST(ToyMethod, TheViewerListsAndRunsIt) {

@@ -88,6 +88,9 @@ int main(int argc, char** argv) {
     } catch (const std::exception& e) {
         std::fprintf(stderr, "atrous: error: %s\n", oneLine(e.what()).c_str());
         return 2;
+    } catch (...) {  // a plug-in may throw anything
+        std::fprintf(stderr, "atrous: error: an exception that is not a std::exception\n");
+        return 2;
     }
     return 0;
 }

@@ -107,6 +107,8 @@ def register_method(name: str, cascade: Any, summary: str = "",
     as RuntimeError naming it. docs/python.md has an example."""
     if not callable(cascade):
         raise ValueError(f"register_method: cascade must be callable (got {type(cascade).__name__})")
+    if isinstance(reads, str):
+        reads = (reads,)
     _core.register_method(str(name), str(summary), cascade, [str(r) for r in reads])
 
 

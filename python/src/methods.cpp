@@ -53,7 +53,7 @@ struct PyCascade {
             // renders: one line for the caller.
             std::string what = e.what();
             while (!what.empty() && what.back() == '\n') what.pop_back();
-            throw RuntimeError("the method's cascade raised " + what.substr(what.rfind('\n') + 1));
+            throw RuntimeError("its cascade raised " + what.substr(what.rfind('\n') + 1));
         }
     }
 };

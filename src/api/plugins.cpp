@@ -4,6 +4,7 @@
 
 #include <dlfcn.h>
 
+#include <exception>
 #include <filesystem>
 #include <mutex>
 #include <set>
@@ -16,7 +17,8 @@ namespace atrous {
 
 void loadPlugin(const std::string& path) {
     std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path + ": no such plugin file");
+    if (!std::filesystem::exists(path, ec)) throw InputError(path + ": no such plugin file");
+    if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path + ": is not a file (a plugin is a shared library)");
     static std::mutex mutex;
     static std::set<std::string> loaded;
     const std::lock_guard<std::mutex> lock(mutex);
@@ -37,7 +39,15 @@ void loadPlugin(const std::string& path) {
     using Entry = void (*)();
     const auto entry = reinterpret_cast<Entry>(dlsym(lib, kPluginEntry));
     if (!entry) throw InputError(path + ": not an atrous plugin (no " + kPluginEntry + " function)");
-    entry();  // its registerDenoiseMethod errors (a taken name) reach the caller
+    try {
+        entry();
+    } catch (const InputError& e) {  // registerDenoiseMethod's (a taken name), named after the file
+        throw InputError(path + ": " + e.what());
+    } catch (const std::exception& e) {
+        throw RuntimeError(path + ": " + e.what());
+    } catch (...) {
+        throw RuntimeError(path + ": its " + kPluginEntry + " threw something that is not a std::exception");
+    }
     loaded.insert(key);
 }
 

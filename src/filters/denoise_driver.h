@@ -3,11 +3,14 @@
 // the executor's device; temporaries are allocated there.
 #pragma once
 #include <cmath>
+#include <exception>
+#include <string>
 #include <type_traits>
 #include <utility>
 #include <vector>
 
 #include "atrous/denoise.h"
+#include "atrous/error.h"
 #include "atrous/image.h"
 #include "atrous/learned.h"
 #include "filters/eaw.h"
@@ -183,6 +186,22 @@ struct FiniteOr {
             if (!finite(out(x, y, k))) out(x, y, k) = fallback(x, y, k);
     }
 };
+
+// A registered method's cascade, its errors named after the method: an InputError stays one, any
+// other exception (or a throw of something that is no std::exception) becomes a RuntimeError.
+inline void callCascade(const StillCascade& cascade, const char* name, const StillPlanes& P, const DenoiseOptions& o,
+                        const ImageView& out) {
+    const std::string who = std::string("method '") + name + "': ";
+    try {
+        cascade(P, o, out);
+    } catch (const InputError& e) {
+        throw InputError(who + e.what());
+    } catch (const std::exception& e) {
+        throw RuntimeError(who + e.what());
+    } catch (...) {
+        throw RuntimeError(who + "its cascade threw something that is not a std::exception");
+    }
+}
 
 // Memory (docs/architecture.md, "Memory"): every temporary is allocated without a zero fill
 // (each is written whole before it is read), once per call (the cascade's planes live through it:
@@ -393,7 +412,7 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
         P.position = reads.position ? first(in.position.valid() ? position : ImageView{}, 3) : ImageView{};
         P.depth = reads.depth ? first(in.depth.valid() ? depth : ImageView{}, 1) : ImageView{};
         P.ids = reads.ids ? first(ids, 2) : ImageView{};
-        (*own)(P, o, learnedOut.view());
+        callCascade(*own, info.name, P, o, learnedOut.view());
         exec.forEachPixel(w, h, FiniteOr{learnedOut.view(), cA.view()});
         cur = &learnedOut;
         markStage(out.clock, info.name);

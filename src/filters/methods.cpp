@@ -6,6 +6,7 @@
 
 #include "atrous/denoise.h"
 #include "atrous/error.h"
+#include "atrous/temporal.h"
 
 namespace atrous {
 
@@ -40,6 +41,10 @@ DenoiseMethod registerDenoiseMethod(DenoiseMethodInfo info) {
     for (char ch : name) ok = ok && (std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-');
     if (!ok) throw InputError("registerDenoiseMethod: '" + name + "' is not a method name (letters, digits, '_', '-')");
     if (findDenoiseMethod(name)) throw InputError("registerDenoiseMethod: there is already a method '" + name + "'");
+    // The sequence methods' names, and the front-ends' own words for no filter and for OIDN.
+    bool taken = name == "none" || name == "noisy" || name == "oidn";
+    for (const SequenceMethodInfo& m : sequenceMethods()) taken = taken || name == m.name;
+    if (taken) throw InputError("registerDenoiseMethod: '" + name + "' is a name the front-ends use (a sequence method, none, noisy or oidn)");
     if (!info.registered()) throw InputError("registerDenoiseMethod: method '" + name + "' has no cascade (cpu or cuda)");
     if (info.usesWeights)
         throw InputError("registerDenoiseMethod: method '" + name + "': a registered cascade cannot read the learned weights");

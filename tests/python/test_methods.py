@@ -77,7 +77,7 @@ def test_bad_registrations_and_cascades():
 
     atrous.register_method("boom", boom)
     atrous.register_method("writes-input", writes_input)
-    with pytest.raises(RuntimeError, match="KeyError"):
+    with pytest.raises(RuntimeError, match="method .boom.: its cascade raised KeyError"):
         atrous.denoise(b["color"], method="boom")
     with pytest.raises(RuntimeError, match="read-only"):
         atrous.denoise(b["color"], method="writes-input")
@@ -173,3 +173,44 @@ def test_the_cpp_toy_plugin_is_one_method_for_the_cli_and_python(tmp_path):
     np.testing.assert_array_equal(atrous.read_image(tmp_path / "py.exr"), atrous.read_image(tmp_path / "cli.exr"))
     with pytest.raises(ValueError, match="no such plugin file"):
         atrous.load_plugin(tmp_path / "nope.so")
+
+
+def test_names_the_front_ends_use_are_taken_and_reads_takes_one_name():
+    for name in ("temporal", "svgf", "none", "noisy", "oidn"):
+        with pytest.raises(ValueError, match="a name the front-ends use"):
+            atrous.register_method(name, toy_plugin.toy_cascade)
+    seen = {}
+
+    def spy(planes, out):
+        seen.update({k: v is not None for k, v in planes.items()})
+        out[...] = planes["color"]
+
+    atrous.register_method("normal-only-2", spy, reads="normal")
+    b = _render()
+    atrous.denoise(method="normal-only-2", **b)
+    assert seen["normal"] and not seen["albedo"] and not seen["position"]
+
+
+def test_a_plugins_errors_name_its_file(tmp_path):
+    """The toy plugin under a second name: its registration fails (the name 'toy' is taken) with
+    an error naming that file; a folder is not a plugin."""
+    import shutil
+    import subprocess
+    import sys
+
+    from atrous_cli import toy_plugin_so
+
+    so = toy_plugin_so()
+    if so is None:
+        pytest.skip("no C++ build with the toy plugin")
+    copy = tmp_path / "second.so"
+    shutil.copy(so, copy)
+    code = ("import sys, atrous\natrous.load_plugin(sys.argv[1])\n"
+            "try:\n    atrous.load_plugin(sys.argv[2])\nexcept ValueError as e:\n    print('ValueError', e)\n"
+            "try:\n    atrous.load_plugin(sys.argv[3])\nexcept ValueError as e:\n    print('ValueError', e)\n")
+    r = subprocess.run([sys.executable, "-c", code, so, str(copy), str(tmp_path)], capture_output=True, text=True,
+                       timeout=120)
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.strip().splitlines()
+    assert "second.so" in lines[0] and "already a method 'toy'" in lines[0], lines
+    assert "is not a file" in lines[1], lines
