@@ -82,7 +82,6 @@ int main(int argc, char** argv) {
         img[ids] = firstChannels(std::move(img[ids]), 2);
         const double rssInputs = peakRssMb();
         DenoiseReport rep;
-        o.report = &rep;
         auto ptr = [&](io::Buffer b) { return img[int(b)].empty() ? nullptr : &img[int(b)]; };
         std::printf("{\"in\": \"%s\", \"method\": \"%s\", \"width\": %d, \"height\": %d, \"read_ms\": %.1f, "
                     "\"peak_rss_after_read_mb\": %.1f",
@@ -93,7 +92,9 @@ int main(int argc, char** argv) {
             b.albedo = ptr(io::Buffer::Albedo), b.normal = ptr(io::Buffer::Normal), b.position = ptr(io::Buffer::Position);
             b.depth = ptr(io::Buffer::Depth), b.ids = ptr(io::Buffer::ObjectId);
             Timer t;
-            const Image out = denoise(b, o);
+            DenoiseResult res = denoiseWithReport(b, o);
+            const Image out = std::move(res.image);
+            rep = std::move(res.report);
             std::printf(", \"mode\": \"one-shot\", \"total_ms\": %.1f, \"filter_ms\": %.1f, \"peak_rss_mb\": %.1f, \"stages\": [",
                         t.ms(), rep.milliseconds, peakRssMb());
             for (size_t i = 0; i < rep.stages.size(); ++i)
@@ -107,7 +108,7 @@ int main(int argc, char** argv) {
         std::vector<std::vector<double>> stage;
         for (int i = 0; i < warm + 2; ++i) {
             Timer t;
-            denoise(di, o);
+            rep = denoiseWithReport(di, o).report;
             if (i < 2) continue;
             total.push_back(t.ms());
             filter.push_back(rep.milliseconds);

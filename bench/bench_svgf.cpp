@@ -33,14 +33,14 @@ using namespace atrous;
 
 namespace {
 
-struct Frame {
+struct BenchFrame {
     Image color, albedo, normal, depth, ids, motion;
 };
 
 // A textured ground plane receding in depth under a camera that pans 1.5 px per frame, a sky strip,
 // and a box moving the other way: every stage (bilinear reprojection, disocclusion, edges) works.
-Frame makeFrame(int w, int h, int t, Device device) {
-    Frame f{Image(w, h, 3), Image(w, h, 3), Image(w, h, 3), Image(w, h, 3), Image(w, h, 3), Image(w, h, 3)};
+BenchFrame makeFrame(int w, int h, int t, Device device) {
+    BenchFrame f{Image(w, h, 3), Image(w, h, 3), Image(w, h, 3), Image(w, h, 3), Image(w, h, 3), Image(w, h, 3)};
     std::mt19937 rng(1234u + unsigned(t));
     std::exponential_distribution<float> spp1(1.0f);  // 1-spp-like: heavy-tailed, mean 1
     const float pan = 1.5f * float(t);
@@ -66,7 +66,7 @@ Frame makeFrame(int w, int h, int t, Device device) {
             f.motion(x, y, 0) = box ? 2.0f : 1.5f;  // previous - current
         }
     if (device != Device::Cpu)
-        f = Frame{f.color.to(device), f.albedo.to(device), f.normal.to(device), f.depth.to(device), f.ids.to(device),
+        f = BenchFrame{f.color.to(device), f.albedo.to(device), f.normal.to(device), f.depth.to(device), f.ids.to(device),
                   f.motion.to(device)};
     return f;
 }
@@ -116,16 +116,15 @@ int main(int argc, char** argv) {
         const int sizes[2][2] = {{512, 512}, {1920, 1080}};
         for (const auto& sz : sizes) {
             const int w = sz[0], h = sz[1];
-            std::vector<Frame> frames;
+            std::vector<BenchFrame> frames;
             for (int t = 0; t < 4; ++t) frames.push_back(makeFrame(w, h, t, device));
             SvgfDenoiser denoiser(params, device);
-            SvgfReport report;
-            if (stages) denoiser.setReport(&report);
+            denoiser.setTiming(stages);
             std::vector<std::string> stageOrder;
             std::map<std::string, std::vector<double>> stageMs;
             std::vector<double> ms, cpuMs;
             for (int i = 0; i < warmup + runs; ++i) {
-                const Frame& f = frames[i % frames.size()];
+                const BenchFrame& f = frames[i % frames.size()];
                 SvgfFrame in;
                 in.color = &f.color, in.albedo = &f.albedo, in.normal = &f.normal;
                 in.depth = &f.depth, in.ids = &f.ids, in.motion = &f.motion;
@@ -135,7 +134,7 @@ int main(int argc, char** argv) {
                 if (i >= warmup) {
                     ms.push_back(timer.ms());
                     cpuMs.push_back(processCpuMs() - cpu0);
-                    for (const StageTime& st : report.stages) {
+                    for (const StageTime& st : denoiser.lastReport().stages) {
                         if (!stageMs.count(st.name)) stageOrder.push_back(st.name);
                         stageMs[st.name].push_back(st.milliseconds);
                     }

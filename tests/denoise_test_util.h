@@ -5,12 +5,21 @@
 #include <random>
 
 #include <string>
+#include <utility>
 
 #include "atrous/denoise.h"
 #include "atrous/error.h"
 #include "atrous/image.h"
 
 namespace atrous::test {
+
+// denoiseWithReport's image, with its report in `rep` (tests that check both).
+template <class In>
+Image denoiseReporting(In&& in, const DenoiseOptions& o, DenoiseReport& rep) {
+    DenoiseResult r = denoiseWithReport(in, o);
+    rep = std::move(r.report);
+    return std::move(r.image);
+}
 
 // DenoiseInputs over seven buffers the caller keeps alive (emission unset). Also bench_denoise's.
 inline DenoiseInputs inputsOf(const Image& color, const Image& variance, const Image& albedo, const Image& normal,

@@ -34,8 +34,7 @@ struct Flat {
     DenoiseReport defaultReport() const {
         DenoiseReport rep;
         DenoiseOptions o;
-        o.report = &rep;
-        denoise(inputs(), o);
+        test::denoiseReporting(inputs(), o, rep);
         return rep;
     }
 };
@@ -50,8 +49,7 @@ TEST(Firefly, ClampsAnOutlierAndLeavesNoiseAlone) {
     DenoiseReport rep;
     DenoiseOptions o;
     o.method = DenoiseMethod::Eaw;
-    o.report = &rep;
-    Image out = denoise(f.inputs(), o);
+    Image out = test::denoiseReporting(f.inputs(), o, rep);
     // Gaussian noise exceeds 4 local σ with probability ~3e-5 per pixel: of 4096 pixels, the
     // firefly plus at most a handful.
     EXPECT_GE(rep.firefliesClamped, 1);
@@ -64,7 +62,7 @@ TEST(Firefly, ClampsAnOutlierAndLeavesNoiseAlone) {
     for (size_t i = 0; i < out.size(); ++i) ASSERT_NEAR(out.data()[i], 0.5f, 0.2f);
     // Without suppression the blotch is there.
     o.firefly.enabled = false;
-    Image raw = denoise(f.inputs(), o);
+    Image raw = test::denoiseReporting(f.inputs(), o, rep);
     EXPECT_GT(raw(30, 20, 0), 2.0f);
 }
 
@@ -119,8 +117,7 @@ TEST(NonFinite, NanAndInfNeverSpread) {
             DenoiseReport rep;
             DenoiseOptions o;
             o.method = m;
-            o.report = &rep;
-            Image out = denoise(in, o);
+            Image out = test::denoiseReporting(in, o, rep);
             EXPECT_TRUE(allFinite(out)) << denoiseMethodName(m);
             EXPECT_EQ(rep.nonFinitePixels, 13);
             // Missing pixels are filled from their neighbourhood: close to the truth there.

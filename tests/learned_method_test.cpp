@@ -58,10 +58,11 @@ struct Synth {
     }
 };
 
+// The learned method with a weight file's network ("" = the built-in weights), loaded once.
 DenoiseOptions learnedOptions(const std::string& weights) {
     DenoiseOptions o;
     o.method = DenoiseMethod::Learned;
-    o.learnedWeights = weights;
+    if (!weights.empty()) o.weights = LearnedWeights::load(weights);
     return o;
 }
 
@@ -144,8 +145,7 @@ protected:
 
 TEST_F(LearnedSynth, IgnoresLevelsAndTheEawParametersButNotTheSafetyNet) {
     DenoiseOptions o = learnedOptions(wpath);
-    o.report = &rep;
-    const Image base = denoise(sc.inputs(), o);
+    const Image base = test::denoiseReporting(sc.inputs(), o, rep);
     std::vector<std::string> names;
     for (const StageTime& t : rep.stages) names.push_back(t.name);
     EXPECT_EQ(names, (std::vector<std::string>{"sanitize", "fireflies", "demodulate", "learned", "remodulate"}));
@@ -165,8 +165,7 @@ TEST_F(LearnedSynth, IgnoresLevelsAndTheEawParametersButNotTheSafetyNet) {
     const Rendered r;
     DenoiseOptions safety = learnedOptions(wpath);
     safety.safety.enabled = true;
-    safety.report = &rep;
-    EXPECT_GT(firstDifference(denoise(r.inputs(), safety), denoise(r.inputs(), learnedOptions(wpath))), -1);
+    EXPECT_GT(firstDifference(test::denoiseReporting(r.inputs(), safety, rep), denoise(r.inputs(), learnedOptions(wpath))), -1);
     EXPECT_EQ(rep.stages[rep.stages.size() - 2].name, "safety net");
 }
 
@@ -207,7 +206,6 @@ TEST_F(LearnedSynth, OutputIsFiniteWithNanAndInfInEveryBuffer) {
 TEST_F(LearnedSynth, AutoPicksBlendWithAlbedoAndNormalElseSure) {
     DenoiseOptions autoO = learnedOptions(wpath);
     autoO.method = DenoiseMethod::Auto;
-    autoO.report = &rep;
     DenoiseOptions sure;
     sure.method = DenoiseMethod::Sure;
     DenoiseOptions blend = learnedOptions(wpath);
@@ -221,7 +219,7 @@ TEST_F(LearnedSynth, AutoPicksBlendWithAlbedoAndNormalElseSure) {
         DenoiseInputs in = sc.inputs();
         if (!c.albedo) in.albedo = nullptr;
         if (!c.normal) in.normal = nullptr;
-        const Image got = denoise(in, autoO);
+        const Image got = test::denoiseReporting(in, autoO, rep);
         EXPECT_EQ(rep.methodUsed, c.expect) << c.albedo << c.normal;
         EXPECT_EQ(resolveDenoiseMethod(DenoiseMethod::Auto, in), c.expect);
         const Image want = denoise(in, c.expect == DenoiseMethod::Blend ? blend : sure);
@@ -276,8 +274,7 @@ TEST(LearnedMethod, BlendIsTheMeanOfLearnedAndSure) {
         b.method = DenoiseMethod::Blend;
         if (k == 2) l.demodulate = su.demodulate = b.demodulate = false, in.emission = nullptr;
         DenoiseReport rep;
-        b.report = &rep;
-        const Image L = denoise(in, l), S = denoise(in, su), B = denoise(in, b);
+        const Image L = denoise(in, l), S = denoise(in, su), B = test::denoiseReporting(in, b, rep);
         EXPECT_EQ(rep.methodUsed, DenoiseMethod::Blend);
         double worst = 0, moved = 0;
         for (size_t i = 0; i < B.size(); ++i) {
@@ -295,27 +292,20 @@ TEST(LearnedMethod, BlendIsTheMeanOfLearnedAndSure) {
 
 using test::inputErrorOf;
 
+// A bad weight file is an InputError naming it, from the loader (the filter never reads files).
 TEST(LearnedMethod, ABadWeightFileIsAnInputErrorNamingIt) {
     test::TempDir dir;
-    const Synth sc;
     const std::string missing = dir / "no_such.atrl";
-    DenoiseReport rep;
-    DenoiseOptions o = learnedOptions(missing);
-    o.report = &rep;
-    std::string msg = inputErrorOf(sc.inputs(), o);
-    EXPECT_NE(msg.find(missing), std::string::npos) << msg;
-    EXPECT_TRUE(rep.buffersUsed.empty()) << "work was done before the weights were read";
     const std::string junk = dir / "junk.atrl";
     std::ofstream(junk) << "not a weight file";
-    msg = inputErrorOf(sc.inputs(), learnedOptions(junk));
-    EXPECT_NE(msg.find(junk), std::string::npos) << msg;
-    // Auto reads them only when it picks learned.
-    DenoiseOptions autoO = learnedOptions(junk);
-    autoO.method = DenoiseMethod::Auto;
-    EXPECT_NE(inputErrorOf(sc.inputs(), autoO), "");
-    DenoiseInputs noNormal = sc.inputs();
-    noNormal.normal = nullptr;
-    EXPECT_EQ(inputErrorOf(noNormal, autoO), "");
+    for (const std::string& path : {missing, junk}) {
+        try {
+            LearnedWeights::load(path);
+            ADD_FAILURE() << path << " loaded";
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+        }
+    }
 }
 
 TEST(LearnedMethod, BuiltInWeightsBeatTheNoisyInput) {
@@ -402,20 +392,14 @@ TEST(LearnedMethodCli, SequenceDenoisesEveryFrameAndChecksTheWeightsFirst) {
     EXPECT_FALSE(std::filesystem::exists(out2));
 }
 
-// DenoiseOptions::weights, the network loaded once: the same output as the file it came from; when
-// set, the path is not read (a missing file is then no error); the built-in weights by object
-// equal the built-in default.
-TEST(LearnedMethod, LoadedWeightsAreUsedAndThePathIsNotRead) {
+// DenoiseOptions::weights, the network loaded once: a weight file's network is used (not the
+// built-in one), and the built-in weights by object equal the default (none given).
+TEST(LearnedMethod, LoadedWeightsAreUsed) {
     test::TempDir dir;
     const std::string wpath = writeFixtureWeights(dir);
     const Synth sc;
     const DenoiseInputs in = sc.inputs(true);
-    DenoiseOptions byPath = learnedOptions(wpath);
-    DenoiseOptions byObject = learnedOptions("");
-    byObject.weights = LearnedWeights::load(wpath);
-    EXPECT_TRUE(test::sameImages(denoise(in, byPath), denoise(in, byObject)));
-    byObject.learnedWeights = dir / "missing.bin";
-    EXPECT_TRUE(test::sameImages(denoise(in, byPath), denoise(in, byObject)));
+    const DenoiseOptions byPath = learnedOptions(wpath);
     DenoiseOptions builtin = learnedOptions("");
     DenoiseOptions builtinObject = learnedOptions("");
     builtinObject.weights = LearnedWeights::builtin();

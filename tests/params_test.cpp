@@ -52,10 +52,9 @@ TEST(ParamTables, EveryStructFieldHasARow) {
     EXPECT_EQ(rowsOf(d, "sure"), fieldCount<SureParams>());
     EXPECT_EQ(rowsOf(d, "firefly"), fieldCount<FireflyParams>());
     EXPECT_EQ(rowsOf(d, "safety"), fieldCount<SafetyNetParams>());
-    // DenoiseOptions' own rows; method, device, the four structs, weights (the loaded network),
-    // learnedWeights (a path, with a flag and keyword of its own: --learned-weights,
-    // learned_weights) and report are not parameters.
-    EXPECT_EQ(rowsOf(d, "") + 9, fieldCount<DenoiseOptions>());
+    // DenoiseOptions' own rows; method, device, the four structs and weights (the loaded network:
+    // --learned-weights and learned_weights= name its file) are not parameters.
+    EXPECT_EQ(rowsOf(d, "") + 7, fieldCount<DenoiseOptions>());
     EXPECT_EQ(d.count, rowsOf(d, "eaw") + rowsOf(d, "sure") + rowsOf(d, "firefly") + rowsOf(d, "safety") + rowsOf(d, ""));
     EXPECT_EQ(svgfParams().count, fieldCount<SvgfParams>());
     EXPECT_EQ(temporalParams().count, fieldCount<TemporalParams>());

@@ -23,8 +23,7 @@ static DenoiseReport stillReport(DenoiseMethod method, int levels, unsigned seed
     o.method = method;
     o.eaw.levels = levels;
     DenoiseReport rep;
-    o.report = &rep;
-    denoise(scene.inputs(), o);
+    test::denoiseReporting(scene.inputs(), o, rep);
     return rep;
 }
 
@@ -56,18 +55,17 @@ TEST(StageTimes, NoiseEstimateStagesWithoutAVariance) {
     o.method = DenoiseMethod::Eaw;
     o.eaw.levels = 2;
     DenoiseReport rep;
-    o.report = &rep;
     DenoiseInputs in = scene.inputs();
     in.variance = nullptr;
     in.albedo = nullptr;
-    denoise(in, o);
+    test::denoiseReporting(in, o, rep);
     const std::vector<std::string> expected = {"noise sigma", "sanitize", "fireflies", "demodulate", "noise estimate",
                                                "sigma scales", "level 0", "level 1", "remodulate"};
     EXPECT_EQ(test::stageNames(rep.stages), expected);
     EXPECT_LE(test::stageSum(rep.stages), rep.milliseconds + 1e-6);
 }
 
-TEST(StageTimes, SvgfReportFollowsTheFramesWhileSet) {
+TEST(StageTimes, SvgfReportFollowsTheFramesWhileTimed) {
     const test::SyntheticScene scene = test::makeScene(40, 32, 0.3f, 9);
     SvgfParams p;
     p.levels = 2;
@@ -79,22 +77,21 @@ TEST(StageTimes, SvgfReportFollowsTheFramesWhileSet) {
     f.albedo = &scene.albedo;
     f.normal = &scene.normal;
     f.depth = &scene.depth;
-    d.denoiseFrame(f);  // untimed: no report set
-    SvgfReport rep;
-    d.setReport(&rep);
+    d.denoiseFrame(f);  // untimed: timing is off by default
+    EXPECT_TRUE(d.lastReport().stages.empty());
+    d.setTiming(true);
     d.denoiseFrame(f);
+    const SvgfReport rep = d.lastReport();
     const std::vector<std::string> expected = {"demodulate", "reproject", "accumulate", "variance",
                                                "level 0",    "level 1",   "remodulate", "taa"};
     EXPECT_EQ(test::stageNames(rep.stages), expected);
     // milliseconds is the start-to-last-mark span, i.e. the sum of the stages up to rounding.
     EXPECT_NEAR(rep.milliseconds, test::stageSum(rep.stages), 1e-6);
-    // Cleared: later frames leave the report alone.
-    d.setReport(nullptr);
-    rep.stages.clear();
-    rep.milliseconds = -1;
+    // Off again: no report, and later frames are not timed.
+    d.setTiming(false);
     d.denoiseFrame(f);
-    EXPECT_TRUE(rep.stages.empty());
-    EXPECT_EQ(rep.milliseconds, -1);
+    EXPECT_TRUE(d.lastReport().stages.empty());
+    EXPECT_EQ(d.lastReport().milliseconds, 0.0);
 }
 
 // The viewer's timing table (apps/atrous/view/stage_history.h, header-only, no GL).

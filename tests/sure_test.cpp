@@ -226,8 +226,7 @@ TEST(Sure, EstimatesTheNoiseWithoutAVarianceBuffer) {
     in.color = &y;
     DenoiseReport rep;
     DenoiseOptions o;
-    o.report = &rep;
-    Image out = denoise(in, o);
+    Image out = test::denoiseReporting(in, o, rep);
     EXPECT_TRUE(rep.noiseEstimated);
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(rep.noiseSigma[c], 0.05f, 0.005f);
     EXPECT_TRUE(allFinite(out));
@@ -252,13 +251,11 @@ TEST(Sure, IgnoresAnAllZeroVarianceBuffer) {
         DenoiseOptions o;
         o.method = m;
         DenoiseReport rep;
-        o.report = &rep;
-        Image a = denoise(withZero, o);
+        Image a = test::denoiseReporting(withZero, o, rep);
         EXPECT_TRUE(rep.varianceIgnored);
         EXPECT_TRUE(rep.noiseEstimated);
         EXPECT_NE(rep.buffersUsed.find("variance(ignored"), std::string::npos) << rep.buffersUsed;
         EXPECT_GT(maxAbsDiff(a, y), 0.05) << "the filter left the noisy input unchanged";
-        o.report = nullptr;
         Image b = denoise(without, o);
         // Same path as no variance at all: identical output (same code, same estimate).
         EXPECT_EQ(maxAbsDiff(a, b), 0.0);
@@ -270,8 +267,7 @@ TEST(Sure, IgnoresAnAllZeroVarianceBuffer) {
     in.variance = &zero;
     DenoiseReport rep;
     DenoiseOptions o;
-    o.report = &rep;
-    denoise(in, o);
+    test::denoiseReporting(in, o, rep);
     EXPECT_FALSE(rep.varianceIgnored);
     EXPECT_FALSE(rep.noiseEstimated);
 }

@@ -87,13 +87,11 @@ TEST(ToyMethod, IsItsCascadeOnThePreparedPlanesThenRemodulate) {
         DenoiseOptions o;
         o.method = toy::toyMethod();
         DenoiseReport rep;
-        o.report = &rep;
-        const Image out = denoise(in, o);
+        const Image out = test::denoiseReporting(in, o, rep);
         EXPECT_EQ(rep.methodUsed, toy::toyMethod());
         bool staged = false;
         for (const StageTime& s : rep.stages) staged = staged || s.name == "toy";
         EXPECT_TRUE(staged) << "no stage 'toy'";
-        o.report = nullptr;
         const PreparedPlanes p = learnedPlanes(in, o);
         StillPlanes P;
         P.color = p.d.view(), P.variance = p.var.view();

@@ -138,9 +138,10 @@ void run(const BenchArgs& a) {
     auto wants = [&](const char* k) { return std::find(what.begin(), what.end(), k) != what.end(); };
     bool anyLearned = false;
     for (const DenoiseMethodInfo& m : denoiseMethods()) anyLearned = anyLearned || (m.usesWeights && wants(m.name));
+    LearnedWeights weights;  // loaded once, before any timing (empty: the built-in weights)
     if (anyLearned && !a.learnedWeights.empty()) {
         try {
-            LearnedWeights::load(a.learnedWeights);  // a bad file: one line before any timing
+            weights = LearnedWeights::load(a.learnedWeights);  // a bad file: one line
         } catch (const InputError& e) {
             throw InputError(std::string("--learned-weights: ") + e.what());
         }
@@ -219,22 +220,20 @@ void run(const BenchArgs& a) {
             const char* m = info.name;
             if (info.method == DenoiseMethod::Auto || !wants(m)) continue;
             DenoiseInputs in = denoiseInputsOf(inputs);
-            DenoiseReport rep;
             DenoiseOptions o;
             o.method = parseDenoiseMethod(m);
-            o.learnedWeights = a.learnedWeights;
+            o.weights = weights;
             const bool learned = info.usesWeights;
             o.device = device;
-            o.report = &rep;
             std::vector<double> total;
             StageSamples stages;
             int call = 0;
             auto t = repeat(a.warmup, runs, [&] {
                 Timer tt;
-                denoise(in, o);
+                const DenoiseResult res = denoiseWithReport(in, o);
                 total.push_back(tt.ms());
-                if (call++ >= a.warmup) stages.add(rep.stages);
-                return rep.milliseconds;
+                if (call++ >= a.warmup) stages.add(res.report.stages);
+                return res.report.milliseconds;
             });
             total.erase(total.begin(), total.begin() + a.warmup);
             nlohmann::json r = stats(t);
@@ -273,15 +272,14 @@ void run(const BenchArgs& a) {
             f.depth = &inputs.depth;
             f.ids = &inputs.ids;
             f.motion = device == Device::Cuda ? &motionIn : &motion;
-            SvgfReport srep;
-            sv.setReport(&srep);
+            sv.setTiming(true);
             StageSamples stages;
             int call = 0;
             auto t = repeat(a.warmup, runs, [&] {
                 Timer tt;
                 sv.denoiseFrameOnDevice(f);
                 const double ms = tt.ms();
-                if (call++ >= a.warmup) stages.add(srep.stages);
+                if (call++ >= a.warmup) stages.add(sv.lastReport().stages);
                 return ms;
             });
             nlohmann::json r = stats(t);

@@ -34,6 +34,7 @@ struct DenoiseArgs {
     std::string spatial = "auto";  // --spatial: the still method of --method temporal
     io::FrameRange range;  // --start, --end, --step (with --sequence)
     DenoiseOptions opt;  // the filter parameters' flags write here (params.h's table)
+    std::string learnedWeights;  // --learned-weights: loaded once into opt.weights
     SvgfParams svgf;
     TemporalParams temporal;
 };
@@ -163,8 +164,8 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     noteIgnoredFlags(cmd, a.method, still, sequence, learnedSvgf);
     // A bad weight file fails here, before any buffer is read or anything written.
     LearnedWeights weights;
-    if ((learnedMethod(still) || learnedSvgf) && !o.learnedWeights.empty())
-        weights = withFlag("--learned-weights", [&] { return LearnedWeights::load(o.learnedWeights); });
+    if ((learnedMethod(still) || learnedSvgf) && !a.learnedWeights.empty())
+        weights = withFlag("--learned-weights", [&] { return LearnedWeights::load(a.learnedWeights); });
     o.weights = weights;  // loaded once: denoise() does not read the file again
     if (sequence) {
         if (!a.inDir.empty() || !a.color.empty())
@@ -217,12 +218,10 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
                                               io::Buffer::Normal,   io::Buffer::Position, io::Buffer::Depth,
                                               io::Buffer::ObjectId, io::Buffer::Emission};
     static const char* const kLibraryNames[] = {"color", "variance", "albedo", "normal", "position", "depth", "ids", "emission"};
-    DenoiseReport rep;
-    o.report = &rep;
     Timer t;
-    Image out;
+    DenoiseResult result;
     try {
-        out = denoise(in, o);
+        result = denoiseWithReport(in, o);
     } catch (const InputError& e) {
         // Name the buffer's file: library messages name the buffer ("variance buffer has ...").
         throw InputError(io::withSourceFile(e.what(), [&](const std::string& name) {
@@ -232,6 +231,8 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
         }, ""));
     }
     const double ms = t.ms();
+    Image& out = result.image;
+    const DenoiseReport& rep = result.report;
     if (a.ldr) clampUnit(out);
     if (a.srgb) linearToSrgb(out);
     Timer writeTimer;
@@ -324,7 +325,7 @@ void addDenoiseCommand(CLI::App& app) {
     cmd->add_option("--spatial", a->spatial, "With --method temporal: the still method run on the averaged frame")
         ->capture_default_str()
         ->group(kGroupTemporal);
-    cmd->add_option("--learned-weights", a->opt.learnedWeights,
+    cmd->add_option("--learned-weights", a->learnedWeights,
                     "Weight file of the learned filter (version 4, or 3; docs/learned.md; default: the built-in weights)")
         ->group(kGroupLearned);
     cmd->add_option("--device,-d", a->device, "cpu | cuda | auto (cuda when a GPU is present; oidnDenoise's 'default' = auto)")

@@ -70,8 +70,6 @@ int main(int argc, char** argv) {
         atrous::DenoiseOptions options;
         options.method = atrous::parseDenoiseMethod(method);  // InputError for another word
         options.device = atrous::parseDevice(device);         // "auto": CUDA when a GPU is usable
-        atrous::DenoiseReport report;
-        options.report = &report;
 
         const atrous::Image color = atrous::readImage(colorPath);
         std::map<std::string, atrous::Image> images;
@@ -89,8 +87,10 @@ int main(int argc, char** argv) {
         inputs.emission = find("emission");  // a visible light is filtered apart (denoising.md)
 
         // Throws InputError for sizes that do not match the colour's or a negative variance.
-        const atrous::Image result = atrous::denoise(inputs, options);
-        atrous::writeImage(outPath, result);
+        // denoiseWithReport: the image and what the run did (atrous::denoise gives the image alone).
+        const atrous::DenoiseResult result = atrous::denoiseWithReport(inputs, options);
+        const atrous::DenoiseReport& report = result.report;
+        atrous::writeImage(outPath, result.image);
 
         std::printf("denoised %s (%dx%d) with %s on %s, buffers: %s\n", colorPath.c_str(),
                     color.width(), color.height(), atrous::denoiseMethodName(options.method),

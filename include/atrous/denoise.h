@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "atrous/buffers.h"
 #include "atrous/device.h"
 #include "atrous/image.h"
 #include "atrous/learned.h"
@@ -27,23 +28,12 @@ namespace atrous {
 // Registered methods (registerDenoiseMethod, below) take the values after Blend.
 enum class DenoiseMethod : int { Eaw, Sure, Learned, Auto, Blend };
 
-// Per-pixel buffers, planar Images of the colour's size (see docs/rendering.md, "The buffers"):
-// 3 channels each (more are ignored), but depth (1: channel 0 is read) and ids (2: R and G).
-// Only `color` is required; a missing feature simply removes its edge stop.
-struct DenoiseInputs {
-    const Image* color = nullptr;     // mean radiance, linear HDR
-    const Image* variance = nullptr;  // variance of the mean, per channel
-    const Image* albedo = nullptr;
-    const Image* normal = nullptr;    // world-space unit normals (0 for background)
-    const Image* position = nullptr;  // world-space hit points
-    const Image* depth = nullptr;     // view depth in channel 0 (1 channel or more)
-    const Image* ids = nullptr;       // R = mesh id, G = material id, -1 for background (2 channels or more)
-    // Emitted radiance of the primary hit (mean over the pixel's samples). When given, the filters
-    // work on color - emission and add it back, through an edge-avoiding filter of its own
-    // (EawParams::emissionLevels) that averages a visible light's partly covered edge pixels
-    // (pixel-coverage noise) with each other and with nothing else.
-    const Image* emission = nullptr;
-};
+// The buffers of a denoise() call: one Frame (atrous/buffers.h, where each buffer's channels and
+// conventions are stated). Only `color` is required; a missing feature simply removes its edge
+// stop. Motion is not read. With an emission buffer the filters work on color - emission and add
+// it back through an edge-avoiding filter of its own (EawParams::emissionLevels), which averages
+// a visible light's partly covered edge pixels with each other and with nothing else.
+using DenoiseInputs = Frame;
 
 // Edge-avoiding à-trous cascade (docs/denoising.md). Also the cascade that SURE runs on.
 // Edge-stopping weight of a tap: w = exp(-(Δc²/σ_c,i² + Δn²/σ_n,i² + Δx²/σ_x² + (Δz/(σ_z z))² + ids)).
@@ -112,8 +102,6 @@ struct SafetyNetParams {
     float trigger = 2.0f;  // τ >= 0: act where ΣD > τ ΣV (2: the SURE risk of the output is above the input's)
 };
 
-struct DenoiseReport;
-
 // The parameters' user-facing names (Python keywords, CLI flags), ranges and doc lines are one
 // table, denoiseParams() in atrous/params.h: a new field needs a row there (tests/params_test.cpp).
 struct DenoiseOptions {
@@ -132,15 +120,10 @@ struct DenoiseOptions {
     // Other renderers' albedo is 0 on glass, mirrors, emitters and the sky (docs/algorithms.md).
     // 0.05: 0.1 half-demodulated dark texture (docs/decisions.md).
     float albedoFloor = 0.05f;  // [0, 1]
-    // The learned methods' network (learned, blend, auto), loaded once by the caller
-    // (LearnedWeights::load or ::builtin, include/atrous/learned.h) and shared between calls: a
-    // sequence or a batch reads its weight file once. When it holds none, learnedWeights below.
+    // The learned methods' network (learned, blend, auto): a resource loaded once by the caller
+    // (LearnedWeights::load for a weight file, version 4 or 3; docs/learned.md) and shared between
+    // calls, so a sequence or a batch reads its file once. Empty = the built-in weights.
     LearnedWeights weights;
-    // A weight file (version 4, or 3; docs/learned.md) that denoise() loads on each call when
-    // `weights` holds none; empty = the built-in weights. A bad file is an InputError naming it,
-    // before any work.
-    std::string learnedWeights;
-    DenoiseReport* report = nullptr;  // optional: filled with what the run did
 };
 
 // What a denoise() call did, for the CLI and for measurements.
@@ -176,6 +159,15 @@ struct DenoiseReport {
 // InputError for mismatched sizes, missing colour, negative variance or parameters out of range.
 Image denoise(const DenoiseInputs& inputs, const DenoiseOptions& options);
 
+// The same, with what the run did (the CLI's line, the benchmarks' stage times). The image is bit
+// for bit denoise()'s; on CUDA the stages are timed with events on the stream, which the plain call
+// does not record.
+struct DenoiseResult {
+    Image image;
+    DenoiseReport report;
+};
+DenoiseResult denoiseWithReport(const DenoiseInputs& inputs, const DenoiseOptions& options);
+
 // The inputs of a denoise() call whose caller hands its colour, variance and emission images over
 // to the filter, as a one-shot caller does that read them from files only to denoise them (the
 // CLI). On the CPU the filter then works in their storage instead of copying them (c_0 and its
@@ -192,10 +184,11 @@ struct DenoiseBuffers {
     const Image* albedo = nullptr;
     const Image* normal = nullptr;
     const Image* position = nullptr;
-    const Image* depth = nullptr;     // 1 channel or more
-    const Image* ids = nullptr;       // 2 channels or more
+    const Image* depth = nullptr;
+    const Image* ids = nullptr;
 };
 Image denoise(DenoiseBuffers& buffers, const DenoiseOptions& options);
+DenoiseResult denoiseWithReport(DenoiseBuffers& buffers, const DenoiseOptions& options);
 
 // The planes every still method is prepared with, as host images: what denoise() does before any
 // filter (validation, noise estimate, sanitise, the emission split and filter, fireflies,
@@ -208,10 +201,15 @@ struct PreparedPlanes {
 };
 PreparedPlanes learnedPlanes(const DenoiseInputs& inputs, const DenoiseOptions& options);
 
-// denoise() with method Sure on the CPU, and SURE's kept fraction s_i(p) of each level's detail in
-// `fractions` (one channel per level; levels below sure.firstLevel are 0): the viewer's debug view.
+// denoiseWithReport() with method Sure on the CPU, and SURE's kept fraction s_i(p) of each level's
+// detail (one channel per level; levels below sure.firstLevel are 0): the viewer's debug view.
 // InputError for another method or device.
-Image denoiseWithSureFractions(const DenoiseInputs& inputs, const DenoiseOptions& options, Image& fractions);
+struct SureFractionsResult {
+    Image image;
+    Image fractions;
+    DenoiseReport report;
+};
+SureFractionsResult denoiseWithSureFractions(const DenoiseInputs& inputs, const DenoiseOptions& options);
 
 // Throws ParamError (atrous/params.h: an InputError naming the field, `sigma_normal`) when a
 // parameter is out of range; the ranges are the rows of denoiseParams().
@@ -249,7 +247,7 @@ struct DenoiseMethodInfo {
     DenoiseMethod method;
     const char* name;     // "eaw", ...: the CLI's --method, Python's method=, the report's column
     const char* summary;  // one line for --help
-    bool usesWeights;     // reads the learned filter's weights (DenoiseOptions::learnedWeights)
+    bool usesWeights;     // reads the learned filter's weights (DenoiseOptions::weights)
     // A registered method's cascade on the CPU and on CUDA (empty: not on that device); empty
     // for the built-in methods.
     StillCascade cpu = {}, cuda = {};

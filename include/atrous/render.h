@@ -37,21 +37,10 @@ struct RenderSettings {
     std::atomic<uint64_t>* samplesDone = nullptr;
 };
 
-// All buffers are 3-channel planar host images of width x height (docs/rendering.md, "The buffers"):
-//   color     mean radiance of the pixel's samples, linear HDR (W sr^-1 m^-2 per channel)
-//   variance  variance of that mean, per channel: (E[y^2] - E[y]^2) / (n - 1); 0 at spp = 1
-//   albedo    directional reflectance in [0,1] of the first non-delta surface (delta-bounce
-//             throughput multiplied in); background: environment radiance clamped to [0,1]
-//   normal    world-space unit shading normal of that surface; 0 for background
-//   position  world-space point of that surface; 0 for background
-//   depth     distance of the primary hit along the camera's forward axis, repeated in R,G,B;
-//             1e30 for background
-//   ids       R = mesh id, G = material id, B = 0; -1 for background
-//   motion    (animation frames only, renderFrame) R = dx, G = dy in pixels, B = 0: the primary
-//             hit's image position in the previous frame minus its position now (mean over the
-//             samples); background from the camera rotation alone; empty for render()
-//   emission  emitted radiance of the primary hit towards the camera (front faces of emitters),
-//             0 elsewhere and for background
+// The renderer's buffers: 3-channel planar host images of width x height, each with the meaning
+// and conventions of atrous/buffers.h (depth repeated in R, G, B; ids R = mesh id, G = material
+// id, B = 0). motion: animation frames only (renderFrame), the mean over the pixel's samples,
+// background from the camera rotation alone; empty for render(). io::refsOf gives their Frame.
 struct RenderBuffers {
     Image color, variance, albedo, normal, position, depth, ids;
     Image motion, emission;

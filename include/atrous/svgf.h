@@ -4,6 +4,7 @@
 #pragma once
 #include <memory>
 
+#include "atrous/buffers.h"
 #include "atrous/device.h"
 #include "atrous/image.h"
 #include "atrous/learned.h"
@@ -70,25 +71,15 @@ struct SvgfParams {
 // parameter is out of range.
 void validateSvgfParams(const SvgfParams& p);
 
-// One frame's buffers, each a planar Image of the colour's size on the host or on the denoiser's
-// device. Only `color` is required; a missing buffer takes a neutral default (albedo 1, normal
-// +z, depth 1, id 0, motion 0, emission 0). Non-finite values anywhere are treated as missing for
-// that pixel (a non-finite colour is no sample; non-finite motion means "no history").
-struct SvgfFrame {
-    const Image* color = nullptr;     // 1 spp radiance, linear HDR, 3 channels
-    const Image* albedo = nullptr;    // 3 channels, [0, 1]; demodulation divides by max(albedo, 1e-3), fading to 1 below 0.1
-    const Image* normal = nullptr;    // world-space unit normal, 3 channels (0 = background)
-    const Image* depth = nullptr;     // view depth in channel 0 (>= 1e29 = background, e.g. 1e30)
-    const Image* ids = nullptr;       // mesh id in channel 0, -1 for background
-    const Image* motion = nullptr;    // channel 0 = dx, channel 1 = dy in pixels, previous - current
-    const Image* emission = nullptr;  // optional: emitted radiance at the primary hit, 3 channels
-    // Read by the offline sequence denoiser (atrous/temporal.h) only; SVGF estimates its own
-    // variance and has no use for positions.
-    const Image* variance = nullptr;  // variance of the colour's mean, per channel (1 or 3 channels)
-    const Image* position = nullptr;  // world-space hit points, 3 channels
-};
+// One frame's buffers (atrous/buffers.h: channels and conventions). SVGF reads color (1 spp),
+// albedo, normal, depth, ids (channel 0), motion and emission; it estimates its own variance and
+// has no use for positions. Only `color` is required; a missing buffer takes a neutral default
+// (albedo 1, normal +z, depth 1, id 0, motion 0, emission 0). Non-finite values anywhere are
+// treated as missing for that pixel (a non-finite colour is no sample; non-finite motion means
+// "no history"). Demodulation divides by max(albedo, 1e-3), fading to 1 below 0.1.
+using SvgfFrame = Frame;
 
-// What the last timed frame did: per-stage times (SvgfDenoiser::setReport).
+// What the last timed frame did: per-stage times (SvgfDenoiser::lastReport).
 struct SvgfReport {
     std::vector<StageTime> stages;  // demodulate, reproject, accumulate, variance, level i, learned, remodulate, taa
     double milliseconds = 0;        // sum of the stages (the frame's filter time, uploads excluded)
@@ -120,10 +111,12 @@ public:
     const Image& denoiseFrameOnDevice(const SvgfFrame& frame);
     // Forgets all history (next frame is treated as the first).
     void reset();
-    // Each later denoiseFrame* call fills *report with its per-stage times (null: stop timing).
-    // The report must outlive those calls. On CUDA the stages are timed with events on the
-    // stream, read after the frame's final synchronisation (no extra synchronisation).
-    void setReport(SvgfReport* report);
+    // Times the stages of each later denoiseFrame* call (off: no timing, the default). On CUDA the
+    // stages are timed with events on the stream, read after the frame's final synchronisation
+    // (no extra synchronisation).
+    void setTiming(bool on);
+    // The last timed frame's stage times (empty when timing is off or no frame ran yet).
+    SvgfReport lastReport() const;
 
     const SvgfParams& params() const { return mParams; }
     Device device() const { return mDevice; }

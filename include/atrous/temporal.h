@@ -102,8 +102,16 @@ struct TemporalReport {
 // gatherTemporal, then `spatial` (a still method's options: auto, eaw, ...) on the average, with
 // the centre frame's depth, ids and position. Returns the denoised frame on the host.
 Image denoiseTemporal(const std::vector<SvgfFrame>& window, size_t center, const TemporalParams& params,
-                      const DenoiseOptions& spatial, TemporalReport* report = nullptr, TemporalCache* cache = nullptr,
+                      const DenoiseOptions& spatial, TemporalCache* cache = nullptr,
                       const std::vector<long long>* ids = nullptr);
+// The same, with what it did (the image is bit for bit denoiseTemporal's).
+struct TemporalResult {
+    Image image;
+    TemporalReport report;
+};
+TemporalResult denoiseTemporalWithReport(const std::vector<SvgfFrame>& window, size_t center,
+                                         const TemporalParams& params, const DenoiseOptions& spatial,
+                                         TemporalCache* cache = nullptr, const std::vector<long long>* ids = nullptr);
 
 // Motion vectors for frames that have a Position pass but no vectors (LuxCore's POSITION): each
 // frame's pinhole camera fitted to its own pixels and world positions (src/filters/camera_fit.cpp),

@@ -224,7 +224,6 @@ class ViewPipeline {
     TemporalCache mTemporalCache[2];
     void runTemporal(int i, const PipelineSettings& s, SlotResult& r);
     SvgfParams mSvgfParams[2];
-    SvgfReport mSvgfReport[2];
     bool mSvgfResetPending = false;
     Image mDetail, mSureS;
     int mDetailLevelShown = -1;

@@ -33,6 +33,7 @@ from typing import Any, Dict, Iterator, Optional, Sequence, Union
 import numpy as np
 
 from . import _core
+from .vocabulary import Weights, _weights_arg, buffers, load_weights
 
 __all__ = [
     "denoise",
@@ -40,6 +41,8 @@ __all__ = [
     "render",
     "render_sequence",
     "metrics",
+    "relmse",
+    "temporal_metrics",
     "read_image",
     "read_buffers",
     "write_image",
@@ -60,6 +63,9 @@ __all__ = [
     "methods",
     "register_method",
     "load_plugin",
+    "Weights",
+    "load_weights",
+    "buffers",
 ]
 
 __version__ = "0.1.0"
@@ -264,25 +270,28 @@ def denoise(
     emission: Any = None,
     method: str = "auto",
     device: str = "auto",
-    learned_weights: Optional["PathLike"] = None,
+    learned_weights: Union["PathLike", "Weights", None] = None,
     **params: Any,
 ) -> Any:
     """Denoises a Monte Carlo rendering with EAW, SURE-based À-Trous or the learned à-trous filter.
 
-    color: H x W x 3 mean radiance (linear HDR). variance: the variance of that mean per channel
-    (not the sample variance); without it the noise is estimated from the image. albedo, normal
-    (world-space, unit), position (world-space), depth (view depth), ids (R mesh id, G material id,
-    -1 background): optional features; a missing one simply has no edge stop. emission: the
-    emitted radiance seen at the primary hit; the filter works on color - emission and adds it
-    back, so a visible light's edge is not smeared.
+    The buffers and their conventions are :func:`buffers`' (one table for the renderer, the
+    readers and every denoiser). color: H x W x 3 mean radiance (linear HDR). variance: the
+    variance of that mean per channel (not the sample variance); without it the noise is estimated
+    from the image. albedo, normal (world-space, unit), position (world-space), depth (view depth,
+    channel 0), ids (object id, and the material id in a second channel when given; -1
+    background): optional features; a missing one simply has no edge stop. emission: the emitted
+    radiance seen at the primary hit; the filter works on color - emission and adds it back, so a
+    visible light's edge is not smeared.
 
     method: "eaw", "sure", "learned" (the learned à-trous filter, docs/learned.md: it uses the
     firefly, emission, albedo and safety-net parameters, not levels, the sigma's or SURE's) or
     "blend" (the mean of the learned and the SURE outputs, from one preparation) or "auto" (the
     default: blend when an albedo and a normal are given, else sure: the method measured best for
-    those buffers, docs/quality.md). learned_weights: a weight
-    file (version 4, or 3) for "learned"/"blend"/"auto"; None = the built-in weights; a bad file raises
-    ValueError naming it. device: "auto" (the arrays' device: CUDA arrays on the GPU, numpy on
+    those buffers, docs/quality.md). learned_weights: the network of "learned"/"blend"/"auto":
+    a Weights from :func:`load_weights` (read once, shared by calls), a weight file's path (version
+    4, or 3; read by this call) or None (the built-in weights); a bad file raises ValueError naming
+    it. device: "auto" (the arrays' device: CUDA arrays on the GPU, numpy on
     the CPU), "cpu" or "cuda" (numpy inputs are then copied to the GPU and back).
 
     params: the filter parameters, the rows of :func:`denoise_params` (the CLI's flags with '_'
@@ -297,7 +306,7 @@ def denoise(
         raise ValueError(f"unknown method '{method}' (expected one of {', '.join(known)})")
     if device not in ("auto", "cpu", "cuda"):
         raise ValueError(f"unknown device '{device}' (expected auto, cpu or cuda)")
-    weights = "" if learned_weights is None else os.fsdecode(os.fspath(learned_weights))
+    weights = _weights_arg(learned_weights)
     c = _prepare(color, "color", allow_gray=False)
     bufs = {
         name: _prepare(val, name, channels=(2, 3) if name == "ids" else (3,))
@@ -397,16 +406,6 @@ def render_sequence(scene: str, frames: int, *, camera_path: str = "auto", spp: 
         yield dict(_core.render_frame(str(scene), f, int(frames), str(camera_path), rs))
 
 
-def metrics(image: Any, reference: Any) -> Dict[str, float]:
-    """MSE, relMSE, PSNR (tonemapped) and SSIM of `image` against `reference` (docs/eval.md, "What is measured").
-
-    NaN/Inf pixels count as 0 in the figures; their numbers are returned as ``non_finite_pixels``
-    (in `image`) and ``reference_non_finite_pixels``, so a broken image cannot pass for a good one.
-    """
-    return dict(_core.metrics(_prepare(image, "image", allow_gray=False),
-                              _prepare(reference, "reference", allow_gray=False)))
-
-
 PathLike = Union[str, "os.PathLike[str]"]
 
 
@@ -462,7 +461,7 @@ _FRAME_KEYS = ("color", "albedo", "normal", "position", "depth", "variance", "id
 
 
 def denoise_temporal(frames: Sequence[Dict[str, Any]], center: int, *, method: str = "auto",
-                     device: str = "auto", learned_weights: Optional["PathLike"] = None,
+                     device: str = "auto", learned_weights: Union["PathLike", "Weights", None] = None,
                      temporal: Optional[Dict[str, Any]] = None, **params: Any) -> Any:
     """Denoises frames[center] of an animation with the frames around it (docs/temporal.md): the
     offline sequence denoiser that `atrous denoise --sequence` runs by default.
@@ -490,13 +489,13 @@ def denoise_temporal(frames: Sequence[Dict[str, Any]], center: int, *, method: s
                             for k, v in f.items() if v is not None and k != "time"})
     if isinstance(center, bool) or not isinstance(center, (int, np.integer)) or not 0 <= int(center) < len(frames):
         raise ValueError(f"center must be a frame index in 0..{len(frames) - 1}, got {center!r}")
-    weights = "" if learned_weights is None else os.fsdecode(os.fspath(learned_weights))
+    weights = _weights_arg(learned_weights)
     out = _core.denoise_temporal(core_frames, int(center), method, weights, device, dict(temporal or {}), dict(params))
     return _wrap_like(out, frames[int(center)]["color"])
 
 
 def denoise_sequence(input: "PathLike", out: "PathLike", *, method: str = "temporal", spatial: str = "auto",
-                     device: str = "auto", learned_weights: Optional["PathLike"] = None,
+                     device: str = "auto", learned_weights: Union["PathLike", "Weights", None] = None,
                      passes: Optional[Dict[str, str]] = None, layer: str = "", add_pass: str = "",
                      start: Optional[int] = None, end: Optional[int] = None, step: int = 1,
                      exposure: float = 1.0, pngs: bool = True, preview: bool = True,
@@ -521,7 +520,7 @@ def denoise_sequence(input: "PathLike", out: "PathLike", *, method: str = "tempo
     wall_ms_per_frame, preview (the video's path, or None) and notes.
     Raises ValueError for bad input (nothing is written then)."""
     pass_specs = [f"{k}={v}" for k, v in (passes or {}).items()]
-    weights = "" if learned_weights is None else os.fsdecode(os.fspath(learned_weights))
+    weights = _weights_arg(learned_weights)
     return _core.denoise_sequence(os.fsdecode(os.fspath(input)), os.fsdecode(os.fspath(out)), method, spatial,
                                   device, weights, pass_specs, layer, add_pass,
                                   -1 if start is None else int(start), -1 if end is None else int(end), int(step),
@@ -537,13 +536,14 @@ class Svgf:
 {params}
     """
 
-    def __init__(self, device: str = "auto", *, learned_weights: Optional["PathLike"] = None,
+    def __init__(self, device: str = "auto", *, learned_weights: Union["PathLike", "Weights", None] = None,
                  **params: Any) -> None:
         """device: "auto" (CUDA when this build has a usable GPU, else the CPU, as everywhere in
         atrous), "cpu" or "cuda". Frames on another device than the filter's are copied over.
-        learned_weights: a weight file (version 4, or 3) for learned_spatial=True; None = the built-in
-        weights; a bad file raises ValueError naming it; unused without learned_spatial."""
-        weights = "" if learned_weights is None else os.fsdecode(os.fspath(learned_weights))
+        learned_weights: for learned_spatial=True, a Weights (:func:`load_weights`) or a weight
+        file (version 4, or 3); None = the built-in weights; a bad file raises ValueError naming it;
+        unused without learned_spatial."""
+        weights = _weights_arg(learned_weights)
         self._impl = _core.Svgf(device, weights, dict(params))
 
     def denoise_frame(self, color: Any, *, albedo: Any = None, normal: Any = None, depth: Any = None,
@@ -580,3 +580,7 @@ if Svgf.__doc__:
     Svgf.__doc__ = Svgf.__doc__.replace("{params}", _list_params(svgf_params()))
 if render.__doc__:
     render.__doc__ = render.__doc__.replace("{params}", _list_params(render_params()))
+
+
+# The metrics (measure.py) use _prepare above.
+from .measure import metrics, relmse, temporal_metrics  # noqa: E402

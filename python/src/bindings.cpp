@@ -27,66 +27,27 @@
 #include "atrous/temporal.h"
 #include "atrous/io/buffer_set.h"
 #include "atrous/io/image_io.h"
+#include "arrays.h"
 
 namespace nb = nanobind;
 using namespace atrous;
 
 namespace atrous::python {
 void bindMethods(nb::module_& m);  // methods.cpp: register_method
+void bindMetrics(nb::module_& m);  // metrics.cpp: metrics, temporal_metrics
+void bindVocabulary(nb::module_& m);  // vocabulary.cpp: buffers, Weights, load_weights
+LearnedWeights weightsFrom(nb::handle h);  // vocabulary.cpp: None, "", a path or a Weights
 }
 
 namespace {
 
-using Array = nb::ndarray<nb::ro>;  // any dtype, shape, strides and device: checked below
-
-Device deviceOf(const Array& a, const char* what) {
-    if (a.device_type() == nb::device::cpu::value) return Device::Cpu;
-    if (a.device_type() == nb::device::cuda::value) {
-        if (!cudaAvailable())
-            throw InputError(std::string(what) + ": a CUDA array was given but this build of atrous has no usable CUDA backend");
-        return Device::Cuda;
-    }
-    throw InputError(std::string(what) + ": arrays must live on the CPU or a CUDA device");
-}
-
-// Copies a H x W x C (or H x W) float32 array into a planar Image on the array's device.
-Image toImage(const Array& a, const char* what, int channels = 3) {
-    if (a.dtype() != nb::dtype<float>())
-        throw InputError(std::string(what) + ": expected float32 data");
-    if (a.ndim() != 2 && a.ndim() != 3)
-        throw InputError(std::string(what) + ": expected an array of shape (H, W, 3), got " + std::to_string(a.ndim()) + " dimensions");
-    StridedArray s;
-    s.data = static_cast<const float*>(a.data());
-    s.height = int(a.shape(0));
-    s.width = int(a.shape(1));
-    s.channels = a.ndim() == 3 ? int(a.shape(2)) : 1;
-    s.strideY = a.stride(0);
-    s.strideX = a.stride(1);
-    s.strideC = a.ndim() == 3 ? a.stride(2) : 0;
-    s.device = deviceOf(a, what);
-    if (a.shape(0) == 0 || a.shape(1) == 0) throw InputError(std::string(what) + ": empty array");
-    return imageFromStrided(s, channels, what);
-}
-
-// Hands an Image to Python as a C-contiguous H x W x C float32 array on the image's device.
-nb::object fromImage(Image&& img) {
-    const Device dev = img.device();
-    // Holds H x W x C floats, every one written by imageToInterleaved: no zero fill first.
-    Image* inter = new Image(Image::uninitialized(img.width(), img.height(), img.channels(), dev));
-    imageToInterleaved(img, inter->data());
-    nb::capsule owner(inter, [](void* p) noexcept { delete static_cast<Image*>(p); });
-    const size_t shape[3] = {size_t(img.height()), size_t(img.width()), size_t(img.channels())};
-    const int devType = dev == Device::Cuda ? nb::device::cuda::value : nb::device::cpu::value;
-    if (dev == Device::Cpu) {
-        nb::ndarray<nb::numpy, float> arr(inter->data(), 3, shape, owner);
-        return arr.cast();
-    }
-    nb::ndarray<float> arr(inter->data(), 3, shape, owner, nullptr, nb::dtype<float>(), devType, 0);
-    return arr.cast();
-}
+using python::Array;
+using python::fromImage;
+using python::toImage;
+using python::weightsFrom;
 
 // The arrays of one denoise call as images, put into the library's one input assembly
-// (io::BufferRefs -> denoiseInputs / svgfFrame), as the CLI and the viewer do.
+// (io::BufferRefs, the Frame every denoiser takes), as the CLI and the viewer do.
 struct Buffers {
     std::vector<std::unique_ptr<Image>> owned;
     const Image& color;
@@ -237,7 +198,7 @@ nb::list paramRows(const ParamTable<S>& t) {
 
 nb::object pyDenoise(const Array& color, nb::handle albedo, nb::handle normal, nb::handle position, nb::handle depth,
                      nb::handle variance, nb::handle ids, nb::handle emission, const std::string& method,
-                     const std::string& learnedWeights, nb::dict params) {
+                     nb::handle learnedWeights, nb::dict params) {
     using B = io::Buffer;
     Image c = toImage(color, "color");
     Buffers b(c);
@@ -246,7 +207,7 @@ nb::object pyDenoise(const Array& color, nb::handle albedo, nb::handle normal, n
            {emission, B::Emission, "emission"}});
     DenoiseOptions o;
     o.method = parseDenoiseMethod(method);
-    o.learnedWeights = learnedWeights;  // "" = the built-in weights
+    if (denoiseMethodInfo(o.method).usesWeights || o.method == DenoiseMethod::Auto) o.weights = weightsFrom(learnedWeights);
     o.device = c.device();
     for (auto [k, v] : params) applyParam(o, denoiseParams(), nb::cast<std::string>(k), v, "denoise");
     // The colour, variance and emission are the binding's own copies (toImage): handed over, the
@@ -271,7 +232,7 @@ nb::dict pyLearnedPlanes(const Array& color, nb::handle variance, nb::handle alb
     Buffers b(c);
     b.add({{albedo, B::Albedo, "albedo"}, {normal, B::Normal, "normal"}, {depth, B::Depth, "depth"},
            {variance, B::Variance, "variance"}, {emission, B::Emission, "emission"}});
-    const DenoiseInputs in = io::denoiseInputs(b.refs);
+    const DenoiseInputs in = b.refs;
     DenoiseOptions o;
     for (auto [k, v] : params) applyParam(o, denoiseParams(), nb::cast<std::string>(k), v, "denoise");
     PreparedPlanes p;
@@ -290,12 +251,10 @@ nb::dict pyLearnedPlanes(const Array& color, nb::handle variance, nb::handle alb
 
 class PySvgf {
 public:
-    // learnedWeights: a weight file for learned_spatial ("" = the built-in weights).
-    PySvgf(const std::string& device, const std::string& learnedWeights, nb::dict params) {
+    PySvgf(const std::string& device, nb::handle learnedWeights, nb::dict params) {
         SvgfParams p;
         for (auto [k, v] : params) applyParam(p, svgfParams(), nb::cast<std::string>(k), v, "SVGF");
-        const LearnedWeights w = p.learnedSpatial && !learnedWeights.empty() ? LearnedWeights::load(learnedWeights)
-                                                                             : LearnedWeights{};
+        const LearnedWeights w = p.learnedSpatial ? weightsFrom(learnedWeights) : LearnedWeights{};
         mDenoiser = std::make_unique<SvgfDenoiser>(p, parseDevice(device), w);
     }
     nb::object denoiseFrame(const Array& color, nb::handle albedo, nb::handle normal, nb::handle depth, nb::handle ids,
@@ -305,7 +264,7 @@ public:
         Buffers b(c);
         b.add({{albedo, B::Albedo, "albedo"}, {normal, B::Normal, "normal"}, {depth, B::Depth, "depth"},
                {ids, B::ObjectId, "ids"}, {motion, B::Motion, "motion"}, {emission, B::Emission, "emission"}});
-        const SvgfFrame f = io::svgfFrame(b.refs);
+        const SvgfFrame f = b.refs;
         Image out;
         {
             nb::gil_scoped_release release;
@@ -327,7 +286,7 @@ private:
 // The offline sequence denoiser (include/atrous/temporal.h) on a window of frames, each a dict of
 // host arrays (color required; albedo, normal, position, depth, variance, ids, emission, motion).
 nb::object pyDenoiseTemporal(nb::list frames, size_t center, const std::string& method,
-                             const std::string& learnedWeights, const std::string& device, nb::dict temporal,
+                             nb::handle learnedWeights, const std::string& device, nb::dict temporal,
                              nb::dict params) {
     using B = io::Buffer;
     static const std::pair<const char*, B> kKeys[] = {
@@ -371,12 +330,12 @@ nb::object pyDenoiseTemporal(nb::list frames, size_t center, const std::string& 
         for (size_t i = 0; i < buffers.size(); ++i) buffers[i]->refs.set(B::Motion, &fitted[i]);
     }
     std::vector<SvgfFrame> window;
-    for (const auto& b : buffers) window.push_back(io::svgfFrame(b->refs));
+    for (const auto& b : buffers) window.push_back(b->refs);
     TemporalParams tp;
     for (auto [k, v] : temporal) applyParam(tp, temporalParams(), nb::cast<std::string>(k), v, "temporal");
     DenoiseOptions o;
     o.method = parseDenoiseMethod(method);
-    o.learnedWeights = learnedWeights;
+    if (denoiseMethodInfo(o.method).usesWeights || o.method == DenoiseMethod::Auto) o.weights = weightsFrom(learnedWeights);
     o.device = parseDevice(device);
     for (auto [k, v] : params) applyParam(o, denoiseParams(), nb::cast<std::string>(k), v, "denoise");
     Image out;
@@ -390,7 +349,7 @@ nb::object pyDenoiseTemporal(nb::list frames, size_t center, const std::string& 
 // A sequence from its files to files (include/atrous/sequence.h): the session `atrous denoise
 // --sequence` runs. on_frame (or None) is called with each frame's dict as it is done.
 nb::dict pyDenoiseSequence(const std::string& input, const std::string& out, const std::string& method,
-                           const std::string& spatial, const std::string& device, const std::string& learnedWeights,
+                           const std::string& spatial, const std::string& device, nb::handle learnedWeights,
                            const std::vector<std::string>& passes, const std::string& layer, const std::string& addPass,
                            int start, int end, int step, float exposure, bool pngs, bool preview, nb::dict temporal,
                            nb::dict svgf, nb::dict params, nb::object onFrame) {
@@ -400,9 +359,11 @@ nb::dict pyDenoiseSequence(const std::string& input, const std::string& out, con
     for (auto [k, v] : temporal) applyParam(o.temporal, temporalParams(), nb::cast<std::string>(k), v, "temporal");
     for (auto [k, v] : svgf) applyParam(o.svgf, svgfParams(), nb::cast<std::string>(k), v, "SVGF");
     o.frame.method = parseDenoiseMethod(spatial);
-    o.frame.learnedWeights = learnedWeights;
     for (auto [k, v] : params) applyParam(o.frame, denoiseParams(), nb::cast<std::string>(k), v, "denoise");
-    if (o.svgf.learnedSpatial && !learnedWeights.empty()) o.svgfWeights = LearnedWeights::load(learnedWeights);
+    // Read once for the whole sequence, when a method of the run uses it.
+    const DenoiseMethodInfo* still = findDenoiseMethod(method == "temporal" ? spatial : method);
+    if (method == "svgf" ? o.svgf.learnedSpatial : still && (still->usesWeights || still->method == DenoiseMethod::Auto))
+        o.frame.weights = o.svgfWeights = weightsFrom(learnedWeights);
     o.passes = passes, o.viewLayer = layer, o.addPass = addPass;
     o.start = start, o.end = end, o.step = step;
     o.exposure = exposure, o.pngs = pngs, o.preview = preview;
@@ -499,21 +460,6 @@ nb::dict pyRenderFrame(const std::string& scene, int frame, int frames, const st
     return d;
 }
 
-nb::dict pyMetrics(const Array& image, const Array& reference) {
-    Image a = toImage(image, "image"), r = toImage(reference, "reference");
-    if (a.device() != Device::Cpu) a = a.to(Device::Cpu);
-    if (r.device() != Device::Cpu) r = r.to(Device::Cpu);
-    ImageMetrics m = computeMetrics(a, r);
-    nb::dict d;
-    d["mse"] = m.mse;
-    d["relmse"] = m.relMse;
-    d["psnr"] = m.psnr;
-    d["ssim"] = m.ssim;
-    d["non_finite_pixels"] = m.nonFinitePixels;
-    d["reference_non_finite_pixels"] = m.referenceNonFinitePixels;
-    return d;
-}
-
 // Image files go through the library's readers and writers (OpenEXR, PFM, stb), so Python reads
 // exactly what the CLI writes and the other way round; errors name the file (InputError).
 nb::object pyReadImage(const std::string& path) {
@@ -540,11 +486,12 @@ void pyWriteImage(const std::string& path, const Array& image) {
 
 // Library errors name the field (`max_depth`, `device`, `camera_path`: ParamError) or the file,
 // never a CLI flag, so Python shows them as they are: the field is the keyword.
-
 }  // namespace
 
 NB_MODULE(_core, m) {
     atrous::python::bindMethods(m);
+    atrous::python::bindMetrics(m);
+    atrous::python::bindVocabulary(m);
     m.doc() = "atrous native core (use the `atrous` package, not this module)";
     nb::register_exception_translator([](const std::exception_ptr& p, void*) {
         try {
@@ -557,19 +504,17 @@ NB_MODULE(_core, m) {
     });
     m.def("denoise", &pyDenoise, nb::arg("color"), nb::arg("albedo").none(), nb::arg("normal").none(),
           nb::arg("position").none(), nb::arg("depth").none(), nb::arg("variance").none(), nb::arg("ids").none(),
-          nb::arg("emission").none(), nb::arg("method"), nb::arg("learned_weights"), nb::arg("params"));
+          nb::arg("emission").none(), nb::arg("method"), nb::arg("learned_weights").none(), nb::arg("params"));
     m.def("learned_planes", &pyLearnedPlanes, nb::arg("color"), nb::arg("variance").none(), nb::arg("albedo").none(),
           nb::arg("normal").none(), nb::arg("depth").none(), nb::arg("emission").none(), nb::arg("params"));
     m.def("render", &pyRender, nb::arg("scene"), nb::arg("params"));
     m.def("render_frame", &pyRenderFrame, nb::arg("scene"), nb::arg("frame"), nb::arg("frames"), nb::arg("camera_path"),
           nb::arg("params"));
-    m.def("metrics", &pyMetrics, nb::arg("image"), nb::arg("reference"));
     m.def("read_image", &pyReadImage, nb::arg("path"));
     m.def("read_buffers", &pyReadBuffers, nb::arg("path"), nb::arg("passes"), nb::arg("layer"));
     m.def("write_image", &pyWriteImage, nb::arg("path"), nb::arg("image"));
     m.def("denoise_params", [] { return paramRows(denoiseParams()); });
-    // The still methods (denoiseMethods(), include/atrous/denoise.h): atrous.METHODS and the rows of
-    // atrous.denoise_methods().
+    // The still methods (denoiseMethods()): atrous.METHODS and the rows of atrous.denoise_methods().
     m.def("denoise_methods",
           [] { return methodRows(denoiseMethods(), "uses_weights", &DenoiseMethodInfo::usesWeights); });
     m.def("svgf_params", [] { return paramRows(svgfParams()); });
@@ -577,9 +522,9 @@ NB_MODULE(_core, m) {
     // The sequence methods (sequenceMethods(), include/atrous/temporal.h): atrous.SEQUENCE_METHODS.
     m.def("sequence_methods", [] { return methodRows(sequenceMethods(), "causal", &SequenceMethodInfo::causal); });
     m.def("denoise_temporal", &pyDenoiseTemporal, nb::arg("frames"), nb::arg("center"), nb::arg("method"),
-          nb::arg("learned_weights"), nb::arg("device"), nb::arg("temporal"), nb::arg("params"));
+          nb::arg("learned_weights").none(), nb::arg("device"), nb::arg("temporal"), nb::arg("params"));
     m.def("denoise_sequence", &pyDenoiseSequence, nb::arg("input"), nb::arg("out"), nb::arg("method"), nb::arg("spatial"),
-          nb::arg("device"), nb::arg("learned_weights"), nb::arg("passes"), nb::arg("layer"), nb::arg("add_pass"),
+          nb::arg("device"), nb::arg("learned_weights").none(), nb::arg("passes"), nb::arg("layer"), nb::arg("add_pass"),
           nb::arg("start"), nb::arg("end"), nb::arg("step"), nb::arg("exposure"), nb::arg("pngs"), nb::arg("preview"),
           nb::arg("temporal"), nb::arg("svgf"), nb::arg("params"), nb::arg("on_frame").none());
     m.def("render_params", [] { return paramRows(renderParams()); });
@@ -590,7 +535,7 @@ NB_MODULE(_core, m) {
     m.def("cuda_compiled", &cudaCompiled);
     m.def("device_name", [](const std::string& d) { return deviceName(parseDevice(d)); });
     nb::class_<PySvgf>(m, "Svgf")
-        .def(nb::init<const std::string&, const std::string&, nb::dict>(), nb::arg("device"), nb::arg("learned_weights"),
+        .def(nb::init<const std::string&, nb::handle, nb::dict>(), nb::arg("device"), nb::arg("learned_weights").none(),
              nb::arg("params"))
         .def("denoise_frame", &PySvgf::denoiseFrame, nb::arg("color"), nb::arg("albedo").none(), nb::arg("normal").none(),
              nb::arg("depth").none(), nb::arg("ids").none(), nb::arg("motion").none(), nb::arg("emission").none())

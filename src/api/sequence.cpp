@@ -138,12 +138,8 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
         if (!temporal) options.method = parseDenoiseMethod(args.method);
         options.device = args.device;
         validateDenoiseOptions(options);
-        // A weight file is read once for the whole sequence (not by each frame's denoise()).
-        if (!options.weights.impl && !options.learnedWeights.empty() && denoiseMethodInfo(options.method).usesWeights)
-            options.weights = LearnedWeights::load(options.learnedWeights);
     }
     DenoiseReport frameReport;
-    options.report = &frameReport;
     io::StagedDir staged("--out", outDir);
     const std::string stage = staged.stage();
 
@@ -185,21 +181,23 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
         r.mseInput = r.hasReference ? meanSquaredError(f.color, f.reference) : 0.0;
         try {
             if (svgf) {
-                out = svgfDenoiser->denoiseFrame(io::svgfFrame(refsOf(f)));
+                out = svgfDenoiser->denoiseFrame(refsOf(f));
             } else if (temporal) {
-                std::vector<io::BufferRefs> refs;
-                std::vector<SvgfFrame> frameSet;
-                for (const io::SequenceFrame& w : window) refs.push_back(refsOf(w));
-                for (const io::BufferRefs& b : refs) frameSet.push_back(io::svgfFrame(b));
+                std::vector<Frame> frameSet;
+                for (const io::SequenceFrame& w : window) frameSet.push_back(refsOf(w));
                 std::vector<long long> ids;
                 for (size_t j = 0; j < window.size(); ++j) ids.push_back((long long)(winFirst + j));
-                out = denoiseTemporal(frameSet, i - winFirst, args.temporal, options, &temporalReport, &temporalCache,
-                                      &ids);
-                frameReport.methodUsed = temporalReport.spatial.methodUsed;
+                TemporalResult tr =
+                    denoiseTemporalWithReport(frameSet, i - winFirst, args.temporal, options, &temporalCache, &ids);
+                out = std::move(tr.image);
+                temporalReport = std::move(tr.report);
+                frameReport = temporalReport.spatial;
             } else {
                 // The frame's colour, variance and emission are not read after this: handed over.
                 DenoiseBuffers bufs = io::handOver(refsOf(f), f.color, &f.variance, &f.emission);
-                out = denoise(bufs, options);
+                DenoiseResult dr = denoiseWithReport(bufs, options);
+                out = std::move(dr.image);
+                frameReport = std::move(dr.report);
             }
         } catch (const InputError& e) {
             // The library names the buffer; the message names the frame's file too.
@@ -290,7 +288,7 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
             // Each frame is checked as it arrives, so a bad value is named by its own file (the
             // window's checks would name the frame being denoised).
             try {
-                checkTemporalFrame(io::svgfFrame(refsOf(f)));
+                checkTemporalFrame(refsOf(f));
             } catch (const InputError& e) {
                 throw InputError(io::withSourceFile(e.what(), [&](const std::string& b) { return f.fileOf(b); }, f.dir));
             }

@@ -292,14 +292,13 @@ DenoiseInputs ViewPipeline::accumulatedInputs() const {
     // Emission: the filters work on colour - emission and add back its edge-filtered mean, so a
     // visible light neither bleeds into the ceiling nor keeps its coverage noise (docs/denoising.md).
     if (mEmissionValid) r.set(io::Buffer::Emission, &mEmissionMean);
-    return io::denoiseInputs(r);
+    return r;
 }
 
 DenoiseOptions ViewPipeline::denoiseOptions(Method m, const PipelineSettings& s) const {
     DenoiseOptions o = s.denoise;
     o.method = m.kind == Method::Kind::Still ? m.still : DenoiseMethod::Eaw;
     o.device = mDevice;
-    o.report = nullptr;
     return o;
 }
 
@@ -363,7 +362,7 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
             if (!mSvgf[i] || !sameParams(mSvgfParams[i], s.svgf, svgfParams())) {
                 mSvgf[i] = std::make_unique<SvgfDenoiser>(s.svgf, mDevice);  // validates
                 mSvgfParams[i] = s.svgf;
-                mSvgf[i]->setReport(&mSvgfReport[i]);
+                mSvgf[i]->setTiming(true);
             }
             if (mSvgfResetPending || (mCameraMoved && !s.svgfMotionVectors)) mSvgf[i]->reset();
             // SVGF does its own temporal accumulation, so it takes this frame's samples, not the
@@ -372,14 +371,14 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
             const RenderBuffers& fr = frame();
             io::BufferRefs refs = io::refsOf(fr);
             refs.set(io::Buffer::Motion, &mMotion).set(io::Buffer::Emission, &mEmission);
-            const SvgfFrame f = io::svgfFrame(refs);
+            const SvgfFrame f = refs;
             Timer t;
             if (onDevice)
                 r.deviceImage = mSvgf[i]->denoiseFrameOnDevice(f).clone();  // valid until next frame
             else
                 r.image = mSvgf[i]->denoiseFrame(f);
             r.filterMs = t.ms();
-            r.stages = mSvgfReport[i].stages;
+            r.stages = mSvgf[i]->lastReport().stages;
         } catch (const InputError& e) {
             mSvgf[i].reset();
             r.error = e.what();
@@ -393,25 +392,26 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
     }
     DenoiseInputs in = accumulatedInputs();
     DenoiseOptions o = denoiseOptions(m, s);
-    DenoiseReport rep;
-    o.report = &rep;
     Timer t;
     try {
         if (m == Method::of(DenoiseMethod::Sure) && s.sureFractions && mDevice == Device::Cpu) {
-            r.image = denoiseWithSureFractions(in, o, mSureS);
-        } else if (mDevice == Device::Cuda) {
-            // The inputs are the running means on the GPU: denoise() reads them in place and
-            // leaves its result there.
-            Image result = denoise(in, o);
-            if (onDevice)
-                r.deviceImage = std::move(result);
-            else
-                r.image = hostCopy(result);
+            SureFractionsResult result = denoiseWithSureFractions(in, o);
+            r.image = std::move(result.image);
+            mSureS = std::move(result.fractions);
+            r.stages = std::move(result.report.stages);
         } else {
-            r.image = denoise(in, o);
+            // On CUDA the inputs are the running means on the GPU: denoise() reads them in place
+            // and leaves its result there.
+            DenoiseResult result = denoiseWithReport(in, o);
+            r.stages = std::move(result.report.stages);
+            if (mDevice == Device::Cpu)
+                r.image = std::move(result.image);
+            else if (onDevice)
+                r.deviceImage = std::move(result.image);
+            else
+                r.image = hostCopy(result.image);
         }
         r.filterMs = t.ms();
-        r.stages = rep.stages;
     } catch (const InputError& e) {
         r.error = e.what();
         r.image = hostCopy(mColor);
@@ -442,15 +442,15 @@ void ViewPipeline::runTemporal(int i, const PipelineSettings& s, SlotResult& r) 
         std::vector<SvgfFrame> window;
         std::vector<long long> ids;
         for (const HistoryFrame& x : h) {
-            window.push_back(io::svgfFrame(io::refsOf(x.b)));
+            window.push_back(io::refsOf(x.b));
             ids.push_back(x.index);
         }
         DenoiseOptions o = denoiseOptions(Method::of(DenoiseMethod::Auto), s);
-        TemporalReport rep;
         Timer t;
-        r.image = denoiseTemporal(window, window.size() - 1, p, o, &rep, &mTemporalCache[i], &ids);
+        TemporalResult tr = denoiseTemporalWithReport(window, window.size() - 1, p, o, &mTemporalCache[i], &ids);
         r.filterMs = t.ms();
-        r.stages = rep.spatial.stages;
+        r.image = std::move(tr.image);
+        r.stages = std::move(tr.report.spatial.stages);
     } catch (const InputError& e) {
         h.clear();
         r.error = e.what();

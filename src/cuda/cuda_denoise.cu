@@ -136,7 +136,8 @@ void estimateNoiseSigmaCuda(const Image& color, const Image* albedo, float eps, 
     globalNoiseSigma(CudaExec{}, color.view(), a, eps, floor, sigma);
 }
 
-Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const PreparedInputs& prep, DenoiseReport& rep) {
+Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const PreparedInputs& prep, DenoiseReport& rep,
+                  bool timed) {
     const int w = in.color->width(), h = in.color->height();
     if (in.variance && in.variance->device() == Device::Cuda) checkDeviceVariance(*in.variance);
     // A device input is used in place (no copy); a host input is uploaded into its holder, which
@@ -175,7 +176,7 @@ Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const Prepar
     dout.afterFirefly = after.view();
     dout.fireflyFlag = flag.view();
     // Per-stage GPU times only when the caller asked for a report (events, read after the sync).
-    std::unique_ptr<StageClock> clock = o.report ? makeStageClock(Device::Cuda) : nullptr;
+    std::unique_ptr<StageClock> clock = timed ? makeStageClock(Device::Cuda) : nullptr;
     dout.clock = clock.get();
     Timer t;
     DriverConfig cfg{o};

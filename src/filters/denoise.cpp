@@ -217,7 +217,7 @@ PreparedInputs prepareInputsDropping(const DenoiseInputs& given, const DenoiseOp
     checkBuffer(in.normal, color, "normal");
     checkBuffer(in.position, color, "position");
     checkBuffer(in.depth, color, "depth", 1);  // channel 0 is read
-    checkBuffer(in.ids, color, "ids", 2);      // R mesh, G material
+    checkBuffer(in.ids, color, "ids", 1);      // object id, and the material id in channel 1 when given
     checkBuffer(in.emission, color, "emission");
     validateDenoiseOptions(o);
     PreparedInputs p;
@@ -436,10 +436,9 @@ void requireHostInputs(const DenoiseInputs& inputs) {
 }
 
 // denoise() with, optionally, the caller's images handed over (used on the CPU only).
+// timed: the CUDA path records its stages (denoiseWithReport; the CPU's clock costs nothing).
 Image denoiseWith(const DenoiseInputs& given, const DenoiseOptions& options, const filters::HandedOver* stores,
-                  filters::DriverDebug* debug = nullptr) {
-    DenoiseReport local;
-    DenoiseReport& rep = options.report ? *options.report : local;
+                  DenoiseReport& rep, bool timed, filters::DriverDebug* debug = nullptr) {
     DenoiseInputs inputs = given;
     DenoiseOptions o = options;
     o.method = resolveDenoiseMethod(options.method, inputs);
@@ -447,18 +446,23 @@ Image denoiseWith(const DenoiseInputs& given, const DenoiseOptions& options, con
     if (info.registered() && !(o.device == Device::Cuda ? info.cuda : info.cpu))
         throw InputError(std::string("method '") + info.name + "' has no cascade for " +
                          (o.device == Device::Cuda ? "CUDA" : "the CPU"));
-    // The weights before any work: a bad file is an InputError naming it, nothing computed.
     LearnedWeights weights;
-    if (info.usesWeights)
-        weights = o.weights.impl              ? o.weights
-                  : o.learnedWeights.empty() ? LearnedWeights::builtin()
-                                             : LearnedWeights::load(o.learnedWeights);
+    if (info.usesWeights) weights = o.weights.impl ? o.weights : LearnedWeights::builtin();
     filters::PreparedInputs prep = prepareCall(inputs, o, rep, true);
     prep.learned = weights;
+    // ids of one channel (the object id alone): the material id is then the same everywhere.
+    Image ids2;
+    if (inputs.ids && inputs.ids->channels() == 1) {
+        const Image host = inputs.ids->to(Device::Cpu);
+        ids2 = Image(host.width(), host.height(), 2);
+        std::copy(host.data(), host.data() + host.plane(), ids2.data());
+        if (inputs.ids->device() != Device::Cpu) ids2 = ids2.to(inputs.ids->device());
+        inputs.ids = &ids2;
+    }
     rep.methodUsed = o.method;
     if (o.device == Device::Cuda) {
         requireCuda();
-        return filters::denoiseCuda(inputs, o, prep, rep);
+        return filters::denoiseCuda(inputs, o, prep, rep, timed);
     }
     requireHostInputs(inputs);
     return filters::denoiseCpu(inputs, o, prep, rep, debug, stores);
@@ -466,30 +470,56 @@ Image denoiseWith(const DenoiseInputs& given, const DenoiseOptions& options, con
 
 }  // namespace
 
-Image denoise(const DenoiseInputs& given, const DenoiseOptions& options) { return denoiseWith(given, options, nullptr); }
-
-Image denoise(DenoiseBuffers& buffers, const DenoiseOptions& options) {
-    const DenoiseInputs in{buffers.color, buffers.variance, buffers.albedo, buffers.normal, buffers.position,
-                           buffers.depth, buffers.ids, buffers.emission};
-    filters::HandedOver stores;
-    stores.color = buffers.color, stores.variance = buffers.variance, stores.emission = buffers.emission;
-    return denoiseWith(in, options, &stores);
+Image denoise(const DenoiseInputs& given, const DenoiseOptions& options) {
+    DenoiseReport rep;
+    return denoiseWith(given, options, nullptr, rep, false);
 }
 
-Image denoiseWithSureFractions(const DenoiseInputs& inputs, const DenoiseOptions& options, Image& fractions) {
+DenoiseResult denoiseWithReport(const DenoiseInputs& given, const DenoiseOptions& options) {
+    DenoiseResult r;
+    r.image = denoiseWith(given, options, nullptr, r.report, true);
+    return r;
+}
+
+namespace {
+
+DenoiseInputs inputsOf(const DenoiseBuffers& buffers, filters::HandedOver& stores) {
+    stores.color = buffers.color, stores.variance = buffers.variance, stores.emission = buffers.emission;
+    return DenoiseInputs{buffers.color, buffers.variance, buffers.albedo, buffers.normal, buffers.position,
+                         buffers.depth, buffers.ids, buffers.emission};
+}
+
+}  // namespace
+
+Image denoise(DenoiseBuffers& buffers, const DenoiseOptions& options) {
+    filters::HandedOver stores;
+    const DenoiseInputs in = inputsOf(buffers, stores);
+    DenoiseReport rep;
+    return denoiseWith(in, options, &stores, rep, false);
+}
+
+DenoiseResult denoiseWithReport(DenoiseBuffers& buffers, const DenoiseOptions& options) {
+    filters::HandedOver stores;
+    const DenoiseInputs in = inputsOf(buffers, stores);
+    DenoiseResult r;
+    r.image = denoiseWith(in, options, &stores, r.report, true);
+    return r;
+}
+
+SureFractionsResult denoiseWithSureFractions(const DenoiseInputs& inputs, const DenoiseOptions& options) {
     if (options.method != DenoiseMethod::Sure || options.device != Device::Cpu)
         throw InputError("SURE's fractions: the method must be sure and the device the CPU");
     if (!inputs.color || inputs.color->empty()) throw InputError("missing color buffer");
     filters::DriverDebug dbg;
     dbg.sureS = Image(inputs.color->width(), inputs.color->height(), options.eaw.levels);
-    Image out = denoiseWith(inputs, options, nullptr, &dbg);
-    fractions = std::move(dbg.sureS);
-    return out;
+    SureFractionsResult r;
+    r.image = denoiseWith(inputs, options, nullptr, r.report, true, &dbg);
+    r.fractions = std::move(dbg.sureS);
+    return r;
 }
 
 PreparedPlanes learnedPlanes(const DenoiseInputs& given, const DenoiseOptions& options) {
-    DenoiseReport local;
-    DenoiseReport& rep = options.report ? *options.report : local;
+    DenoiseReport rep;
     DenoiseInputs in = given;
     const filters::PreparedInputs prep = prepareCall(in, options, rep);
     requireHostInputs(in);
@@ -518,7 +548,7 @@ PreparedPlanes learnedPlanes(const DenoiseInputs& given, const DenoiseOptions& o
 
 #if !defined(ATROUS_HAVE_CUDA)
 namespace atrous::filters {
-Image denoiseCuda(const DenoiseInputs&, const DenoiseOptions&, const PreparedInputs&, DenoiseReport&) {
+Image denoiseCuda(const DenoiseInputs&, const DenoiseOptions&, const PreparedInputs&, DenoiseReport&, bool) {
     noCudaBackend();
 }
 void estimateNoiseSigmaCuda(const Image&, const Image*, float, float, float[3]) {

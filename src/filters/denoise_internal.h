@@ -67,6 +67,8 @@ struct HandedOver {
 };
 Image denoiseCpu(const DenoiseInputs& in, const DenoiseOptions& o, const PreparedInputs& prep, DenoiseReport& rep,
                  DriverDebug* debug, const HandedOver* stores = nullptr);
-Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const PreparedInputs& prep, DenoiseReport& rep);
+// timed: per-stage GPU times into rep.stages (events on the stream; denoiseWithReport).
+Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const PreparedInputs& prep, DenoiseReport& rep,
+                  bool timed);
 
 }  // namespace atrous::filters

@@ -79,6 +79,8 @@ const Image& SvgfDenoiser::denoiseFrameOnDevice(const SvgfFrame& frame) { return
 
 void SvgfDenoiser::reset() { mImpl->reset(); }
 
-void SvgfDenoiser::setReport(SvgfReport* report) { mImpl->setReport(report); }
+void SvgfDenoiser::setTiming(bool on) { mImpl->setTiming(on); }
+
+SvgfReport SvgfDenoiser::lastReport() const { return mImpl->lastReport(); }
 
 }  // namespace atrous

@@ -30,7 +30,8 @@ public:
     virtual Image denoiseFrame(const SvgfFrame& frame) = 0;
     virtual const Image& denoiseFrameOnDevice(const SvgfFrame& frame) = 0;
     virtual void reset() = 0;
-    virtual void setReport(SvgfReport* report) = 0;
+    virtual void setTiming(bool on) = 0;
+    virtual SvgfReport lastReport() const = 0;
     virtual void setLearnedWeights(const LearnedWeights& weights) = 0;
 };
 
@@ -131,7 +132,7 @@ public:
                 views[i] = holders[i].view();
             }
         }
-        filters::StageClock* clock = mReport ? mClock.get() : nullptr;
+        filters::StageClock* clock = mTiming ? mClock.get() : nullptr;
         if (clock) clock->start();
         const ImageView color = views[0], albedo = views[1], normalIn = views[2], depthIn = views[3], idsIn = views[4],
                         motionIn = views[5], emission = views[6];
@@ -270,7 +271,7 @@ public:
         s.havePrevious = true;
         ++s.frames;
         mExec.synchronize();  // the holders die at the end of this scope
-        if (clock) mReport->milliseconds = clock->collect(mReport->stages);
+        if (clock) mReport.milliseconds = clock->collect(mReport.stages);
     }
 
     // run() and a copy of the result on the host.
@@ -280,11 +281,13 @@ public:
     }
 
     SvgfState& state() { return mState; }
-    // Per-stage timings of each later run() go to *report (null: no timing).
-    void setReport(SvgfReport* report) {
-        mReport = report;
-        if (report && !mClock) mClock = filters::makeStageClock(mExec.device());
+    // Per-stage timings of each later run() (lastReport); off: no timing.
+    void setTiming(bool on) {
+        mTiming = on;
+        if (on && !mClock) mClock = filters::makeStageClock(mExec.device());
+        if (!on) mReport = SvgfReport{};
     }
+    const SvgfReport& lastReport() const { return mReport; }
     const SvgfParams& params() const { return mParams; }
 
 private:
@@ -292,7 +295,8 @@ private:
     LearnedWeights mLearned;  // learnedSpatial: the built-in weights or setLearnedWeights
     Exec mExec;
     SvgfState mState;
-    SvgfReport* mReport = nullptr;
+    bool mTiming = false;
+    SvgfReport mReport;  // the last timed frame's
     std::unique_ptr<filters::StageClock> mClock;
 };
 
@@ -306,7 +310,8 @@ public:
         return *mPipeline.state().result;
     }
     void reset() override { mPipeline.reset(); }
-    void setReport(SvgfReport* report) override { mPipeline.setReport(report); }
+    void setTiming(bool on) override { mPipeline.setTiming(on); }
+    SvgfReport lastReport() const override { return mPipeline.lastReport(); }
     void setLearnedWeights(const LearnedWeights& weights) override { mPipeline.setLearnedWeights(weights); }
 
 private:

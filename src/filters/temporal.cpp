@@ -228,9 +228,11 @@ TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t cente
     return g;
 }
 
-Image denoiseTemporal(const std::vector<SvgfFrame>& window, size_t center, const TemporalParams& params,
-                      const DenoiseOptions& spatial, TemporalReport* report, TemporalCache* cache,
-                      const std::vector<long long>* ids) {
+namespace {
+
+Image denoiseTemporalWith(const std::vector<SvgfFrame>& window, size_t center, const TemporalParams& params,
+                          const DenoiseOptions& spatial, TemporalReport* report, TemporalCache* cache,
+                          const std::vector<long long>* ids) {
     Timer timer;
     TemporalGather g = gatherTemporal(window, center, params, cache, ids);
     if (report) {
@@ -240,12 +242,6 @@ Image denoiseTemporal(const std::vector<SvgfFrame>& window, size_t center, const
         report->meanFrames = sum / double(g.frames.plane());
     }
     const SvgfFrame& c = window[center];
-    // DenoiseInputs reads ids as R = mesh, G = material: a 1-channel id image gets a G of 0.
-    Image ids2;
-    if (c.ids && c.ids->channels() < 2) {
-        ids2 = Image(c.ids->width(), c.ids->height(), 2);
-        std::copy(c.ids->data(), c.ids->data() + c.ids->plane(), ids2.data());
-    }
     DenoiseBuffers b;
     b.color = &g.color;
     b.variance = g.variance.empty() ? nullptr : &g.variance;
@@ -254,10 +250,26 @@ Image denoiseTemporal(const std::vector<SvgfFrame>& window, size_t center, const
     b.normal = g.normal.empty() ? nullptr : &g.normal;
     b.position = c.position;
     b.depth = c.depth;
-    b.ids = ids2.empty() ? c.ids : &ids2;
-    DenoiseOptions o = spatial;
-    if (report) o.report = &report->spatial;
-    return denoise(b, o);
+    b.ids = c.ids;
+    if (!report) return denoise(b, spatial);
+    DenoiseResult r = denoiseWithReport(b, spatial);
+    report->spatial = std::move(r.report);
+    return std::move(r.image);
+}
+
+}  // namespace
+
+Image denoiseTemporal(const std::vector<SvgfFrame>& window, size_t center, const TemporalParams& params,
+                      const DenoiseOptions& spatial, TemporalCache* cache, const std::vector<long long>* ids) {
+    return denoiseTemporalWith(window, center, params, spatial, nullptr, cache, ids);
+}
+
+TemporalResult denoiseTemporalWithReport(const std::vector<SvgfFrame>& window, size_t center,
+                                         const TemporalParams& params, const DenoiseOptions& spatial,
+                                         TemporalCache* cache, const std::vector<long long>* ids) {
+    TemporalResult r;
+    r.image = denoiseTemporalWith(window, center, params, spatial, &r.report, cache, ids);
+    return r;
 }
 
 }  // namespace atrous

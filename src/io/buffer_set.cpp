@@ -30,7 +30,7 @@ Image composeIds(const Image* object, const Image* material, int w, int h) {
 
 }  // namespace
 
-DenoiseInputs BufferSet::inputs() const { return denoiseInputs(refsOf(*this)); }
+DenoiseInputs BufferSet::inputs() const { return refsOf(*this); }
 
 BufferRefs refsOf(const BufferSet& set) {
     BufferRefs r;
@@ -53,21 +53,9 @@ BufferRefs refsOfNamed(const B& b) {
 BufferRefs refsOf(const RenderBuffers& b) { return refsOfNamed(b); }
 BufferRefs refsOf(const SequenceFrame& f) { return refsOfNamed(f); }
 
-DenoiseInputs denoiseInputs(const BufferRefs& r) {
-    DenoiseInputs in;
-    in.color = r.get(Buffer::Color);
-    in.variance = r.get(Buffer::Variance);
-    in.albedo = r.get(Buffer::Albedo);
-    in.normal = r.get(Buffer::Normal);
-    in.position = r.get(Buffer::Position);
-    in.depth = r.get(Buffer::Depth);
-    in.ids = r.get(Buffer::ObjectId);
-    in.emission = r.get(Buffer::Emission);
-    return in;
-}
 
 DenoiseBuffers handOver(const BufferRefs& r, Image& color, Image* variance, Image* emission) {
-    const DenoiseInputs in = denoiseInputs(r);
+    const DenoiseInputs& in = r;
     DenoiseBuffers b;
     b.color = &color;
     b.variance = variance && !variance->empty() ? variance : nullptr;
@@ -76,12 +64,6 @@ DenoiseBuffers handOver(const BufferRefs& r, Image& color, Image* variance, Imag
     return b;
 }
 
-// The same buffers as denoiseInputs() gives, plus motion (SvgfFrame's order).
-SvgfFrame svgfFrame(const BufferRefs& r) {
-    const DenoiseInputs in = denoiseInputs(r);
-    return SvgfFrame{in.color,    in.albedo,   in.normal,  in.depth, in.ids, r.get(Buffer::Motion),
-                     in.emission, in.variance, in.position};
-}
 
 namespace {
 
@@ -303,5 +285,5 @@ BufferSet loadBuffers(const BufferFiles& f) {
 }  // namespace atrous::io
 
 namespace atrous {
-DenoiseInputs denoiseInputsOf(const RenderBuffers& b) { return io::denoiseInputs(io::refsOf(b)); }
+DenoiseInputs denoiseInputsOf(const RenderBuffers& b) { return io::refsOf(b); }
 }  // namespace atrous

@@ -10,9 +10,6 @@ namespace atrous::io {
 
 namespace {
 
-const char* const kNames[kBufferCount] = {"color",    "variance",  "albedo",      "normal",   "position",
-                                          "depth",    "object_id", "material_id", "emission", "motion"};
-
 // Pass names of each buffer by tier ('|' separates tiers), compared after lower-casing and mapping
 // '_' and '-' to ' '. "" is the root layer (R, G, B without a prefix). Sources: Blender's pass
 // names (Combined, Denoising Albedo, IndexOB...), Mitsuba's AOV types and common user names.
@@ -73,7 +70,7 @@ std::vector<int> channelsFor(const ExrInfo& info, const ExrLayer& layer, Buffer 
     std::vector<int> ch = pickComponents(info, layer, bufferChannels(b));
     if (ch.empty())
         throw InputError(info.path + where(info, layer) + ": layer " + layerLabel(layer) + " has no usable channels for " +
-                         kNames[int(b)] + " (it has " + std::to_string(layer.components.size()) + ")");
+                         bufferName(b) + " (it has " + std::to_string(layer.components.size()) + ")");
     requireComponents(b, int(ch.size()), info.path + where(info, layer) + ": layer " + layerLabel(layer));
     return ch;
 }
@@ -91,10 +88,10 @@ int matchRules(const ExrInfo& info, Buffer b, const std::string& viewLayer, std:
                 if (!match) continue;
                 if (pickComponents(info, l, bufferChannels(b)).empty()) continue;  // e.g. alpha only
                 if (found >= 0)
-                    throw InputError(info.path + ": ambiguous " + std::string(kNames[int(b)]) + " pass: both " +
+                    throw InputError(info.path + ": ambiguous " + std::string(bufferName(b)) + " pass: both " +
                                      layerLabel(info.layers[size_t(found)]) + where(info, info.layers[size_t(found)]) +
                                      " and " + layerLabel(l) + where(info, l) +
-                                     " match; choose a view layer with --layer or a pass with --pass " + kNames[int(b)] + "=NAME");
+                                     " match; choose a view layer with --layer or a pass with --pass " + bufferName(b) + "=NAME");
                 found = int(i);
             }
             if (found >= 0) {
@@ -108,7 +105,7 @@ int matchRules(const ExrInfo& info, Buffer b, const std::string& viewLayer, std:
 
 PassChoice requested(const ExrInfo& info, const PassRequest& r) {
     PassChoice c;
-    c.rule = "--pass " + std::string(kNames[int(r.buffer)]) + "=" + r.name;
+    c.rule = "--pass " + std::string(bufferName(r.buffer)) + "=" + r.name;
     for (size_t i = 0; i < info.layers.size(); ++i)
         if (info.layers[i].name == r.name) {
             c.layer = int(i);
@@ -139,7 +136,6 @@ PassChoice requested(const ExrInfo& info, const PassRequest& r) {
 
 }  // namespace
 
-const char* bufferName(Buffer b) { return kNames[int(b)]; }
 
 std::string layerList(const ExrInfo& info) {
     std::string s;
@@ -150,13 +146,11 @@ std::string layerList(const ExrInfo& info) {
 Buffer parseBufferName(const std::string& name) {
     if (name == "ids") return Buffer::ObjectId;
     for (int i = 0; i < kBufferCount; ++i)
-        if (name == kNames[i]) return Buffer(i);
+        if (name == bufferName(Buffer(i))) return Buffer(i);
     std::string all;
-    for (const char* n : kNames) all += (all.empty() ? "" : ", ") + std::string(n);
+    for (int i = 0; i < kBufferCount; ++i) all += (all.empty() ? "" : ", ") + std::string(bufferName(Buffer(i)));
     throw InputError("unknown buffer '" + name + "' (expected one of " + all + ")");
 }
-
-bool bufferTakesGrey(Buffer b) { return b != Buffer::Normal && b != Buffer::Position && b != Buffer::Motion; }
 
 void requireComponents(Buffer b, int have, const std::string& source) {
     if (have >= bufferChannels(b) || bufferTakesGrey(b)) return;
@@ -177,7 +171,7 @@ void requireDistinctPasses(const std::vector<PassRequest>& requests) {
     for (size_t i = 0; i < requests.size(); ++i)
         for (size_t j = 0; j < i; ++j)
             if (requests[i].buffer == requests[j].buffer)
-                throw InputError(std::string("--pass ") + kNames[int(requests[i].buffer)] + " given twice ('" + requests[j].name +
+                throw InputError(std::string("--pass ") + bufferName(requests[i].buffer) + " given twice ('" + requests[j].name +
                                  "' and '" + requests[i].name + "'): name each buffer once");
 }
 
@@ -188,15 +182,6 @@ PassRequest parsePassRequest(const std::string& spec) {
     return {parseBufferName(spec.substr(0, eq)), spec.substr(eq + 1)};
 }
 
-int bufferChannels(Buffer b) {
-    switch (b) {
-        case Buffer::Depth:
-        case Buffer::ObjectId:
-        case Buffer::MaterialId: return 1;
-        case Buffer::Motion: return 2;
-        default: return 3;
-    }
-}
 
 PassMap mapPasses(const ExrInfo& info, const std::vector<PassRequest>& requests, const std::string& viewLayer) {
     if (!viewLayer.empty()) {

@@ -133,8 +133,7 @@ TEST(DeviceFrameCuda, DenoiseOnDeviceInputsMatchesHostInputsAndItsReport) {
     DenoiseInputs hin = s.inputs();
     hin.emission = &emission;
     DenoiseReport hostRep, devRep;
-    o.report = &hostRep;
-    const Image hostOut = denoise(hin, o);  // host inputs: uploaded, result downloaded
+    const Image hostOut = test::denoiseReporting(hin, o, hostRep);  // host inputs: uploaded, result downloaded
     EXPECT_EQ(hostOut.device(), Device::Cpu);
     const Image c = s.noisy.to(Device::Cuda), v = s.variance.to(Device::Cuda), a = s.albedo.to(Device::Cuda),
                 n = s.normal.to(Device::Cuda), p = s.position.to(Device::Cuda), d = s.depth.to(Device::Cuda),
@@ -142,8 +141,7 @@ TEST(DeviceFrameCuda, DenoiseOnDeviceInputsMatchesHostInputsAndItsReport) {
     DenoiseInputs din;
     din.color = &c, din.variance = &v, din.albedo = &a, din.normal = &n, din.position = &p, din.depth = &d;
     din.ids = &id, din.emission = &e;
-    o.report = &devRep;
-    const Image devOut = denoise(din, o);  // device inputs: in place, result stays on the GPU
+    const Image devOut = test::denoiseReporting(din, o, devRep);  // device inputs: in place, result stays on the GPU
     EXPECT_EQ(devOut.device(), Device::Cuda);
     EXPECT_EQ(maxRelDiff(hostOut, devOut), 0.0);  // the same kernels on the same data
     EXPECT_EQ(devRep.nonFinitePixels, 1);
@@ -156,8 +154,7 @@ TEST(DeviceFrameCuda, DenoiseOnDeviceInputsMatchesHostInputsAndItsReport) {
     DenoiseReport cpuRep;
     DenoiseOptions oc = o;
     oc.device = Device::Cpu;
-    oc.report = &cpuRep;
-    denoise(hin, oc);
+    test::denoiseReporting(hin, oc, cpuRep);
     EXPECT_NEAR(devRep.meanLuminanceIn, cpuRep.meanLuminanceIn, 1e-9 * std::fabs(cpuRep.meanLuminanceIn));
     EXPECT_NEAR(devRep.meanLuminanceAfterFirefly, cpuRep.meanLuminanceAfterFirefly,
                 1e-5 * std::fabs(cpuRep.meanLuminanceAfterFirefly));  // after: GPU vs CPU clamp, ulps
@@ -167,10 +164,8 @@ TEST(DeviceFrameCuda, DenoiseOnDeviceInputsMatchesHostInputsAndItsReport) {
     // ulp between GCC and nvcc, hence 1e-6 relative on σ and 1e-4 on the results (values ~1).
     hin.variance = nullptr;
     din.variance = nullptr;
-    o.report = &hostRep;
-    const Image hostEst = denoise(hin, o);
-    o.report = &devRep;
-    const Image devEst = denoise(din, o);
+    const Image hostEst = test::denoiseReporting(hin, o, hostRep);
+    const Image devEst = test::denoiseReporting(din, o, devRep);
     EXPECT_TRUE(devRep.noiseEstimated);
     for (int c = 0; c < 3; ++c) {
         EXPECT_GT(hostRep.noiseSigma[c], 0.0f);

@@ -21,11 +21,9 @@ TEST(StageTimesCuda, DenoiseStagesMatchTheCpuListAndFitInTheTotal) {
         DenoiseOptions o;
         o.method = m;
         DenoiseReport cpu, gpu;
-        o.report = &cpu;
-        denoise(scene.inputs(), o);
+        test::denoiseReporting(scene.inputs(), o, cpu);
         o.device = Device::Cuda;
-        o.report = &gpu;
-        denoise(scene.inputs(), o);
+        test::denoiseReporting(scene.inputs(), o, gpu);
         EXPECT_EQ(test::stageNames(gpu.stages), test::stageNames(cpu.stages)) << denoiseMethodName(m);
         // GPU time between the first and last event lies inside the host's wall-clock window
         // around the driver (which also waits for the final synchronisation); 0.01 ms of slack for
@@ -40,14 +38,14 @@ TEST(StageTimesCuda, SvgfReportOnTheGpu) {
     SvgfParams p;
     p.levels = 3;
     SvgfDenoiser d(p, Device::Cuda);
-    SvgfReport rep;
-    d.setReport(&rep);
+    d.setTiming(true);
     SvgfFrame f;
     f.color = &scene.noisy;
     f.albedo = &scene.albedo;
     f.normal = &scene.normal;
     f.depth = &scene.depth;
     for (int i = 0; i < 2; ++i) d.denoiseFrameOnDevice(f);
+    const SvgfReport rep = d.lastReport();
     const std::vector<std::string> expected = {"demodulate", "reproject", "accumulate", "variance",
                                                "level 0",    "level 1",   "level 2",    "remodulate"};
     EXPECT_EQ(test::stageNames(rep.stages), expected);

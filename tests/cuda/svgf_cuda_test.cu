@@ -13,15 +13,15 @@ using namespace atrous;
 
 namespace {
 
-struct Frame {
+struct CudaTestFrame {
     Image color, albedo, normal, depth, ids, motion, emission;
 };
 
 // A textured, tilted ground plane, a sky strip and a box sliding right by 3 px per frame, with
 // Gaussian noise (and a few NaN samples) on the colour, and a light (emission 17) in the box's top
 // rows whose bottom edge row is covered at random (1-spp coverage noise on a moving emitter).
-Frame makeFrame(int w, int h, int t) {
-    Frame f{Image(w, h, 3), Image(w, h, 3), Image(w, h, 3), Image(w, h, 3), Image(w, h, 3), Image(w, h, 3),
+CudaTestFrame makeFrame(int w, int h, int t) {
+    CudaTestFrame f{Image(w, h, 3), Image(w, h, 3), Image(w, h, 3), Image(w, h, 3), Image(w, h, 3), Image(w, h, 3),
             Image(w, h, 3)};
     std::bernoulli_distribution cover(0.5);
     std::mt19937 rng(99u + unsigned(t));
@@ -50,7 +50,7 @@ Frame makeFrame(int w, int h, int t) {
 }
 
 // The SVGF inputs of a test frame.
-SvgfFrame inputsOf(const Frame& f) {
+SvgfFrame inputsOf(const CudaTestFrame& f) {
     SvgfFrame in;
     in.color = &f.color, in.albedo = &f.albedo, in.normal = &f.normal;
     in.depth = &f.depth, in.ids = &f.ids, in.motion = &f.motion, in.emission = &f.emission;
@@ -78,7 +78,7 @@ TEST(SvgfCuda, MatchesTheCpuBackend) {
         p.emissionMotionAlpha = taa ? 0.1f : 0.0f;  // both α rules of the emission accumulation
         SvgfDenoiser cpu(p, Device::Cpu), gpu(p, Device::Cuda);
         for (int t = 0; t < 5; ++t) {
-            Frame f = makeFrame(96, 64, t);
+            CudaTestFrame f = makeFrame(96, 64, t);
             const SvgfFrame in = inputsOf(f);
             Image a = cpu.denoiseFrame(in);
             Image b = gpu.denoiseFrame(in);  // host inputs are uploaded by the driver
@@ -102,7 +102,7 @@ TEST(SvgfCuda, LearnedSpatialMatchesTheCpuBackend) {
         p.feedbackTap = tap;
         SvgfDenoiser cpu(p, Device::Cpu), gpu(p, Device::Cuda);
         for (int t = 0; t < 5; ++t) {
-            Frame f = makeFrame(96, 64, t);
+            CudaTestFrame f = makeFrame(96, 64, t);
             const SvgfFrame in = inputsOf(f);
             Image a = cpu.denoiseFrame(in);
             Image b = gpu.denoiseFrame(in);
@@ -125,7 +125,7 @@ TEST(SvgfCuda, LearnedSpatialRunsTheGivenWeightsAcrossSizes) {
     const int sizes[][2] = {{96, 64}, {64, 40}};
     for (const auto& sz : sizes) {
         for (int t = 0; t < 3; ++t) {
-            Frame f = makeFrame(sz[0], sz[1], t);
+            CudaTestFrame f = makeFrame(sz[0], sz[1], t);
             const SvgfFrame in = inputsOf(f);
             Image a = cpu.denoiseFrame(in), b = gpu.denoiseFrame(in), c = gpuBuiltin.denoiseFrame(in);
             const float maxDiff = maxRelDiff(a, b);

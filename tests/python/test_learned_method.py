@@ -128,6 +128,11 @@ def test_learned_denoise_is_finite_filters_and_takes_a_path(tmp_path):
     # str and PathLike give the same; levels is not a parameter of the learned filter.
     again = atrous.denoise(b["color"], method="learned", learned_weights=str(w), levels=2, **kw)
     np.testing.assert_array_equal(out, again)
+    # A network loaded once (atrous.load_weights) gives the same as its file; the built-in is other.
+    loaded = atrous.load_weights(w)
+    assert isinstance(loaded, atrous.Weights)
+    np.testing.assert_array_equal(atrous.denoise(b["color"], method="learned", learned_weights=loaded, **kw), out)
+    assert np.abs(atrous.denoise(b["color"], method="learned", **kw) - out).max() > 1e-4
     # auto (the default) with albedo and normal is blend, the mean of learned and sure; without a
     # normal it is sure.
     blend = atrous.denoise(b["color"], method="blend", learned_weights=w, **kw)
@@ -166,6 +171,8 @@ def test_bad_weights_raise_value_error_naming_the_file(tmp_path):
     junk.write_bytes(b"ATRL\x02\x00\x00\x00 truncated")
     with pytest.raises(ValueError, match="junk.atrl"):
         atrous.denoise(b["color"], albedo=b["albedo"], normal=b["normal"], method="auto", learned_weights=junk)
+    with pytest.raises(ValueError, match="junk.atrl"):
+        atrous.load_weights(junk)
     with pytest.raises(ValueError, match="unknown method"):
         atrous.denoise(b["color"], method="learnt")
 

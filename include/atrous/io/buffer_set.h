@@ -38,32 +38,19 @@ struct BufferSet {
     std::vector<std::string> notes;    // conventions applied, passes not found, ...
     std::vector<Buffer> skipped;       // present but not decoded (BufferFiles::wanted)
     const Image* get(Buffer b) const { return image[int(b)].empty() ? nullptr : &image[int(b)]; }
-    DenoiseInputs inputs() const;  // denoiseInputs(refsOf(*this))
+    DenoiseInputs inputs() const;  // refsOf(*this)
 };
 
-// One set of buffers by buffer, not owned (nullptr = absent; ids in the object_id slot, as in
+// One set of buffers, not owned: a Frame (atrous/buffers.h; ids in the object_id slot, as in
 // BufferSet). Every entry point (render --denoise, denoise, denoise --sequence, the viewer,
-// Python) puts what it holds here and takes each denoiser's inputs from denoiseInputs() /
-// svgfFrame(): the one place where buffers become a denoiser's inputs, so a new buffer reaches
+// Python) puts what it holds here and hands it to the denoisers as it is, so a new buffer reaches
 // all of them at once.
-struct BufferRefs {
-    const Image* at[kBufferCount] = {};
-    const Image* get(Buffer b) const { return at[int(b)]; }
-    // An empty image counts as absent.
-    BufferRefs& set(Buffer b, const Image* img) {
-        at[int(b)] = img && !img->empty() ? img : nullptr;
-        return *this;
-    }
-};
+using BufferRefs = Frame;
 BufferRefs refsOf(const BufferSet& set);
 BufferRefs refsOf(const RenderBuffers& b);  // motion too, when the render made one
 BufferRefs refsOf(const SequenceFrame& f);  // all but the reference
 
-// EAW/SURE read colour, variance, albedo, normal, position, depth, ids and emission; SVGF colour,
-// albedo, normal, depth, ids, motion and emission (its variance is its own, from the history).
-DenoiseInputs denoiseInputs(const BufferRefs& r);
-SvgfFrame svgfFrame(const BufferRefs& r);
-// The same for denoise(DenoiseBuffers&): the colour, variance and emission are the caller's own
+// The buffers of denoise(DenoiseBuffers&): the colour, variance and emission are the caller's own
 // images (those r points at), handed over, so the filter works in their storage and they are not
 // read afterwards; the features are read only. An empty (or null) variance or emission is absent.
 DenoiseBuffers handOver(const BufferRefs& r, Image& color, Image* variance, Image* emission);

@@ -9,18 +9,21 @@
 #include <utility>
 #include <vector>
 
+#include "atrous/buffers.h"
 #include "atrous/image.h"
 #include "atrous/io/exr_layers.h"
 
 namespace atrous::io {
 
-enum class Buffer { Color, Variance, Albedo, Normal, Position, Depth, ObjectId, MaterialId, Emission, Motion };
-constexpr int kBufferCount = 10;
+// The buffers and their conventions: include/atrous/buffers.h.
+using atrous::Buffer;
+using atrous::bufferChannels;
+using atrous::bufferName;
+using atrous::bufferTakesGrey;
+using atrous::kBufferCount;
 
-const char* bufferName(Buffer b);  // "color", "variance", ..., "object_id", "material_id", "motion"
 // The buffer of a --pass name ("color", "albedo", ..., also "ids" for object_id); InputError otherwise.
 Buffer parseBufferName(const std::string& name);
-int bufferChannels(Buffer b);  // the components a buffer takes: 1 (depth, ids), 2 (motion) or 3
 
 struct PassRequest {
     Buffer buffer;
@@ -37,8 +40,8 @@ void requireDistinctPasses(const std::vector<PassRequest>& requests);
 // The channel-count rule (docs/inputs.md, "Channels"): a buffer takes bufferChannels(b) components;
 // one channel is repeated into all three where a grey value means the same thing (colour,
 // variance, albedo, emission; depth and ids take one), and refused for the directions and points
-// (normal, position: 3; motion: 2), where (x, x, x) or (x, -x) would be a silent wrong answer.
-bool bufferTakesGrey(Buffer b);
+// (normal, position: 3; motion: 2), where (x, x, x) or (x, -x) would be a silent wrong answer
+// (bufferTakesGrey).
 // Throws InputError "<source> has N channels; motion needs 2 ..." when `have` components cannot be
 // buffer b by that rule.
 void requireComponents(Buffer b, int have, const std::string& source);

@@ -16,16 +16,11 @@ from pathlib import Path
 
 import numpy as np
 
+import atrous
+
 ROOT = Path.cwd()  # the repository root: run from it (its out/ and build/ are the defaults)
 BUFS = ("color", "variance", "albedo", "normal", "depth", "emission")
 METHODS = ("noisy", "eaw", "sure", "learned", "blend", "oidn")
-
-
-def relmse(x, r):
-    """docs/eval.md's relMSE, as the library computes it (atrous.metrics)."""
-    import atrous
-
-    return float(atrous.metrics(np.ascontiguousarray(x, np.float32), np.ascontiguousarray(r, np.float32))["relmse"])
 
 
 def buffers(z, spp: int) -> dict:
@@ -92,7 +87,7 @@ def main(argv=None) -> int:
                 b.pop("variance", None)
             r = res.setdefault(key, {})
             for m in a.methods:
-                r[m] = relmse(run_method(m, b, a.weights), z["reference"])
+                r[m] = atrous.relmse(run_method(m, b, a.weights), z["reference"])
             print(key, {k: round(v, 5) for k, v in r.items()}, flush=True)
     s = summary(res)
     if a.json:

@@ -127,15 +127,13 @@ def evaluate_sequence(seq_dir: str, methods: Dict[str, Optional[Callable]],
         row: Dict[str, Any] = {"frame": p.name, "relmse": {}}
         if ref is not None:
             for m, o in outs.items():
-                row["relmse"][m] = float(atrous.metrics(o, ref)["relmse"])
+                row["relmse"][m] = atrous.relmse(o, ref)
                 if prev_ref is not None and m in prev:
-                    d_out = o.astype(np.float64) - prev[m]
-                    d_ref = ref.astype(np.float64) - prev_ref
-                    temporal[m].append(float(np.mean((d_out - d_ref) ** 2 / (ref.astype(np.float64) ** 2 + 0.01))))
+                    temporal[m].append(atrous.temporal_metrics(o, prev[m], ref, prev_ref)["relmse"])
             if i == len(paths) - 1:
                 last = {m: score(o, ref) for m, o in outs.items()}
-        prev = {m: o.astype(np.float64) for m, o in outs.items()}
-        prev_ref = None if ref is None else ref.astype(np.float64)
+        prev = dict(outs)
+        prev_ref = ref
         frames_out.append(row)
         log(f"sequence {p.name}: " + ", ".join(f"{m} {v:.4f}" for m, v in row["relmse"].items()))
     summary: Dict[str, Dict[str, Any]] = {}

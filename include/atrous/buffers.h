@@ -1,0 +1,66 @@
+// One frame of named buffers: the vocabulary of the renderer's output, the file readers, every
+// denoiser (denoise(), SvgfDenoiser, the sequence methods) and Python. Each buffer's channels and
+// conventions are stated here, once; docs/inputs.md says how other renderers' passes are mapped
+// onto them.
+#pragma once
+#include "atrous/image.h"
+
+namespace atrous {
+
+// The buffers, in the order of bufferInfo's table. ObjectId and MaterialId are the two passes a
+// renderer writes for ids (Blender's IndexOB and IndexMA); in a Frame they are one image, `ids`
+// (channel 0 the object, channel 1 the material).
+enum class Buffer { Color, Variance, Albedo, Normal, Position, Depth, ObjectId, MaterialId, Emission, Motion };
+constexpr int kBufferCount = 10;
+
+struct BufferInfo {
+    Buffer buffer;
+    const char* name;     // "color", ...: atrous's file NAME.exr, --pass NAME=..., Python's key
+    int channels;         // the components a buffer takes: 3, but depth, object_id, material_id 1, motion 2
+    bool takesGrey;       // one channel may stand for all three (colour, variance, albedo, emission)
+    const char* meaning;  // the convention: units, sign, the background's value
+};
+
+// The table, one row per buffer in enum order:
+//   color     mean radiance of the pixel's samples, linear HDR (W sr^-1 m^-2 per channel)
+//   variance  variance of that mean per channel, (E[y^2] - E[y]^2) / (n - 1); all zero (a 1-spp
+//             render) counts as absent: the noise is then estimated from the image
+//   albedo    directional reflectance in [0, 1] of the first non-delta surface (delta-bounce
+//             throughput multiplied in); read values are clamped to [0, 1]
+//   normal    world-space unit shading normal of that surface; 0 for background
+//   position  world-space point of that surface; 0 for background
+//   depth     distance of the primary hit along the camera's forward axis, in channel 0 (further
+//             channels are ignored; atrous's renderer repeats it in R, G, B); 1e30 for background
+//             (>= 1e29 is background; read values <= 0, >= 1e9 or non-finite become 1e30)
+//   object_id channel 0 of `ids`: the object (mesh) id, -1 for background
+//   material_id channel 1 of `ids`: the material id, -1 for background (absent: one material)
+//   emission  emitted radiance of the primary hit towards the camera, 0 elsewhere
+//   motion    channel 0 = dx, channel 1 = dy in pixels: the point's image position in the previous
+//             frame minus its position now (previous - current); non-finite = no history
+const BufferInfo& bufferInfo(Buffer b);
+const char* bufferName(Buffer b);  // bufferInfo(b).name
+int bufferChannels(Buffer b);      // bufferInfo(b).channels
+bool bufferTakesGrey(Buffer b);    // bufferInfo(b).takesGrey
+
+// One frame's buffers, not owned, each a planar Image of the colour's size on the host or on the
+// denoiser's device (nullptr = absent; only `color` is required). What every denoiser takes
+// (DenoiseInputs and SvgfFrame are this type): a denoiser reads the buffers it uses and ignores the
+// others (denoise() no motion; SVGF no variance or position; the sequence methods all of them).
+// Non-finite values are treated as missing for that pixel.
+struct Frame {
+    const Image* color = nullptr;
+    const Image* variance = nullptr;
+    const Image* albedo = nullptr;
+    const Image* normal = nullptr;
+    const Image* position = nullptr;
+    const Image* depth = nullptr;     // 1 channel or more
+    const Image* ids = nullptr;       // object_id, and material_id in channel 1 when it has two
+    const Image* emission = nullptr;
+    const Image* motion = nullptr;    // 2 channels or more
+    // By buffer: ObjectId is `ids`; MaterialId is no slot of its own (get gives nullptr; set
+    // throws InputError for an image, takes none). set() takes an empty image as absent.
+    const Image* get(Buffer b) const;
+    Frame& set(Buffer b, const Image* img);
+};
+
+}  // namespace atrous
