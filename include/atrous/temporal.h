@@ -144,6 +144,10 @@ struct SequenceMethodInfo {
     bool causal;          // each frame from the frames before it only (real time, the viewer)
     bool causalMode;      // not causal itself, but has a causal mode (temporal's TemporalParams::causal),
                           // which a viewer runs
+    // Its parameter table: "temporal" (temporalParams(), the CLI's --temporal-* flags; the still
+    // method it ends with takes denoiseParams()) or "svgf" (svgfParams(), --svgf-*).
+    const char* params;
+    std::vector<Buffer> reads;  // the frame's buffers it reads (atrous/buffers.h); colour required
 };
 const std::vector<SequenceMethodInfo>& sequenceMethods();  // temporal (the --sequence default) first
 const SequenceMethodInfo* findSequenceMethod(const std::string& name);  // null when unknown

@@ -86,13 +86,14 @@ def __getattr__(name: str) -> Any:
 
 def methods() -> list:
     """Every method, one dict each, from the library's registry: name, kind ("still": a method of
-    :func:`denoise`; "sequence": of :func:`denoise_sequence` / :class:`Svgf`), summary and
-    registered (added with :func:`register_method`). The still methods come first, in the order of
-    the CLI's ``--method`` help."""
-    rows = [dict(name=str(r["name"]), kind="still", summary=str(r["summary"]), registered=bool(r["registered"]))
-            for r in _core.denoise_methods()]
-    rows += [dict(name=str(r["name"]), kind="sequence", summary=str(r["summary"]), registered=False)
-             for r in _core.sequence_methods()]
+    :func:`denoise`; "sequence": of :func:`denoise_sequence` / :class:`Svgf`), summary, registered
+    (added with :func:`register_method`) and params (its parameter table: "denoise",
+    "temporal" or "svgf", i.e. :func:`denoise_params` ...). The still methods come first, in the
+    order of the CLI's ``--method`` help."""
+    rows = [dict(name=str(r["name"]), kind="still", summary=str(r["summary"]), registered=bool(r["registered"]),
+                 params=str(r["params"])) for r in _core.denoise_methods()]
+    rows += [dict(name=str(r["name"]), kind="sequence", summary=str(r["summary"]), registered=False,
+                  params=str(r["params"])) for r in _core.sequence_methods()]
     return rows
 
 
@@ -132,7 +133,8 @@ def denoise_methods() -> list:
 
 
 def sequence_methods() -> list:
-    """The sequence methods, one dict per method: name, summary, causal (the library's list)."""
+    """The sequence methods, one dict per method: name, summary, causal, params (its parameter table)
+    and reads (the buffers it reads, :func:`buffers`), the library's list."""
     return [dict(r) for r in _core.sequence_methods()]
 
 

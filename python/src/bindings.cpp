@@ -160,7 +160,13 @@ nb::list methodRows(const Rows& infos, const char* flagName, bool Info::*flag) {
         d["name"] = i.name;
         d["summary"] = i.summary;
         d[flagName] = i.*flag;
-        if constexpr (std::is_same_v<Info, DenoiseMethodInfo>) d["registered"] = i.registered();
+        if constexpr (std::is_same_v<Info, DenoiseMethodInfo>) d["registered"] = i.registered(), d["params"] = "denoise";
+        if constexpr (std::is_same_v<Info, SequenceMethodInfo>) {
+            d["params"] = i.params;
+            nb::list reads;
+            for (Buffer b : i.reads) reads.append(bufferName(b));
+            d["reads"] = reads;
+        }
         rows.append(d);
     }
     return rows;

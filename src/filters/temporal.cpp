@@ -31,9 +31,13 @@ const std::vector<SequenceMethodInfo>& sequenceMethods() {
         {"temporal",
          "the default with --sequence: frames t-3..t+3 reprojected onto t and averaged, then the still method "
          "--spatial (docs/temporal.md)",
-         false, true},
+         false, true, "temporal",
+         {Buffer::Color, Buffer::Variance, Buffer::Albedo, Buffer::Normal, Buffer::Position, Buffer::Depth,
+          Buffer::ObjectId, Buffer::Emission, Buffer::Motion}},
         {"svgf", "spatiotemporal variance-guided filtering, causal: each frame from the ones before it (docs/svgf.md)",
-         true, false},
+         true, false, "svgf",
+         {Buffer::Color, Buffer::Albedo, Buffer::Normal, Buffer::Depth, Buffer::ObjectId, Buffer::Emission,
+          Buffer::Motion}},
     };
     return rows;
 }

@@ -23,6 +23,15 @@ def test_the_toy_is_in_every_list():
     assert [r["name"] for r in atrous.methods()][:5] == ["eaw", "sure", "learned", "blend", "auto"]
     assert "pytoy" in atrous.METHODS and "pytoy" not in atrous.WEIGHTED_METHODS
     assert "pytoy" in all_methods() and "pytoy" in denoise_choices() and "pytoy" in eval_choices()
+    # Each row names its parameter table, which Python can read: the still methods share denoise's.
+    for r in atrous.methods():
+        assert callable(getattr(atrous, r["params"] + "_params")), r
+    assert rows["pytoy"]["params"] == "denoise" and rows["svgf"]["params"] == "svgf"
+    assert rows["temporal"]["params"] == "temporal"
+    seq = {r["name"]: r for r in atrous.sequence_methods()}
+    known = {b["name"] for b in atrous.buffers()}
+    assert set(seq["svgf"]["reads"]) <= known and "motion" in seq["svgf"]["reads"]
+    assert "variance" not in seq["svgf"]["reads"] and "variance" in seq["temporal"]["reads"]
 
 
 def test_denoise_is_the_cascade_on_the_prepared_planes_then_remodulation():
