@@ -180,3 +180,58 @@ TEST(SequenceCompare, RealFlipWhereInstalled) {
     EXPECT_GT(j["sequences"][1]["flip"].get<double>(), 0.0);
     EXPECT_LT(j["sequences"][1]["flip"].get<double>(), 1.0);
 }
+
+// ColorVideoVDP: with the atrous-cvvdp command on PATH and its --check passing, one JOD per sequence
+// from the "JOD: x" it prints for a --pairs list of REFERENCE<TAB>TEST frames it can read (a
+// stand-in here that checks the list names written EXRs, one line per frame); --no-cvvdp gives
+// none; a --check that fails (cvvdp not installed) gives none and its reason in one note; no
+// command gives none and a note; a run that fails leaves that sequence's value null, exit 0.
+TEST(SequenceCompare, CvvdpColumnFromTheAtrousCvvdpCommand) {
+    TempDir dir;
+    writeSequence(dir / "ref", 3, 0.0f, false);
+    writeSequence(dir / "out", 3, 0.1f, false);
+    auto standIn = [&](const std::string& name, const std::string& body) {
+        const std::string bin = dir / name;
+        fs::create_directories(bin);
+        std::ofstream(bin + "/atrous-cvvdp") << "#!/bin/sh\n" << body;
+        fs::permissions(bin + "/atrous-cvvdp", fs::perms::owner_all);
+        return bin;
+    };
+    const std::string good = standIn(
+        "good", "[ \"$1\" = --check ] && { echo 'ColorVideoVDP: ready'; exit 0; }\n"
+                "[ \"$1\" = --pairs ] && [ \"$(wc -l < \"$2\")\" -eq 3 ] || exit 3\n"
+                "while IFS=\"$(printf '\\t')\" read -r r t; do [ -s \"$r\" ] && [ -s \"$t\" ] || exit 4; done < \"$2\"\n"
+                "echo 'JOD: 7.500000'\n");
+    const std::string missing = standIn("missing", "echo 'cvvdp is not installed in /x/python (pip install cvvdp)'\nexit 3\n");
+    const std::string failing = standIn("failing", "[ \"$1\" = --check ] && exit 0\necho boom\nexit 1\n");
+    const char* old = std::getenv("PATH");
+    const std::string oldPath = old ? old : "/usr/bin:/bin";
+    auto compare = [&](const std::string& path, const std::string& args) {
+        setenv("PATH", path.c_str(), 1);
+        auto r = runCli("compare --json --no-flip " + args + " --sequence " + dir / "ref" + " " + dir / "out");
+        setenv("PATH", oldPath.c_str(), 1);
+        EXPECT_EQ(r.exitCode, 0) << r.output;
+        const auto s = nlohmann::json::parse(r.output.substr(r.output.find('{')))["sequences"][0];
+        EXPECT_GT(s["relmse"].get<double>(), 0.0) << r.output;
+        return std::make_pair(s["cvvdp"], r.output);
+    };
+    EXPECT_DOUBLE_EQ(compare(good + ":" + oldPath, "").first.get<double>(), 7.5);
+    EXPECT_TRUE(compare(good + ":" + oldPath, "--no-cvvdp").first.is_null());
+    auto notInstalled = compare(missing + ":/usr/bin:/bin", "");
+    EXPECT_TRUE(notInstalled.first.is_null());
+    EXPECT_NE(notInstalled.second.find("note: no CVVDP column: cvvdp is not installed"), std::string::npos)
+        << notInstalled.second;
+    auto none = compare("/usr/bin:/bin", "");
+    EXPECT_TRUE(none.first.is_null());
+    EXPECT_NE(none.second.find("atrous-cvvdp command"), std::string::npos) << none.second;
+    auto failed = compare(failing + ":/usr/bin:/bin", "");
+    EXPECT_TRUE(failed.first.is_null());
+    EXPECT_NE(failed.second.find("ColorVideoVDP (" + failing + "/atrous-cvvdp) failed on"), std::string::npos)
+        << failed.second;
+    // The text table has the column when it runs.
+    setenv("PATH", (good + ":" + oldPath).c_str(), 1);
+    auto table = runCli("compare --no-flip --sequence " + dir / "ref" + " " + dir / "out");
+    setenv("PATH", oldPath.c_str(), 1);
+    EXPECT_NE(table.output.find("CVVDP(JOD)"), std::string::npos) << table.output;
+    EXPECT_NE(table.output.find("7.5000"), std::string::npos) << table.output;
+}

@@ -1,6 +1,6 @@
 // `atrous compare`: MSE, relMSE, tonemapped PSNR and SSIM of images against a reference; with
 // --sequence, of denoised sequences against a reference sequence, with the temporal metrics and
-// (where the flip command is installed) HDR-FLIP.
+// (where they are installed) HDR-FLIP and ColorVideoVDP.
 #include <unistd.h>
 
 #include <algorithm>
@@ -34,7 +34,39 @@ struct CompareArgs {
     std::string ref, errorMaps, sequence, video;
     std::vector<std::string> images;
     bool json = false;
-    bool noFlip = false;
+    bool noFlip = false, noCvvdp = false;
+};
+
+// Runs a shell command, returns what it printed (stdout; the caller adds 2>&1), its status in *rc.
+std::string runCommand(const std::string& cmd, int* rc = nullptr) {
+    std::string out;
+    if (FILE* f = ::popen(cmd.c_str(), "r")) {
+        char buf[512];
+        while (std::fgets(buf, sizeof buf, f)) out += buf;
+        const int status = ::pclose(f);
+        if (rc) *rc = status;
+    } else if (rc) {
+        *rc = -1;
+    }
+    return out;
+}
+
+// A fresh temporary folder named for this process, removed with the object.
+struct TempFolder {
+    fs::path path;
+    explicit TempFolder(const std::string& prefix) {
+        path = fs::temp_directory_path() / (prefix + std::to_string(::getpid()));
+        std::error_code ec;
+        fs::remove_all(path, ec);
+        fs::create_directories(path, ec);
+        if (ec) throw RuntimeError(path.string() + ": cannot create (" + ec.message() + ")");
+    }
+    ~TempFolder() {
+        std::error_code ec;
+        fs::remove_all(path, ec);
+    }
+    TempFolder(const TempFolder&) = delete;
+    TempFolder& operator=(const TempFolder&) = delete;
 };
 
 // HDR-FLIP (NVIDIA's FLIP, the `flip` command of PyPI's flip-evaluator, which `make python` puts in
@@ -53,23 +85,13 @@ public:
             mExe.clear();
             mNoted = true;
         }
-        if (mExe.empty()) return;
-        mDir = fs::temp_directory_path() / ("atrous-flip-" + std::to_string(::getpid()));
-        std::error_code ec;
-        fs::remove_all(mDir, ec);
-        fs::create_directories(mDir, ec);
-        if (ec) throw RuntimeError(mDir.string() + ": cannot create (" + ec.message() + ")");
+        if (!mExe.empty()) mTemp = std::make_unique<TempFolder>("atrous-flip-");
     }
-    ~FlipRunner() {
-        std::error_code ec;
-        if (!mDir.empty()) fs::remove_all(mDir, ec);
-    }
-    FlipRunner(const FlipRunner&) = delete;
-    FlipRunner& operator=(const FlipRunner&) = delete;
     bool enabled() const { return !mExe.empty(); }
     bool noted() const { return mNoted; }
 
     std::optional<double> frame(int index, const Image& ref, const Image& test) {
+        const fs::path& mDir = mTemp->path;
         const std::string refPath = (mDir / ("ref_" + std::to_string(index) + ".exr")).string();
         if (!fs::exists(refPath)) io::writeImage(refPath, ref);
         const std::string testPath = (mDir / "test.exr").string();
@@ -84,21 +106,68 @@ public:
     }
 
 private:
-    static std::string run(const std::string& cmd, int* rc = nullptr) {
-        std::string out;
-        if (FILE* f = ::popen(cmd.c_str(), "r")) {
-            char buf[512];
-            while (std::fgets(buf, sizeof buf, f)) out += buf;
-            const int status = ::pclose(f);
-            if (rc) *rc = status;
-        } else if (rc) {
-            *rc = -1;
-        }
-        return out;
-    }
+    static std::string run(const std::string& cmd, int* rc = nullptr) { return runCommand(cmd, rc); }
     std::string mExe;
-    fs::path mDir;
+    std::unique_ptr<TempFolder> mTemp;
     bool mNoted = false;
+};
+
+// ColorVideoVDP (PyPI's cvvdp) of a whole sequence against the reference's, in JOD (10: no visible
+// difference), through the atrous Python package's `atrous-cvvdp` command (python/atrous/eval/
+// cvvdp.py; `make python` puts it in .venv/bin; cvvdp itself is `pip install cvvdp`, with PyTorch):
+// the frames written as EXR into a temporary folder (the reference's once), a list of
+// REFERENCE<TAB>TEST lines handed to `atrous-cvvdp --pairs`, its "JOD: x" read. Off, with one note,
+// when the command is not on PATH or its --check says cvvdp cannot run; off with --no-cvvdp. A
+// sequence it fails on gives no value (nullopt) and one note.
+class CvvdpRunner {
+public:
+    explicit CvvdpRunner(bool wanted) {
+        if (!wanted) return;
+        mExe = io::findOnPath("atrous-cvvdp");
+        if (mExe.empty()) {
+            mNote = "the atrous-cvvdp command (the atrous Python package's; make python puts it in .venv/bin) is not on PATH";
+            return;
+        }
+        int rc = 0;
+        const std::string out = runCommand(io::shellQuote(mExe) + " --check 2>&1", &rc);
+        if (rc != 0) {
+            mNote = out.substr(0, out.find('\n'));
+            mExe.clear();
+            return;
+        }
+        mTemp = std::make_unique<TempFolder>("atrous-cvvdp-");
+    }
+    bool enabled() const { return !mExe.empty(); }
+    const std::string& note() const { return mNote; }  // why it is off ("" when on or not wanted)
+
+    std::optional<double> sequence(const std::string& name, const std::vector<std::pair<int, Image>>& ref,
+                                   const std::vector<std::pair<int, Image>>& test) {
+        const fs::path& dir = mTemp->path;
+        std::string pairs;
+        for (size_t i = 0; i < ref.size(); ++i) {
+            const std::string r = (dir / ("ref_" + std::to_string(ref[i].first) + ".exr")).string();
+            const std::string t = (dir / ("test_" + std::to_string(test[i].first) + ".exr")).string();
+            if (!fs::exists(r)) io::writeImage(r, ref[i].second);
+            io::writeImage(t, test[i].second);
+            pairs += r + "\t" + t + "\n";
+        }
+        const std::string list = (dir / "pairs.txt").string();
+        if (FILE* f = std::fopen(list.c_str(), "w")) {
+            std::fputs(pairs.c_str(), f);
+            std::fclose(f);
+        }
+        int rc = 0;
+        const std::string out = runCommand(io::shellQuote(mExe) + " --pairs " + io::shellQuote(list) + " 2>&1", &rc);
+        const size_t at = out.find("JOD:");
+        if (rc == 0 && at != std::string::npos) return std::strtod(out.c_str() + at + 4, nullptr);
+        std::fprintf(stderr, "note: ColorVideoVDP (%s) failed on %s: %s\n", mExe.c_str(), name.c_str(),
+                     out.substr(0, 200).c_str());
+        return std::nullopt;
+    }
+
+private:
+    std::string mExe, mNote;
+    std::unique_ptr<TempFolder> mTemp;
 };
 
 // The frames of a sequence by number: a reference frame's reference.exr when it has one (`atrous
@@ -184,9 +253,11 @@ void runSequence(const CompareArgs& a) {
     if (!a.noFlip && !flip.enabled() && !flip.noted())
         std::fprintf(stderr, "note: no FLIP column: the flip command (pip install flip-evaluator; make python puts it in "
                              ".venv/bin) is not on PATH\n");
+    CvvdpRunner cvvdp(!a.noCvvdp);
+    if (!cvvdp.note().empty()) std::fprintf(stderr, "note: no CVVDP column: %s\n", cvvdp.note().c_str());
     if (!a.json)
-        std::printf("%-32s %7s %14s %10s %8s %14s %10s%s\n", "sequence", "frames", "relMSE", "PSNR(dB)", "SSIM", "temporal relMSE",
-                    "tPSNR(dB)", flip.enabled() ? "     FLIP" : "");
+        std::printf("%-32s %7s %14s %10s %8s %14s %10s%s%s\n", "sequence", "frames", "relMSE", "PSNR(dB)", "SSIM", "temporal relMSE",
+                    "tPSNR(dB)", flip.enabled() ? "     FLIP" : "", cvvdp.enabled() ? " CVVDP(JOD)" : "");
     for (const std::string& dir : a.images) {
         auto seq = sequenceImages(dir, false);
         // The frames are matched by number: the same numbers in both, or one line naming the first that is not.
@@ -223,12 +294,15 @@ void runSequence(const CompareArgs& a) {
                             {"psnr", psnr / n},      {"ssim", ssim / n},           {"temporal_relmse", trel / steps},
                             {"tpsnr", tpsnr / steps}};
         s["flip"] = flipOk ? nlohmann::json(flipSum / n) : nlohmann::json(nullptr);
+        const std::optional<double> jod = cvvdp.enabled() ? cvvdp.sequence(dir, ref, seq) : std::nullopt;
+        s["cvvdp"] = jod ? nlohmann::json(*jod) : nlohmann::json(nullptr);
         if (a.json) {
             j["sequences"].push_back(s);
         } else {
             std::printf("%-32s %7zu %14.6g %10.3f %8.4f %14.6g %10.3f", dir.c_str(), seq.size(), rel / n, psnr / n, ssim / n,
                         trel / steps, tpsnr / steps);
             if (flip.enabled()) flipOk ? std::printf(" %8.4f", flipSum / n) : std::printf(" %8s", "-");
+            if (cvvdp.enabled()) jod ? std::printf(" %10.4f", *jod) : std::printf(" %10s", "-");
             std::printf("\n");
         }
         if (!a.video.empty()) all.push_back(std::move(seq));  // every frame has the reference's size (computeMetrics)
@@ -338,6 +412,9 @@ void addCompareCommand(CLI::App& app) {
     cmd->add_flag("--no-flip", a->noFlip,
                   "With --sequence: no FLIP column (by default the mean HDR-FLIP over the frames when the flip command "
                   "of pip's flip-evaluator is on PATH)");
+    cmd->add_flag("--no-cvvdp", a->noCvvdp,
+                  "With --sequence: no ColorVideoVDP column (by default the JOD of each sequence when the atrous-cvvdp "
+                  "command of the atrous Python package is on PATH and pip's cvvdp is installed beside it)");
     cmd->add_option("--error-maps", a->errorMaps, "Write <name>_se.exr and <name>_relse.exr error maps into DIR");
     cmd->callback([a] { run(*a); });
 }

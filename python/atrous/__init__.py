@@ -43,6 +43,7 @@ __all__ = [
     "metrics",
     "relmse",
     "temporal_metrics",
+    "tonemap",
     "read_image",
     "read_buffers",
     "write_image",
@@ -585,4 +586,4 @@ if render.__doc__:
 
 
 # The metrics (measure.py) use _prepare above.
-from .measure import metrics, relmse, temporal_metrics  # noqa: E402
+from .measure import metrics, relmse, temporal_metrics, tonemap  # noqa: E402

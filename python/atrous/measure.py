@@ -32,3 +32,9 @@ def temporal_metrics(image: Any, previous: Any, reference: Any, previous_referen
                                                            (reference, "reference"),
                                                            (previous_reference, "previous_reference"))]
     return dict(_core.temporal_metrics(*arrays))
+
+
+def tonemap(image: Any) -> Any:
+    """The tonemap the PSNR and SSIM of :func:`metrics` compare through: clamp((x / (1 + x))^(1/2.2),
+    0, 1), x < 0 -> 0 (tonemapForMetrics, include/atrous/metrics.h); an H x W x 3 numpy array."""
+    return _core.tonemap(_prepare(image, "image", allow_gray=False))

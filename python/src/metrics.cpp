@@ -39,12 +39,22 @@ nb::dict pyTemporalMetrics(const Array& image, const Array& previous, const Arra
     return d;
 }
 
+// The tonemap of the PSNR and SSIM (tonemapForMetrics), as an H x W x 3 array: what the metrics
+// compare, and what ColorVideoVDP is shown (atrous.eval.cvvdp).
+nb::object pyTonemap(const Array& image) {
+    Image img = hostImage(image, "image");
+    float* v = img.data();
+    for (size_t i = 0, n = img.plane() * size_t(img.channels()); i < n; ++i) v[i] = tonemapForMetrics(v[i]);
+    return fromImage(std::move(img));
+}
+
 }  // namespace
 
 void bindMetrics(nb::module_& m) {
     m.def("metrics", &pyMetrics, nb::arg("image"), nb::arg("reference"));
     m.def("temporal_metrics", &pyTemporalMetrics, nb::arg("image"), nb::arg("previous"), nb::arg("reference"),
           nb::arg("previous_reference"));
+    m.def("tonemap", &pyTonemap, nb::arg("image"));
 }
 
 }  // namespace atrous::python
