@@ -440,7 +440,9 @@ TEST(Reliability, NonFiniteInputsNeverReachTheOutput) {
     for (Image* img : {&color, &var, &albedo, &normal, &position, &depth, &emission, &motion})
         for (int j = 0; j < 6; ++j, ++k)  // -Inf variance is negative: an error of its own
             (*img)((k * 7) % w, (k * 5) % h, k % 3) = img == &var ? bad[k % 2] : bad[k % 3];
-    DenoiseInputs in{&color, &var, &albedo, &normal, &position, &depth, &ids, &emission};
+    DenoiseInputs in;
+    in.color = &color, in.variance = &var, in.albedo = &albedo, in.normal = &normal, in.position = &position;
+    in.depth = &depth, in.ids = &ids, in.emission = &emission;
     for (DenoiseMethod m : {DenoiseMethod::Eaw, DenoiseMethod::Sure}) {
         DenoiseOptions o;
         o.method = m;
@@ -450,7 +452,9 @@ TEST(Reliability, NonFiniteInputsNeverReachTheOutput) {
         in.variance = &var;
     }
     SvgfDenoiser svgf;
-    SvgfFrame f{&color, &albedo, &normal, &depth, &ids, &motion, &emission};
+    SvgfFrame f;  // by name: Frame's order is not SvgfFrame's old one
+    f.color = &color, f.albedo = &albedo, f.normal = &normal, f.depth = &depth, f.ids = &ids, f.motion = &motion;
+    f.emission = &emission;
     for (int i = 0; i < 3; ++i) EXPECT_TRUE(allFinite(svgf.denoiseFrame(f))) << "svgf frame " << i;
 }
 

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -21,6 +22,35 @@ using atrous::test::TempDir;
 namespace fs = std::filesystem;
 
 namespace {
+
+// A stand-in for an external command (flip, atrous-cvvdp): DIR/NAME/EXE, a shell script.
+std::string standIn(const TempDir& dir, const std::string& name, const std::string& exe, const std::string& body) {
+    const std::string bin = dir / name;
+    fs::create_directories(bin);
+    std::ofstream(bin + "/" + exe) << "#!/bin/sh\n" << body;
+    fs::permissions(bin + "/" + exe, fs::perms::owner_all);
+    return bin;
+}
+
+// `compare --json ARGS --sequence DIR/ref DIR/out` with PATH set to `path`: the first sequence's
+// value of `key` and the output. The other metrics must be there (exit 0, relMSE > 0).
+std::pair<nlohmann::json, std::string> compareWith(const TempDir& dir, const std::string& path, const std::string& args,
+                                                   const char* key) {
+    const char* old = std::getenv("PATH");
+    const std::string oldPath = old ? old : "/usr/bin:/bin";
+    setenv("PATH", path.c_str(), 1);
+    auto r = runCli("compare --json " + args + " --sequence " + dir / "ref" + " " + dir / "out");
+    setenv("PATH", oldPath.c_str(), 1);
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    const auto s = nlohmann::json::parse(r.output.substr(r.output.find('{')))["sequences"][0];
+    EXPECT_GT(s["relmse"].get<double>(), 0.0) << r.output;
+    return {s[key], r.output};
+}
+
+std::string currentPath() {
+    const char* old = std::getenv("PATH");
+    return old ? old : "/usr/bin:/bin";
+}
 
 atrous::Image frame(float base, float offset) {
     atrous::Image img(16, 12, 3);
@@ -125,31 +155,17 @@ TEST(SequenceCompare, FlipColumnFromTheFlipCommandOnPath) {
     TempDir dir;
     writeSequence(dir / "ref", 3, 0.0f, false);
     writeSequence(dir / "out", 3, 0.1f, false);
-    auto standIn = [&](const std::string& name, const std::string& body) {
-        const std::string bin = dir / name;
-        fs::create_directories(bin);
-        std::ofstream(bin + "/flip") << "#!/bin/sh\n" << body;
-        fs::permissions(bin + "/flip", fs::perms::owner_all);
-        return bin;
-    };
-    const std::string good = standIn("good", "[ \"$1\" = -h ] && { echo 'FLIP v1.7.'; exit 0; }\n"
-                                             "[ \"$1\" = -r ] && [ -s \"$2\" ] && [ \"$3\" = -t ] && [ -s \"$4\" ] || exit 3\n"
-                                             "echo 'FLIP between reference image and test image'\necho '     Mean: 0.250000'\n");
-    const std::string other = standIn("other", "echo 'usage: flip [-t|-u|-m] file ...'\nexit 1\n");
-    const std::string failing = standIn("failing", "[ \"$1\" = -h ] && { echo 'FLIP v1.7.'; exit 0; }\necho 'boom'\nexit 1\n");
-    const char* old = std::getenv("PATH");
-    const std::string oldPath = old ? old : "/usr/bin:/bin";
-    auto compare = [&](const std::string& path, const std::string& args) {
-        setenv("PATH", path.c_str(), 1);
-        auto r = runCli("compare --json " + args + " --sequence " + dir / "ref" + " " + dir / "out");
-        setenv("PATH", oldPath.c_str(), 1);
-        EXPECT_EQ(r.exitCode, 0) << r.output;
-        const auto s = nlohmann::json::parse(r.output.substr(r.output.find('{')))["sequences"][0];
-        EXPECT_GT(s["relmse"].get<double>(), 0.0) << r.output;  // the other metrics are there
-        return std::make_pair(s["flip"], r.output);
-    };
-    EXPECT_DOUBLE_EQ(compare(good + ":" + oldPath, "").first.get<double>(), 0.25);
-    EXPECT_TRUE(compare(good + ":" + oldPath, "--no-flip").first.is_null());
+    const std::string good = standIn(dir, "good", "flip",
+                                     "[ \"$1\" = -h ] && { echo 'FLIP v1.7.'; exit 0; }\n"
+                                     "[ \"$1\" = -r ] && [ -s \"$2\" ] && [ \"$3\" = -t ] && [ -s \"$4\" ] || exit 3\n"
+                                     "echo 'FLIP between reference image and test image'\necho '     Mean: 0.250000'\n");
+    const std::string other = standIn(dir, "other", "flip", "echo 'usage: flip [-t|-u|-m] file ...'\nexit 1\n");
+    const std::string failing =
+        standIn(dir, "failing", "flip", "[ \"$1\" = -h ] && { echo 'FLIP v1.7.'; exit 0; }\necho 'boom'\nexit 1\n");
+    const std::string path = currentPath();
+    auto compare = [&](const std::string& p, const std::string& args) { return compareWith(dir, p, "--no-cvvdp " + args, "flip"); };
+    EXPECT_DOUBLE_EQ(compare(good + ":" + path, "").first.get<double>(), 0.25);
+    EXPECT_TRUE(compare(good + ":" + path, "--no-flip").first.is_null());
     auto none = compare("/usr/bin:/bin", "");
     EXPECT_TRUE(none.first.is_null());
     EXPECT_NE(none.second.find("note: no FLIP column"), std::string::npos) << none.second;
@@ -190,35 +206,23 @@ TEST(SequenceCompare, CvvdpColumnFromTheAtrousCvvdpCommand) {
     TempDir dir;
     writeSequence(dir / "ref", 3, 0.0f, false);
     writeSequence(dir / "out", 3, 0.1f, false);
-    auto standIn = [&](const std::string& name, const std::string& body) {
-        const std::string bin = dir / name;
-        fs::create_directories(bin);
-        std::ofstream(bin + "/atrous-cvvdp") << "#!/bin/sh\n" << body;
-        fs::permissions(bin + "/atrous-cvvdp", fs::perms::owner_all);
-        return bin;
-    };
+    const std::string exe = "atrous-cvvdp";
     const std::string good = standIn(
-        "good", "[ \"$1\" = --check ] && { echo 'ColorVideoVDP: ready'; exit 0; }\n"
-                "[ \"$1\" = --pairs ] && [ \"$(wc -l < \"$2\")\" -eq 3 ] || exit 3\n"
-                "while IFS=\"$(printf '\\t')\" read -r r t; do [ -s \"$r\" ] && [ -s \"$t\" ] || exit 4; done < \"$2\"\n"
-                "echo 'JOD: 7.500000'\n");
-    const std::string missing = standIn("missing", "echo 'cvvdp is not installed in /x/python (pip install cvvdp)'\nexit 3\n");
-    const std::string failing = standIn("failing", "[ \"$1\" = --check ] && exit 0\necho boom\nexit 1\n");
-    const char* old = std::getenv("PATH");
-    const std::string oldPath = old ? old : "/usr/bin:/bin";
-    auto compare = [&](const std::string& path, const std::string& args) {
-        setenv("PATH", path.c_str(), 1);
-        auto r = runCli("compare --json --no-flip " + args + " --sequence " + dir / "ref" + " " + dir / "out");
-        setenv("PATH", oldPath.c_str(), 1);
-        EXPECT_EQ(r.exitCode, 0) << r.output;
-        const auto s = nlohmann::json::parse(r.output.substr(r.output.find('{')))["sequences"][0];
-        EXPECT_GT(s["relmse"].get<double>(), 0.0) << r.output;
-        return std::make_pair(s["cvvdp"], r.output);
-    };
-    EXPECT_DOUBLE_EQ(compare(good + ":" + oldPath, "").first.get<double>(), 7.5);
-    EXPECT_TRUE(compare(good + ":" + oldPath, "--no-cvvdp").first.is_null());
+        dir, "good", exe,
+        "[ \"$1\" = --check ] && { echo 'ColorVideoVDP: ready'; exit 0; }\n"
+        "[ \"$1\" = --pairs ] && [ \"$(wc -l < \"$2\")\" -eq 3 ] || exit 3\n"
+        "while IFS=\"$(printf '\\t')\" read -r r t; do [ -s \"$r\" ] && [ -s \"$t\" ] || exit 4; done < \"$2\"\n"
+        "echo 'JOD: 7.500000'\n");
+    const std::string missing =
+        standIn(dir, "missing", exe, "echo 'Traceback (most recent call last):'\necho 'cvvdp is not installed in /x/python (pip install cvvdp)'\nexit 3\n");
+    const std::string failing = standIn(dir, "failing", exe, "[ \"$1\" = --check ] && exit 0\necho boom\nexit 1\n");
+    const std::string path = currentPath();
+    auto compare = [&](const std::string& p, const std::string& args) { return compareWith(dir, p, "--no-flip " + args, "cvvdp"); };
+    EXPECT_DOUBLE_EQ(compare(good + ":" + path, "").first.get<double>(), 7.5);
+    EXPECT_TRUE(compare(good + ":" + path, "--no-cvvdp").first.is_null());
     auto notInstalled = compare(missing + ":/usr/bin:/bin", "");
     EXPECT_TRUE(notInstalled.first.is_null());
+    // The note gives the command's last line (a Python error's is what went wrong).
     EXPECT_NE(notInstalled.second.find("note: no CVVDP column: cvvdp is not installed"), std::string::npos)
         << notInstalled.second;
     auto none = compare("/usr/bin:/bin", "");
@@ -229,9 +233,9 @@ TEST(SequenceCompare, CvvdpColumnFromTheAtrousCvvdpCommand) {
     EXPECT_NE(failed.second.find("ColorVideoVDP (" + failing + "/atrous-cvvdp) failed on"), std::string::npos)
         << failed.second;
     // The text table has the column when it runs.
-    setenv("PATH", (good + ":" + oldPath).c_str(), 1);
+    setenv("PATH", (good + ":" + path).c_str(), 1);
     auto table = runCli("compare --no-flip --sequence " + dir / "ref" + " " + dir / "out");
-    setenv("PATH", oldPath.c_str(), 1);
+    setenv("PATH", path.c_str(), 1);
     EXPECT_NE(table.output.find("CVVDP(JOD)"), std::string::npos) << table.output;
     EXPECT_NE(table.output.find("7.5000"), std::string::npos) << table.output;
 }

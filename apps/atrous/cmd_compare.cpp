@@ -131,7 +131,7 @@ public:
         int rc = 0;
         const std::string out = runCommand(io::shellQuote(mExe) + " --check 2>&1", &rc);
         if (rc != 0) {
-            mNote = out.substr(0, out.find('\n'));
+            mNote = lastLine(out);
             mExe.clear();
             return;
         }
@@ -152,20 +152,26 @@ public:
             pairs += r + "\t" + t + "\n";
         }
         const std::string list = (dir / "pairs.txt").string();
-        if (FILE* f = std::fopen(list.c_str(), "w")) {
-            std::fputs(pairs.c_str(), f);
-            std::fclose(f);
-        }
+        FILE* f = std::fopen(list.c_str(), "w");
+        if (!f || std::fputs(pairs.c_str(), f) < 0 || std::fclose(f) != 0)
+            throw RuntimeError(list + ": cannot write the list of frames for ColorVideoVDP");
         int rc = 0;
         const std::string out = runCommand(io::shellQuote(mExe) + " --pairs " + io::shellQuote(list) + " 2>&1", &rc);
         const size_t at = out.find("JOD:");
         if (rc == 0 && at != std::string::npos) return std::strtod(out.c_str() + at + 4, nullptr);
         std::fprintf(stderr, "note: ColorVideoVDP (%s) failed on %s: %s\n", mExe.c_str(), name.c_str(),
-                     out.substr(0, 200).c_str());
+                     lastLine(out).c_str());
         return std::nullopt;
     }
 
 private:
+    // A Python error's last line says what went wrong (the first is "Traceback ...").
+    static std::string lastLine(const std::string& out) {
+        size_t end = out.find_last_not_of(" \n\r\t");
+        if (end == std::string::npos) return "(no output)";
+        const size_t start = out.rfind('\n', end);
+        return out.substr(start == std::string::npos ? 0 : start + 1, end + 1 - (start == std::string::npos ? 0 : start + 1)).substr(0, 300);
+    }
     std::string mExe, mNote;
     std::unique_ptr<TempFolder> mTemp;
 };

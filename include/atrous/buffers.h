@@ -48,6 +48,10 @@ bool bufferTakesGrey(Buffer b);    // bufferInfo(b).takesGrey
 // others (denoise() no motion; SVGF no variance or position; the sequence methods all of them).
 // Non-finite values are treated as missing for that pixel.
 struct Frame {
+    // Not an aggregate: the buffers are set by name (f.color = &c; ...), never by position, so that
+    // code written for an older order (SvgfFrame's: color, albedo, normal, depth, ids, motion,
+    // emission) does not compile instead of silently taking one buffer for another.
+    Frame() {}
     const Image* color = nullptr;
     const Image* variance = nullptr;
     const Image* albedo = nullptr;

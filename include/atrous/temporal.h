@@ -135,6 +135,22 @@ CameraFit fitCamera(const Image& position);  // host image, 3 channels; 0 or non
 // or the point is behind one.
 Image motionFromPositions(const Image& position, const CameraFit& current, const CameraFit& previous);
 
+// Motion for frames that have neither motion vectors nor a Position pass: from the colours
+// themselves (src/filters/motion_estimate.cpp). Coarse-to-fine block matching on log(1 + the
+// 3x3-averaged luminance), `levels` halvings, blocks of `block` pixels searched ±radius pixels at
+// the coarsest level (±radius · 2^(levels-1) at full size) and ±1 around the coarser level's
+// vectors (of the block and its four neighbours) below; a block whose costs tie within 2% keeps
+// the vector nearest its prediction (flat regions). The vectors are bilinear between block
+// centres: right for a camera's smooth field, a blur of it at the edges of what moves, which the
+// temporal method's depth, normal and colour tests then reject. 2 channels, previous − current
+// in pixels (Frame's motion); host images of one size (3 channels, or 1).
+struct MotionEstimateParams {
+    int levels = 4;
+    int block = 8;
+    int radius = 4;
+};
+Image estimateMotion(const Image& current, const Image& previous, const MotionEstimateParams& params = {});
+
 // The methods that denoise a sequence as a sequence, beside the still methods (denoiseMethods(),
 // which `atrous denoise --sequence` also runs frame by frame): one row each, the one list the
 // CLI's --method help and messages and Python (atrous.SEQUENCE_METHODS) read.

@@ -488,7 +488,7 @@ def denoise_temporal(frames: Sequence[Dict[str, Any]], center: int, *, method: s
         if unknown:
             raise ValueError(f"frame {i}: unknown buffer {unknown[0]!r} (expected {', '.join(_FRAME_KEYS)})")
         core_frames.append({k: _prepare(v, f"frames[{i}].{k}", allow_gray=k != "color",
-                                        channels=(2, 3) if k == "motion" else (3,))
+                                        channels=(2, 3) if k in ("motion", "ids") else (3,))
                             for k, v in f.items() if v is not None and k != "time"})
     if isinstance(center, bool) or not isinstance(center, (int, np.integer)) or not 0 <= int(center) < len(frames):
         raise ValueError(f"center must be a frame index in 0..{len(frames) - 1}, got {center!r}")

@@ -8,6 +8,7 @@
 #include <nanobind/stl/vector.h>
 #include <nanobind/stl/unordered_map.h>
 
+#include <cmath>
 #include <initializer_list>
 #include <memory>
 #include <string>
@@ -332,6 +333,18 @@ nb::object pyDenoiseTemporal(nb::list frames, size_t center, const std::string& 
             const CameraFit fit = fitCamera(pos);
             fitted.push_back(motionFromPositions(pos, fit, previous));
             previous = fit;
+        }
+        for (size_t i = 0; i < buffers.size(); ++i) buffers[i]->refs.set(B::Motion, &fitted[i]);
+    } else if (!anyMotion && buffers.size() > 1) {
+        // Neither: motion from the colours themselves (estimateMotion), as the CLI does; the first
+        // frame has no previous one (NaN: no history).
+        for (size_t i = 0; i < buffers.size(); ++i) {
+            if (i == 0) {
+                fitted.push_back(Image(colors[0]->width(), colors[0]->height(), 2));
+                std::fill(fitted[0].data(), fitted[0].data() + fitted[0].size(), std::nanf(""));
+            } else {
+                fitted.push_back(estimateMotion(*colors[i], *colors[i - 1]));
+            }
         }
         for (size_t i = 0; i < buffers.size(); ++i) buffers[i]->refs.set(B::Motion, &fitted[i]);
     }

@@ -485,8 +485,10 @@ namespace {
 
 DenoiseInputs inputsOf(const DenoiseBuffers& buffers, filters::HandedOver& stores) {
     stores.color = buffers.color, stores.variance = buffers.variance, stores.emission = buffers.emission;
-    return DenoiseInputs{buffers.color, buffers.variance, buffers.albedo, buffers.normal, buffers.position,
-                         buffers.depth, buffers.ids, buffers.emission};
+    DenoiseInputs in;
+    in.color = buffers.color, in.variance = buffers.variance, in.albedo = buffers.albedo, in.normal = buffers.normal;
+    in.position = buffers.position, in.depth = buffers.depth, in.ids = buffers.ids, in.emission = buffers.emission;
+    return in;
 }
 
 }  // namespace

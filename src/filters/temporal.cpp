@@ -60,7 +60,7 @@ namespace {
 
 // A frame as the hops read it: its sanitised G-buffer and colour statistics, owned here.
 struct PreparedFrame {
-    Image depth, normal, ids, motion, grad, stats, color;
+    Image depth, normal, ids, motion, grad, stats, color, emission;
     temporal::FrameViews views;
 };
 
@@ -101,9 +101,16 @@ void prepare(const CpuExec& exec, const SvgfFrame& f, bool stats, float fireflyK
         Image zero(w, h, 3), scratch = Image::uninitialized(w, h, 3);
         filters::runFireflyClamp(exec, filters::FireflyClamp{fireflyK, 0, v.color, zero.view(), p.color.view(),
                                                              scratch.view(), ImageView{}});
+        // The emission is scaled with its colour: a firefly on a light (the sun seen through the
+        // sky, where colour = emission) clamped in the colour alone would leave colour - emission,
+        // which the still method filters, hugely negative in the average.
+        if (f.emission) {
+            p.emission = Image::uninitialized(w, h, 3);
+            exec.forEachPixel(w, h, temporal::ScaleLikeColour{v.color, p.color.view(), viewOf(f.emission), p.emission.view()});
+        }
         v.color = p.color.view();
     }
-    v.emission = viewOf(f.emission);
+    v.emission = p.emission.empty() ? viewOf(f.emission) : p.emission.view();
     if (stats) {
         p.stats = Image::uninitialized(w, h, 3);
         v.stats = p.stats.view();
@@ -192,7 +199,7 @@ TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t cente
             temporal::FrameViews& v = it->second.views;
             if (it->second.color.empty()) v.color = viewOf(window[i].color);
             v.albedo = viewOf(window[i].albedo), v.normalRaw = viewOf(window[i].normal);
-            v.emission = viewOf(window[i].emission);
+            v.emission = it->second.emission.empty() ? viewOf(window[i].emission) : it->second.emission.view();
         }
         prepared[i - lo] = &it->second;
     }
@@ -206,6 +213,7 @@ TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t cente
     // The centre's colour as its neighbours' is taken (after the firefly pass).
     const PreparedFrame& pc = *prepared[center - lo];
     g.color = pc.color.empty() ? c.color->clone() : pc.color.clone();
+    if (!pc.emission.empty()) g.emission = pc.emission.clone();  // scaled with the colour's firefly clamp
     Image track(w, h, 2), alive(w, h, 1);
     for (int dir = -1; dir <= 1; dir += 2) {
         if ((dir < 0 && center == lo) || (dir > 0 && center == hi)) continue;

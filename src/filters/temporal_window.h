@@ -200,6 +200,18 @@ struct Hop {
     }
 };
 
+// out = e × (the factor the firefly pass scaled this pixel's colour by: lum(after) / lum(before),
+// 1 where the colour was not positive).
+struct ScaleLikeColour {
+    ImageView before, after, e, out;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        const float lb = filters::lum(before(x, y, 0), before(x, y, 1), before(x, y, 2));
+        const float la = filters::lum(after(x, y, 0), after(x, y, 1), after(x, y, 2));
+        const float s = lb > 0.0f && la < lb ? la / lb : 1.0f;
+        for (int k = 0; k < 3; ++k) out(x, y, k) = e(x, y, k) * s;
+    }
+};
+
 // Sums -> means in place: colour, albedo, emission / count; variance / count² (the variance of a
 // mean of independent frames); the normal renormalised (a zero sum stays zero: background).
 struct Finish {

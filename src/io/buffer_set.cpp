@@ -34,7 +34,8 @@ DenoiseInputs BufferSet::inputs() const { return refsOf(*this); }
 
 BufferRefs refsOf(const BufferSet& set) {
     BufferRefs r;
-    for (int b = 0; b < kBufferCount; ++b) r.set(Buffer(b), &set.image[b]);
+    for (int b = 0; b < kBufferCount; ++b)
+        if (Buffer(b) != Buffer::MaterialId) r.set(Buffer(b), &set.image[b]);  // its values are the ids' channel 1
     return r;
 }
 

@@ -80,3 +80,24 @@ def test_motion_from_positions_when_no_frame_has_motion(frames, reference):
          for name, fs in (("vectors", frames), ("fitted", no_motion), ("still", still))}
     assert e["fitted"] < 1.1 * e["vectors"], e
     assert e["fitted"] < e["still"], e
+
+
+def test_a_dolly_without_motion_or_positions_uses_the_colours_motion():
+    # As `denoise --sequence` does (tests/camera_fit_test.cpp): frames with neither motion nor
+    # positions get motion estimated from their colours; zero motion (frames taken as still)
+    # averages what moved. The same dolly gives 0.061 against 0.397 from the CLI; the bound is half.
+    seq = list(atrous.render_sequence("cornell-spheres", 6, camera_path="dolly", width=96, height=72, spp=2, seed=5))
+    refs = list(atrous.render_sequence("cornell-spheres", 6, camera_path="dolly", width=96, height=72, spp=128,
+                                       seed=77))
+    bare = [{k: v for k, v in f.items() if k not in ("motion", "position", "time")} for f in seq]
+    still = [dict(f, motion=np.zeros(f["color"].shape[:2] + (2,), np.float32)) for f in bare]
+    est = np.mean([atrous.relmse(atrous.denoise_temporal(bare, c, method="eaw"), refs[c]["color"]) for c in range(6)])
+    zero = np.mean([atrous.relmse(atrous.denoise_temporal(still, c, method="eaw"), refs[c]["color"]) for c in range(6)])
+    assert est < 0.5 * zero, (est, zero)
+
+
+def test_ids_of_two_channels_as_read_buffers_gives_them(frames):
+    # atrous.read_buffers gives ids as H x W x 2 (object, material): denoise_temporal takes that.
+    two = [dict(f, ids=np.ascontiguousarray(f["ids"][..., :2])) for f in frames]
+    np.testing.assert_array_equal(atrous.denoise_temporal(two, 2, method="eaw"),
+                                  atrous.denoise_temporal(frames, 2, method="eaw"))

@@ -116,6 +116,8 @@ def _atrous_method(name: str, learned_weights: Optional[str] = None) -> Callable
     # Sequences from `atrous render --frames` carry emission.exr; newer atrous.denoise filters
     # colour - emission and adds it back (no leak of visible lights), older ones have no keyword.
     extra_kw = ("emission",) if _takes_emission() else ()
+    # The weight file is read once for every call (atrous.load_weights), not by each denoise().
+    weights = atrous.load_weights(learned_weights) if learned_weights and name in atrous.WEIGHTED_METHODS else None
 
     def run(b: Dict[str, np.ndarray]) -> np.ndarray:
         # At 1 spp the renderer cannot estimate a variance and writes zeros; a zero variance
@@ -124,8 +126,8 @@ def _atrous_method(name: str, learned_weights: Optional[str] = None) -> Callable
         if var is not None and not np.any(var > 0):
             var = None
         kw = {k: b[k] for k in extra_kw if b.get(k) is not None}
-        if name in atrous.WEIGHTED_METHODS and learned_weights:
-            kw["learned_weights"] = learned_weights
+        if weights is not None:
+            kw["learned_weights"] = weights
         return atrous.denoise(b["color"], albedo=b.get("albedo"), normal=b.get("normal"),
                               position=b.get("position"), depth=b.get("depth"),
                               variance=var, ids=b.get("ids"), method=name, **kw)
