@@ -318,6 +318,8 @@ nb::object pyDenoiseTemporal(nb::list frames, size_t center, const std::string& 
         for (const auto& [name, b] : kKeys)
             if (d.contains(name)) buffers.back()->add({d[name], b, name});
     }
+    TemporalParams tp;
+    for (auto [k, v] : temporal) applyParam(tp, temporalParams(), nb::cast<std::string>(k), v, "temporal");
     // No motion in any frame but positions in all: motion from each frame's fitted camera, as
     // `atrous denoise --sequence` does (include/atrous/temporal.h, fitCamera).
     std::vector<Image> fitted;
@@ -336,22 +338,24 @@ nb::object pyDenoiseTemporal(nb::list frames, size_t center, const std::string& 
         }
         for (size_t i = 0; i < buffers.size(); ++i) buffers[i]->refs.set(B::Motion, &fitted[i]);
     } else if (!anyMotion && buffers.size() > 1) {
-        // Neither: motion from the colours themselves (estimateMotion), as the CLI does; the first
-        // frame has no previous one (NaN: no history).
-        for (size_t i = 0; i < buffers.size(); ++i) {
-            if (i == 0) {
-                fitted.push_back(Image(colors[0]->width(), colors[0]->height(), 2));
-                std::fill(fitted[0].data(), fitted[0].data() + fitted[0].size(), std::nanf(""));
+        // Neither: motion from the colours themselves (estimateMotion), as the CLI does, for the
+        // frames the window reads (centre ± radius) whose previous frame has their size; the
+        // others, and the window's first frame (no previous one), get NaN: no history.
+        const size_t n = buffers.size(), r = size_t(std::max(tp.radius, 0)), c = std::min(center, n - 1);
+        const size_t lo = c > r ? c - r : 0, hi = tp.causal ? c : std::min(n - 1, c + r);
+        for (size_t i = 0; i < n; ++i) {
+            const Image& cur = *colors[i];
+            if (i > lo && i <= hi && cur.view().sameSize(colors[i - 1]->view())) {
+                fitted.push_back(estimateMotion(cur, *colors[i - 1]));
             } else {
-                fitted.push_back(estimateMotion(*colors[i], *colors[i - 1]));
+                fitted.push_back(Image(cur.width(), cur.height(), 2));
+                std::fill(fitted.back().data(), fitted.back().data() + fitted.back().size(), std::nanf(""));
             }
         }
-        for (size_t i = 0; i < buffers.size(); ++i) buffers[i]->refs.set(B::Motion, &fitted[i]);
+        for (size_t i = 0; i < n; ++i) buffers[i]->refs.set(B::Motion, &fitted[i]);
     }
     std::vector<SvgfFrame> window;
     for (const auto& b : buffers) window.push_back(b->refs);
-    TemporalParams tp;
-    for (auto [k, v] : temporal) applyParam(tp, temporalParams(), nb::cast<std::string>(k), v, "temporal");
     DenoiseOptions o;
     o.method = parseDenoiseMethod(method);
     if (denoiseMethodInfo(o.method).usesWeights || o.method == DenoiseMethod::Auto) o.weights = weightsFrom(learnedWeights);

@@ -242,6 +242,7 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
         const std::string name = io::sequenceFrameName(f.index);
         if (i == 0) firstIndex = f.index;
         // No motion vectors but a Position pass (LuxCore): motion from each frame's fitted camera.
+        bool estimated = false;  // motion from the colours (below): not the user's vectors to judge
         const bool usesMotion = svgf || (temporal && radius > 0);
         if (usesMotion && f.motion.empty() && !f.position.empty()) {
             const CameraFit fit = fitCamera(f.position);
@@ -263,6 +264,7 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
             // motion from the colours themselves, block matching against the previous frame.
             if (!window.empty() && window.back().color.view().sameSize(f.color.view())) {
                 f.motion = estimateMotion(f.color, window.back().color);
+                estimated = true;
                 if (!notedMotion)
                     note("denoise: note: the frames have no motion vectors and no Position pass: motion estimated "
                          "from the frames' colours (block matching, docs/temporal.md)");
@@ -274,7 +276,7 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
         }
         // Other renderers' sequences: how much reprojects, with which sign, and whether ids hold.
         io::ReprojectionCheck& check = checks[i];
-        if (!window.empty()) {
+        if (!window.empty() && !estimated) {
             const io::SequenceFrame& prev = window.back();
             check = io::checkReprojection(f.depth, f.normal, f.ids, f.motion, prev.depth, prev.normal, prev.ids);
         }

@@ -101,3 +101,14 @@ def test_ids_of_two_channels_as_read_buffers_gives_them(frames):
     two = [dict(f, ids=np.ascontiguousarray(f["ids"][..., :2])) for f in frames]
     np.testing.assert_array_equal(atrous.denoise_temporal(two, 2, method="eaw"),
                                   atrous.denoise_temporal(frames, 2, method="eaw"))
+
+
+def test_estimated_motion_only_for_the_window(frames):
+    # Colour-only frames: motion is estimated for the frames the window reads; a frame of another
+    # size outside the window is not looked at (as with motion vectors), and one inside is named.
+    small = [{"color": f["color"]} for f in frames[:2]]
+    odd = {"color": np.ones((32, 48, 3), np.float32)}
+    out = atrous.denoise_temporal(small + [odd], 0, method="eaw", temporal={"radius": 1})
+    assert out.shape == (32, 40, 3) and np.isfinite(out).all()
+    with pytest.raises(ValueError, match="frame 2"):
+        atrous.denoise_temporal(small + [odd], 1, method="eaw", temporal={"radius": 1})
