@@ -51,54 +51,64 @@ std::string runCommand(const std::string& cmd, int* rc = nullptr) {
     return out;
 }
 
-// A fresh temporary folder named for this process, removed with the object.
-struct TempFolder {
-    fs::path path;
-    explicit TempFolder(const std::string& prefix) {
-        path = fs::temp_directory_path() / (prefix + std::to_string(::getpid()));
+// The frames as EXR files for the external metrics (FLIP, ColorVideoVDP), in one temporary folder
+// named for this process, removed with the object: each reference frame written once, each
+// sequence's frames once (the next sequence's replace them).
+class FrameFiles {
+public:
+    FrameFiles() {
+        mDir = fs::temp_directory_path() / ("atrous-compare-" + std::to_string(::getpid()));
         std::error_code ec;
-        fs::remove_all(path, ec);
-        fs::create_directories(path, ec);
-        if (ec) throw RuntimeError(path.string() + ": cannot create (" + ec.message() + ")");
+        fs::remove_all(mDir, ec);
+        fs::create_directories(mDir, ec);
+        if (ec) throw RuntimeError(mDir.string() + ": cannot create (" + ec.message() + ")");
     }
-    ~TempFolder() {
+    ~FrameFiles() {
         std::error_code ec;
-        fs::remove_all(path, ec);
+        fs::remove_all(mDir, ec);
     }
-    TempFolder(const TempFolder&) = delete;
-    TempFolder& operator=(const TempFolder&) = delete;
+    FrameFiles(const FrameFiles&) = delete;
+    FrameFiles& operator=(const FrameFiles&) = delete;
+    const fs::path& dir() const { return mDir; }
+    // The reference's frame `index` (written the first time) and the sequence's (written now).
+    std::pair<std::string, std::string> frame(int index, const Image& ref, const Image& test) const {
+        const std::string r = (mDir / ("ref_" + std::to_string(index) + ".exr")).string();
+        const std::string t = (mDir / ("test_" + std::to_string(index) + ".exr")).string();
+        if (!fs::exists(r)) io::writeImage(r, ref);
+        io::writeImage(t, test);
+        return {r, t};
+    }
+
+private:
+    fs::path mDir;
 };
 
 // HDR-FLIP (NVIDIA's FLIP, the `flip` command of PyPI's flip-evaluator, which `make python` puts in
 // .venv/bin) of a frame against the reference's, when `flip` is on PATH and says it is FLIP (`flip
-// -h`; Debian has a line-ending converter of that name): both written as EXR into a temporary
-// folder (the reference's once per frame), `flip -r REF -t TEST -v 1` run, its "Mean: x" read.
+// -h`; Debian has a line-ending converter of that name): `flip -r REF -t TEST -v 1` on the
+// frames' files (FrameFiles), its "Mean: x" read.
 // Off (enabled() false) when there is no such `flip`, or with --no-flip; a frame it fails on
 // gives no value (nullopt) and one note on stderr, and the other metrics go on.
 class FlipRunner {
 public:
     explicit FlipRunner(bool wanted) {
         if (wanted) mExe = io::findOnPath("flip");
-        if (!mExe.empty() && run(io::shellQuote(mExe) + " -h 2>&1").find("FLIP") == std::string::npos) {
+        if (!mExe.empty() && runCommand(io::shellQuote(mExe) + " -h 2>&1").find("FLIP") == std::string::npos) {
             std::fprintf(stderr, "note: no FLIP column: %s is not NVIDIA's FLIP (pip install flip-evaluator)\n",
                          mExe.c_str());
             mExe.clear();
             mNoted = true;
         }
-        if (!mExe.empty()) mTemp = std::make_unique<TempFolder>("atrous-flip-");
     }
     bool enabled() const { return !mExe.empty(); }
     bool noted() const { return mNoted; }
 
-    std::optional<double> frame(int index, const Image& ref, const Image& test) {
-        const fs::path& mDir = mTemp->path;
-        const std::string refPath = (mDir / ("ref_" + std::to_string(index) + ".exr")).string();
-        if (!fs::exists(refPath)) io::writeImage(refPath, ref);
-        const std::string testPath = (mDir / "test.exr").string();
-        io::writeImage(testPath, test);
+    // refPath, testPath: the frame's files; `dir` takes FLIP's own outputs (none with -nerm -nexm).
+    std::optional<double> frame(int index, const std::string& refPath, const std::string& testPath, const fs::path& dir) {
         int rc = 0;
-        const std::string out = run(io::shellQuote(mExe) + " -r " + io::shellQuote(refPath) + " -t " + io::shellQuote(testPath) +
-                                    " -v 1 -nerm -nexm -d " + io::shellQuote(mDir.string()) + " 2>&1", &rc);
+        const std::string out = runCommand(io::shellQuote(mExe) + " -r " + io::shellQuote(refPath) + " -t " +
+                                           io::shellQuote(testPath) + " -v 1 -nerm -nexm -d " + io::shellQuote(dir.string()) +
+                                           " 2>&1", &rc);
         const size_t at = out.find("Mean:");
         if (rc == 0 && at != std::string::npos) return std::strtod(out.c_str() + at + 5, nullptr);
         std::fprintf(stderr, "note: FLIP (%s) failed on frame %d: %s\n", mExe.c_str(), index, out.substr(0, 200).c_str());
@@ -106,17 +116,15 @@ public:
     }
 
 private:
-    static std::string run(const std::string& cmd, int* rc = nullptr) { return runCommand(cmd, rc); }
     std::string mExe;
-    std::unique_ptr<TempFolder> mTemp;
     bool mNoted = false;
 };
 
 // ColorVideoVDP (PyPI's cvvdp) of a whole sequence against the reference's, in JOD (10: no visible
 // difference), through the atrous Python package's `atrous-cvvdp` command (python/atrous/eval/
 // cvvdp.py; `make python` puts it in .venv/bin; cvvdp itself is `pip install cvvdp`, with PyTorch):
-// the frames written as EXR into a temporary folder (the reference's once), a list of
-// REFERENCE<TAB>TEST lines handed to `atrous-cvvdp --pairs`, its "JOD: x" read. Off, with one note,
+// a list of the frames' files (FrameFiles), REFERENCE<TAB>TEST lines, handed to `atrous-cvvdp
+// --pairs`, its "JOD: x" read. Off, with one note,
 // when the command is not on PATH or its --check says cvvdp cannot run; off with --no-cvvdp. A
 // sequence it fails on gives no value (nullopt) and one note.
 class CvvdpRunner {
@@ -135,22 +143,15 @@ public:
             mExe.clear();
             return;
         }
-        mTemp = std::make_unique<TempFolder>("atrous-cvvdp-");
     }
     bool enabled() const { return !mExe.empty(); }
     const std::string& note() const { return mNote; }  // why it is off ("" when on or not wanted)
 
-    std::optional<double> sequence(const std::string& name, const std::vector<std::pair<int, Image>>& ref,
-                                   const std::vector<std::pair<int, Image>>& test) {
-        const fs::path& dir = mTemp->path;
+    // files: each frame's reference and test file, in order; `dir` takes the list.
+    std::optional<double> sequence(const std::string& name, const std::vector<std::pair<std::string, std::string>>& files,
+                                   const fs::path& dir) {
         std::string pairs;
-        for (size_t i = 0; i < ref.size(); ++i) {
-            const std::string r = (dir / ("ref_" + std::to_string(ref[i].first) + ".exr")).string();
-            const std::string t = (dir / ("test_" + std::to_string(test[i].first) + ".exr")).string();
-            if (!fs::exists(r)) io::writeImage(r, ref[i].second);
-            io::writeImage(t, test[i].second);
-            pairs += r + "\t" + t + "\n";
-        }
+        for (const auto& [r, t] : files) pairs += r + "\t" + t + "\n";
         const std::string list = (dir / "pairs.txt").string();
         FILE* f = std::fopen(list.c_str(), "w");
         if (!f || std::fputs(pairs.c_str(), f) < 0 || std::fclose(f) != 0)
@@ -173,7 +174,6 @@ private:
         return out.substr(start == std::string::npos ? 0 : start + 1, end + 1 - (start == std::string::npos ? 0 : start + 1)).substr(0, 300);
     }
     std::string mExe, mNote;
-    std::unique_ptr<TempFolder> mTemp;
 };
 
 // The frames of a sequence by number: a reference frame's reference.exr when it has one (`atrous
@@ -261,6 +261,8 @@ void runSequence(const CompareArgs& a) {
                              ".venv/bin) is not on PATH\n");
     CvvdpRunner cvvdp(!a.noCvvdp);
     if (!cvvdp.note().empty()) std::fprintf(stderr, "note: no CVVDP column: %s\n", cvvdp.note().c_str());
+    // Written once for both external metrics, only when one of them runs.
+    const std::unique_ptr<FrameFiles> files = flip.enabled() || cvvdp.enabled() ? std::make_unique<FrameFiles>() : nullptr;
     if (!a.json)
         std::printf("%-32s %7s %14s %10s %8s %14s %10s%s%s\n", "sequence", "frames", "relMSE", "PSNR(dB)", "SSIM", "temporal relMSE",
                     "tPSNR(dB)", flip.enabled() ? "     FLIP" : "", cvvdp.enabled() ? " CVVDP(JOD)" : "");
@@ -277,6 +279,7 @@ void runSequence(const CompareArgs& a) {
         }
         double rel = 0, psnr = 0, ssim = 0, trel = 0, tpsnr = 0, flipSum = 0;
         bool flipOk = flip.enabled();
+        std::vector<std::pair<std::string, std::string>> frameFiles;  // for FLIP and ColorVideoVDP
         for (size_t i = 0; i < seq.size(); ++i) {
             ImageMetrics m;
             try {
@@ -289,8 +292,10 @@ void runSequence(const CompareArgs& a) {
                 throw InputError(dir + ": frame " + std::to_string(seq[i].first) + " vs the reference's: " + e.what());
             }
             rel += m.relMse, psnr += m.psnr, ssim += m.ssim;
+            if (files) frameFiles.push_back(files->frame(seq[i].first, ref[i].second, seq[i].second));
             if (flipOk) {
-                const std::optional<double> f = flip.frame(seq[i].first, ref[i].second, seq[i].second);
+                const std::optional<double> f =
+                    flip.frame(seq[i].first, frameFiles.back().first, frameFiles.back().second, files->dir());
                 flipOk = f.has_value();
                 if (f) flipSum += *f;
             }
@@ -300,7 +305,7 @@ void runSequence(const CompareArgs& a) {
                             {"psnr", psnr / n},      {"ssim", ssim / n},           {"temporal_relmse", trel / steps},
                             {"tpsnr", tpsnr / steps}};
         s["flip"] = flipOk ? nlohmann::json(flipSum / n) : nlohmann::json(nullptr);
-        const std::optional<double> jod = cvvdp.enabled() ? cvvdp.sequence(dir, ref, seq) : std::nullopt;
+        const std::optional<double> jod = cvvdp.enabled() ? cvvdp.sequence(dir, frameFiles, files->dir()) : std::nullopt;
         s["cvvdp"] = jod ? nlohmann::json(*jod) : nlohmann::json(nullptr);
         if (a.json) {
             j["sequences"].push_back(s);
