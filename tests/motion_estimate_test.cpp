@@ -1,7 +1,8 @@
 // Motion from the frames themselves (estimateMotion, include/atrous/temporal.h): a textured image
 // moved by a known offset gives that offset (previous − current), exactly away from the border,
 // at shifts up to the coarsest level's reach; a flat image and an unmoved one give zero; noise of a
-// few samples per pixel does not throw the estimate off by more than a pixel; bad inputs throw.
+// few samples per pixel does not throw the estimate off by more than a pixel; bad inputs throw; no
+// previous frame gives NaN (no history).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -42,7 +43,7 @@ TEST(MotionEstimate, RecoversAKnownShift) {
     for (const auto& d : {std::pair{3, -2}, std::pair{-7, 5}, std::pair{19, 11}, std::pair{0, 0}}) {
         const Image previous = texture(160, 120, 0, 0);
         const Image current = texture(160, 120, float(d.first), float(d.second));
-        const Image m = estimateMotion(current, previous);
+        const Image m = estimateMotion(current, &previous);
         ASSERT_EQ(m.channels(), 2);
         EXPECT_LT(worstError(m, float(d.first), float(d.second), 32), 1e-4f) << d.first << "," << d.second;
     }
@@ -51,22 +52,26 @@ TEST(MotionEstimate, RecoversAKnownShift) {
 TEST(MotionEstimate, NoisyFramesStayWithinAPixel) {
     const Image previous = texture(160, 120, 0, 0, 0.15f, 1);
     const Image current = texture(160, 120, 4, -3, 0.15f, 2);
-    EXPECT_LE(worstError(estimateMotion(current, previous), 4, -3, 32), 1.0f);
+    EXPECT_LE(worstError(estimateMotion(current, &previous), 4, -3, 32), 1.0f);
 }
 
 TEST(MotionEstimate, FlatFramesGiveZero) {
     Image flat(64, 48, 3);
     for (size_t i = 0; i < flat.size(); ++i) flat.data()[i] = 0.5f;
-    EXPECT_EQ(worstError(estimateMotion(flat, flat), 0, 0, 0), 0.0f);
+    EXPECT_EQ(worstError(estimateMotion(flat, &flat), 0, 0, 0), 0.0f);
 }
 
 TEST(MotionEstimate, BadInputsThrow) {
     const Image a(32, 32, 3), b(32, 16, 3);
-    EXPECT_THROW(estimateMotion(a, b), InputError);
-    EXPECT_THROW(estimateMotion(Image(), a), InputError);
+    EXPECT_THROW(estimateMotion(a, &b), InputError);
+    EXPECT_THROW(estimateMotion(Image(), &a), InputError);
     MotionEstimateParams p;
     p.block = 1;
-    EXPECT_THROW(estimateMotion(a, a, p), InputError);
+    EXPECT_THROW(estimateMotion(a, &a, p), InputError);
+    // No previous frame: NaN, no history.
+    const Image none = estimateMotion(a, nullptr);
+    EXPECT_EQ(none.channels(), 2);
+    EXPECT_TRUE(std::isnan(none(5, 7, 0)) && std::isnan(none(5, 7, 1)));
 }
 
 }  // namespace

@@ -143,13 +143,14 @@ Image motionFromPositions(const Image& position, const CameraFit& current, const
 // the vector nearest its prediction (flat regions). The vectors are bilinear between block
 // centres: right for a camera's smooth field, a blur of it at the edges of what moves, which the
 // temporal method's depth, normal and colour tests then reject. 2 channels, previous − current
-// in pixels (Frame's motion); host images of one size (3 channels, or 1).
+// in pixels (Frame's motion); host images of one size (3 channels, or 1). Without a previous
+// frame (null: the first of a sequence) NaN everywhere: no history.
 struct MotionEstimateParams {
     int levels = 4;
     int block = 8;
     int radius = 4;
 };
-Image estimateMotion(const Image& current, const Image& previous, const MotionEstimateParams& params = {});
+Image estimateMotion(const Image& current, const Image* previous, const MotionEstimateParams& params = {});
 
 // The methods that denoise a sequence as a sequence, beside the still methods (denoiseMethods(),
 // which `atrous denoise --sequence` also runs frame by frame): one row each, the one list the

@@ -214,7 +214,7 @@ nb::object pyDenoise(const Array& color, nb::handle albedo, nb::handle normal, n
            {emission, B::Emission, "emission"}});
     DenoiseOptions o;
     o.method = parseDenoiseMethod(method);
-    if (denoiseMethodInfo(o.method).usesWeights || o.method == DenoiseMethod::Auto) o.weights = weightsFrom(learnedWeights);
+    if (denoiseMethodInfo(o.method).usesWeights) o.weights = weightsFrom(learnedWeights);  // auto's too
     o.device = c.device();
     for (auto [k, v] : params) applyParam(o, denoiseParams(), nb::cast<std::string>(k), v, "denoise");
     // The colour, variance and emission are the binding's own copies (toImage): handed over, the
@@ -344,13 +344,8 @@ nb::object pyDenoiseTemporal(nb::list frames, size_t center, const std::string& 
         const size_t n = buffers.size(), r = size_t(std::max(tp.radius, 0)), c = std::min(center, n - 1);
         const size_t lo = c > r ? c - r : 0, hi = tp.causal ? c : std::min(n - 1, c + r);
         for (size_t i = 0; i < n; ++i) {
-            const Image& cur = *colors[i];
-            if (i > lo && i <= hi && cur.view().sameSize(colors[i - 1]->view())) {
-                fitted.push_back(estimateMotion(cur, *colors[i - 1]));
-            } else {
-                fitted.push_back(Image(cur.width(), cur.height(), 2));
-                std::fill(fitted.back().data(), fitted.back().data() + fitted.back().size(), std::nanf(""));
-            }
+            const bool read = i > lo && i <= hi && colors[i]->view().sameSize(colors[i - 1]->view());
+            fitted.push_back(estimateMotion(*colors[i], read ? colors[i - 1].get() : nullptr));
         }
         for (size_t i = 0; i < n; ++i) buffers[i]->refs.set(B::Motion, &fitted[i]);
     }
@@ -358,7 +353,7 @@ nb::object pyDenoiseTemporal(nb::list frames, size_t center, const std::string& 
     for (const auto& b : buffers) window.push_back(b->refs);
     DenoiseOptions o;
     o.method = parseDenoiseMethod(method);
-    if (denoiseMethodInfo(o.method).usesWeights || o.method == DenoiseMethod::Auto) o.weights = weightsFrom(learnedWeights);
+    if (denoiseMethodInfo(o.method).usesWeights) o.weights = weightsFrom(learnedWeights);  // auto's too
     o.device = parseDevice(device);
     for (auto [k, v] : params) applyParam(o, denoiseParams(), nb::cast<std::string>(k), v, "denoise");
     Image out;
@@ -385,7 +380,7 @@ nb::dict pyDenoiseSequence(const std::string& input, const std::string& out, con
     for (auto [k, v] : params) applyParam(o.frame, denoiseParams(), nb::cast<std::string>(k), v, "denoise");
     // Read once for the whole sequence, when a method of the run uses it.
     const DenoiseMethodInfo* still = findDenoiseMethod(method == "temporal" ? spatial : method);
-    if (method == "svgf" ? o.svgf.learnedSpatial : still && (still->usesWeights || still->method == DenoiseMethod::Auto))
+    if (method == "svgf" ? o.svgf.learnedSpatial : still && still->usesWeights)
         o.frame.weights = o.svgfWeights = weightsFrom(learnedWeights);
     o.passes = passes, o.viewLayer = layer, o.addPass = addPass;
     o.start = start, o.end = end, o.step = step;

@@ -261,18 +261,14 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
             prevCamera = fit;
         } else if (usesMotion && f.motion.empty() && !f.color.empty()) {
             // Neither vectors nor positions (a renderer that writes colour, albedo and normal):
-            // motion from the colours themselves, block matching against the previous frame.
-            if (!window.empty() && window.back().color.view().sameSize(f.color.view())) {
-                f.motion = estimateMotion(f.color, window.back().color);
-                estimated = true;
-                if (!notedMotion)
-                    note("denoise: note: the frames have no motion vectors and no Position pass: motion estimated "
-                         "from the frames' colours (block matching, docs/temporal.md)");
-                notedMotion = true;
-            } else {
-                f.motion = Image(f.color.width(), f.color.height(), 2);
-                std::fill(f.motion.data(), f.motion.data() + f.motion.size(), std::nanf(""));  // no history
-            }
+            // motion from the colours themselves, block matching against the previous frame (the
+            // first has none: no history; the frames' sizes were checked above).
+            f.motion = estimateMotion(f.color, window.empty() ? nullptr : &window.back().color);
+            estimated = !window.empty();
+            if (estimated && !notedMotion)
+                note("denoise: note: the frames have no motion vectors and no Position pass: motion estimated "
+                     "from the frames' colours (block matching, docs/temporal.md)");
+            notedMotion = notedMotion || estimated;
         }
         // Other renderers' sequences: how much reprojects, with which sign, and whether ids hold.
         io::ReprojectionCheck& check = checks[i];

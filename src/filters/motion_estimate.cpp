@@ -91,7 +91,13 @@ float cost(const Plane& cur, const Plane& prev, int x0, int y0, int size, int dx
 
 }  // namespace
 
-Image estimateMotion(const Image& current, const Image& previous, const MotionEstimateParams& p) {
+Image estimateMotion(const Image& current, const Image* previousFrame, const MotionEstimateParams& p) {
+    if (!current.empty() && current.device() == Device::Cpu && !previousFrame) {
+        Image none(current.width(), current.height(), 2);
+        none.fill(std::nanf(""));  // no history
+        return none;
+    }
+    const Image& previous = previousFrame ? *previousFrame : current;
     if (current.empty() || previous.empty() || current.device() != Device::Cpu || previous.device() != Device::Cpu)
         throw InputError("motion estimate: the frames must be host images");
     if (current.width() != previous.width() || current.height() != previous.height())
