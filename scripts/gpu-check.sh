@@ -96,9 +96,29 @@ step() {
 }
 
 # ---------------------------------------------------------------- setup (in this shell: it sets the environment)
+oidn_archive() {  # the OIDN archive: in the pack, or the second pack gpu-pack.sh makes beside it
+  local f
+  for f in "$PACK/oidn.tar.xz" "$PACK/oidn.tar.gz" "$ROOT/build-gpu/pack-oidn/oidn.tar.xz"; do
+    [ -f "$f" ] && { echo "$f"; return 0; }
+  done
+  return 1
+}
+unpack_oidn() {
+  local a
+  a=$(oidn_archive) || { echo "no OIDN archive (build-gpu/pack-oidn/oidn.tar.xz): the OIDN step is skipped"; return 0; }
+  rm -rf "$OIDN" && mkdir -p "$RUN" && tar -xaf "$a" -C "$RUN" && echo "OIDN from $a"
+}
 setup() {
   local bad=0
   [ -d "$PACK" ] || { echo "no pack at $PACK: run 'make gpu-pack' on the build machine and carry build-gpu/pack"; return 1; }
+  if [ ! -f "$PACK/bin.tar.xz" ] && oidn_archive > /dev/null; then
+    # The OIDN pack alone (a second call): keep the binaries a first call on this machine unpacked.
+    echo "OIDN pack only: atrous's binaries $([ -x "$WORK/atrous" ] && echo "kept from an earlier call" || echo "absent (a fresh machine)")"
+    [ -d "$PREFIX" ] && export LD_LIBRARY_PATH="$PREFIX/usr/lib/x86_64-linux-gnu:$PREFIX/lib/x86_64-linux-gnu:$PREFIX/fallback/usr/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+    [ -x "$WORK/atrous" ] && mkdir -p "$LINK" && rm -rf "$LINK/build" "$LINK/src" && ln -s "$WORK" "$LINK/build" && ln -s "$WORK/src" "$LINK/src"
+    unpack_oidn
+    return
+  fi
   for f in bin.tar.xz tests.txt manifest.json; do [ -f "$PACK/$f" ] || { echo "missing $PACK/$f"; bad=1; }; done
   [ "$bad" = 0 ] || return 1
   rm -rf "$RUN" && mkdir -p "$WORK" "$PREFIX" "$LINK" || return 1
@@ -133,9 +153,7 @@ setup() {
       bad=1
     fi
   done
-  if [ -f "$PACK/oidn.tar.gz" ]; then
-    tar -xzf "$PACK/oidn.tar.gz" -C "$RUN" || bad=1
-  fi
+  unpack_oidn || bad=1
   cp "$PACK/manifest.json" "$OUTDIR/manifest.json"
   echo "LD_LIBRARY_PATH=$LD_LIBRARY_PATH"
   ldd "$WORK/atrous"
@@ -174,7 +192,7 @@ for f, v in j.items(): print(f"{f.rsplit('/run/', 1)[-1]}: SASS {v['sass']} PTX 
 sys.exit(f"no sm_90 SASS in {bad}" if bad else 0)
 EOF
   ls "$PACK"/debs/*.deb > /dev/null 2>&1 || { echo "no debs in $PACK/debs"; bad=1; }
-  [ -f "$PACK/oidn.tar.gz" ] || echo "no oidn.tar.gz: the OIDN step will be skipped"
+  oidn_archive > /dev/null || echo "no OIDN archive (build-gpu/pack-oidn): the OIDN step will be skipped"
   local pc hc
   pc=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["commit"])' "$PACK/manifest.json")
   hc=$(git -C "$ROOT" rev-parse HEAD 2> /dev/null || echo unknown)
@@ -321,21 +339,32 @@ if [ -x "$WORK/atrous" ]; then
       for w in sure svgf; do step "racecheck-$w" 90 sanitize racecheck "$w"; done
     fi
   fi
-  if wants oidn; then
-    if [ ! -x "$OIDN/bin/oidnBenchmark" ]; then record oidn skipped "" 0 "" "no oidn.tar.gz in the pack"
-    elif [ "$DRY" = 1 ]; then step oidn-dry 60 oidn 64x64
-    else for s in $SIZES; do step "oidn-$s" 60 oidn "$s"; done; fi
-  fi
+fi
+if wants oidn; then
+  if [ ! -x "$OIDN/bin/oidnBenchmark" ]; then record oidn skipped "" 0 "" "no OIDN archive carried"
+  elif [ "$DRY" = 1 ]; then step oidn-dry 60 oidn 64x64
+  else for s in $SIZES; do step "oidn-$s" 60 oidn "$s"; done; fi
 fi
 $TOOL summary "$STEPS" "$OUTDIR/summary.json" > "$LOGS/summary.out" 2>&1
 ok=$(python3 -c 'import json,sys; print(int(json.load(open(sys.argv[1]))["ok"]))' "$OUTDIR/summary.json" 2> /dev/null || echo 0)
 say "summary: $OUTDIR/summary.json ($(cat "$LOGS/summary.out")); $(( $(date +%s) - START ))s"
+if [ "$DRY" = 0 ]; then
+  # At most 8 files come back from the GPU machine: everything goes into one archive, summary beside it.
+  cat "$OUTDIR/summary.json"
+  tar -C "$OUTDIR" -czf /tmp/gpu-check.tar.gz --exclude=gpu-check.tar.gz . && mv /tmp/gpu-check.tar.gz "$OUTDIR/" \
+    && find "$OUTDIR" -mindepth 1 -maxdepth 1 ! -name gpu-check.tar.gz ! -name summary.json -exec rm -rf {} +
+fi
 if [ "$DRY" = 1 ]; then
   cat <<EOF
 
 A session lent a GPU machine runs, in one call (the pack is carried; \$OUT comes back):
 
-  run(command="bash scripts/gpu-check.sh", carry=["build-gpu/pack"], timeout_s=480)
+  run(command="bash scripts/gpu-check.sh --budget 400", carry=["build-gpu/pack"], timeout_s=480)
+  run(command="bash scripts/gpu-check.sh --pack build-gpu/pack-oidn --only bench,oidn --budget 200",
+      carry=["build-gpu/pack-oidn"], timeout_s=260)      # at once, while the machine is warm
+
+(\$OUT comes back as gpu-check.tar.gz with summary.json beside it; a call sends the tracked tree
+plus what it carries, at most 64 MiB, so OIDN travels in the second call)
 
 then reads \$OUT/summary.json (step status), bandwidth.json, bench/*.json, oidn/*.json, tests/*.json,
 and records the figures in docs/benchmarks.md ("GPU"). To rerun a part: --only tests,bench,oidn,sanitizer,...

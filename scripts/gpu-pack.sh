@@ -9,9 +9,11 @@
 #   debs/           the Debian packages of every shared library those binaries load that a bare
 #                   Debian/Ubuntu + CUDA image lacks (ldd + dpkg -S + apt-get download);
 #                   debs/fallback/ libstdc++6 and libgcc-s1, used only if the machine's are too old
-#   oidn.tar.gz     Intel Open Image Denoise from the pyoidn wheel, cut to what oidnBenchmark needs
-#                   for its CUDA device (core + CUDA + CPU devices, TBB): the OIDN comparison
 #   tests.txt       the GPU test binaries, one a line;  manifest.json  what is in it, sizes, commit
+# and build-gpu/pack-oidn/ (carried by a second call: each call sends the tracked tree, 18 MB, plus
+# what it carries, and the two together pass the 64 MiB a call may send):
+#   oidn.tar.xz     Intel Open Image Denoise from the pyoidn wheel, cut to what oidnBenchmark needs
+#                   for its CUDA device (core + CUDA + CPU devices, TBB): the OIDN comparison
 # The build is of the committed tree (a `git archive HEAD` snapshot in build-gpu/src), not of the
 # working tree, so that the figures belong to a commit; GPU_PACK_SOURCE=worktree builds the working
 # tree instead. Compiled-in paths (the tests' ATROUS_CLI and ATROUS_SOURCE_DIR) go through
@@ -26,6 +28,7 @@ WITH_OIDN=${GPU_PACK_OIDN:-1}
 G=$ROOT/build-gpu
 CM=$G/cmake
 PACK=$G/pack
+OPACK=$G/pack-oidn
 LINK=/tmp/atrous-gpu
 LIMIT=$((64 * 1024 * 1024))
 # Packages of a bare Debian/Ubuntu image (with the CUDA driver): not carried.
@@ -141,7 +144,9 @@ if [ "$WITH_OIDN" = 1 ]; then
     # Only what the CUDA (and, for the dry run, CPU) devices load; SYCL/HIP and their runtimes stay behind.
     (cd "$OD/lib" && cp -L libOpenImageDenoise.so.2 libOpenImageDenoise_core.so.2.* libOpenImageDenoise_device_cuda.so.2.* \
        libOpenImageDenoise_device_cpu.so.2.* libtbb.so.12 "$G/oidn-stage/oidn/lib/")
-    tar -C "$G/oidn-stage" -cf - oidn | gzip -6 > "$PACK/oidn.tar.gz"
+    rm -rf "$OPACK" && mkdir -p "$OPACK"
+    tar -C "$G/oidn-stage" -cf - oidn | xz -9 -T"$JOBS" > "$OPACK/oidn.tar.xz"
+    cp "$PACK/tests.txt" "$OPACK/" 2> /dev/null || true
     OIDN_NOTE="OIDN $(ls "$OD"/lib/libOpenImageDenoise.so.2.* | sed 's/.*\.so\.//') (oidnBenchmark, core, CUDA + CPU devices, TBB) from pyoidn in $FROM"
   else
     OIDN_NOTE="pyoidn wheel not found (.venv or pip download): no OIDN comparison"
@@ -164,9 +169,15 @@ json.dump({"commit": commit, "built_utc": datetime.datetime.now(datetime.timezon
           open(os.path.join(pack, "manifest.json"), "w"), indent=1)
 EOF
 TOTAL=$(du -sb "$PACK" | cut -f1)
-say "pack: $PACK, $((TOTAL / 1024)) KiB of the 65536 KiB carry limit (binaries need $GLIBC, $GLIBCXX)"
-if [ "$TOTAL" -gt "$LIMIT" ]; then
-  echo "gpu-pack: the pack is over 64 MiB; GPU_PACK_OIDN=0 leaves OIDN out" >&2
-  exit 1
+# What a call sends: the tracked (and untracked, not ignored) files plus the carried pack.
+TREE=$( (git ls-files -z; git ls-files -z --others --exclude-standard) | du -cb --files0-from=- 2> /dev/null | tail -1 | cut -f1)
+say "pack: $PACK, $((TOTAL / 1024)) KiB + the tree's $((TREE / 1024)) KiB of the 65536 KiB a call sends (binaries need $GLIBC, $GLIBCXX)"
+BAD=0
+[ $((TOTAL + TREE)) -le "$LIMIT" ] || { echo "gpu-pack: pack + tree are over 64 MiB" >&2; BAD=1; }
+if [ -f "$OPACK/oidn.tar.xz" ]; then
+  OT=$(du -sb "$OPACK" | cut -f1)
+  say "pack-oidn: $OPACK, $((OT / 1024)) KiB + the tree's $((TREE / 1024)) KiB of 65536 KiB"
+  [ $((OT + TREE)) -le "$LIMIT" ] || { echo "gpu-pack: pack-oidn + tree are over 64 MiB" >&2; BAD=1; }
 fi
+[ "$BAD" = 0 ] || exit 1
 say "next: scripts/gpu-check.sh --dry-run (prints the run invocation for a GPU session)"
