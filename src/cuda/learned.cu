@@ -2,7 +2,7 @@
 // context branch's passes and direct convolutions of filters/learned_context.h, one thread per
 // output sample; pass A, pass B one thread per pixel with the MLP in registers, the five levels as
 // AtrousLevel<LearnedStop>).
-// The weights are copied to the device and the temporaries (one device image) made once per call,
+// The weights are copied to the device and the temporaries (a device image and a buffer) made once per call,
 // or once for all the calls that share a LearnedCache (SVGF's frames).
 #include <chrono>
 
@@ -22,7 +22,8 @@ void runLearned(const CudaExec& exec, const LearnedWeights& weights, const Learn
     struct Store {
         cuda::DeviceBuffer<LearnedNet> net{1};
         Image temps;
-        Image ctx;  // the context branch's planes (one block; none without a context)
+        cuda::DeviceBuffer<float> ctx;  // the context branch's planes, one block (not an Image: it
+                                        // can pass the 16384 a side an image may have)
     };
     LearnedCache local;
     LearnedCache& c = cache ? *cache : local;
@@ -33,7 +34,7 @@ void runLearned(const CudaExec& exec, const LearnedWeights& weights, const Learn
         store->temps = Image(w, h, kLearnedTempChannels, Device::Cuda);
         LearnedCtxPlanes ctx;
         if (weights.impl->net.context) {
-            store->ctx = Image(int(learnedCtxFloats(w, h)), 1, 1, Device::Cuda);
+            store->ctx = cuda::DeviceBuffer<float>(learnedCtxFloats(w, h));
             ctx = learnedCtxPlanes(store->ctx.data(), w, h);
         }
         c = LearnedCache{w, h, weights.impl, store, learnedTemps(store->temps.data(), w, h), store->net.data(), ctx};

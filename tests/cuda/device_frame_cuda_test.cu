@@ -125,7 +125,9 @@ TEST(DeviceFrameCuda, DenoiseOnDeviceInputsMatchesHostInputsAndItsReport) {
     if (!cudaAvailable()) GTEST_SKIP() << "no CUDA device";
     SyntheticScene s = makeScene(64, 48, 0.4f, 17);
     s.noisy(3, 4, 1) = std::nanf("");          // one non-finite pixel
-    s.noisy(10, 10, 0) = 500.0f;               // a firefly
+    s.noisy(10, 10, 0) = 500.0f;               // a firefly, with the large sample variance a
+    for (int c = 0; c < 3; ++c) s.variance(10, 10, c) = 500.0f * 500.0f / 4;  // 1-of-4-samples spike has
+    // (with a given variance, a bright pixel of small own variance is a highlight and kept: prepass.h)
     Image emission(64, 48, 3);
     emission(20, 20, 0) = emission(20, 20, 1) = emission(20, 20, 2) = 4.0f;
     DenoiseOptions o;
