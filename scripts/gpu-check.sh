@@ -7,8 +7,9 @@
 #   tests      every CUDA test binary (tests/cuda/*_test.cu; GoogleTest JSON per binary)
 #   bench      atrous bench --device cuda --json (render, EAW, SURE, SVGF) at 512x512, 1280x720,
 #              1920x1080, 3840x2160, one call per size; bench_gpu_render at 1920x1080
-#   sanitizer  compute-sanitizer memcheck on a CUDA render (built-in and OBJ scenes), CUDA EAW, SURE
-#              and SVGF denoises; racecheck on the SURE and SVGF denoises
+#   sanitizer  compute-sanitizer memcheck on a CUDA render (built-in and OBJ scenes), CUDA EAW, SURE,
+#              learned and SVGF denoises; racecheck on the SURE, learned and SVGF denoises
+#   profile    Nsight Compute (ncu) over each kernel of a 1080p EAW and SURE denoise (profile/*.csv)
 #   oidn       oidnBenchmark on OIDN's CUDA device (RT filter, hdr + albedo + normal, quality high)
 #              at the same four sizes (a CNN: its time does not depend on the pixels)
 # Each command runs under `timeout`, within a total budget (default 420 s), and the script goes on
@@ -23,7 +24,7 @@
 # CUDA-only commands must fail cleanly), and prints the `run` invocation for a GPU session.
 #
 # usage: scripts/gpu-check.sh [--dry-run] [--pack DIR] [--out DIR] [--budget SECONDS]
-#                             [--only info,bandwidth,tests,bench,oidn,sanitizer]   (setup always runs)
+#                             [--only info,bandwidth,tests,bench,oidn,sanitizer,profile]   (setup always runs)
 set -uo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
@@ -298,11 +299,27 @@ sanitize() {  # tool what
   case $what in
     render) "${san[@]}" "$A" render --scene cornell --width 128 --height 128 --spp 4 --device "$DEV" --quiet --out "$SCRATCH/rc" ;;
     render-obj) "${san[@]}" "$A" render --scene "$WORK/src/scenes/example.json" --width 96 --height 96 --spp 2 --device "$DEV" --quiet --out "$SCRATCH/ro" ;;
-    eaw|sure) "${san[@]}" "$A" denoise --in "$SCRATCH/r" --device "$DEV" --method "$what" --out "$SCRATCH/$tool-$what.exr" ;;
+    eaw|sure|learned) "${san[@]}" "$A" denoise --in "$SCRATCH/r" --device "$DEV" --method "$what" --out "$SCRATCH/$tool-$what.exr" ;;
     svgf) "${san[@]}" "$A" denoise --sequence "$SCRATCH/seq" --method svgf --device "$DEV" --out "$SCRATCH/$tool-svgf" ;;
   esac
 }
-export -f info bandwidth gtest bench_size bench_render oidn sanitize_prep sanitize
+profile() {  # Nsight Compute on each kernel of one 1080p EAW and SURE denoise: the data for tuning them
+  mkdir -p "$OUTDIR/profile" "$SCRATCH"
+  local ncu
+  ncu=$(command -v ncu || ls /opt/nvidia/nsight-compute/*/ncu /usr/local/cuda/bin/ncu 2> /dev/null | head -1)
+  if [ -z "$ncu" ]; then
+    [ "$DRY" = 1 ] && { echo "no ncu here (dry run)"; return 0; }
+    echo "ncu not found"; return 1
+  fi
+  "$WORK/atrous" render --scene cornell --width 1920 --height 1080 --spp 1 --device "$DEV" --quiet --out "$SCRATCH/p1080" || return 1
+  local m
+  for m in eaw sure; do
+    "$ncu" --clock-control none --section SpeedOfLight --section MemoryWorkloadAnalysis --section LaunchStats \
+      --section Occupancy --csv --page details "$WORK/atrous" denoise --in "$SCRATCH/p1080" --device "$DEV" \
+      --method $m --out "$SCRATCH/p-$m.exr" > "$OUTDIR/profile/ncu_${m}_1080p.csv" || return 1
+  done
+}
+export -f info bandwidth gtest bench_size bench_render oidn sanitize_prep sanitize profile
 
 # ---------------------------------------------------------------- run
 say "$([ "$DRY" = 1 ] && echo "dry run (no GPU)" || echo "GPU run"); pack $PACK; out $OUTDIR; budget ${BUDGET}s"
@@ -335,10 +352,11 @@ if [ -x "$WORK/atrous" ]; then
   fi
   if wants sanitizer; then
     if step sanitizer-inputs 60 sanitize_prep; then
-      for w in render render-obj eaw sure svgf; do step "memcheck-$w" 90 sanitize memcheck "$w"; done
-      for w in sure svgf; do step "racecheck-$w" 90 sanitize racecheck "$w"; done
+      for w in render render-obj eaw sure learned svgf; do step "memcheck-$w" 90 sanitize memcheck "$w"; done
+      for w in sure learned svgf; do step "racecheck-$w" 90 sanitize racecheck "$w"; done
     fi
   fi
+  wants profile && step profile 120 profile
 fi
 if wants oidn; then
   if [ ! -x "$OIDN/bin/oidnBenchmark" ]; then record oidn skipped "" 0 "" "no OIDN archive carried"
