@@ -9,6 +9,7 @@
 #              1920x1080, 3840x2160, one call per size; bench_gpu_render at 1920x1080
 #   sanitizer  compute-sanitizer memcheck on a CUDA render (built-in and OBJ scenes), CUDA EAW, SURE,
 #              learned and SVGF denoises; racecheck on the SURE, learned and SVGF denoises
+#   variants   the pack's other builds of atrous (variants.tar.xz), benched against it in 3 turns
 #   profile    Nsight Compute (ncu) over each kernel of a 1080p EAW and SURE denoise (profile/*.csv)
 #   oidn       oidnBenchmark on OIDN's CUDA device (RT filter, hdr + albedo + normal, quality high)
 #              at the same four sizes (a CNN: its time does not depend on the pixels)
@@ -24,7 +25,7 @@
 # CUDA-only commands must fail cleanly), and prints the `run` invocation for a GPU session.
 #
 # usage: scripts/gpu-check.sh [--dry-run] [--pack DIR] [--out DIR] [--budget SECONDS]
-#                             [--only info,bandwidth,tests,bench,oidn,sanitizer,profile]   (setup always runs)
+#                             [--only info,bandwidth,tests,bench,oidn,sanitizer,profile,variants]   (setup always runs)
 set -uo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
@@ -303,6 +304,22 @@ sanitize() {  # tool what
     svgf) "${san[@]}" "$A" denoise --sequence "$SCRATCH/seq" --method svgf --device "$DEV" --out "$SCRATCH/$tool-svgf" ;;
   esac
 }
+variants() {  # the pack's other builds of atrous (gpu-pack's GPU_PACK_VARIANTS), timed against it in turns
+  local d=$RUN/variants
+  rm -rf "$d" && mkdir -p "$d" && tar -xJf "$PACK/variants.tar.xz" -C "$d" || return 1
+  local round v s
+  for round in 1 2 3; do
+    for v in main $(ls "$d"); do
+      local bin=$d/$v/atrous
+      [ "$v" = main ] && bin=$WORK/atrous
+      for s in 1920x1080 512x512; do
+        "$bin" bench --device "$DEV" --json --sizes "$s" --what eaw,sure,svgf,learned \
+          > "$OUTDIR/bench/variant_${v}_${s}_r$round.json" || return 1
+      done
+    done
+  done
+  python3 "$ROOT/scripts/gpu_pack_tool.py" variants "$OUTDIR/bench"
+}
 profile() {  # Nsight Compute on each kernel of one 1080p EAW and SURE denoise: the data for tuning them
   mkdir -p "$OUTDIR/profile" "$SCRATCH"
   local ncu
@@ -319,7 +336,7 @@ profile() {  # Nsight Compute on each kernel of one 1080p EAW and SURE denoise: 
       --method $m --out "$SCRATCH/p-$m.exr" > "$OUTDIR/profile/ncu_${m}_1080p.csv" || return 1
   done
 }
-export -f info bandwidth gtest bench_size bench_render oidn sanitize_prep sanitize profile
+export -f info bandwidth gtest bench_size bench_render oidn sanitize_prep sanitize profile variants
 
 # ---------------------------------------------------------------- run
 say "$([ "$DRY" = 1 ] && echo "dry run (no GPU)" || echo "GPU run"); pack $PACK; out $OUTDIR; budget ${BUDGET}s"
@@ -357,6 +374,7 @@ if [ -x "$WORK/atrous" ]; then
     fi
   fi
   wants profile && step profile 120 profile
+  wants variants && [ -f "$PACK/variants.tar.xz" ] && step variants 150 variants
 fi
 if wants oidn; then
   if [ ! -x "$OIDN/bin/oidnBenchmark" ]; then record oidn skipped "" 0 "" "no OIDN archive carried"

@@ -18,7 +18,8 @@
 # working tree, so that the figures belong to a commit; GPU_PACK_SOURCE=worktree builds the working
 # tree instead. Compiled-in paths (the tests' ATROUS_CLI and ATROUS_SOURCE_DIR) go through
 # /tmp/atrous-gpu/{src,build}, symlinks that gpu-check.sh re-creates on the GPU machine.
-# Env: JOBS (default 2), GPU_PACK_SOURCE (head | worktree), GPU_PACK_OIDN=0 to leave OIDN out.
+# Env: JOBS (default 2), GPU_PACK_SOURCE (head | worktree), GPU_PACK_OIDN=0 to leave OIDN out,
+# GPU_PACK_VARIANTS and GPU_PACK_BEFORE (other builds of atrous to time beside it; below).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
@@ -91,6 +92,32 @@ if grep -q '"sass": \[\]' "$PACK/fatbin.json" || [ "$(grep -c '"sm_90"' "$PACK/f
 fi
 say "compressing the binaries (xz, solid)"
 tar -C "$ST" -cf - . | xz -T1 -6 > "$PACK/bin.tar.xz"
+
+# ---- variants of `atrous` to time against it on the GPU in one call (gpu-check.sh's variants step) ----
+# GPU_PACK_VARIANTS="NAME=CMAKE_ARG[,CMAKE_ARG...] ..." builds atrous again with those cache
+# arguments (e.g. r64=-DCMAKE_CUDA_FLAGS=-maxrregcount=64); GPU_PACK_BEFORE=COMMIT adds "before",
+# that commit's atrous. Each in build-gpu/var-NAME; all in the pack's variants.tar.xz.
+VARS=(${GPU_PACK_VARIANTS:-})
+if [ -n "${GPU_PACK_BEFORE:-}" ]; then
+  rm -rf "$G/src-before" && mkdir -p "$G/src-before"
+  git archive --format=tar "$GPU_PACK_BEFORE" | tar -x -C "$G/src-before"
+  VARS+=("before=")
+fi
+if [ ${#VARS[@]} -gt 0 ]; then
+  rm -rf "$G/variants" && mkdir -p "$G/variants"
+  for v in "${VARS[@]}"; do
+    name=${v%%=*} args=${v#*=} vsrc=$LINK/src
+    [ "$name" = before ] && vsrc=$G/src-before
+    IFS=',' read -r -a extra <<< "$args"
+    say "variant $name: ${extra[*]:-(commit ${GPU_PACK_BEFORE:-})}"
+    cmake -S "$vsrc" -B "$G/var-$name" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CUDA_ARCHITECTURES=90 \
+      -DATROUS_BUILD_VIEWER=OFF -DATROUS_INSTALL=OFF -DATROUS_BUILD_PYTHON=OFF -DATROUS_ONEDNN=OFF "${extra[@]}" \
+      > "$G/var-$name.log" 2>&1 && cmake --build "$G/var-$name" -j "$JOBS" --target atrous >> "$G/var-$name.log" 2>&1 \
+      || { tail -30 "$G/var-$name.log"; exit 1; }
+    mkdir -p "$G/variants/$name" && cp "$G/var-$name/atrous" "$G/variants/$name/" && strip --strip-unneeded "$G/variants/$name/atrous"
+  done
+  tar -C "$G/variants" -cf - . | xz -T1 -6 > "$PACK/variants.tar.xz"
+fi
 
 # ---- Debian packages of the shared libraries ----
 declare -A PKG=()

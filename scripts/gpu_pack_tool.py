@@ -15,6 +15,7 @@ has Python 3.12 and nothing installed for this project).
   summary STEPS.tsv OUT     the step table (name, status, rc, seconds, log, note) as OUT (JSON); ok
                             when every step is ok or skipped (absent on purpose, e.g. no OIDN)
 """
+import glob
 import json
 import os
 import shutil
@@ -194,8 +195,25 @@ def summary(tsv, out):
     print(json.dumps({"ok": doc["ok"], "failed": doc["failed"]}))
 
 
+def variants(folder):
+    """The variants step's table: per size, method and build, the median of the rounds' medians."""
+    import statistics
+    rows = {}
+    for f in glob.glob(os.path.join(folder, "variant_*.json")):
+        v, size = os.path.basename(f)[len("variant_"):].rsplit("_r", 1)[0].rsplit("_", 1)
+        for r in json.load(open(f))["results"]:
+            rows.setdefault((size, r["what"], v), []).append(r["median_ms"])
+    table = [{"size": k[0], "what": k[1], "build": k[2], "median_ms": statistics.median(t), "rounds_ms": t}
+             for k, t in sorted(rows.items())]
+    with open(os.path.join(folder, "variants.json"), "w") as f:
+        json.dump(table, f, indent=1)
+    for r in table:
+        print(f"{r['size']:>10} {r['what']:8} {r['build']:8} {r['median_ms']:8.3f} ms  rounds {r['rounds_ms']}")
+
+
 if __name__ == "__main__":
     cmd, args = sys.argv[1], sys.argv[2:]
     {"sync": lambda: sync(*args), "fatbin-arch": lambda: fatbin_arch(args),
      "deb-extract": lambda: deb_extract(*args), "untar": lambda: untar(*args), "gtest-count": lambda: gtest_count(args),
-     "oidn-json": lambda: oidn_json(args[0]), "summary": lambda: summary(*args)}[cmd]()
+     "oidn-json": lambda: oidn_json(args[0]), "summary": lambda: summary(*args),
+     "variants": lambda: variants(args[0])}[cmd]()
