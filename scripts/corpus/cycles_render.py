@@ -320,6 +320,41 @@ def scene_orbit(sc, nframes):
         "world constant (0.05, 0.05, 0.06)"
 
 
+def scene_turntable(sc, nframes):
+    """A product turntable: static camera, objects turning; glass, polished copper, a visible softbox."""
+    add("plane", material("floor", "diffuse", tex=tex_checker((0.6, 0.6, 0.6), (0.2, 0.2, 0.22), 8), index=1),
+        scale=(5, 5, 1))
+    add("plane", material("backdrop", "diffuse", color=(0.55, 0.5, 0.45), index=2), loc=(0, 2.2, 1.5),
+        rot=(math.pi / 2, 0, 0), scale=(5, 2, 1))
+    pivot = bpy.data.objects.new("Turntable", None)
+    sc.collection.objects.link(pivot)
+    disc = add("cylinder", material("disc", "metal", color=(0.7, 0.7, 0.72), rough=0.35, index=3), loc=(0, 0, 0.05),
+               scale=(1.3, 1.3, 0.05), vertices=96)
+    monkey = add("monkey", material("glass", "glass", index=4), loc=(-0.5, 0, 0.6), rot=(0, 0, -0.5),
+                 scale=(0.45, 0.45, 0.45))
+    torus = add("torus", material("copper", "metal", color=(0.95, 0.64, 0.54), rough=0.1, index=5),
+                loc=(0.6, 0.1, 0.45), rot=(math.pi / 2, 0, 0.4), major_radius=0.35, minor_radius=0.12)
+    for o in (disc, monkey, torus):
+        o.parent = pivot
+    add("plane", material("softbox", "emission", color=(1, 0.97, 0.92), strength=14, index=6), loc=(1.9, 1.3, 1.7),
+        rot=(math.radians(70), 0, math.radians(-130)), scale=(0.5, 0.35, 1))
+    add("plane", material("key", "emission", color=(1, 1, 1), strength=5, index=7), loc=(-2.0, -1.8, 3.0),
+        rot=(math.radians(-40), math.radians(-35), 0), scale=(1.0, 1.0, 1))  # out of view
+    world_constant(sc, (0.03, 0.03, 0.035))
+    camera(sc, (0.2, -4.1, 1.8), (0.1, 0.2, 0.5), lens=35)
+    sc.frame_start, sc.frame_end = 1, nframes
+    for f in range(nframes):
+        pivot.rotation_euler = (0, 0, math.radians(90 * f / max(1, nframes - 1)))
+        pivot.keyframe_insert("rotation_euler", frame=f + 1)
+    act = pivot.animation_data.action
+    for fc in act.fcurves if hasattr(act, "fcurves") else []:
+        for k in fc.keyframe_points:
+            k.interpolation = "LINEAR"
+    return "turntable: glass Suzanne, polished copper torus and a brushed disc turning 90 degrees on a checker " \
+        "floor before a backdrop, a visible softbox and a key light out of view; static camera", \
+        "world constant (0.03, 0.03, 0.035)"
+
+
 STILLS = {
     "cy_glass_mirror": scene_glass_mirror,
     "cy_sunsky_thin": scene_sunsky_thin,
@@ -327,7 +362,9 @@ STILLS = {
     "cy_textures_box": scene_textures_box,
 }
 QUICK = ["cy_glass_mirror", "cy_sunsky_thin"]
-SEQ_NAME = "cy_orbit"
+# The sequences: cy_orbit in every mode (the CI subset renders it at 48x48), cy_turntable in --full.
+SEQUENCES = {"cy_orbit": scene_orbit, "cy_turntable": scene_turntable}
+QUICK_SEQUENCES = ["cy_orbit"]
 
 
 # ---------------------------------------------------------------- render settings
@@ -491,10 +528,15 @@ def main():
                        "sensor_width_mm": cam.data.sensor_width},
         })
 
-    if a.scenes and SEQ_NAME not in a.scenes.split(","):
-        return
+    seqs = QUICK_SEQUENCES if a.mode == "quick" else list(SEQUENCES)
+    for seq in seqs:
+        if not a.scenes or seq in a.scenes.split(","):
+            render_sequence(seq, mode, root, version)
+
+
+def render_sequence(name, mode, root, version):
     n, sres, rspp = mode["seq_frames"], mode["seq_res"], mode["seq_ref_spp"]
-    d = root / SEQ_NAME
+    d = root / name
     kinds = [("frames", seq_spp_folder(s), s, SEED_SEQ if s == 1 else SEED_SEQ_SPP + 1000 * s)
              for s in mode["seq_spp"]] + [("ref", "ref", rspp, SEED_SEQ_REF)]
     for _, folder, _, _ in kinds:
@@ -504,14 +546,14 @@ def main():
     for kind, folder, spp, seed0 in kinds:
         _obj_index[0] = 0
         sc = reset()
-        what, bg = scene_orbit(sc, n)
+        what, bg = SEQUENCES[name](sc, n)
         for f in range(n):
             configure(sc, sres, spp, seed0 + f)
             sc.frame_set(f + 1)
             target = d / folder / f"{f:04d}.exr"
             if not done(target):
                 if kind == "ref":
-                    log(f"cycles {SEQ_NAME} frame {f} ref ...")
+                    log(f"cycles {name} frame {f} ref ...")
                 render_to(sc, target)
             if kind == "ref" and f in (1, n - 1):
                 checks[f] = vector_check(target, sc, f)  # frame_set numbering is f+1: previous is f
@@ -519,9 +561,9 @@ def main():
     for f in range(n):
         frames.append({"frame": f, "blender_frame": f + 1, "file": f"frames/{f:04d}.exr",
                        "reference": f"ref/{f:04d}.exr", "seed": SEED_SEQ + f, "ref_seed": SEED_SEQ_REF + f})
-    log(f"cycles {SEQ_NAME} {n} frames {time.time() - t0:.1f}s")
+    log(f"cycles {name} {n} frames {time.time() - t0:.1f}s")
     write_manifest(d / "manifest.json", {
-        "scene": SEQ_NAME, "renderer": "blender-cycles", "version": version, "description": what,
+        "scene": name, "renderer": "blender-cycles", "version": version, "description": what,
         "resolution": [sres, sres], "spp": 1, "reference_spp": rspp, "layout": "blender-multilayer-exr-sequence",
         "spp_folders": {str(s): seq_spp_folder(s) for s in mode["seq_spp"]},
         "frames": frames, "settings": settings, "channels": exr_channels(d / "frames" / "0000.exr"),
