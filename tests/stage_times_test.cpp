@@ -83,7 +83,7 @@ TEST(StageTimes, SvgfReportFollowsTheFramesWhileTimed) {
     d.denoiseFrame(f);
     const SvgfReport rep = d.lastReport();
     const std::vector<std::string> expected = {"demodulate", "reproject", "accumulate", "variance",
-                                               "level 0",    "level 1",   "remodulate", "taa"};
+                                               "level 0",    "level 1",   "remodulate", "taa", "safety net"};
     EXPECT_EQ(test::stageNames(rep.stages), expected);
     // milliseconds is the start-to-last-mark span, i.e. the sum of the stages up to rounding.
     EXPECT_NEAR(rep.milliseconds, test::stageSum(rep.stages), 1e-6);

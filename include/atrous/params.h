@@ -212,6 +212,9 @@ inline const ParamField<P> kSvgf[] = {
     {"learned_spatial", &at<&P::learnedSpatial>, {},
      "the learned a-trous cascade (built-in weights, or learned_weights / --learned-weights) as the spatial "
      "filter instead of SVGF's a-trous"},
+    {"safety_net", &at<&P::safetyNet>, paramAtLeast(0),
+     "per-frame safety net: where SVGF's output differs from the still default's of the frame alone by more "
+     "than this (3x3 mean relative luminance difference), the output becomes the still one's (0 = off)"},
 };
 
 inline const ParamField<T> kTemporal[] = {

@@ -65,6 +65,12 @@ struct SvgfParams {
     // >= 0 SVGF's à-trous levels 0..feedbackTap still run for the colour history only, so the
     // history is SVGF's own.
     bool learnedSpatial = false;
+    // Per-frame safety net (svgf_safety.h, docs/svgf.md): the still default (auto) also denoises
+    // each frame alone, and SVGF's output gives way to it where their luminances disagree by more
+    // than this, as the 3x3 mean of the signed relative difference (fully from twice this on), so
+    // a ghost, a smeared light or a lagging highlight comes out as the per-frame filter's. Costs
+    // a still denoise per frame. >= 0; 0 = off (SVGF alone).
+    float safetyNet = 0.05f;
 };
 
 // Throws ParamError (atrous/params.h: an InputError naming the field, `sigma_l`) when a

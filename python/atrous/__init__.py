@@ -550,12 +550,15 @@ class Svgf:
         self._impl = _core.Svgf(device, weights, dict(params))
 
     def denoise_frame(self, color: Any, *, albedo: Any = None, normal: Any = None, depth: Any = None,
-                      ids: Any = None, motion: Any = None, emission: Any = None) -> Any:
-        """Denoises the next frame; motion is (dx, dy) in pixels, previous - current."""
+                      ids: Any = None, motion: Any = None, emission: Any = None, position: Any = None,
+                      variance: Any = None) -> Any:
+        """Denoises the next frame; motion is (dx, dy) in pixels, previous - current. position and
+        variance reach the per-frame safety net's still filter (safety_net; SVGF itself has no use
+        for them)."""
         c = _prepare(color, "color", allow_gray=False)
         b = [_prepare(v, n, channels=(2, 3) if n in ("motion", "ids") else (3,))
              for n, v in (("albedo", albedo), ("normal", normal), ("depth", depth), ("ids", ids),
-                          ("motion", motion), ("emission", emission))]
+                          ("motion", motion), ("emission", emission), ("position", position), ("variance", variance))]
         return _wrap_like(self._impl.denoise_frame(c, *b), color)
 
     def reset(self) -> None:

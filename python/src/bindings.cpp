@@ -265,12 +265,13 @@ public:
         mDenoiser = std::make_unique<SvgfDenoiser>(p, parseDevice(device), w);
     }
     nb::object denoiseFrame(const Array& color, nb::handle albedo, nb::handle normal, nb::handle depth, nb::handle ids,
-                            nb::handle motion, nb::handle emission) {
+                            nb::handle motion, nb::handle emission, nb::handle position, nb::handle variance) {
         using B = io::Buffer;
         Image c = toImage(color, "color");
         Buffers b(c);
         b.add({{albedo, B::Albedo, "albedo"}, {normal, B::Normal, "normal"}, {depth, B::Depth, "depth"},
-               {ids, B::ObjectId, "ids"}, {motion, B::Motion, "motion"}, {emission, B::Emission, "emission"}});
+               {ids, B::ObjectId, "ids"}, {motion, B::Motion, "motion"}, {emission, B::Emission, "emission"},
+               {position, B::Position, "position"}, {variance, B::Variance, "variance"}});
         const SvgfFrame f = b.refs;
         Image out;
         {
@@ -556,7 +557,8 @@ NB_MODULE(_core, m) {
         .def(nb::init<const std::string&, nb::handle, nb::dict>(), nb::arg("device"), nb::arg("learned_weights").none(),
              nb::arg("params"))
         .def("denoise_frame", &PySvgf::denoiseFrame, nb::arg("color"), nb::arg("albedo").none(), nb::arg("normal").none(),
-             nb::arg("depth").none(), nb::arg("ids").none(), nb::arg("motion").none(), nb::arg("emission").none())
+             nb::arg("depth").none(), nb::arg("ids").none(), nb::arg("motion").none(), nb::arg("emission").none(),
+             nb::arg("position").none(), nb::arg("variance").none())
         .def("reset", &PySvgf::reset)
         .def_prop_ro("device", &PySvgf::device);
 }

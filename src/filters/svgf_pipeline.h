@@ -7,6 +7,7 @@
 #include <string>
 #include <utility>
 
+#include "atrous/denoise.h"
 #include "atrous/error.h"
 #include "atrous/learned.h"
 #include "atrous/svgf.h"
@@ -18,6 +19,7 @@
 #include "filters/svgf_gbuffer.h"
 #include "filters/svgf_learned.h"
 #include "filters/svgf_reproject.h"
+#include "filters/svgf_safety.h"
 #include "filters/svgf_taa.h"
 #include "filters/svgf_variance.h"
 
@@ -65,6 +67,7 @@ struct SvgfState {
     Image accIllum, accMoments, accLength, variance;
     Image levelIllum[2], levelVariance[2], nextHistIllum;
     Image output, taaOutput, accEmission, accEmissionLength;
+    Image safeRel, safeOut;  // the safety net's difference plane and output (allocated on first use)
     Image lumStop;  // the à-trous level's luminance stop (Atrous::lumStop)
     Image learnedVar, learnedOut;  // learnedSpatial: the cascade's var and d_out (3 channels each)
     filters::LearnedCache learnedCache;  // learnedSpatial: the cascade's temporaries and device network
@@ -85,6 +88,7 @@ struct SvgfState {
         for (int i = 0; i < 2; ++i) levelIllum[i] = make(3), levelVariance[i] = make(1);
         nextHistIllum = make(3), lumStop = make(1);
         learnedVar = Image(), learnedOut = Image();  // made by the first learned frame
+        safeRel = Image(), safeOut = Image();        // made by the first frame with the safety net
         output = make(3), taaOutput = make(3);
         histEmission = make(3), histEmissionLength = make(1), accEmission = make(3), accEmissionLength = make(1);
         result = nullptr;
@@ -249,6 +253,22 @@ public:
             std::swap(s.taaHistory, s.taaOutput);
             s.haveTaa = true;
             s.result = &s.taaHistory;
+        }
+        if (mParams.safetyNet > 0.0f) {
+            // The still default on the frame alone (on this device; host inputs come back on the
+            // host and go up again), then the per-pixel give-way (svgf_safety.h).
+            DenoiseOptions o;
+            o.device = dev;
+            o.weights = mLearned;
+            Image still = denoise(frame, o);
+            if (still.device() != dev) still = still.to(dev);
+            if (s.safeRel.empty()) s.safeRel = Image::uninitialized(w, h, 1, dev), s.safeOut = Image::uninitialized(w, h, 3, dev);
+            mExec.forEachPixel(w, h, SafetyDifference{s.result->view(), still.view(), s.safeRel.view()});
+            mExec.forEachPixel(w, h, SafetyBlend{mParams.safetyNet, s.result->view(), still.view(), s.safeRel.view(),
+                                                 s.safeOut.view()});
+            filters::markStage(clock, "safety net");
+            s.result = &s.safeOut;
+            mExec.synchronize();  // `still` dies at the end of this scope
         }
 
         // This frame becomes the history. Swaps move ownership only; nothing is copied.

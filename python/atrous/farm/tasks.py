@@ -209,7 +209,8 @@ def run_svgf(item: Dict[str, Any], out: Path, threads: int, device: str) -> Dict
         for name in p["frames"]:
             b = load_frame(Path(p["input"]) / name)
             img = s.denoise_frame(b["color"], albedo=b["albedo"], normal=b["normal"], depth=b["depth"],
-                                  ids=b["ids"], motion=b["motion"], emission=b.get("emission"))
+                                  ids=b["ids"], motion=b["motion"], emission=b.get("emission"),
+                                  position=b.get("position"), variance=b.get("variance"))
             atrous.write_image(stage / f"{name}.exr", img)
             atrous.write_image(stage / f"{name}.png", img)
         publish_dir(stage, out / item["outputs"][0])
