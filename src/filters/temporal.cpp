@@ -36,8 +36,9 @@ const std::vector<SequenceMethodInfo>& sequenceMethods() {
           Buffer::ObjectId, Buffer::Emission, Buffer::Motion}},
         {"svgf", "spatiotemporal variance-guided filtering, causal: each frame from the ones before it (docs/svgf.md)",
          true, false, "svgf",
-         {Buffer::Color, Buffer::Albedo, Buffer::Normal, Buffer::Depth, Buffer::ObjectId, Buffer::Emission,
-          Buffer::Motion}},
+         // Variance and position: for the safety net's still filter (SVGF itself does not read them).
+         {Buffer::Color, Buffer::Variance, Buffer::Albedo, Buffer::Normal, Buffer::Position, Buffer::Depth,
+          Buffer::ObjectId, Buffer::Emission, Buffer::Motion}},
     };
     return rows;
 }
