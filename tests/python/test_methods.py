@@ -31,7 +31,9 @@ def test_the_toy_is_in_every_list():
     seq = {r["name"]: r for r in atrous.sequence_methods()}
     known = {b["name"] for b in atrous.buffers()}
     assert set(seq["svgf"]["reads"]) <= known and "motion" in seq["svgf"]["reads"]
-    assert "variance" not in seq["svgf"]["reads"] and "variance" in seq["temporal"]["reads"]
+    # SVGF reads the variance (and position) for its safety net's still filter only
+    assert "variance" in seq["svgf"]["reads"] and "variance" in seq["temporal"]["reads"]
+    assert "position" in seq["svgf"]["reads"]
 
 
 def test_denoise_is_the_cascade_on_the_prepared_planes_then_remodulation():
