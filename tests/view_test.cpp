@@ -131,6 +131,10 @@ TEST(ViewCli, BadInputExitsTwoBeforeOpeningAWindow) {
     r = runCli(std::string(kBase) + " --width 0" + shot);
     EXPECT_EQ(r.exitCode, 2);
     EXPECT_NE(r.output.find("--width"), std::string::npos) << r.output;
+    // SVGF's flags come from its parameter table, checked before any window opens.
+    r = runCli(std::string(kBase) + " --method svgf --svgf-safety-net -1" + shot);
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.output.find("--svgf-safety-net"), std::string::npos) << r.output;
     if (!atrous::cudaAvailable()) {
         r = runCli(std::string(kBase) + " --device cuda" + shot);
         EXPECT_EQ(r.exitCode, 2);

@@ -42,6 +42,8 @@ void addViewCommand(CLI::App& app) {
                     });
     cmd->add_option("--method", o.method, "Denoiser of the main view: " + methodList())
         ->capture_default_str();
+    // --svgf-* (and --taa) from the SVGF parameter table: start values of the panel's SVGF section.
+    addParamOptions(*cmd, o.svgf, svgfParams(), [](const ParamField<SvgfParams>&) { return "SVGF (--method svgf)"; });
     cmd->add_option("--compare", o.compare, "Split screen: the method shown on the right half");
     cmd->add_flag("--no-accumulate", o.noAccumulate,
                   "Filter each frame on its own (no running mean)");

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "atrous/render.h"
+#include "atrous/svgf.h"
 
 namespace atrous::view {
 
@@ -31,6 +32,7 @@ struct ViewerOptions {
     float orbitDegPerFrame = 0.0f;       // turntable: yaw the orbit camera by this much every frame
     bool hideUi = false;                 // no control panel: the window is exactly width x height
     bool benchmark = false;              // print a JSON line with frame and stage timings at exit
+    SvgfParams svgf;                     // --svgf-* flags (the svgf parameter table): SVGF's start values
 };
 
 // Opens the window and runs until it is closed (or --frames are done). Throws InputError for bad
