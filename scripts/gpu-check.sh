@@ -10,7 +10,8 @@
 #   sanitizer  compute-sanitizer memcheck on a CUDA render (built-in and OBJ scenes), CUDA EAW, SURE,
 #              learned and SVGF denoises; racecheck on the SURE, learned and SVGF denoises
 #   variants   the pack's other builds of atrous (variants.tar.xz), benched against it in 3 turns
-#   profile    Nsight Compute (ncu) over each kernel of a 1080p EAW and SURE denoise (profile/*.csv)
+#   profile    Nsight Compute (ncu) over each kernel of a 1080p EAW and SURE denoise and of two
+#              1080p SVGF frames (profile/*.csv)
 #   oidn       oidnBenchmark on OIDN's CUDA device (RT filter, hdr + albedo + normal, quality high)
 #              at the same four sizes (a CNN: its time does not depend on the pixels)
 # Each command runs under `timeout`, within a total budget (default 420 s), and the script goes on
@@ -335,6 +336,11 @@ profile() {  # Nsight Compute on each kernel of one 1080p EAW and SURE denoise: 
       --section Occupancy --csv --page details "$WORK/atrous" denoise --in "$SCRATCH/p1080" --device "$DEV" \
       --method $m --out "$SCRATCH/p-$m.exr" > "$OUTDIR/profile/ncu_${m}_1080p.csv" || return 1
   done
+  # SVGF with its safety net over a 2-frame 1080p sequence (the second frame has a history)
+  "$WORK/atrous" render --scene cornell-moving --frames 2 --width 1920 --height 1080 --spp 1 --device "$DEV" --quiet \
+    --out "$SCRATCH/s1080" || return 1
+  "$ncu" --clock-control none --section SpeedOfLight --section LaunchStats --csv --page details "$WORK/atrous" denoise \
+    --sequence "$SCRATCH/s1080" --device "$DEV" --method svgf --out "$SCRATCH/s-svgf" > "$OUTDIR/profile/ncu_svgf_1080p.csv" || return 1
 }
 export -f info bandwidth gtest bench_size bench_render oidn sanitize_prep sanitize profile variants
 
