@@ -337,7 +337,7 @@ profile() {  # Nsight Compute on each kernel of one 1080p EAW and SURE denoise: 
       --method $m --out "$SCRATCH/p-$m.exr" > "$OUTDIR/profile/ncu_${m}_1080p.csv" || return 1
   done
   # SVGF with its safety net over a 2-frame 1080p sequence (the second frame has a history)
-  "$WORK/atrous" render --scene cornell-moving --frames 2 --width 1920 --height 1080 --spp 1 --device "$DEV" --quiet \
+  "$WORK/atrous" render --scene cornell-moving --frames 2 --width 1920 --height 1080 --spp 1 --device cpu --quiet \
     --out "$SCRATCH/s1080" || return 1
   "$ncu" --clock-control none --section SpeedOfLight --section LaunchStats --csv --page details "$WORK/atrous" denoise \
     --sequence "$SCRATCH/s1080" --device "$DEV" --method svgf --out "$SCRATCH/s-svgf" > "$OUTDIR/profile/ncu_svgf_1080p.csv" || return 1
