@@ -48,7 +48,13 @@ def main() -> int:
     ap.add_argument("--frames", type=int, default=12)
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--out", help="write the JSON here too")
+    ap.add_argument("--variant", action="append", default=[], metavar="NAME=FLAGS",
+                    help="also time `denoise --sequence` with these flags (e.g. static0=\"--temporal-static-radius 0\")")
     a = ap.parse_args()
+    variants = dict(VARIANTS)
+    for v in a.variant:
+        name, flags = v.split("=", 1)
+        variants[name] = flags.split()
     w, h = (int(v) for v in a.size.lower().split("x"))
     work = ROOT / "out" / "bench" / "seq"
     seq = work / f"{w}x{h}_{a.frames}"
@@ -56,9 +62,9 @@ def main() -> int:
         subprocess.run([a.atrous, "render", "--scene", "cornell-moving", "--width", str(w), "--height", str(h),
                         "--spp", "1", "--frames", str(a.frames), "--quiet", "--out", str(seq)], check=True,
                        capture_output=True)
-    samples = {k: [] for k in VARIANTS}
+    samples = {k: [] for k in variants}
     for run in range(a.runs + 1):
-        for name, flags in VARIANTS.items():
+        for name, flags in variants.items():
             r = run_once(a.atrous, seq, work / f"out_{name}", flags)
             if run > 0:  # the first round warms the page cache and the CPU up
                 samples[name].append(r)
@@ -70,6 +76,7 @@ def main() -> int:
            "device": "cpu", "commit": git_commit(), "size": [w, h], "frames": a.frames, "runs": a.runs,
            "median_ms_per_frame": med,
            "temporal_over_per_frame": {m: med["temporal"][m] / base[m] for m in ("filter_ms", "wall_ms")},
+           "over_per_frame": {k: {m: med[k][m] / base[m] for m in ("filter_ms", "wall_ms")} for k in med},
            "samples": samples}
     emit(doc, a.out)
     return 0

@@ -218,7 +218,8 @@ inline const ParamField<P> kSvgf[] = {
 };
 
 inline const ParamField<T> kTemporal[] = {
-    {"radius", &at<&T::radius>, paramIn(0, 16), "frames on each side of the one denoised (0 = that frame alone)"},
+    {"radius", &at<&T::radius>, paramIn(0, 16),
+     "frames on each side of the one denoised (0 = that frame alone; where nothing moves: static_radius)"},
     {"depth_tolerance", &at<&T::depthTolerance>, paramAtLeast(0),
      "reprojection depth test tau_z, relative to the depth gradient"},
     {"normal_cos", &at<&T::normalCos>, paramIn(-1, 1), "reprojection: minimum cosine between normals"},
@@ -231,6 +232,9 @@ inline const ParamField<T> kTemporal[] = {
     {"causal", &at<&T::causal>, {},
      "the frames before each one only (t-radius .. t): each frame as soon as it is rendered, as in a viewer"},
     {"causal_falloff", &at<&T::causalFalloff>, paramAtLeast(0), "the falloff in causal mode (in place of falloff)"},
+    {"static_radius", &at<&T::staticRadius>, paramIn(0, 16),
+     "frames on each side, equally weighted, for the pixels that have not moved (static camera and surface; "
+     "offline mode; 0 = off)"},
 };
 
 // threads: a ceiling, since tbb::task_arena aborts in its destructor from 65537 threads on

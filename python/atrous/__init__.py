@@ -53,6 +53,7 @@ __all__ = [
     "denoise_params",
     "svgf_params",
     "temporal_params",
+    "temporal_window_radius",
     "denoise_temporal",
     "denoise_sequence",
     "render_params",
@@ -165,6 +166,11 @@ def svgf_params() -> list:
 def temporal_params() -> list:
     """The keywords of :func:`denoise_temporal`'s ``temporal`` dict, in the form of :func:`denoise_params`."""
     return [dict(r) for r in _core.temporal_params()]
+
+
+def temporal_window_radius(temporal: Optional[Dict[str, Any]] = None) -> int:
+    """Frames on each side of t that :func:`denoise_temporal` reads with these ``temporal`` keywords."""
+    return int(_core.temporal_window_radius(dict(temporal or {})))
 
 
 def render_params() -> list:
@@ -510,7 +516,7 @@ def denoise_sequence(input: "PathLike", out: "PathLike", *, method: str = "tempo
     input: a folder in any layout the CLI reads (atrous's frame_NNNN folders, one folder per frame
     with a renderer's own names such as LuxCore's, color_0001.exr-style numbered files, Blender's
     numbered multilayer renderNNNN.exr) or a pattern ("renders/render####.exr", "%04d").
-    method: "temporal" (frames t-3..t+3, the default), "svgf", or a still method of :data:`METHODS`
+    method: "temporal" (frames t-3..t+3, t-6..t+6 where still; the default), "svgf", or a method of :data:`METHODS`
     run on each frame alone. spatial: the still method temporal runs on its average.
     passes: {buffer: pass name} for layered frames (the CLI's --pass); layer: the view layer.
     start/end/step: the frames to denoise (None: the first / the last).

@@ -538,6 +538,12 @@ NB_MODULE(_core, m) {
           [] { return methodRows(denoiseMethods(), "uses_weights", &DenoiseMethodInfo::usesWeights); });
     m.def("svgf_params", [] { return paramRows(svgfParams()); });
     m.def("temporal_params", [] { return paramRows(temporalParams()); });
+    m.def("temporal_window_radius", [](nb::dict temporal) {
+        TemporalParams tp;
+        for (auto [k, v] : temporal) applyParam(tp, temporalParams(), nb::cast<std::string>(k), v, "temporal");
+        validateTemporalParams(tp);
+        return temporalWindowRadius(tp);
+    });
     // The sequence methods (sequenceMethods(), include/atrous/temporal.h): atrous.SEQUENCE_METHODS.
     m.def("sequence_methods", [] { return methodRows(sequenceMethods(), "causal", &SequenceMethodInfo::causal); });
     m.def("denoise_temporal", &pyDenoiseTemporal, nb::arg("frames"), nb::arg("center"), nb::arg("method"),

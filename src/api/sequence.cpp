@@ -144,9 +144,9 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
     const std::string stage = staged.stage();
 
     // Frames are read in order; frame i is denoised once frames up to i + lookahead are in
-    // (temporal: its radius, 0 when causal; the other methods: 0). `window` holds frames winFirst
-    // .. the last read, at most radius behind the one denoised.
-    const size_t radius = temporal ? size_t(args.temporal.radius) : 0;
+    // (temporal: its window's radius, 0 when causal; the other methods: 0). `window` holds frames
+    // winFirst .. the last read, at most radius behind the one denoised.
+    const size_t radius = temporal ? size_t(temporalWindowRadius(args.temporal)) : 0;
     const size_t lookahead = temporal && !args.temporal.causal ? radius : 0;
     std::deque<io::SequenceFrame> window;
     size_t winFirst = 0;
@@ -219,8 +219,11 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
         r.methodUsed = svgf ? "svgf" : denoiseMethodName(frameReport.methodUsed);
         r.method = args.method;
         if (temporal)
-            r.method += format(" (%s%zu frames, %.1f averaged per pixel in %.0f ms; then %s%s%s)",
-                               args.temporal.causal ? "causal, -" : "+-", radius,
+            r.method += format(" (%s%d frames%s, %.1f averaged per pixel in %.0f ms; then %s%s%s)",
+                               args.temporal.causal ? "causal, -" : "+-", args.temporal.radius,
+                               size_t(args.temporal.radius) < radius
+                                   ? format(" (+-%zu where nothing moves)", radius).c_str()
+                                   : "",
                                temporalReport.meanFrames, temporalReport.gatherMs, denoiseMethodName(options.method),
                                resolved ? " -> " : "", resolved ? r.methodUsed.c_str() : "");
         else if (resolved)

@@ -24,13 +24,18 @@ void checkFrame(const SvgfFrame& frame);  // svgf.cpp: sizes, channels, the colo
 
 void validateTemporalParams(const TemporalParams& p) { validateParams(p, temporalParams()); }
 
+int temporalWindowRadius(const TemporalParams& p) {
+    if (p.radius == 0 || p.causal) return p.radius;
+    return std::max(p.radius, p.staticRadius);
+}
+
 void checkTemporalFrame(const SvgfFrame& frame) { svgf::checkFrame(frame); }
 
 const std::vector<SequenceMethodInfo>& sequenceMethods() {
     static const std::vector<SequenceMethodInfo> rows = {
         {"temporal",
-         "the default with --sequence: frames t-3..t+3 reprojected onto t and averaged, then the still method "
-         "--spatial (docs/temporal.md)",
+         "the default with --sequence: frames t-3..t+3 (t-6..t+6 where nothing moves) reprojected onto t and "
+         "averaged, then the still method --spatial (docs/temporal.md)",
          false, true, "temporal",
          {Buffer::Color, Buffer::Variance, Buffer::Albedo, Buffer::Normal, Buffer::Position, Buffer::Depth,
           Buffer::ObjectId, Buffer::Emission, Buffer::Motion}},
@@ -63,6 +68,11 @@ namespace {
 struct PreparedFrame {
     Image depth, normal, ids, motion, grad, stats, color, emission;
     temporal::FrameViews views;
+    // At least half of the frame's pixels moved less than kTemporalStaticMotion: the camera stood
+    // still (TemporalParams::staticRadius applies to hops through this frame's motion). Where the
+    // camera moves, a pixel that keeps its place on screen (an orbit's pivot) still sees its
+    // highlights and reflections change.
+    bool stillCamera = false;
 };
 
 struct TemporalCache::Impl {
@@ -90,6 +100,12 @@ void prepare(const CpuExec& exec, const SvgfFrame& f, bool stats, float fireflyK
     exec.forEachPixel(w, h, svgf::SanitizeGbuffer{viewOf(f.depth), viewOf(f.normal), viewOf(f.ids), viewOf(f.motion),
                                                   p.depth.view(), p.normal.view(), p.ids.view(), p.motion.view()});
     exec.forEachPixel(w, h, svgf::DepthGradient{p.depth.view(), p.grad.view()});
+    size_t still = 0;
+    const size_t plane = p.motion.plane();
+    for (size_t i = 0; i < plane; ++i)
+        still += std::fabs(p.motion.data()[i]) < kTemporalStaticMotion &&
+                 std::fabs(p.motion.data()[plane + i]) < kTemporalStaticMotion;
+    p.stillCamera = 2 * still >= plane;
     temporal::FrameViews& v = p.views;
     v.depth = p.depth.view(), v.normal = p.normal.view(), v.ids = p.ids.view(), v.motion = p.motion.view();
     v.grad = p.grad.view();
@@ -133,7 +149,7 @@ TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t cente
     const SvgfFrame& c = window[center];
     if (!c.color || c.color->empty()) svgf::checkFrame(c);  // throws: the colour is missing
     const int w = c.color->width(), h = c.color->height();
-    const size_t r = size_t(params.radius);
+    const size_t r = size_t(temporalWindowRadius(params));
     const size_t lo = center > r ? center - r : 0, hi = params.causal ? center : std::min(window.size() - 1, center + r);
     const bool stats = params.colorSigmas > 0.0f;
     // The cache holds what a frame's id was prepared into, for this size and these settings only.
@@ -227,7 +243,10 @@ TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t cente
             hop.to.variance = viewOf(window[to].variance);
             hop.backward = dir < 0;
             const float fo = params.causal ? params.causalFalloff : params.falloff;
-            hop.weight = fo > 0.0f ? std::exp(-float(k * k) / (2.0f * fo * fo)) : 1.0f;
+            hop.weight = k > size_t(params.radius) ? 0.0f : fo > 0.0f ? std::exp(-float(k * k) / (2.0f * fo * fo)) : 1.0f;
+            // Static tracks: equal weights out to staticRadius (offline), else as the others.
+            const bool still = prepared[(dir < 0 ? from : to) - lo]->stillCamera;  // whose motion the hop reads
+            hop.staticWeight = !params.causal && still && k <= size_t(params.staticRadius) ? 1.0f : hop.weight;
             hop.depthTolerance = params.depthTolerance, hop.normalCos = params.normalCos;
             hop.colorSigmas = params.colorSigmas;
             hop.track = track.view(), hop.alive = alive.view();

@@ -4,6 +4,7 @@
 // src/filters/temporal.cpp. The G-buffer of every frame is first sanitised by SVGF's functors
 // (svgf_gbuffer.h), so depth, normal, ids and motion follow SVGF's rules here too.
 #pragma once
+#include "atrous/temporal.h"
 #include "filters/svgf_common.h"
 
 namespace atrous::temporal {
@@ -77,7 +78,10 @@ struct Hop {
     FrameViews from, to, centre;
     bool backward = true;
     float depthTolerance = 2.0f, normalCos = 0.9f, colorSigmas = 3.0f;
-    float weight = 1.0f;  // this frame's weight in the average (the centre's is 1)
+    float weight = 1.0f;  // this frame's weight in the average (the centre's is 1); 0: the track stops
+    // The weight of a track that has not moved yet (TemporalParams::staticRadius); `alive` is 1
+    // for such a track and 0.5 once it has moved.
+    float staticWeight = 1.0f;
     ImageView track;  // 2 channels: the position in `from`, then in `to`
     ImageView alive;  // 1 channel: 1 while the track holds
     ImageView sumColor, sumAlbedo, sumNormal, sumEmission, sumVariance, count;
@@ -121,6 +125,7 @@ struct Hop {
 
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         if (alive(x, y, 0) == 0.0f) return;
+        bool moved = alive(x, y, 0) < 1.0f;
         const float tx = track(x, y, 0), ty = track(x, y, 1);
         const int fx = nearest(tx), fy = nearest(ty);
         if (fx < 0 || fy < 0 || fx >= from.depth.width || fy >= from.depth.height) return stop(x, y);
@@ -129,6 +134,7 @@ struct Hop {
             const float mx = from.motion(fx, fy, 0), my = from.motion(fx, fy, 1);
             if (!(fabsf(mx) < kMaxMotion) || !(fabsf(my) < kMaxMotion)) return stop(x, y);
             px = tx + mx, py = ty + my;
+            moved = moved || !(fabsf(mx) < kTemporalStaticMotion && fabsf(my) < kTemporalStaticMotion);
         } else {
             // Constant velocity: the step to the next frame is minus the step to the previous one.
             float mx = from.motion(fx, fy, 0), my = from.motion(fx, fy, 1);
@@ -144,8 +150,10 @@ struct Hop {
             const int qx = nearest(px), qy = nearest(py);
             if (!inside(qx, qy)) return stop(x, y);
             // The found pixel must map back onto the track (a fold of the motion field does not).
-            const float rx = float(qx) + to.motion(qx, qy, 0) - tx, ry = float(qy) + to.motion(qx, qy, 1) - ty;
+            const float ux = to.motion(qx, qy, 0), uy = to.motion(qx, qy, 1);
+            const float rx = float(qx) + ux - tx, ry = float(qy) + uy - ty;
             if (!(fabsf(rx) <= 1.0f && fabsf(ry) <= 1.0f)) return stop(x, y);
+            moved = moved || !(fabsf(ux) < kTemporalStaticMotion && fabsf(uy) < kTemporalStaticMotion);
         }
         const int qx = nearest(px), qy = nearest(py);
         const Anchor an = anchor(fx, fy);
@@ -186,8 +194,11 @@ struct Hop {
                         isFiniteF(v[k]);
         }
         if (!finiteAll) return stop(x, y);
+        const float weight = moved ? this->weight : staticWeight;
+        if (!(weight > 0.0f)) return stop(x, y);
         track(x, y, 0) = px;
         track(x, y, 1) = py;
+        if (moved) alive(x, y, 0) = 0.5f;
         for (int k = 0; k < 3; ++k) {
             sumColor(x, y, k) += weight * c[k];
             if (sumAlbedo.valid()) sumAlbedo(x, y, k) += weight * a[k];

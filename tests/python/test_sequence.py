@@ -55,9 +55,14 @@ def test_the_same_files_as_the_cli(sequence, tmp_path):
     names = sorted(p.name for p in (tmp_path / "py").iterdir())
     assert names == ["frame_0001.exr", "frame_0001.png", "frame_0002.exr", "frame_0002.png", "frame_0003.exr",
                      "frame_0003.png"]
+    # The module and the CLI run the same C++ (denoiseSequence) but are separate builds (the CLI's
+    # with CUDA, the module's without), and blend's arithmetic can differ in the last bits between
+    # them (seen: 7e-9 on values of 1e-3, one frame in three). A wrong window, method or parameter
+    # moves values by far more than 1e-5 relative.
     for n in names:
         if n.endswith(".exr"):
-            np.testing.assert_array_equal(atrous.read_image(tmp_path / "py" / n), atrous.read_image(tmp_path / "cli" / n))
+            np.testing.assert_allclose(atrous.read_image(tmp_path / "py" / n), atrous.read_image(tmp_path / "cli" / n),
+                                       rtol=1e-5, atol=1e-7)
 
 
 def test_bad_input_raises_and_writes_nothing(sequence, tmp_path):

@@ -69,17 +69,17 @@ def write_static_sequence(seq_dir: str, scene: str, frames: int, width: int, hei
         atrous.write_image(f / "reference.exr", ref)
 
 
-def temporal_window(count: int, index: int, radius: Optional[int] = None) -> Tuple[int, int]:
+def temporal_window(count: int, index: int, temporal: Optional[Dict[str, Any]] = None) -> Tuple[int, int]:
     """The first and last frame (inclusive) that atrous.denoise_temporal reads for frame `index` of
-    `count` frames: index ± radius, clipped to the sequence (radius None: the method's default)."""
-    if radius is None:
-        radius = next(int(r["default"]) for r in atrous.temporal_params() if r["name"] == "radius")
-    return max(0, index - int(radius)), min(count - 1, index + int(radius))
+    `count` frames with the `temporal` parameters (None: the defaults): index ± the window's radius
+    (radius, or static_radius when larger), clipped to the sequence."""
+    r = atrous.temporal_window_radius(temporal)
+    return max(0, index - r), min(count - 1, index + r)
 
 
 def evaluate_sequence(seq_dir: str, methods: Dict[str, Optional[Callable]],
                       log: Callable[[str], None] = print) -> Dict[str, Any]:
-    """The temporal method (frames t-3..t+3, the CLI's --sequence default), SVGF (history carried
+    """The temporal method (frames t-3..t+3, t-6..t+6 where still: the CLI's --sequence default), SVGF (history carried
     over frames) and every per-frame method on each frame.
 
     Metrics per frame against reference.exr when present (FLIP on the last frame only: it costs

@@ -227,7 +227,7 @@ def run_temporal(item: Dict[str, Any], out: Path, threads: int, device: str) -> 
     p = item["params"]
     own, spatial, still = split_temporal_params(p["params"])
     i, names = int(p["index"]), p["frames"]
-    lo, hi = temporal_window(len(names), i, own.get("radius"))
+    lo, hi = temporal_window(len(names), i, own)
     frames = [{k: v for k, v in load_frame(Path(p["input"]) / n).items() if k != "reference"} for n in names[lo:hi + 1]]
     t0 = time.perf_counter()
     img = atrous.denoise_temporal(frames, i - lo, temporal=own, method=spatial, device=device, **still)
