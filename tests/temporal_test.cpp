@@ -182,6 +182,51 @@ TEST(TemporalGather, PixelsThatNeverMoveTakeTheStaticWindow) {
     EXPECT_EQ(temporalWindowRadius(p), 0);
 }
 
+// A still camera sees the edge of a light in a ceiling: column 8 of a 16x8 image is covered half
+// by each, and its one sample a frame (1 spp: the colour, depth and id are that sample's) lands
+// on the light (5) in some frames and on the ceiling (0) in the others. The frames' samples are
+// samples of the same footprint: with the static window they are all averaged, whichever surface
+// each one hit (the id test accepts the surfaces next to the pixel), and the edge pixel's mean is
+// the fraction of frames that hit the light. Without it (static_radius 0) only the frames that hit
+// what the centre frame's sample hit are kept: the centre's 0 or 5 with t-3..t+3 of the same.
+TEST(TemporalGather, AStillEdgePixelAveragesWhateverItsSamplesHit) {
+    const int w = 16, h = 8, n = 13;
+    const int hits[n] = {1, 0, 0, 1, 1, 0, 1, 0, 1, 1, 0, 0, 1};  // frame 6 hit the light; 7 of 13
+    std::vector<Image> color, albedo, normal, depth, ids, motion;
+    for (int t = 0; t < n; ++t) {
+        color.emplace_back(w, h, 3), albedo.emplace_back(w, h, 3), normal.emplace_back(w, h, 3);
+        depth.emplace_back(w, h, 1), ids.emplace_back(w, h, 1), motion.emplace_back(w, h, 2);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const bool light = x > 8 || (x == 8 && hits[t]);
+                for (int c = 0; c < 3; ++c) {
+                    color.back()(x, y, c) = light ? 5.0f : 0.0f;
+                    albedo.back()(x, y, c) = 1.0f;
+                    normal.back()(x, y, c) = c == 1 ? -1.0f : 0.0f;  // both face down
+                }
+                depth.back()(x, y, 0) = light ? 3.999f : 4.0f;
+                ids.back()(x, y, 0) = light ? 1.0f : 0.0f;
+            }
+    }
+    std::vector<SvgfFrame> frames(n);
+    for (int t = 0; t < n; ++t) {
+        frames[t].color = &color[t], frames[t].albedo = &albedo[t], frames[t].normal = &normal[t];
+        frames[t].depth = &depth[t], frames[t].ids = &ids[t], frames[t].motion = &motion[t];
+    }
+    TemporalParams p;
+    p.falloff = 0.0f, p.colorSigmas = 0.0f, p.fireflyK = 0.0f;  // plain means: the tests alone decide
+    const TemporalGather g = gatherTemporal(frames, 6, p);
+    for (int y = 0; y < h; ++y) {
+        EXPECT_NEAR(g.color(8, y, 0), 5.0f * 7.0f / 13.0f, 1e-4f) << y;
+        EXPECT_EQ(g.frames(8, y, 0), 13.0f) << y;
+        EXPECT_NEAR(g.color(3, y, 0), 0.0f, 1e-6f) << y;   // the ceiling and the light away from the
+        EXPECT_NEAR(g.color(12, y, 0), 5.0f, 1e-6f) << y;  // edge keep their own value
+    }
+    p.staticRadius = 0;
+    const TemporalGather g0 = gatherTemporal(frames, 6, p);
+    for (int y = 0; y < h; ++y) EXPECT_NEAR(g0.color(8, y, 0), 5.0f, 1e-6f) << y;  // frame 6's light only
+}
+
 // The neighbours are 20 noise sigmas brighter (a light switched on): the colour test leaves them
 // out and the centre stands alone. With the test off they are averaged in.
 TEST(TemporalGather, LeavesOutNeighboursWhoseColourChanged) {

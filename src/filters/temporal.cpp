@@ -247,6 +247,8 @@ TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t cente
             // Static tracks: equal weights out to staticRadius (offline), else as the others.
             const bool still = prepared[(dir < 0 ? from : to) - lo]->stillCamera;  // whose motion the hop reads
             hop.staticWeight = !params.causal && still && k <= size_t(params.staticRadius) ? 1.0f : hop.weight;
+            // ... and whose G-buffer test also accepts the static surfaces next to the pixel.
+            hop.stillHop = !params.causal && still && params.staticRadius > 0;
             hop.depthTolerance = params.depthTolerance, hop.normalCos = params.normalCos;
             hop.colorSigmas = params.colorSigmas;
             hop.track = track.view(), hop.alive = alive.view();

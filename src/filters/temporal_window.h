@@ -121,6 +121,30 @@ struct Hop {
 
     ATROUS_HOST_DEVICE static int nearest(float v) { return int(floorf(v + 0.5f)); }
 
+    // A track that has not moved, in a hop through a still camera's frames (stillHop): the
+    // reached pixel is the same footprint, and its sample may have hit any surface the footprint
+    // covers. A renderer's depth, normal and id are one sample's (at 1 spp, the pixel's only one),
+    // so a pixel on an edge (a light in a ceiling, a silhouette) shows one side in one frame and
+    // the other in the next, and the test against the pixel's own G-buffer would keep only the
+    // frames that agree with the centre's sample. Here a tap is also kept where it passes the test
+    // against a static pixel of the 3x3 neighbourhood in `from`: a surface next to the pixel.
+    // What moves next to it (a moving object's edge) is not such a surface.
+    bool stillHop = false;
+    ATROUS_HOST_DEVICE bool consistentNear(const Anchor& a, int fx, int fy, int qx, int qy, bool moved) const {
+        if (consistent(a, qx, qy)) return true;
+        if (moved || !stillHop) return false;
+        for (int j = -1; j <= 1; ++j)
+            for (int i = -1; i <= 1; ++i) {
+                const int nx = fx + i, ny = fy + j;
+                if ((!i && !j) || nx < 0 || ny < 0 || nx >= from.depth.width || ny >= from.depth.height) continue;
+                if (!(fabsf(from.motion(nx, ny, 0)) < kTemporalStaticMotion &&
+                      fabsf(from.motion(nx, ny, 1)) < kTemporalStaticMotion))
+                    continue;
+                if (consistent(anchor(nx, ny), qx, qy)) return true;
+            }
+        return false;
+    }
+
     ATROUS_HOST_DEVICE void stop(int x, int y) const { alive(x, y, 0) = 0.0f; }
 
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
@@ -157,7 +181,7 @@ struct Hop {
         }
         const int qx = nearest(px), qy = nearest(py);
         const Anchor an = anchor(fx, fy);
-        if (!consistent(an, qx, qy)) return stop(x, y);
+        if (!consistentNear(an, fx, fy, qx, qy, moved)) return stop(x, y);
         if (colorSigmas > 0.0f) {
             // Two 3x3 means of independent noise: their difference has the sum of their variances.
             const float d = to.stats(qx, qy, 0) - centre.stats(x, y, 0);
@@ -174,7 +198,7 @@ struct Hop {
             for (int i = 0; i < 2; ++i) {
                 const float wt = (i ? ax : 1.0f - ax) * (j ? ay : 1.0f - ay);
                 const int sx = x0 + i, sy = y0 + j;
-                if (wt <= 0.0f || !consistent(an, sx, sy)) continue;
+                if (wt <= 0.0f || !consistentNear(an, fx, fy, sx, sy, moved)) continue;
                 w += wt;
                 for (int k = 0; k < 3; ++k) {
                     c[k] += wt * to.color(sx, sy, k);
