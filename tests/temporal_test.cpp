@@ -172,6 +172,11 @@ TEST(TemporalGather, PixelsThatNeverMoveTakeTheStaticWindow) {
         for (int y = 0; y < by + bs + 4; ++y)
             for (int x = 0; x < o.width; ++x) f.motion(x, y, 0) += 0.5f;
     EXPECT_NEAR(regionMean(gatherTemporal(framesOf(panned), 6, p).frames, false), nEff, 0.05 * nEff);
+    // Frames without motion are taken as still: nothing then tells the box from the ground, and
+    // the static window is off.
+    std::vector<SvgfFrame> noMotion = framesOf(synth);
+    for (SvgfFrame& f : noMotion) f.motion = nullptr;
+    EXPECT_NEAR(regionMean(gatherTemporal(noMotion, 6, p).frames, false), nEff, 0.05 * nEff);
 
     p.staticRadius = 0;
     EXPECT_EQ(temporalWindowRadius(p), 3);

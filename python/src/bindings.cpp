@@ -338,6 +338,7 @@ nb::object pyDenoiseTemporal(nb::list frames, size_t center, const std::string& 
             previous = fit;
         }
         for (size_t i = 0; i < buffers.size(); ++i) buffers[i]->refs.set(B::Motion, &fitted[i]);
+        tp.staticRadius = 0;  // a fitted camera's motion cannot see what moves (as the CLI)
     } else if (!anyMotion && buffers.size() > 1) {
         // Neither: motion from the colours themselves (estimateMotion), as the CLI does, for the
         // frames the window reads (centre ± radius) whose previous frame has their size; the
@@ -349,6 +350,7 @@ nb::object pyDenoiseTemporal(nb::list frames, size_t center, const std::string& 
             fitted.push_back(estimateMotion(*colors[i], read ? colors[i - 1].get() : nullptr));
         }
         for (size_t i = 0; i < n; ++i) buffers[i]->refs.set(B::Motion, &fitted[i]);
+        tp.staticRadius = 0;  // nor can motion from the colours
     }
     std::vector<SvgfFrame> window;
     for (const auto& b : buffers) window.push_back(b->refs);

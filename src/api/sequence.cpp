@@ -154,6 +154,9 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
     std::vector<io::ReprojectionCheck> checks(frames.size());
     TemporalCache temporalCache;  // each frame prepared once for all the windows it is in
     bool idsTrusted = true, warnedSign = false, notedMotion = false;
+    // The static window (TemporalParams::staticRadius) needs the renderer's own motion vectors:
+    // motion fitted to positions or estimated from colours sees a moving object as still.
+    TemporalParams temporalParams = args.temporal;
     CameraFit prevCamera;  // the previous frame's, for motion from positions
     auto load = [&](size_t i) { return io::loadSequenceFrame(frames[i], present, layers); };
     std::future<io::SequenceFrame> next = std::async(std::launch::async, load, size_t(0));
@@ -188,7 +191,7 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
                 std::vector<long long> ids;
                 for (size_t j = 0; j < window.size(); ++j) ids.push_back((long long)(winFirst + j));
                 TemporalResult tr =
-                    denoiseTemporalWithReport(frameSet, i - winFirst, args.temporal, options, &temporalCache, &ids);
+                    denoiseTemporalWithReport(frameSet, i - winFirst, temporalParams, options, &temporalCache, &ids);
                 out = std::move(tr.image);
                 temporalReport = std::move(tr.report);
                 frameReport = temporalReport.spatial;
@@ -221,8 +224,8 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
         if (temporal)
             r.method += format(" (%s%d frames%s, %.1f averaged per pixel in %.0f ms; then %s%s%s)",
                                args.temporal.causal ? "causal, -" : "+-", args.temporal.radius,
-                               size_t(args.temporal.radius) < radius
-                                   ? format(" (+-%zu where nothing moves)", radius).c_str()
+                               temporalWindowRadius(temporalParams) > args.temporal.radius
+                                   ? format(" (+-%d where nothing moves)", temporalWindowRadius(temporalParams)).c_str()
                                    : "",
                                temporalReport.meanFrames, temporalReport.gatherMs, denoiseMethodName(options.method),
                                resolved ? " -> " : "", resolved ? r.methodUsed.c_str() : "");
@@ -250,6 +253,7 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
         if (usesMotion && f.motion.empty() && !f.position.empty()) {
             const CameraFit fit = fitCamera(f.position);
             f.motion = motionFromPositions(f.position, fit, prevCamera);  // frame 0: no previous, NaN (no history)
+            temporalParams.staticRadius = 0;
             if (i > 0 && !notedMotion) {
                 if (prevCamera.ok)
                     note(format("denoise: note: the frames have no motion vectors: motion from the Position pass (a "
@@ -267,6 +271,7 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
             // motion from the colours themselves, block matching against the previous frame (the
             // first has none: no history; the frames' sizes were checked above).
             f.motion = estimateMotion(f.color, window.empty() ? nullptr : &window.back().color);
+            temporalParams.staticRadius = 0;
             estimated = !window.empty();
             if (estimated && !notedMotion)
                 note("denoise: note: the frames have no motion vectors and no Position pass: motion estimated "

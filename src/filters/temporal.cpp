@@ -149,7 +149,11 @@ TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t cente
     const SvgfFrame& c = window[center];
     if (!c.color || c.color->empty()) svgf::checkFrame(c);  // throws: the colour is missing
     const int w = c.color->width(), h = c.color->height();
-    const size_t r = size_t(temporalWindowRadius(params));
+    // Frames without motion are taken as still, so nothing would tell a moving object from the
+    // background: the static window needs every frame's motion.
+    TemporalParams own = params;
+    for (const SvgfFrame& f : window) own.staticRadius = f.motion ? own.staticRadius : 0;
+    const size_t r = size_t(temporalWindowRadius(own));
     const size_t lo = center > r ? center - r : 0, hi = params.causal ? center : std::min(window.size() - 1, center + r);
     const bool stats = params.colorSigmas > 0.0f;
     // The cache holds what a frame's id was prepared into, for this size and these settings only.
@@ -246,9 +250,9 @@ TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t cente
             hop.weight = k > size_t(params.radius) ? 0.0f : fo > 0.0f ? std::exp(-float(k * k) / (2.0f * fo * fo)) : 1.0f;
             // Static tracks: equal weights out to staticRadius (offline), else as the others.
             const bool still = prepared[(dir < 0 ? from : to) - lo]->stillCamera;  // whose motion the hop reads
-            hop.staticWeight = !params.causal && still && k <= size_t(params.staticRadius) ? 1.0f : hop.weight;
+            hop.staticWeight = !params.causal && still && k <= size_t(own.staticRadius) ? 1.0f : hop.weight;
             // ... and whose G-buffer test also accepts the static surfaces next to the pixel.
-            hop.stillHop = !params.causal && still && params.staticRadius > 0;
+            hop.stillHop = !params.causal && still && own.staticRadius > 0;
             hop.depthTolerance = params.depthTolerance, hop.normalCos = params.normalCos;
             hop.colorSigmas = params.colorSigmas;
             hop.track = track.view(), hop.alive = alive.view();

@@ -93,6 +93,19 @@ def test_motion_from_positions_when_no_frame_has_motion(frames, reference):
     assert e["fitted"] < e["still"], e
 
 
+def test_the_static_window_needs_the_renderers_motion(frames):
+    # Motion fitted to the Position pass, or estimated from the colours, sees the moving sphere as
+    # still: the static window (static_radius) is then off, as in the CLI.
+    no_motion = [{k: v for k, v in f.items() if k != "motion"} for f in frames]
+    colours = [{"color": f["color"]} for f in frames]
+    for fs in (no_motion, colours):
+        np.testing.assert_array_equal(atrous.denoise_temporal(fs, 2, method="eaw"),
+                                      atrous.denoise_temporal(fs, 2, method="eaw", temporal={"static_radius": 0}))
+    # with the renderer's vectors it is on (cornell-moving: a still camera)
+    assert not np.array_equal(atrous.denoise_temporal(frames, 2, method="eaw"),
+                              atrous.denoise_temporal(frames, 2, method="eaw", temporal={"static_radius": 0}))
+
+
 def test_a_dolly_without_motion_or_positions_uses_the_colours_motion():
     # As `denoise --sequence` does (tests/camera_fit_test.cpp): frames with neither motion nor
     # positions get motion estimated from their colours; zero motion (frames taken as still)
