@@ -56,9 +56,13 @@ struct TemporalParams {
     // kTemporalStaticMotion pixels, through frames in which at least half the pixels did not move
     // either, goes on to t ± staticRadius with equal weights; the others keep `radius` and
     // `falloff`. The colour, depth, normal and id tests still apply (a moving shadow
-    // on a static floor is left out as before). Offline mode only (causal ignores it); with
-    // radius 0 the frame is denoised alone. 0 = off. Chosen on atrous's static-camera Cornell
-    // sequence; on the held-out Cycles turntable it takes 7-12% off the error (docs/temporal.md).
+    // on a static floor is left out as before); such a track's test also accepts the static
+    // surfaces next to it (a 1-spp pixel on an edge). Offline mode only (causal ignores it); with
+    // radius 0 the frame is denoised alone. It needs the renderer's motion vectors in every frame:
+    // without them (taken as still), and in `denoise --sequence` and the Python module where the
+    // motion is fitted to positions or estimated from colours, a moving object looks still, and
+    // it is off. 0 = off. Chosen on atrous's static-camera Cornell sequence; on the held-out
+    // Cycles turntable it takes 7-13% off the error (docs/temporal.md).
     int staticRadius = 6;
 };
 
