@@ -234,7 +234,7 @@ inline const ParamField<T> kTemporal[] = {
     {"causal_falloff", &at<&T::causalFalloff>, paramAtLeast(0), "the falloff in causal mode (in place of falloff)"},
     {"static_radius", &at<&T::staticRadius>, paramIn(0, 16),
      "frames on each side, equally weighted, for the pixels that have not moved (static camera and surface; "
-     "offline mode; 0 = off)"},
+     "offline mode, with the renderer's motion vectors; 0 = off)"},
 };
 
 // threads: a ceiling, since tbb::task_arena aborts in its destructor from 65537 threads on
