@@ -119,7 +119,8 @@ TEST(TemporalGather, AveragingCutsTheNoiseByTheEffectiveFrameCount) {
 // A textured box slides 1 pixel a frame over a static textured ground, noisy, 13 frames, the defaults (radius 3,
 // falloff 1.5, static_radius 6): the ground's pixels, which never move, average all 13 frames with
 // equal weights (1/13 of the noise's variance), the box's keep the falloff's 3.7 effective frames
-// of t-3..t+3. Under a moving camera, and with static_radius 0, the ground keeps the falloff too. Tolerances: 5% on the frame counts
+// of t-3..t+3. Under a moving camera, and with static_radius 0, the ground keeps the falloff too;
+// a frame whose camera moved ends the static part of a track. Tolerances: 5% on the frame counts
 // (a few 3-sigma colour rejections), 15% on a variance measured over ~1000 values (one standard
 // error ~4.5%).
 TEST(TemporalGather, PixelsThatNeverMoveTakeTheStaticWindow) {
@@ -172,6 +173,21 @@ TEST(TemporalGather, PixelsThatNeverMoveTakeTheStaticWindow) {
         for (int y = 0; y < by + bs + 4; ++y)
             for (int x = 0; x < o.width; ++x) f.motion(x, y, 0) += 0.5f;
     EXPECT_NEAR(regionMean(gatherTemporal(framesOf(panned), 6, p).frames, false), nEff, 0.05 * nEff);
+    // The camera moves in frame 8 only: the ground's tracks are static up to frame 7 (weight 1),
+    // then take the falloff (t+2, t+3) and stop at t+3; backward they reach t-6.
+    auto once = makeFrames(o, 13);
+    for (int y = 0; y < by + bs + 4; ++y)
+        for (int x = 0; x < o.width; ++x) once[8].motion(x, y, 0) += 0.5f;
+    const double g2 = std::exp(-4.0 / (2.0 * p.falloff * p.falloff)), g3 = std::exp(-9.0 / (2.0 * p.falloff * p.falloff));
+    const double sOnce = 8.0 + g2 + g3, s2Once = 8.0 + g2 * g2 + g3 * g3;
+    EXPECT_NEAR(regionMean(gatherTemporal(framesOf(once), 6, p).frames, false), sOnce * sOnce / s2Once,
+                0.05 * sOnce * sOnce / s2Once);
+    // The ground just behind the box's trailing edge was under the box in the frames before: its
+    // static track must not take the box's taps through the box pixel next to it (a moving
+    // neighbour is not a surface of this pixel's footprint). Backward it stops at once; forward
+    // it reaches t+6: at most 7 frames.
+    const TemporalGather gb = gatherTemporal(framesOf(synth), 6, p);
+    for (int y = by + 2; y < by + bs - 2; ++y) EXPECT_LE(gb.frames(bx - 1, y, 0), 7.0f + 1e-4f) << y;
     // Frames without motion are taken as still: nothing then tells the box from the ground, and
     // the static window is off.
     std::vector<SvgfFrame> noMotion = framesOf(synth);

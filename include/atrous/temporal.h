@@ -105,8 +105,8 @@ public:
     std::unique_ptr<Impl> mImpl;
 };
 
-// Reprojects and averages window[center - r .. center + r] (r = params.radius, clipped to the
-// window; center - r .. center with params.causal) onto window[center]. Every frame must have the centre's buffers and size (SvgfFrame's
+// Reprojects and averages window[center - r .. center + r] (r = temporalWindowRadius(params),
+// clipped to the window; center - radius .. center with params.causal) onto window[center]. Every frame must have the centre's buffers and size (SvgfFrame's
 // conventions: depth and ids in channel 0, motion previous - current in pixels). Frames without
 // motion are taken as still; what moved is then rejected by the depth, normal and id test.
 // Non-finite values of a neighbour are left out; the centre's own pass through. Host images.

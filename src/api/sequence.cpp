@@ -143,10 +143,14 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
     io::StagedDir staged("--out", outDir);
     const std::string stage = staged.stage();
 
+    // The static window (TemporalParams::staticRadius) needs the renderer's own motion vectors:
+    // motion fitted to positions or estimated from colours (below) sees a moving object as still.
+    TemporalParams temporalParams = args.temporal;
+    if (std::find(present.begin(), present.end(), "motion") == present.end()) temporalParams.staticRadius = 0;
     // Frames are read in order; frame i is denoised once frames up to i + lookahead are in
     // (temporal: its window's radius, 0 when causal; the other methods: 0). `window` holds frames
     // winFirst .. the last read, at most radius behind the one denoised.
-    const size_t radius = temporal ? size_t(temporalWindowRadius(args.temporal)) : 0;
+    const size_t radius = temporal ? size_t(temporalWindowRadius(temporalParams)) : 0;
     const size_t lookahead = temporal && !args.temporal.causal ? radius : 0;
     std::deque<io::SequenceFrame> window;
     size_t winFirst = 0;
@@ -154,9 +158,6 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
     std::vector<io::ReprojectionCheck> checks(frames.size());
     TemporalCache temporalCache;  // each frame prepared once for all the windows it is in
     bool idsTrusted = true, warnedSign = false, notedMotion = false;
-    // The static window (TemporalParams::staticRadius) needs the renderer's own motion vectors:
-    // motion fitted to positions or estimated from colours sees a moving object as still.
-    TemporalParams temporalParams = args.temporal;
     CameraFit prevCamera;  // the previous frame's, for motion from positions
     auto load = [&](size_t i) { return io::loadSequenceFrame(frames[i], present, layers); };
     std::future<io::SequenceFrame> next = std::async(std::launch::async, load, size_t(0));

@@ -24,6 +24,8 @@ void checkFrame(const SvgfFrame& frame);  // svgf.cpp: sizes, channels, the colo
 
 void validateTemporalParams(const TemporalParams& p) { validateParams(p, temporalParams()); }
 
+static_assert(temporal::kStaticMotion == kTemporalStaticMotion, "temporal_window.h's copy of the static motion bound");
+
 int temporalWindowRadius(const TemporalParams& p) {
     if (p.radius == 0 || p.causal) return p.radius;
     return std::max(p.radius, p.staticRadius);

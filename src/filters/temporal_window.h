@@ -4,7 +4,6 @@
 // src/filters/temporal.cpp. The G-buffer of every frame is first sanitised by SVGF's functors
 // (svgf_gbuffer.h), so depth, normal, ids and motion follow SVGF's rules here too.
 #pragma once
-#include "atrous/temporal.h"
 #include "filters/svgf_common.h"
 
 namespace atrous::temporal {
@@ -12,6 +11,10 @@ namespace atrous::temporal {
 using svgf::hasNormal;
 using svgf::isBackground;
 using svgf::kMaxMotion;
+
+// atrous::kTemporalStaticMotion (include/atrous/temporal.h; temporal.cpp checks they agree): a hop
+// under this many pixels keeps a track static.
+constexpr float kStaticMotion = 0.05f;
 using svgf::readVec3;
 using svgf::writeVec3;
 
@@ -137,8 +140,8 @@ struct Hop {
             for (int i = -1; i <= 1; ++i) {
                 const int nx = fx + i, ny = fy + j;
                 if ((!i && !j) || nx < 0 || ny < 0 || nx >= from.depth.width || ny >= from.depth.height) continue;
-                if (!(fabsf(from.motion(nx, ny, 0)) < kTemporalStaticMotion &&
-                      fabsf(from.motion(nx, ny, 1)) < kTemporalStaticMotion))
+                if (!(fabsf(from.motion(nx, ny, 0)) < kStaticMotion &&
+                      fabsf(from.motion(nx, ny, 1)) < kStaticMotion))
                     continue;
                 if (consistent(anchor(nx, ny), qx, qy)) return true;
             }
@@ -158,7 +161,7 @@ struct Hop {
             const float mx = from.motion(fx, fy, 0), my = from.motion(fx, fy, 1);
             if (!(fabsf(mx) < kMaxMotion) || !(fabsf(my) < kMaxMotion)) return stop(x, y);
             px = tx + mx, py = ty + my;
-            moved = moved || !(fabsf(mx) < kTemporalStaticMotion && fabsf(my) < kTemporalStaticMotion);
+            moved = moved || !(fabsf(mx) < kStaticMotion && fabsf(my) < kStaticMotion);
         } else {
             // Constant velocity: the step to the next frame is minus the step to the previous one.
             float mx = from.motion(fx, fy, 0), my = from.motion(fx, fy, 1);
@@ -177,7 +180,7 @@ struct Hop {
             const float ux = to.motion(qx, qy, 0), uy = to.motion(qx, qy, 1);
             const float rx = float(qx) + ux - tx, ry = float(qy) + uy - ty;
             if (!(fabsf(rx) <= 1.0f && fabsf(ry) <= 1.0f)) return stop(x, y);
-            moved = moved || !(fabsf(ux) < kTemporalStaticMotion && fabsf(uy) < kTemporalStaticMotion);
+            moved = moved || !(fabsf(ux) < kStaticMotion && fabsf(uy) < kStaticMotion);
         }
         const int qx = nearest(px), qy = nearest(py);
         const Anchor an = anchor(fx, fy);
@@ -218,6 +221,8 @@ struct Hop {
                         isFiniteF(v[k]);
         }
         if (!finiteAll) return stop(x, y);
+        // A hop through a frame whose camera moved ends the track's static part too.
+        moved = moved || !stillHop;
         const float weight = moved ? this->weight : staticWeight;
         if (!(weight > 0.0f)) return stop(x, y);
         track(x, y, 0) = px;

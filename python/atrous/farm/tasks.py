@@ -227,6 +227,8 @@ def run_temporal(item: Dict[str, Any], out: Path, threads: int, device: str) -> 
     p = item["params"]
     own, spatial, still = split_temporal_params(p["params"])
     i, names = int(p["index"]), p["frames"]
+    if not (Path(p["input"]) / names[i] / "motion.exr").exists():
+        own = dict(own, static_radius=0)  # the static window needs the renderer's vectors (docs/temporal.md)
     lo, hi = temporal_window(len(names), i, own)
     frames = [{k: v for k, v in load_frame(Path(p["input"]) / n).items() if k != "reference"} for n in names[lo:hi + 1]]
     t0 = time.perf_counter()
