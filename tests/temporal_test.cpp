@@ -188,6 +188,11 @@ TEST(TemporalGather, PixelsThatNeverMoveTakeTheStaticWindow) {
     // it reaches t+6: at most 7 frames.
     const TemporalGather gb = gatherTemporal(framesOf(synth), 6, p);
     for (int y = by + 2; y < by + bs - 2; ++y) EXPECT_LE(gb.frames(bx - 1, y, 0), 7.0f + 1e-4f) << y;
+    // A centre frame whose motion is zeros only (a renderer's first frame: no previous one) shows
+    // nothing of what moves: no static window through it.
+    auto zeros = makeFrames(o, 13);
+    zeros[6].motion.fill(0.0f);
+    EXPECT_NEAR(regionMean(gatherTemporal(framesOf(zeros), 6, p).frames, false), nEff, 0.05 * nEff);
     // Frames without motion are taken as still: nothing then tells the box from the ground, and
     // the static window is off.
     std::vector<SvgfFrame> noMotion = framesOf(synth);
@@ -228,6 +233,9 @@ TEST(TemporalGather, AStillEdgePixelAveragesWhateverItsSamplesHit) {
                 depth.back()(x, y, 0) = light ? 3.999f : 4.0f;
                 ids.back()(x, y, 0) = light ? 1.0f : 0.0f;
             }
+        // Something moves in a far corner: a motion buffer of zeros only is what renderers write
+        // for a first frame (no sign of what moves), and turns the static window off.
+        motion.back()(15, 7, 0) = 1.0f;
     }
     std::vector<SvgfFrame> frames(n);
     for (int t = 0; t < n; ++t) {

@@ -6,7 +6,6 @@
 #include <map>
 #include <string>
 #include <cmath>
-#include <cstdlib>
 
 #include "atrous/error.h"
 #include "atrous/params.h"
@@ -103,11 +102,16 @@ void prepare(const CpuExec& exec, const SvgfFrame& f, bool stats, float fireflyK
                                                   p.depth.view(), p.normal.view(), p.ids.view(), p.motion.view()});
     exec.forEachPixel(w, h, svgf::DepthGradient{p.depth.view(), p.grad.view()});
     size_t still = 0;
+    bool anyMotion = false;
     const size_t plane = p.motion.plane();
-    for (size_t i = 0; i < plane; ++i)
-        still += std::fabs(p.motion.data()[i]) < kTemporalStaticMotion &&
-                 std::fabs(p.motion.data()[plane + i]) < kTemporalStaticMotion;
-    p.stillCamera = 2 * still >= plane;
+    for (size_t i = 0; i < plane; ++i) {
+        const float mx = p.motion.data()[i], my = p.motion.data()[plane + i];
+        still += std::fabs(mx) < kTemporalStaticMotion && std::fabs(my) < kTemporalStaticMotion;
+        anyMotion = anyMotion || mx != 0.0f || my != 0.0f;
+    }
+    // A motion buffer of zeros only is what renderers write for an animation's first frame (no
+    // previous frame): no sign of what moves, so not a still camera's.
+    p.stillCamera = anyMotion && 2 * still >= plane;
     temporal::FrameViews& v = p.views;
     v.depth = p.depth.view(), v.normal = p.normal.view(), v.ids = p.ids.view(), v.motion = p.motion.view();
     v.grad = p.grad.view();
@@ -251,7 +255,9 @@ TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t cente
             const float fo = params.causal ? params.causalFalloff : params.falloff;
             hop.weight = k > size_t(params.radius) ? 0.0f : fo > 0.0f ? std::exp(-float(k * k) / (2.0f * fo * fo)) : 1.0f;
             // Static tracks: equal weights out to staticRadius (offline), else as the others.
-            const bool still = prepared[(dir < 0 ? from : to) - lo]->stillCamera;  // whose motion the hop reads
+            // Both frames' motion must show a still camera: a hop reads the motion of one of them
+            // and the G-buffers of both.
+            const bool still = prepared[from - lo]->stillCamera && prepared[to - lo]->stillCamera;
             hop.staticWeight = !params.causal && still && k <= size_t(own.staticRadius) ? 1.0f : hop.weight;
             // ... and whose G-buffer test also accepts the static surfaces next to the pixel.
             hop.stillHop = !params.causal && still && own.staticRadius > 0;

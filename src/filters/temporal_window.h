@@ -150,6 +150,20 @@ struct Hop {
 
     ATROUS_HOST_DEVICE void stop(int x, int y) const { alive(x, y, 0) = 0.0f; }
 
+    // Nothing in the 3x3 neighbourhood of (x, y) moves in frame f. A pixel next to a moving
+    // object's edge is not static even where its own (one sample's) motion is zero: the object
+    // covers part of it in one frame and not in the next.
+    ATROUS_HOST_DEVICE static bool stillAround(const FrameViews& f, int x, int y) {
+        for (int j = -1; j <= 1; ++j)
+            for (int i = -1; i <= 1; ++i) {
+                const int nx = x + i, ny = y + j;
+                if (nx < 0 || ny < 0 || nx >= f.motion.width || ny >= f.motion.height) continue;
+                if (!(fabsf(f.motion(nx, ny, 0)) < kStaticMotion && fabsf(f.motion(nx, ny, 1)) < kStaticMotion))
+                    return false;
+            }
+        return true;
+    }
+
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         if (alive(x, y, 0) == 0.0f) return;
         bool moved = alive(x, y, 0) < 1.0f;
@@ -183,6 +197,7 @@ struct Hop {
             moved = moved || !(fabsf(ux) < kStaticMotion && fabsf(uy) < kStaticMotion);
         }
         const int qx = nearest(px), qy = nearest(py);
+        moved = moved || !stillHop || !stillAround(from, fx, fy) || (inside(qx, qy) && !stillAround(to, qx, qy));
         const Anchor an = anchor(fx, fy);
         if (!consistentNear(an, fx, fy, qx, qy, moved)) return stop(x, y);
         if (colorSigmas > 0.0f) {
@@ -221,8 +236,6 @@ struct Hop {
                         isFiniteF(v[k]);
         }
         if (!finiteAll) return stop(x, y);
-        // A hop through a frame whose camera moved ends the track's static part too.
-        moved = moved || !stillHop;
         const float weight = moved ? this->weight : staticWeight;
         if (!(weight > 0.0f)) return stop(x, y);
         track(x, y, 0) = px;
