@@ -67,7 +67,7 @@ namespace {
 
 // A frame as the hops read it: its sanitised G-buffer and colour statistics, owned here.
 struct PreparedFrame {
-    Image depth, normal, ids, motion, grad, stats, color, emission;
+    Image depth, normal, ids, motion, grad, stats, color, emission, still;
     temporal::FrameViews views;
     // At least half of the frame's pixels moved less than kTemporalStaticMotion: the camera stood
     // still (TemporalParams::staticRadius applies to hops through this frame's motion). Where the
@@ -115,6 +115,9 @@ void prepare(const CpuExec& exec, const SvgfFrame& f, bool stats, float fireflyK
     temporal::FrameViews& v = p.views;
     v.depth = p.depth.view(), v.normal = p.normal.view(), v.ids = p.ids.view(), v.motion = p.motion.view();
     v.grad = p.grad.view();
+    p.still = Image::uninitialized(w, h, 1);
+    v.still = p.still.view();
+    exec.forEachPixel(w, h, temporal::StillAround{v});
     v.color = viewOf(f.color), v.albedo = viewOf(f.albedo), v.normalRaw = viewOf(f.normal);
     if (fireflyK > 0.0f) {
         // The still filters' firefly pass on the frame alone (no variance: the 3x3 spread only), so

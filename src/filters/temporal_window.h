@@ -23,6 +23,7 @@ struct FrameViews {
     ImageView depth, normal, ids, motion, grad;           // sanitised: 1, 3, 1, 2, 2 channels
     ImageView color, albedo, normalRaw, emission, variance;  // as given (albedo ... optional)
     ImageView stats;  // 3 channels: the 3x3 mean of the demodulated luminance, that mean's variance, the luminance
+    ImageView still;  // 1 channel: 1 where nothing in the pixel's 3x3 neighbourhood moves (StillAround), else 0
 };
 
 // Channel 2 of `stats`: lum((c - e) / a') per pixel (SVGF's albedo rule; NaN where not finite),
@@ -58,6 +59,24 @@ struct LocalStats {
         const float m = n > 0.0f ? s / n : 0.0f;
         f.stats(x, y, 0) = m;
         f.stats(x, y, 1) = n > 1.0f ? fmaxf(s2 / n - m * m, 0.0f) / (n - 1.0f) : 0.0f;
+    }
+};
+
+// FrameViews::still: 1 where nothing in the 3x3 neighbourhood of the pixel moves. A pixel next to
+// a moving object's edge is not static even where its own (one sample's) motion is zero: the
+// object covers part of it in one frame and not in the next.
+struct StillAround {
+    FrameViews f;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        float s = 1.0f;
+        for (int j = -1; j <= 1; ++j)
+            for (int i = -1; i <= 1; ++i) {
+                const int nx = x + i, ny = y + j;
+                if (nx < 0 || ny < 0 || nx >= f.motion.width || ny >= f.motion.height) continue;
+                if (!(fabsf(f.motion(nx, ny, 0)) < kStaticMotion && fabsf(f.motion(nx, ny, 1)) < kStaticMotion))
+                    s = 0.0f;
+            }
+        f.still(x, y, 0) = s;
     }
 };
 
@@ -150,20 +169,6 @@ struct Hop {
 
     ATROUS_HOST_DEVICE void stop(int x, int y) const { alive(x, y, 0) = 0.0f; }
 
-    // Nothing in the 3x3 neighbourhood of (x, y) moves in frame f. A pixel next to a moving
-    // object's edge is not static even where its own (one sample's) motion is zero: the object
-    // covers part of it in one frame and not in the next.
-    ATROUS_HOST_DEVICE static bool stillAround(const FrameViews& f, int x, int y) {
-        for (int j = -1; j <= 1; ++j)
-            for (int i = -1; i <= 1; ++i) {
-                const int nx = x + i, ny = y + j;
-                if (nx < 0 || ny < 0 || nx >= f.motion.width || ny >= f.motion.height) continue;
-                if (!(fabsf(f.motion(nx, ny, 0)) < kStaticMotion && fabsf(f.motion(nx, ny, 1)) < kStaticMotion))
-                    return false;
-            }
-        return true;
-    }
-
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         if (alive(x, y, 0) == 0.0f) return;
         bool moved = alive(x, y, 0) < 1.0f;
@@ -197,7 +202,7 @@ struct Hop {
             moved = moved || !(fabsf(ux) < kStaticMotion && fabsf(uy) < kStaticMotion);
         }
         const int qx = nearest(px), qy = nearest(py);
-        moved = moved || !stillHop || !stillAround(from, fx, fy) || (inside(qx, qy) && !stillAround(to, qx, qy));
+        moved = moved || !stillHop || from.still(fx, fy, 0) == 0.0f || (inside(qx, qy) && to.still(qx, qy, 0) == 0.0f);
         const Anchor an = anchor(fx, fy);
         if (!consistentNear(an, fx, fy, qx, qy, moved)) return stop(x, y);
         if (colorSigmas > 0.0f) {
