@@ -329,6 +329,9 @@ nb::object pyDenoiseTemporal(nb::list frames, size_t center, const std::string& 
         anyMotion = anyMotion || b->refs.get(B::Motion) != nullptr;
         allPositions = allPositions && b->refs.get(B::Position) != nullptr;
     }
+    // The static window needs the renderer's own vectors: motion fitted to positions or estimated
+    // from colours (below) sees a moving object as still (as the CLI).
+    if (!anyMotion) tp.staticRadius = 0;
     if (!anyMotion && allPositions && buffers.size() > 1) {
         CameraFit previous;
         for (const auto& b : buffers) {
@@ -338,7 +341,6 @@ nb::object pyDenoiseTemporal(nb::list frames, size_t center, const std::string& 
             previous = fit;
         }
         for (size_t i = 0; i < buffers.size(); ++i) buffers[i]->refs.set(B::Motion, &fitted[i]);
-        tp.staticRadius = 0;  // a fitted camera's motion cannot see what moves (as the CLI)
     } else if (!anyMotion && buffers.size() > 1) {
         // Neither: motion from the colours themselves (estimateMotion), as the CLI does, for the
         // frames the window reads (centre ± radius) whose previous frame has their size; the
@@ -350,7 +352,6 @@ nb::object pyDenoiseTemporal(nb::list frames, size_t center, const std::string& 
             fitted.push_back(estimateMotion(*colors[i], read ? colors[i - 1].get() : nullptr));
         }
         for (size_t i = 0; i < n; ++i) buffers[i]->refs.set(B::Motion, &fitted[i]);
-        tp.staticRadius = 0;  // nor can motion from the colours
     }
     std::vector<SvgfFrame> window;
     for (const auto& b : buffers) window.push_back(b->refs);

@@ -225,8 +225,8 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
         if (temporal)
             r.method += format(" (%s%d frames%s, %.1f averaged per pixel in %.0f ms; then %s%s%s)",
                                args.temporal.causal ? "causal, -" : "+-", args.temporal.radius,
-                               temporalWindowRadius(temporalParams) > args.temporal.radius
-                                   ? format(" (+-%d where nothing moves)", temporalWindowRadius(temporalParams)).c_str()
+                               radius > size_t(args.temporal.radius)
+                                   ? format(" (+-%zu where nothing moves)", radius).c_str()
                                    : "",
                                temporalReport.meanFrames, temporalReport.gatherMs, denoiseMethodName(options.method),
                                resolved ? " -> " : "", resolved ? r.methodUsed.c_str() : "");
@@ -254,7 +254,6 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
         if (usesMotion && f.motion.empty() && !f.position.empty()) {
             const CameraFit fit = fitCamera(f.position);
             f.motion = motionFromPositions(f.position, fit, prevCamera);  // frame 0: no previous, NaN (no history)
-            temporalParams.staticRadius = 0;
             if (i > 0 && !notedMotion) {
                 if (prevCamera.ok)
                     note(format("denoise: note: the frames have no motion vectors: motion from the Position pass (a "
@@ -272,7 +271,6 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
             // motion from the colours themselves, block matching against the previous frame (the
             // first has none: no history; the frames' sizes were checked above).
             f.motion = estimateMotion(f.color, window.empty() ? nullptr : &window.back().color);
-            temporalParams.staticRadius = 0;
             estimated = !window.empty();
             if (estimated && !notedMotion)
                 note("denoise: note: the frames have no motion vectors and no Position pass: motion estimated "

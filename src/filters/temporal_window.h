@@ -149,8 +149,9 @@ struct Hop {
     // so a pixel on an edge (a light in a ceiling, a silhouette) shows one side in one frame and
     // the other in the next, and the test against the pixel's own G-buffer would keep only the
     // frames that agree with the centre's sample. Here a tap is also kept where it passes the test
-    // against a static pixel of the 3x3 neighbourhood in `from`: a surface next to the pixel.
-    // What moves next to it (a moving object's edge) is not such a surface.
+    // against a pixel of the 3x3 neighbourhood in `from`: a surface next to the pixel. Such a
+    // track is not `moved`, so nothing in that neighbourhood moves (from.still): a moving
+    // object's edge is never such a surface.
     bool stillHop = false;
     ATROUS_HOST_DEVICE bool consistentNear(const Anchor& a, int fx, int fy, int qx, int qy, bool moved) const {
         if (consistent(a, qx, qy)) return true;
@@ -159,9 +160,6 @@ struct Hop {
             for (int i = -1; i <= 1; ++i) {
                 const int nx = fx + i, ny = fy + j;
                 if ((!i && !j) || nx < 0 || ny < 0 || nx >= from.depth.width || ny >= from.depth.height) continue;
-                if (!(fabsf(from.motion(nx, ny, 0)) < kStaticMotion &&
-                      fabsf(from.motion(nx, ny, 1)) < kStaticMotion))
-                    continue;
                 if (consistent(anchor(nx, ny), qx, qy)) return true;
             }
         return false;
@@ -180,7 +178,6 @@ struct Hop {
             const float mx = from.motion(fx, fy, 0), my = from.motion(fx, fy, 1);
             if (!(fabsf(mx) < kMaxMotion) || !(fabsf(my) < kMaxMotion)) return stop(x, y);
             px = tx + mx, py = ty + my;
-            moved = moved || !(fabsf(mx) < kStaticMotion && fabsf(my) < kStaticMotion);
         } else {
             // Constant velocity: the step to the next frame is minus the step to the previous one.
             float mx = from.motion(fx, fy, 0), my = from.motion(fx, fy, 1);
@@ -196,12 +193,12 @@ struct Hop {
             const int qx = nearest(px), qy = nearest(py);
             if (!inside(qx, qy)) return stop(x, y);
             // The found pixel must map back onto the track (a fold of the motion field does not).
-            const float ux = to.motion(qx, qy, 0), uy = to.motion(qx, qy, 1);
-            const float rx = float(qx) + ux - tx, ry = float(qy) + uy - ty;
+            const float rx = float(qx) + to.motion(qx, qy, 0) - tx, ry = float(qy) + to.motion(qx, qy, 1) - ty;
             if (!(fabsf(rx) <= 1.0f && fabsf(ry) <= 1.0f)) return stop(x, y);
-            moved = moved || !(fabsf(ux) < kStaticMotion && fabsf(uy) < kStaticMotion);
         }
         const int qx = nearest(px), qy = nearest(py);
+        // The motion the hop read (from's at the track, to's at the reached pixel) is in these
+        // masks, with the pixels around it.
         moved = moved || !stillHop || from.still(fx, fy, 0) == 0.0f || (inside(qx, qy) && to.still(qx, qy, 0) == 0.0f);
         const Anchor an = anchor(fx, fy);
         if (!consistentNear(an, fx, fy, qx, qy, moved)) return stop(x, y);
