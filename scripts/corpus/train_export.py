@@ -82,6 +82,8 @@ def main():
     a = ap.parse_args()
     if a.test and a.out == ap.get_default("out"):
         a.out = str(ROOT / "out" / "train" / "data" / "corpus_test")
+    if a.test and a.corpus == ap.get_default("corpus"):  # the test stills are in the full corpus
+        a.corpus = str(ROOT / "out" / "corpus" / "full")
     pattern, spps = ("*/[cm][yi]_*/manifest.json", (4, 16)) if a.test else ("*/tr_*/manifest.json", TRAIN["spp"])
     dest = Path(a.out)
     dest.mkdir(parents=True, exist_ok=True)

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """The learned filter's training data (docs/learned.md, "Data"): randomised JSON scenes rendered by
-atrous's own path tracer at 1, 4 and 16 spp with a >= 1024-spp reference.
+atrous's own path tracer at 1, 4, 16, 64 and 256 spp with a >= 1024-spp reference (--spps: other counts;
+a cached scene renders only the counts it lacks).
 
 Scene i is a pure function of (--seed, i): its type, geometry, materials, textures, lights, camera
 and render seeds. Each finished scene is one file out/train/data/<split>/scene_NNNN.npz (written
@@ -25,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 TYPES = ("room", "outdoor", "envmap", "studio")
-SPPS = (1, 4, 16)
+SPPS = (1, 4, 16, 64, 256)  # 64 and 256: near-clean inputs, so the filter learns to leave them alone (docs/learned.md)
 BUFFERS = ("color", "variance", "albedo", "normal", "depth", "emission")
 
 
@@ -286,18 +287,22 @@ def build_scene(args, index: int, split: str, kind: str) -> Path:
     with tempfile.TemporaryDirectory(dir=Path(args.out)) as tmp:
         t = Path(tmp)
         scene = make_scene(args.seed, index, t, kind, extras=split == "train")
+        arrays = {}
         if dest.exists():  # cached: kept while it is this generator's scene (a changed generator redraws it)
             with np.load(dest) as z:
                 if "scene_json" in z.files and str(z["scene_json"]) == json.dumps(scene):
-                    return dest
+                    arrays = {k: z[k] for k in z.files}
+        todo = [spp for spp in getattr(args, "spps", SPPS) if f"color_{spp}" not in arrays]
+        if arrays and not todo:
+            return dest
         (t / "scene.json").write_text(json.dumps(scene, indent=1))
-        arrays = {}
-        for spp in SPPS:
+        for spp in todo:  # a cached scene renders only the spp it lacks
             render(args.atrous, t / "scene.json", spp, args.seed * 100003 + index * 16 + spp, args.size, t / f"s{spp}")
             for b in BUFFERS:
                 arrays[f"{b}_{spp}"] = read_exr(t / f"s{spp}" / f"{b}.exr")
-        render(args.atrous, t / "scene.json", args.ref_spp, args.seed * 100003 + index * 16 + 15, args.size, t / "ref")
-        arrays["reference"] = read_exr(t / "ref" / "color.exr")
+        if "reference" not in arrays:
+            render(args.atrous, t / "scene.json", args.ref_spp, args.seed * 100003 + index * 16 + 15, args.size, t / "ref")
+            arrays["reference"] = read_exr(t / "ref" / "color.exr")
         arrays["kind"] = np.array(kind)
         arrays["scene_json"] = np.array(json.dumps(scene))
         tmpname = dest.with_suffix(".tmp.npz")
@@ -316,6 +321,7 @@ def main(argv=None) -> int:
     p.add_argument("--size", type=int, default=128, help="image width = height")
     p.add_argument("--ref-spp", type=int, default=1024)
     p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--spps", type=int, nargs="+", default=list(SPPS), help=f"input sample counts (default {SPPS})")
     a = p.parse_args(argv)
     if a.ref_spp < 1024:
         print("dataset.py: --ref-spp below 1024 makes references too noisy to train on", file=sys.stderr)

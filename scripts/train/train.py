@@ -30,6 +30,8 @@ def main() -> int:
     p.add_argument("--lr", type=float)
     p.add_argument("--corpus-share", type=float, help="fraction of the crops drawn from the corpus_train split "
                    "(default: uniform over all images, where it is ~4%%)")
+    p.add_argument("--loss", choices=["relmse", "log", "sqrt"], help="relmse: the batch's mean relMSE (default); log: "
+                   "the mean of each crop's log relMSE (the metric's geometric mean); sqrt: of its square root")
     p.add_argument("--eps", type=float, help="the loss's relMSE epsilon (default 0.01, the metric's)")
     p.add_argument("--no-colour", dest="colour", action="store_const", const=False)
     p.add_argument("--no-vcolour", dest="vcolour", action="store_const", const=False)
@@ -40,7 +42,7 @@ def main() -> int:
     p.add_argument("--eval", action="store_true", help="relMSE on <prep>/test (JAX) into <out>/eval_jax.json")
     p.add_argument("--export", action="store_true", help="write src/filters/learned_weights_default.cpp")
     a = p.parse_args()
-    over = {k: getattr(a, k) for k in ("splits", "spps", "variants", "batch", "crop", "lr", "eps", "corpus_share", "colour", "vcolour",
+    over = {k: getattr(a, k) for k in ("splits", "spps", "variants", "batch", "crop", "lr", "eps", "loss", "corpus_share", "colour", "vcolour",
                                        "blend", "box", "context")}
     params = train.train(Path(a.prep), Path(a.out), a.steps, seed=a.seed, minutes=a.minutes, init=a.init, **over)
     if a.eval:

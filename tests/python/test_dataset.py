@@ -117,3 +117,21 @@ def test_cli_renders_every_kind_and_a_changed_scene_is_redrawn(tmp_path):
     kept = dest.stat().st_mtime_ns
     dataset.build_scene(args, i, "train", kind)
     assert dest.stat().st_mtime_ns == kept
+
+
+@pytest.mark.skipif(atrous_cli() is None, reason="needs the atrous CLI (build/atrous or ATROUS_CLI)")
+def test_a_cached_scene_renders_only_the_sample_counts_it_lacks(tmp_path):
+    # A cache made before the 64 and 256 spp inputs were drawn keeps its renders and its reference;
+    # only the missing counts are rendered and added.
+    args = types.SimpleNamespace(out=str(tmp_path / "cache"), atrous=atrous_cli(), seed=1, size=16, ref_spp=1024,
+                                 spps=[1, 4])
+    dest = dataset.build_scene(args, 3, "train", dataset.scene_kind(1, 3, "studio"))
+    with np.load(dest) as z:
+        before = {k: z[k] for k in z.files}
+    assert "color_1" in before and "color_64" not in before
+    args.spps = [1, 4, 64]
+    dataset.build_scene(args, 3, "train", dataset.scene_kind(1, 3, "studio"))
+    with np.load(dest) as z:
+        assert "color_64" in z.files and np.isfinite(z["color_64"]).all()
+        for k in ("color_1", "color_4", "reference"):
+            assert np.array_equal(z[k], before[k]), k

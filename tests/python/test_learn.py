@@ -165,3 +165,38 @@ def test_zero_context_is_the_mlp_alone():
     cells = jax.numpy.asarray(rng.normal(0, 1, (1, 3, 3, context.N_CTX_IN)).astype(np.float32))
     for a, b in zip(model.network(p, x, cells), model.network(p, x, None)):
         np.testing.assert_array_equal(np.asarray(a), np.asarray(b))
+
+
+def _tiny_prep(folder, rng):
+    """One prepared scene at 1 and 64 spp (prepare.py's keys), 24x24, random but plausible planes."""
+    h = w = 24
+    ref = rng.uniform(0.05, 1.0, (h, w, 3)).astype(np.float32)
+    z = {"reference": ref}
+    for spp, sd in ((1, 0.8), (64, 0.1)):
+        d = np.clip(ref + rng.normal(0, sd, ref.shape), 0, None).astype(np.float32)
+        planes = {"d": d, "var": np.full((h, w, 3), sd * sd, np.float32), "albedo": np.ones((h, w, 3), np.float32),
+                  "normal": np.tile(np.float32([0, 0, 1]), (h, w, 1)), "depth": np.ones((h, w, 1), np.float32),
+                  "mod": np.ones((h, w, 3), np.float32), "emission": np.zeros((h, w, 3), np.float32)}
+        z.update({f"given_{spp}_{k}": v for k, v in planes.items()})
+    (folder / "train").mkdir(parents=True)
+    np.savez(folder / "train" / "scene_0000.npz", **z)
+
+
+def test_training_losses_and_an_evaluation_only_run(tmp_path):
+    # train.py --steps 0 returns the starting weights untouched (evaluation only); each loss trains
+    # (finite weights that moved), and the losses are different objectives (different weights).
+    from atrous.learn import train
+
+    _tiny_prep(tmp_path / "prep", np.random.default_rng(3))
+    common = dict(splits=["train"], spps=[1, 64], variants=["given"], crop=16, context=False)
+    init = model.init_params(1)
+    same = train.train(tmp_path / "prep", tmp_path / "r0", 0, **common)
+    assert all(np.array_equal(np.asarray(same[k]), np.asarray(init[k])) for k in init)
+    got = {}
+    for loss in ("relmse", "sqrt", "log"):
+        p = train.train(tmp_path / "prep", tmp_path / loss, 6, ckpt_every=1000, loss=loss, **common)
+        assert all(np.isfinite(np.asarray(v)).all() for v in p.values()), loss
+        assert any(not np.array_equal(np.asarray(p[k]), np.asarray(init[k])) for k in init), loss
+        got[loss] = p
+    for a, b in (("relmse", "sqrt"), ("sqrt", "log")):
+        assert any(not np.allclose(np.asarray(got[a][k]), np.asarray(got[b][k])) for k in init), (a, b)
