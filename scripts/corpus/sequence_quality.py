@@ -177,6 +177,7 @@ def main():
     ap.add_argument("--strips", type=Path,
                     help="write DIR/<sequence>.png (the middle frame) and .gif (all frames): noisy | variants | "
                          "OIDN per frame | reference")
+    ap.add_argument("--only", nargs="+", help="the sequences whose name holds one of these strings (e.g. 16spp)")
     ap.add_argument("variants", nargs="+", help="NAME=FLAGS")
     a = ap.parse_args()
     variants = [v.split("=", 1) for v in a.variants]
@@ -185,6 +186,8 @@ def main():
         seqs += list(corpus_sequences(a.corpus))
     if a.own:
         seqs += list(own_sequences(a.own))
+    if a.only:
+        seqs = [s for s in seqs if any(o in s[0] for o in a.only)]
     if not seqs:
         sys.exit("sequence_quality: no sequence found (give --corpus and/or --own)")
     results = {}
