@@ -74,8 +74,8 @@ clean:
 
 # The learned filter (docs/learned.md): its training venv (.venv-train), the dataset (out/train/data,
 # resumable), the library's prepared planes (out/train/prep, through the atrous module in .venv) and
-# the training run (out/train/run, then the fine-tuning out/train/run_ft, both resumable), which
-# regenerates src/filters/learned_weights_default.cpp.
+# the training run (out/train/run, then the fine-tunings out/train/run_ft and out/train/run_clean, all resumable),
+# which regenerates src/filters/learned_weights_default.cpp.
 # Within 2 hours from nothing on 2 cores: TRAIN_MINUTES of training. `train-smoke`: a few scenes and steps.
 TRAIN_BUILD ?= build-learn
 TRAIN_STEPS ?= 4000
@@ -86,6 +86,11 @@ TRAIN_MINUTES ?= 60
 # and fine-tunes both (docs/learned.md, "Version 4"; measured, not built in).
 TRAIN_FT_STEPS ?= 2000
 TRAIN_FT_MINUTES ?= 25
+# Phase 3 (2026-12-04): near-clean inputs too (64 spp) and a loss on each crop's root relMSE, so that the filter
+# stops smoothing what is already clean (a sequence's temporal average, 16-spp stills); exports the built-in weights.
+TRAIN_CLEAN_STEPS ?= 1500
+TRAIN_CLEAN_MINUTES ?= 20
+TRAIN_CLEAN_LOSS ?= sqrt
 TRAIN_CTX_STEPS ?= 1500
 TRAIN_CTX_MINUTES ?= 30
 .PHONY: train train-smoke
@@ -101,7 +106,10 @@ train: python
 	@.venv-train/bin/python scripts/train/train.py --variants given est --steps $(TRAIN_STEPS) --minutes $(TRAIN_MINUTES) \
 	  --eval --no-context
 	@.venv-train/bin/python scripts/train/train.py --out out/train/run_ft --init out/train/run/weights.bin --lr 1e-3 \
-	  --corpus-share 0.25 --steps $(TRAIN_FT_STEPS) --minutes $(TRAIN_FT_MINUTES) --eval --export --no-context
+	  --corpus-share 0.25 --steps $(TRAIN_FT_STEPS) --minutes $(TRAIN_FT_MINUTES) --eval --no-context
+	@.venv-train/bin/python scripts/train/train.py --out out/train/run_clean --init out/train/run_ft/weights.bin --lr 1e-3 \
+	  --corpus-share 0.25 --spps 1 4 16 64 --loss $(TRAIN_CLEAN_LOSS) --steps $(TRAIN_CLEAN_STEPS) --minutes $(TRAIN_CLEAN_MINUTES) \
+	  --eval --export --no-context
 
 # Version 4 (the context branch) from `make train`'s weights (or the built-in ones, out/train/v3.bin): whole
 # 128² images, half of them from the corpus's training split; writes out/train/run_ctx/weights.bin.
