@@ -292,7 +292,7 @@ def build_scene(args, index: int, split: str, kind: str) -> Path:
             with np.load(dest) as z:
                 if "scene_json" in z.files and str(z["scene_json"]) == json.dumps(scene):
                     arrays = {k: z[k] for k in z.files}
-        todo = [spp for spp in getattr(args, "spps", SPPS) if f"color_{spp}" not in arrays]
+        todo = [spp for spp in args.spps if f"color_{spp}" not in arrays]
         if arrays and not todo:
             return dest
         (t / "scene.json").write_text(json.dumps(scene, indent=1))

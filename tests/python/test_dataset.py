@@ -97,7 +97,8 @@ def test_cli_renders_every_kind_and_a_changed_scene_is_redrawn(tmp_path):
         tag = (kind, "front" in _names(s), "ofence" in _names(s))
         picks.setdefault(tag, i)
     assert len(picks) >= 5
-    args = types.SimpleNamespace(out=str(tmp_path / "cache"), atrous=atrous_cli(), seed=1, size=16, ref_spp=1024)
+    args = types.SimpleNamespace(out=str(tmp_path / "cache"), atrous=atrous_cli(), seed=1, size=16, ref_spp=1024,
+                                 spps=list(dataset.SPPS))
     for (kind, _, _), i in picks.items():
         dest = dataset.build_scene(args, i, "train", kind)
         with np.load(dest) as z:

@@ -96,6 +96,8 @@ def test_weight_file_round_trip_and_errors():
     v3 = weights.from_bytes(body + struct.pack("<I", weights.fnv1a(body)), "v3.bin")
     np.testing.assert_array_equal(v3["w1"], back["w1"])
     assert not weights.has_context(v3) and not np.any(v3["k1"])
+    # Parameters whose context is all zero are written as that version-3 file, byte for byte.
+    assert weights.to_bytes(v3) == body + struct.pack("<I", weights.fnv1a(body))
     with pytest.raises(ValueError, match="w.bin: version 5, this build reads versions 3 and 4"):
         weights.from_bytes(b[:4] + struct.pack("<I", 5) + b[8:], "w.bin")
     bad = bytearray(b)

@@ -155,6 +155,7 @@ def forward(params: dict, x, cells, d, v, mod, e, colour: bool = True, blend: bo
     return denoise_d(params, x, cells, d, v, colour, blend, vcolour) * mod + e
 
 
-def relmse(out, ref, eps: float = 0.01):
-    """docs/eval.md's relMSE: mean of (x - r)^2 / (r^2 + eps) over pixels and channels (eps 0.01)."""
-    return jnp.mean(jnp.square(out - ref) / (jnp.square(ref) + eps))
+def relmse(out, ref, eps: float = 0.01, axis=None):
+    """docs/eval.md's relMSE: mean of (x - r)^2 / (r^2 + eps) over pixels and channels (eps 0.01);
+    axis: the axes to average over (None: all; the training loss takes each crop's)."""
+    return jnp.mean(jnp.square(out - ref) / (jnp.square(ref) + eps), axis=axis)

@@ -143,7 +143,7 @@ def train(prep: Path, out: Path, steps: int, seed: int = 1, minutes: float | Non
 
     def loss_fn(p, x, c, d, v, m, e, r):
         out = model.forward(p, x, c if cfg["context"] else None, d, v, m, e, cfg["colour"], cfg["blend"], cfg["vcolour"])
-        per = jnp.mean(jnp.square(out - r) / (jnp.square(r) + cfg["eps"]), axis=tuple(range(1, out.ndim)))
+        per = model.relmse(out, r, cfg["eps"], axis=tuple(range(1, out.ndim)))  # each crop's
         if cfg["loss"] == "log":
             return jnp.mean(jnp.log(per + 1e-7)), jnp.mean(per)
         if cfg["loss"] == "sqrt":  # between the two: a crop's gradient weighs 1 / sqrt(its relMSE)

@@ -30,8 +30,14 @@ def fnv1a(data: bytes) -> int:
 
 
 def to_bytes(params: dict) -> bytes:
-    flat = np.concatenate([np.asarray(params[n], np.float32).reshape(-1) for n, _ in ALL_SHAPES]).astype("<f4")
-    body = MAGIC + struct.pack("<8I", VERSION, N_IN, N_HIDDEN, N_FEAT, N_LEVELS, N_CTX_IN, N_CTX, flat.size) + flat.tobytes()
+    """Version 4, or version 3 when the context branch is all zero (the same function without the
+    context's zeros: what a run with --no-context writes and exports)."""
+    if has_context(params):
+        shapes, head = ALL_SHAPES, (VERSION, N_IN, N_HIDDEN, N_FEAT, N_LEVELS, N_CTX_IN, N_CTX)
+    else:
+        shapes, head = SHAPES, (3, N_IN, N_HIDDEN, N_FEAT, N_LEVELS)
+    flat = np.concatenate([np.asarray(params[n], np.float32).reshape(-1) for n, _ in shapes]).astype("<f4")
+    body = MAGIC + struct.pack(f"<{len(head) + 1}I", *head, flat.size) + flat.tobytes()
     return body + struct.pack("<I", fnv1a(body))
 
 
