@@ -369,3 +369,40 @@ TEST(FilterRows, SureWindowEqualsItsTwoPasses) {
                 }
     }
 }
+
+TEST(FilterRows, RimAlbedoEqualsTheFunctor) {
+    // The rim albedo (prepass.h) row by row against its functor, bit for bit, on the rule albedo
+    // sanitised (what the driver hands it); and an albedo with no black pixel comes back as itself.
+    for (const auto& s : kSizes) {
+        const int w = s[0], h = s[1];
+        Image a = ruleAlbedo(w, h, 11u + unsigned(w * 31 + h));
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x)
+                for (int c = 0; c < 3; ++c) a(x, y, c) = sanitizeFeature(a(x, y, c));
+        const float black = kBlackAlbedoFraction * 0.05f;
+        // Colour and emission from which the black pixels' reflected colour is read: dark, bright,
+        // and (emission above the colour) negative before the clamp.
+        const Image color = randomImage(w, h, 3, 5u + unsigned(w), 0.0f, 4.0f);
+        const Image emission = randomImage(w, h, 3, 9u + unsigned(h), 0.0f, 2.0f);
+        for (const bool withEmission : {false, true}) {
+            const ImageView e = withEmission ? emission.view() : ImageView{};
+            Image rows, ref(w, h, 3);
+            const ImageView got = rimAlbedo(CpuExec{}, RimAlbedo{a.view(), {}, color.view(), e, black}, rows);
+            CpuExec{}.forEachPixel(w, h, RimAlbedo{a.view(), ref.view(), color.view(), e, black});
+            Image gotCopy(w, h, 3);
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x)
+                    for (int c = 0; c < 3; ++c) gotCopy(x, y, c) = got(x, y, c);
+            EXPECT_EQ(firstBitDifference(gotCopy, ref), -1) << w << "x" << h << " emission " << withEmission;
+        }
+    }
+    Image grey(9, 7, 3), colour(9, 7, 3);
+    grey.fill(0.5f);
+    colour.fill(1.0f);
+    grey(4, 3, 1) = 0.0f;  // one channel black, the pixel is not: its largest channel is 0.5
+    Image store;
+    const ImageView same =
+        rimAlbedo(CpuExec{}, RimAlbedo{grey.view(), {}, colour.view(), {}, kBlackAlbedoFraction * 0.05f}, store);
+    EXPECT_EQ(same.data, grey.view().data);
+    EXPECT_TRUE(store.empty());
+}

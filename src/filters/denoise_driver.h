@@ -245,9 +245,12 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     if (v0.empty()) v0 = planes(3);
     runSanitizeColor(exec, SanitizeColor{in.color, in.variance, c0.view(), in.variance.valid() ? v0.view() : ImageView{}});
     // The albedo the demodulation divides by, sanitised once (the noise estimate reads it too).
+    // Rims beside black albedo count their uncovered part as albedo 1 (RimAlbedo, prepass.h).
     ImageView albedo = o.demodulate ? in.albedo : ImageView{};
-    Image albedoStore;
+    Image albedoStore, rimStore;
     if (albedo.valid()) albedo = sanitizedFeature(exec, albedo, w, h, 3, albedoStore);
+    if (albedo.valid() && o.albedoFloor > 0.0f)
+        albedo = rimAlbedo(exec, RimAlbedo{albedo, {}, c0.view(), in.emission, kBlackAlbedoFraction * o.albedoFloor}, rimStore);
     if (!in.variance.valid() || (noise && albedo.valid())) {
         // The global estimate in the colour's units, σ_c² a'_c² (noise_estimate.h): without an albedo
         // the constant σ_c², which the GPU path passes in as the variance.

@@ -82,6 +82,64 @@ ImageView sanitizedFeature(const Exec& exec, ImageView in, int width, int height
 }
 ImageView sanitizedFeature(const CpuExec& exec, ImageView in, int width, int height, int channels, Image& storage);
 
+// The rim albedo (docs/denoising.md, "Rims beside black albedo"). Other renderers write albedo 0
+// for the sky, mirrors and lights. A pixel beside such a black pixel (a 3x3 neighbour's largest
+// channel below `black`, kBlackAlbedoFraction times the albedo floor) whose own largest channel
+// m_p is below the neighbourhood's largest m_x is partly covered by the black surface: a thin
+// slat's edge against the sky, whose colour is then mostly the sky's. Its albedo is the covered
+// part's, so dividing its colour by it put values 10-30x the colour into the demodulated image,
+// which the noise estimate read as noise around them and the cascade spread into the sky. The
+// uncovered part counts as albedo k (the black surface is divided by nothing), each channel
+// getting k (1 - m_p / m_x) added, where k = min(L_b / L_p, 1) weighs how much of the pixel's
+// colour the black surface can explain: L_p its own reflected colour (colour - emission, mean of
+// the channels), L_b the brightest black neighbour's (the darkest's cost a rough metal, whose
+// albedo is 0 and whose noisy reflection then read as dark, 39% at 4 spp: docs/decisions.md). A sky or a light without an emission buffer
+// gives k = 1; a black void (colour 0), or a light whose radiance the emission buffer holds, k = 0:
+// its colour is the covered part's alone and the albedo explains it as it is. `out` must not be `in`.
+ATROUS_INLINE float rimReflected(const ImageView& color, const ImageView& emission, int x, int y) {
+    float l = 0.0f;
+    for (int c = 0; c < 3; ++c) {
+        const float e = emission.valid() ? emission(x, y, c) : 0.0f;
+        l += color(x, y, c) - (finite(e) ? e : 0.0f);
+    }
+    return maxSel(l * (1.0f / 3.0f), 0.0f);
+}
+ATROUS_INLINE float rimAdd(float mp, float mn, float mx, float lp, float lb, float black) {
+    const float k = lp > 0.0f ? minSel(lb / lp, 1.0f) : 0.0f;
+    return mp > 0.0f && mn < black ? k * (1.0f - mp / mx) : 0.0f;  // mx >= mp > 0
+}
+struct RimAlbedo {
+    ImageView in, out, color, emission;  // color: sanitised; emission: optional
+    float black = 0.0f;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        const float mp = maxChannel(in(x, y, 0), in(x, y, 1), in(x, y, 2));
+        float mn = 3.0e38f, mx = 0.0f, lb = 0.0f;
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const int xx = clampIdx(x + dx, in.width - 1), yy = clampIdx(y + dy, in.height - 1);
+                const float m = maxChannel(in(xx, yy, 0), in(xx, yy, 1), in(xx, yy, 2));
+                mn = minSel(mn, m);
+                mx = maxSel(mx, m);
+                lb = maxSel(lb, m < black ? rimReflected(color, emission, xx, yy) : 0.0f);
+            }
+        const float add = rimAdd(mp, mn, mx, rimReflected(color, emission, x, y), lb, black);
+        for (int c = 0; c < 3; ++c) out(x, y, c) = in(x, y, c) + add;
+    }
+};
+
+// The albedo the filters read, with the rim albedo applied (sanitised input, 3 channels), kept in
+// `storage`. The CpuExec overload (src/cpu/prepass_cpu.cpp) returns `in` itself, with no copy,
+// when no pixel is black (the rule then changes nothing), and computes the same values row by row.
+template <class Exec>
+ImageView rimAlbedo(const Exec& exec, const RimAlbedo& f, Image& storage) {
+    storage = Image(f.in.width, f.in.height, 3, exec.device());
+    RimAlbedo g = f;
+    g.out = storage.view();
+    exec.forEachPixel(f.in.width, f.in.height, g);
+    return storage.view();
+}
+ImageView rimAlbedo(const CpuExec& exec, const RimAlbedo& f, Image& storage);
+
 // Plain copy of the first N channels.
 template <int N>
 struct CopyChannels {
