@@ -65,7 +65,7 @@ def scene_arrays(atrous, d, man, tmp, spps=TRAIN["spp"]):
         if not np.isfinite(v).all() and not k.startswith("depth"):
             bad = int((~np.isfinite(v)).any(-1).sum())
             print(f"train_export: {d.name} {k}: {bad} non-finite pixels (left: the driver sanitises)", flush=True)
-    arrays["kind"] = np.array("mitsuba" if man["renderer"] == "mitsuba" else "cycles")
+    arrays["kind"] = np.array(man["renderer"])
     arrays["scene_json"] = np.array(json.dumps(man))
     return arrays
 
@@ -84,7 +84,7 @@ def main():
         a.out = str(ROOT / "out" / "train" / "data" / "corpus_test")
     if a.test and a.corpus == ap.get_default("corpus"):  # the test stills are in the full corpus
         a.corpus = str(ROOT / "out" / "corpus" / "full")
-    pattern, spps = ("*/[cm][yi]_*/manifest.json", (4, 16)) if a.test else ("*/tr_*/manifest.json", TRAIN["spp"])
+    pattern, spps = ("*/[cml][yix]_*/manifest.json", (4, 16)) if a.test else ("*/tr_*/manifest.json", TRAIN["spp"])
     dest = Path(a.out)
     dest.mkdir(parents=True, exist_ok=True)
     n = 0
