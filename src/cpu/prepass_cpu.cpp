@@ -330,7 +330,7 @@ struct RimRows {
 #pragma omp simd
         for (int x = 0; x < w; ++x) o[x] = maxChannel(r[x], g[x], b[x]);
     }
-    // rimReflected of row y, vectorised: the same sums in the same order.
+    // rimReflected of row y, vectorised: the same sums in the same order (c - 0 is c, bit for bit).
     void reflectedRow(int y, float* ATROUS_RESTRICT o) const {
         const size_t off = size_t(y) * size_t(w);
         const float* ATROUS_RESTRICT c0 = f.color.channel(0) + off;
@@ -338,7 +338,7 @@ struct RimRows {
         const float* ATROUS_RESTRICT c2 = f.color.channel(2) + off;
         if (!f.emission.valid()) {
 #pragma omp simd
-            for (int x = 0; x < w; ++x) o[x] = maxSel((((0.0f + (c0[x] - 0.0f)) + (c1[x] - 0.0f)) + (c2[x] - 0.0f)) * (1.0f / 3.0f), 0.0f);
+            for (int x = 0; x < w; ++x) o[x] = maxSel((((0.0f + c0[x]) + c1[x]) + c2[x]) * (1.0f / 3.0f), 0.0f);
             return;
         }
         const float* ATROUS_RESTRICT e0 = f.emission.channel(0) + off;

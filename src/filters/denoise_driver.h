@@ -245,7 +245,8 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     if (v0.empty()) v0 = planes(3);
     runSanitizeColor(exec, SanitizeColor{in.color, in.variance, c0.view(), in.variance.valid() ? v0.view() : ImageView{}});
     // The albedo the demodulation divides by, sanitised once (the noise estimate reads it too).
-    // Rims beside black albedo count their uncovered part as albedo 1 (RimAlbedo, prepass.h).
+    // Rims beside black albedo count their uncovered part as unmodulated, weighted by how much of
+    // their colour the black neighbour explains (RimAlbedo, prepass.h).
     ImageView albedo = o.demodulate ? in.albedo : ImageView{};
     Image albedoStore, rimStore;
     if (albedo.valid()) albedo = sanitizedFeature(exec, albedo, w, h, 3, albedoStore);

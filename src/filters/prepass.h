@@ -82,7 +82,8 @@ ImageView sanitizedFeature(const Exec& exec, ImageView in, int width, int height
 }
 ImageView sanitizedFeature(const CpuExec& exec, ImageView in, int width, int height, int channels, Image& storage);
 
-// The rim albedo (docs/denoising.md, "Rims beside black albedo"). Other renderers write albedo 0
+// The rim albedo (docs/algorithms.md, "Albedo demodulation near black albedo"; measured in
+// docs/quality.md, "Rims beside black albedo"). Other renderers write albedo 0
 // for the sky, mirrors and lights. A pixel beside such a black pixel (a 3x3 neighbour's largest
 // channel below `black`, kBlackAlbedoFraction times the albedo floor) whose own largest channel
 // m_p is below the neighbourhood's largest m_x is partly covered by the black surface: a thin
@@ -93,9 +94,10 @@ ImageView sanitizedFeature(const CpuExec& exec, ImageView in, int width, int hei
 // getting k (1 - m_p / m_x) added, where k = min(L_b / L_p, 1) weighs how much of the pixel's
 // colour the black surface can explain: L_p its own reflected colour (colour - emission, mean of
 // the channels), L_b the brightest black neighbour's (the darkest's cost a rough metal, whose
-// albedo is 0 and whose noisy reflection then read as dark, 39% at 4 spp: docs/decisions.md). A sky or a light without an emission buffer
-// gives k = 1; a black void (colour 0), or a light whose radiance the emission buffer holds, k = 0:
-// its colour is the covered part's alone and the albedo explains it as it is. `out` must not be `in`.
+// albedo is 0 and whose noisy reflection then read as dark, 39% at 4 spp: docs/decisions.md). A
+// sky or a light without an emission buffer gives k = 1; a black void (colour 0), or a light whose
+// radiance the emission buffer holds, k = 0: its colour is the covered part's alone and the albedo
+// explains it as it is. `out` must not be `in`.
 ATROUS_INLINE float rimReflected(const ImageView& color, const ImageView& emission, int x, int y) {
     float l = 0.0f;
     for (int c = 0; c < 3; ++c) {
@@ -128,8 +130,8 @@ struct RimAlbedo {
 };
 
 // The albedo the filters read, with the rim albedo applied (sanitised input, 3 channels), kept in
-// `storage`. The CpuExec overload (src/cpu/prepass_cpu.cpp) returns `in` itself, with no copy,
-// when no pixel is black (the rule then changes nothing), and computes the same values row by row.
+// `storage`. The CpuExec overload (src/cpu/prepass_cpu.cpp) computes the same values row by row
+// and returns `in` itself, with no copy, when the rule changes no pixel.
 template <class Exec>
 ImageView rimAlbedo(const Exec& exec, const RimAlbedo& f, Image& storage) {
     storage = Image(f.in.width, f.in.height, 3, exec.device());
