@@ -3,8 +3,8 @@
 with LuxCoreRender (pyluxcore, PATHCPU, its default Blackman-Harris pixel filter) in LuxCore's own
 layout, one folder per render holding RGB.exr, ALBEDO.exr, AVG_SHADING_NORMAL.exr, POSITION.exr
 and DEPTH.exr (the film outputs OIDN's LuxCore plugin reads; the albedo and the normal follow
-glass and mirrors, so they are noisy there). A third renderer beside Mitsuba and Cycles, never
-used in training (the corpus's training split has none).
+glass and mirrors, so they are noisy there). A third renderer beside Mitsuba and Cycles; these
+scenes are never trained on (the training split's LuxCore scenes are luxcore_train.py's).
 
     python -m venv /tmp/luxvenv && /tmp/luxvenv/bin/pip install pyluxcore numpy   # Python 3.11 wheel
     /tmp/luxvenv/bin/python scripts/corpus/luxcore_stills.py out/corpus/full/luxcore
@@ -125,7 +125,7 @@ def typed(p, kind, items):
             p.Set(pyluxcore.Property(f"scene.{kind}.{n}.{k}", v))
 
 
-def render(build, out, spp, seed, size=SIZE):
+def render(build, out, spp, seed, size=SIZE, pixel_filter="BLACKMANHARRIS"):
     parts = build()
     mats, shapes, lights, (orig, target, fov) = parts[:4]
     tex = parts[4] if len(parts) > 4 else {}
@@ -148,7 +148,7 @@ def render(build, out, spp, seed, size=SIZE):
     scene.Parse(p)
     c = pyluxcore.Properties()
     for k, v in {"renderengine.type": "PATHCPU", "sampler.type": "RANDOM", "batch.haltspp": spp, "film.width": size,
-                 "film.height": size, "path.pathdepth.total": 8, "film.filter.type": "BLACKMANHARRIS",
+                 "film.height": size, "path.pathdepth.total": 8, "film.filter.type": pixel_filter,
                  "native.threads.count": 2, "renderengine.seed": seed, "film.imagepipelines.0.0.type": "NOP"}.items():
         c.Set(pyluxcore.Property(k, v))
     tmp = out + ".tmp"

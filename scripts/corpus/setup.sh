@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Creates .venv-corpus/ (ignored) with the third-party renderers used by
 # scripts/corpus/render.py: Mitsuba 3 and Blender's bpy (Cycles), plus OpenEXR
-# and numpy. Idempotent: does nothing when the venv already has them.
+# and numpy, and pyluxcore (LuxCoreRender) when it installs. Idempotent: does nothing when the venv already has them.
 # Usage: scripts/corpus/setup.sh   (from anywhere)
 set -euo pipefail
 ROOT="$(cd "$(dirname "$0")/../.." && pwd)"
@@ -16,7 +16,15 @@ if ! ls /usr/lib/x86_64-linux-gnu/libLLVM-19.so* >/dev/null 2>&1 && command -v a
   apt-cache show libllvm19 >/dev/null 2>&1 || $SUDO apt-get update -qq >/dev/null 2>&1 || true
   $SUDO apt-get install -y -q libllvm19 >/dev/null 2>&1 || echo "setup.sh: libllvm19 not installed; Mitsuba uses scalar_rgb" >&2
 fi
+# pyluxcore (LuxCoreRender) renders the training split's third renderer (luxcore_train.py); optional:
+# without it render.py --train renders Mitsuba and Cycles only and says so.
+luxcore() {
+  "$VENV/bin/python" -c 'import pyluxcore' 2>/dev/null ||
+    "$VENV/bin/python" -m pip install --quiet pyluxcore >/dev/null 2>&1 ||
+    echo "setup.sh: pyluxcore not installed; the training split has no LuxCore scenes" >&2
+}
 if [ -x "$VENV/bin/python" ] && "$VENV/bin/python" -c 'import mitsuba, bpy, OpenEXR, numpy' 2>/dev/null; then
+  luxcore
   exit 0
 fi
 "$PY" - <<'P'
@@ -28,4 +36,5 @@ P
 "$VENV/bin/python" -m pip install --quiet --upgrade pip
 "$VENV/bin/python" -m pip install --quiet mitsuba OpenEXR numpy
 "$VENV/bin/python" -m pip install --quiet bpy
+luxcore
 "$VENV/bin/python" -c 'import mitsuba, bpy, OpenEXR; print("mitsuba", mitsuba.__version__, "bpy", bpy.app.version_string)'

@@ -10,7 +10,7 @@ DIR` (the same reader and conventions as `atrous denoise --in FILE`), read back 
 Keys per spp in (1, 4, 16): color_{spp}, albedo_{spp}, normal_{spp}, depth_{spp} (3 channels,
 background 1e30), emission_{spp} (zeros where the renderer gives none); no variance_{spp} (the
 renderers give none: the driver estimates it); reference (the >= 1024-spp render's colour);
-kind ("mitsuba" / "cycles"); scene_json (the scene's manifest). All arrays H x W x 3 float32.
+kind ("mitsuba" / "cycles" / "luxcore"); scene_json (the scene's manifest). All arrays H x W x 3 float32.
 Written under a temporary name and renamed; a scene whose npz is newer than its manifest is skipped.
 """
 import argparse
