@@ -74,7 +74,7 @@ clean:
 
 # The learned filter (docs/learned.md): its training venv (.venv-train), the dataset (out/train/data,
 # resumable), the library's prepared planes (out/train/prep, through the atrous module in .venv) and
-# the training run (out/train/run, then the fine-tunings out/train/run_ft and out/train/run_clean, all resumable),
+# the training run (out/train/run, then the fine-tunings out/train/run_ft, run_clean and run_lux, all resumable),
 # which regenerates src/filters/learned_weights_default.cpp.
 # Within 2 hours from nothing on 2 cores: TRAIN_MINUTES of training. `train-smoke`: a few scenes and steps.
 TRAIN_BUILD ?= build-learn
@@ -91,6 +91,10 @@ TRAIN_FT_MINUTES ?= 25
 TRAIN_CLEAN_STEPS ?= 1500
 TRAIN_CLEAN_MINUTES ?= 20
 TRAIN_CLEAN_LOSS ?= sqrt
+# Phase 4 (2026-12-04): phase 3's settings at half the learning rate, with the corpus's training split grown by 16
+# LuxCore scenes (scripts/corpus/luxcore_train.py) and drawn for 30% of the crops; exports the built-in weights.
+TRAIN_LUX_STEPS ?= 800
+TRAIN_LUX_MINUTES ?= 10
 TRAIN_CTX_STEPS ?= 1500
 TRAIN_CTX_MINUTES ?= 30
 .PHONY: train train-smoke
@@ -109,6 +113,9 @@ train: python
 	  --corpus-share 0.25 --steps $(TRAIN_FT_STEPS) --minutes $(TRAIN_FT_MINUTES) --eval --no-context
 	@.venv-train/bin/python scripts/train/train.py --out out/train/run_clean --init out/train/run_ft/weights.bin --lr 1e-3 \
 	  --corpus-share 0.25 --spps 1 4 16 64 --loss $(TRAIN_CLEAN_LOSS) --steps $(TRAIN_CLEAN_STEPS) --minutes $(TRAIN_CLEAN_MINUTES) \
+	  --eval --no-context
+	@.venv-train/bin/python scripts/train/train.py --out out/train/run_lux --init out/train/run_clean/weights.bin --lr 5e-4 \
+	  --corpus-share 0.3 --spps 1 4 16 64 --loss $(TRAIN_CLEAN_LOSS) --steps $(TRAIN_LUX_STEPS) --minutes $(TRAIN_LUX_MINUTES) \
 	  --eval --export --no-context
 
 # Version 4 (the context branch) from `make train`'s weights (or the built-in ones, out/train/v3.bin): whole
