@@ -19,7 +19,7 @@ fi
 # pyluxcore (LuxCoreRender) renders the training split's third renderer (luxcore_train.py); optional:
 # without it render.py --train renders Mitsuba and Cycles only and says so.
 luxcore() {
-  "$VENV/bin/python" -c 'import pyluxcore' 2>/dev/null ||
+  "$VENV/bin/python" -c 'import pyluxcore' >/dev/null 2>&1 ||
     "$VENV/bin/python" -m pip install --quiet pyluxcore >/dev/null 2>&1 ||
     echo "setup.sh: pyluxcore not installed; the training split has no LuxCore scenes" >&2
 }
