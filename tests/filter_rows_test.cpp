@@ -3,7 +3,8 @@
 // Remodulate and the global variance (src/cpu/modulation_cpu.cpp: a' of a row at once, the rim
 // rule's 3x3 scan as row minima), the noise estimate without a variance buffer
 // (src/cpu/noise_cpu.cpp: the global MAD σ, its median, the local per-pixel estimate), the
-// in-place form of the sanitise pass and the firefly pass's count (src/cpu/prepass_cpu.cpp).
+// in-place form of the sanitise pass, the firefly pass's count and its dense-firefly step
+// (src/cpu/prepass_cpu.cpp).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -269,6 +270,42 @@ TEST(FilterRows, InPlaceSanitiseAndTheFireflyCountEqualTheFunctors) {
             EXPECT_EQ(firstBitDifference(fc1, fc4), -1) << w << "x" << h << " own " << own;
             EXPECT_EQ(firstBitDifference(fv1, fv4), -1) << w << "x" << h << " own " << own;
             EXPECT_EQ(count, want) << w << "x" << h << " own " << own;
+        }
+    }
+}
+
+TEST(FilterRows, DenseFireflyStepEqualsTheFunctors) {
+    // Bright pixels dense in one half (about one in five) and sparse in the other, so that windows
+    // cross the thresholds both ways: the CPU overload (sliding sums, dense windows only) against
+    // BoxSum + FireflyDense over every pixel: the same decisions (flags bit for bit) and values to
+    // a few ulps (as the pass itself: GCC contracts the bound's multiply-add differently in the
+    // two instantiations of the functor).
+    for (auto& sz : kSizes) {
+        const int w = sz[0], h = sz[1];
+        Image c = randomImage(w, h, 3, 21, 0.0f, 1.0f), v = randomImage(w, h, 3, 22, 0.0f, 0.05f);
+        std::mt19937 rng(7);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x)
+                if (rng() % (x < w / 2 ? 5u : 60u) == 0)
+                    for (int ch = 0; ch < 3; ++ch) c(x, y, ch) = 3.0f + float(rng() % 8), v(x, y, ch) = 100.0f;
+        for (int own = 0; own < 2; ++own) {
+            Image co1(w, h, 3), vo1(w, h, 3), flag1(w, h, 1), tmp(w, h, 1), sums(w, h, 1);
+            const FireflyClamp p1{4.0f, own, c.view(), v.view(), co1.view(), vo1.view(), flag1.view()};
+            runFireflyClamp(CpuExec{}, p1);
+            Image co2 = co1.clone(), vo2 = vo1.clone(), flag2 = flag1.clone(), before = co1.clone();
+            runFireflyDense(CpuExec{}, p1, tmp.view(), sums.view());
+            const FireflyClamp p2{4.0f, own, c.view(), v.view(), co2.view(), vo2.view(), flag2.view()};
+            Image tmp2(w, h, 1), sums2(w, h, 1);
+            CpuExec{}.forEachPixel(w, h, BoxSum<false>{kFireflyDenseRadius, flag2.view(), tmp2.view()});
+            CpuExec{}.forEachPixel(w, h, BoxSum<true>{kFireflyDenseRadius, tmp2.view(), sums2.view()});
+            CpuExec{}.forEachPixel(w, h, FireflyDense{p2, sums2.view()});
+            for (size_t i = 0; i < co1.size(); ++i) {
+                ASSERT_NEAR(co1.data()[i], co2.data()[i], 1e-6f * std::fabs(co2.data()[i])) << w << "x" << h << " " << i;
+                ASSERT_NEAR(vo1.data()[i], vo2.data()[i], 1e-6f * std::fabs(vo2.data()[i])) << w << "x" << h << " " << i;
+            }
+            EXPECT_EQ(firstBitDifference(flag1, flag2), -1) << w << "x" << h << " own " << own;
+            // The step did something on the larger sizes (not a test of nothing against nothing).
+            if (w * h > 400) EXPECT_NE(firstBitDifference(co1, before), -1) << w << "x" << h << " own " << own;
         }
     }
 }

@@ -1,12 +1,15 @@
 // Firefly suppression (docs/denoising.md, "Fireflies") and non-finite samples: fireflies are brought down to
-// the local bound, ordinary noise is left alone, NaN/Inf never reach the output.
+// the local bound, ordinary noise and dense bright samples (light, not outliers) are left alone, NaN/Inf
+// never reach the output.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
 #include "atrous/denoise.h"
+#include "core/parallel.h"
 #include "denoise_test_util.h"
+#include "filters/prepass.h"
 
 using namespace atrous;
 using namespace atrous::test;
@@ -97,6 +100,51 @@ TEST(Firefly, BrightPixelWithLowOwnVarianceIsSignal) {
     const DenoiseReport rep = f.defaultReport();
     EXPECT_EQ(rep.firefliesClamped, 0);
     EXPECT_NEAR(rep.meanLuminanceAfterFirefly, rep.meanLuminanceIn, 1e-6);
+}
+
+TEST(Firefly, DenseBrightSamplesAreLightNotFireflies) {
+    // A flat 0.5 (variance 0.0025 per channel, Σ w_c² v_c = 0.0014 in luminance: the bound is
+    // 0.5 + k 0.0375) with bright 0.75 pixels whose own
+    // variance says one outlier made each: on a 3-pixel lattice over the left half (1 pixel in 9,
+    // as a sun patch reached by one bounce at a few spp) and once, alone, on the right.
+    const int w = 64, h = 64;
+    Image c(w, h, 3), v(w, h, 3);
+    c.fill(0.5f);
+    v.fill(0.0025f);
+    auto bright = [&](int x, int y) {
+        for (int ch = 0; ch < 3; ++ch) c(x, y, ch) = 0.75f, v(x, y, ch) = 0.5625f;
+    };
+    for (int y = 1; y < h; y += 3)
+        for (int x = 1; x < w / 2; x += 3) bright(x, y);
+    bright(50, 30);
+    Image co(w, h, 3), vo(w, h, 3), flag(w, h, 1), tmp(w, h, 1), sums(w, h, 1);
+    const filters::FireflyClamp pass{4.0f, 1, c.view(), v.view(), co.view(), vo.view(), flag.view()};
+    filters::runFireflyClamp(CpuExec{}, pass);
+    // The pass alone clamps every bright pixel to 0.65 (what the dense step must undo)...
+    for (int y = 1; y < h; y += 3)
+        for (int x = 1; x < w / 2; x += 3) ASSERT_NEAR(co(x, y, 0), 0.65f, 1e-4f) << x << "," << y;
+    filters::runFireflyDense(CpuExec{}, pass, tmp.view(), sums.view());
+    // ...the dense step gives the lattice its light back where its window is dense (1/9 > 0.06:
+    // k ≈ 7.4, bound 0.78), away from the half's edge where the window also sees the right half...
+    for (int y = 7; y < h - 7; y += 3)
+        for (int x = 7; x < w / 2 - 8; x += 3) {
+            ASSERT_EQ(co(x, y, 1), 0.75f) << x << "," << y;
+            ASSERT_EQ(flag(x, y, 0), 0.0f) << x << "," << y;
+        }
+    // ...and the lone one stays clamped, the flat pixels untouched.
+    EXPECT_NEAR(co(50, 30, 0), 0.65f, 1e-4f);
+    EXPECT_EQ(flag(50, 30, 0), 1.0f);
+    EXPECT_EQ(co(40, 10, 2), 0.5f);
+    // Through the library (measured: 52 of the 232 bright pixels clamped, on the lattice's right
+    // edge, whose windows reach past it, and the lone one; all of them without the dense step) the
+    // light stays: the pass alone took 40% of the bright pixels' excess over 0.5 (0.75 -> 0.65).
+    DenoiseReport rep;
+    DenoiseOptions o;
+    o.method = DenoiseMethod::Eaw;
+    test::denoiseReporting(test::inputsOf(c, v), o, rep);
+    EXPECT_LE(rep.firefliesClamped, 64);
+    EXPECT_GT(rep.firefliesClamped, 0);
+    EXPECT_NEAR(rep.meanLuminanceAfterFirefly, rep.meanLuminanceIn, 0.1 * (rep.meanLuminanceIn - 0.5));
 }
 
 TEST(NonFinite, NanAndInfNeverSpread) {

@@ -1,5 +1,5 @@
 // CPU pieces of the still driver (filters/denoise_driver.h) that are not stages: the report's
-// luminance after the firefly pass.
+// luminance after the firefly pass and its count of clamped pixels.
 #include <vector>
 
 #include "core/parallel.h"
@@ -22,6 +22,22 @@ void reportLuminance(const CpuExec&, const ImageView& c, DriverReport& report) {
     double s = 0, n = 0;
     for (int y = 0; y < h; ++y) s += sum[size_t(y)], n += count[size_t(y)];
     report.lumAfterSum = s, report.lumAfterCount = n;
+}
+
+void reportFireflies(const CpuExec&, const ImageView& flag, DriverReport& report) {
+    const int w = flag.width, h = flag.height;
+    std::vector<int> count(static_cast<size_t>(h));
+    cpu::parallelForIsa(cpu::activeIsa(), 0, h, 16, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y) {
+            const float* f = flag.channel(0) + size_t(y) * size_t(w);
+            int n = 0;
+            for (int x = 0; x < w; ++x) n += f[x] > 0.5f;
+            count[size_t(y)] = n;
+        }
+    });
+    int clamped = 0;
+    for (int n : count) clamped += n;
+    report.firefliesClamped = clamped;
 }
 
 }  // namespace atrous::filters

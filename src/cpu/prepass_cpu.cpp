@@ -10,8 +10,10 @@
 #include "atrous/platform.h"
 ATROUS_NO_TRAPPING_MATH
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <mutex>
 #include <vector>
@@ -112,6 +114,101 @@ void runFireflyClamp(const CpuExec& exec, const FireflyClamp& f, int* clamped) {
         for (int c : rowCount) n += c;
         *clamped = n;
     }
+}
+
+// The dense-firefly step: each row's window sums of the flags along x by a sliding sum (into tmp),
+// then per band of rows the column sums of those slid down y, and the functor's decision where the
+// window is dense. The flags are 0 or 1, so every partial sum is an exact integer below 2^24 and
+// the sliding sums equal BoxSum's tap-order sums bit for bit. Only clamped pixels are decided again.
+void runFireflyDense(const CpuExec&, const FireflyClamp& f, const ImageView& tmp, const ImageView&) {
+    const int w = f.cIn.width, h = f.cIn.height, r = kFireflyDenseRadius;
+    // Row j's window sums along x into `out`, by a sliding sum in three stretches without tests:
+    // x < r (nothing leaves the window yet), both ends inside, x + r + 1 >= w (nothing enters).
+    auto rowSums = [&](int j, float* ATROUS_RESTRICT out) {
+        // In integers: the float form's add-subtract chain cost 8 cycles a pixel of latency.
+        const float* ATROUS_RESTRICT in = f.flag.channel(0) + size_t(j) * w;
+        int s = 0;
+        for (int x = 0; x <= std::min(r, w - 1); ++x) s += in[x] > 0.5f;
+        const int a = std::min(r, w), b = std::max(w - r - 1, a);
+        int x = 0;
+        for (; x < a; ++x) {
+            out[x] = float(s);
+            if (x + r + 1 < w) s += in[x + r + 1] > 0.5f;
+        }
+        for (; x < b; ++x) {
+            out[x] = float(s);
+            s += int(in[x + r + 1] > 0.5f) - int(in[x - r] > 0.5f);
+        }
+        for (; x < w; ++x) {
+            out[x] = float(s);
+            s -= in[x - r] > 0.5f;
+        }
+    };
+    cpu::parallelForIsa(cpu::activeIsa(), 0, h, 16, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y) rowSums(y, tmp.channel(0) + size_t(y) * w);
+    });
+    // Then per band of rows the column sums of those, slid down y (the flags of other rows are
+    // not read any more, so the decisions below may rewrite them).
+    const FireflyDense dense{f, ImageView{}};
+    cpu::parallelForIsa(cpu::activeIsa(), 0, h, 32, [&](int y0, int y1) {
+        std::vector<float> colStore(size_t(w), 0.0f);
+        std::vector<unsigned char> candStore(size_t(w) + 8, 0);
+        float* ATROUS_RESTRICT col = colStore.data();
+        for (int j = std::max(y0 - r, 0); j <= std::min(y0 + r, h - 1); ++j) {
+            const float* ATROUS_RESTRICT row = tmp.channel(0) + size_t(j) * w;
+            for (int x = 0; x < w; ++x) col[x] += row[x];
+        }
+        for (int y = y0; y < y1; ++y) {
+            const float ny = float(std::min(y + r, h - 1) - std::max(y - r, 0) + 1);
+            const float* flag = f.flag.channel(0) + size_t(y) * w;  // rewritten below: no restrict
+            // Candidates without branches (clamped, and the window nearly dense: a margin below the
+            // threshold, so that the exact test below, the functor's, decides), then a scan of them.
+            unsigned char* ATROUS_RESTRICT cand = candStore.data();
+            const float lo = kFireflyDenseLo * (1.0f - 1e-5f) * ny;
+            for (int x = 0; x < w; ++x) {
+                const float nx = float(std::min(x + r, w - 1) - std::max(x - r, 0) + 1);
+                cand[x] = (flag[x] > 0.5f) & (col[x] > lo * nx);
+            }
+            for (int x0 = 0; x0 < w; x0 += 8) {
+                std::uint64_t word = 0;
+                std::memcpy(&word, cand + x0, 8);  // candStore has 8 bytes of slack
+                if (word == 0) continue;
+                for (int x = x0; x < std::min(x0 + 8, w); ++x) {
+                    if (!cand[x]) continue;
+                    const float nx = float(std::min(x + r, w - 1) - std::max(x - r, 0) + 1);
+                    const float rho = col[x] / (nx * ny);  // boxTaps(r, x, y, w, h), the functor's
+                    if (rho > kFireflyDenseLo) {
+                        FireflyClamp g = dense.pass;
+                        g.k = dense.pass.k * (1.0f + minSel((rho - kFireflyDenseLo) *
+                                                                (1.0f / (kFireflyDenseHi - kFireflyDenseLo)), 1.0f));
+                        // The 8 neighbours (indices clamped at the border, as the functor's), in
+                        // apply's order.
+                        float l[8], lv[8];
+                        int n = 0;
+                        for (int dy = -1; dy <= 1; ++dy)
+                            for (int dx = -1; dx <= 1; ++dx) {
+                                if (dx == 0 && dy == 0) continue;
+                                const size_t o = size_t(clampIdx(y + dy, h - 1)) * w + size_t(clampIdx(x + dx, w - 1));
+                                l[n] = lum(g.cIn.channel(0)[o], g.cIn.channel(1)[o], g.cIn.channel(2)[o]);
+                                lv[n] = lumVarianceIndependent(g.vIn.channel(0)[o], g.vIn.channel(1)[o], g.vIn.channel(2)[o]);
+                                ++n;
+                            }
+                        g.flag.channel(0)[size_t(y) * w + size_t(x)] = g.apply(x, y, l, lv);
+                    }
+                }
+            }
+            if (y + 1 < y1) {  // slide the column sums to row y + 1
+                if (y + r + 1 < h) {
+                    const float* ATROUS_RESTRICT add = tmp.channel(0) + size_t(y + r + 1) * w;
+                    for (int x = 0; x < w; ++x) col[x] += add[x];
+                }
+                if (y - r >= 0) {
+                    const float* ATROUS_RESTRICT sub = tmp.channel(0) + size_t(y - r) * w;
+                    for (int x = 0; x < w; ++x) col[x] -= sub[x];
+                }
+            }
+        }
+    });
 }
 
 }  // namespace atrous::filters

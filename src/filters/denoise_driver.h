@@ -156,6 +156,11 @@ inline void sureDetailVarianceFactors(int levels, float* alpha) {
 template <class Exec>
 void reportLuminance(const Exec&, const ImageView&, DriverReport&) {}
 void reportLuminance(const CpuExec& exec, const ImageView& c, DriverReport& report);
+// The report's count of clamped pixels: nothing on a device executor (its caller reduces the flag
+// plane); the CpuExec overload counts the flags (1 where the pass, dense step included, clamped).
+template <class Exec>
+void reportFireflies(const Exec&, const ImageView&, DriverReport&) {}
+void reportFireflies(const CpuExec& exec, const ImageView& flag, DriverReport& report);
 
 // The caller's image behind `v` when it was handed over (3 channels, on `dev`, the view's very
 // storage), moved out of *store; else an empty image.
@@ -313,10 +318,16 @@ void runDenoise(const Exec& exec, const DriverInputs& in, const DriverConfig& cf
     Image cA, vA, spareC, spareV;
     if (o.firefly.enabled) {
         cA = planes(3), vA = planes(3);
-        int* count = out.report ? &out.report->firefliesClamped : nullptr;
-        runFireflyClamp(exec, FireflyClamp{o.firefly.k, cfg.varianceGiven ? 1 : 0, c0.view(), v0.view(), cA.view(),
-                                           vA.view(), out.fireflyFlag},
-                        count);
+        // The flags (the caller's plane, else a scratch one) feed the dense-firefly step.
+        Image flagStore = out.fireflyFlag.valid() ? Image{} : planes(1);
+        const ImageView flag = out.fireflyFlag.valid() ? out.fireflyFlag : flagStore.view();
+        const FireflyClamp pass{o.firefly.k, cfg.varianceGiven ? 1 : 0, c0.view(), v0.view(), cA.view(), vA.view(), flag};
+        runFireflyClamp(exec, pass);
+        {
+            Image tmp = planes(1), sums = planes(1);
+            runFireflyDense(exec, pass, tmp.view(), sums.view());
+        }
+        if (out.report) reportFireflies(exec, flag, *out.report);
         spareC = std::move(c0), spareV = std::move(v0);
     } else {
         cA = std::move(c0), vA = std::move(v0);

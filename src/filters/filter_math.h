@@ -1,4 +1,5 @@
-// Small math shared by the filter functors on host and device: the albedo (de)modulation terms.
+// Small math shared by the filter functors on host and device: the albedo (de)modulation terms and
+// window sums (the give-back's, the firefly pass's density).
 // The B3 taps, the exponential, the luminance and the selects are in filters/atrous_math.h.
 #pragma once
 #include <cmath>
@@ -70,6 +71,35 @@ ATROUS_INLINE void pixelModulationAlbedo(const ImageView& albedo, int x, int y, 
     }
     const float t = modulationTerm(mp, floor * (1.0f + nearBlack * (kRimFloorMul - 1.0f)));
     for (int c = 0; c < 3; ++c) a[c] = modulationAlbedo(v[c], t, eps);
+}
+
+// Window sums of every channel along x (kVertical false: x - R..x + R) or y, over the taps inside
+// the image, added in tap order (the CPU's fused give-back, src/cpu/sure_cpu.cpp, adds the same taps
+// in the same order in its row loops).
+template <bool kVertical>
+struct BoxSum {
+    int radius;
+    ImageView in, out;  // the same channel count
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        const int n = kVertical ? in.height : in.width, i = kVertical ? y : x;
+        const int lo = i - radius < 0 ? 0 : i - radius, hi = i + radius > n - 1 ? n - 1 : i + radius;
+        for (int c = 0; c < in.channels; ++c) {
+            float s = 0.0f;
+            for (int j = lo; j <= hi; ++j) s += kVertical ? in(x, j, c) : in(j, y, c);
+            out(x, y, c) = s;
+        }
+    }
+};
+template <class Exec, bool kVertical>
+void runBoxSum(const Exec& exec, const BoxSum<kVertical>& f) {
+    exec.forEachPixel(f.in.width, f.in.height, f);
+}
+
+// The number of in-image taps of p's window.
+ATROUS_INLINE float boxTaps(int radius, int x, int y, int w, int h) {
+    const int nx = (x + radius < w - 1 ? x + radius : w - 1) - (x - radius > 0 ? x - radius : 0) + 1;
+    const int ny = (y + radius < h - 1 ? y + radius : h - 1) - (y - radius > 0 ? y - radius : 0) + 1;
+    return float(nx * ny);
 }
 
 }  // namespace atrous::filters
