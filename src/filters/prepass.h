@@ -273,8 +273,9 @@ void runFireflyClamp(const CpuExec& exec, const FireflyClamp& f, int* clamped = 
 // away. After the pass, each pixel whose (2R+1)² window (R = kFireflyDenseRadius) holds a fraction
 // ρ of clamped pixels above kFireflyDenseLo is decided again from the unclamped colour with the
 // bound's k raised to k (1 + t), t = min((ρ - lo) / (hi - lo), 1): twice the deviations where ρ
-// reaches kFireflyDenseHi. An isolated firefly (ρ about 1/225) is untouched. Measured on atrous's
-// own 56 training rooms (est: −3.6% / −2.3% / −0.2% relMSE at 1 / 4 / 16 spp; docs/decisions.md).
+// reaches kFireflyDenseHi. An isolated firefly (ρ about 1/225) is untouched. Thresholds set on
+// atrous's own 56 training rooms (the default without a variance: −4.1% / −2.7% / −0.2% relMSE at
+// 1 / 4 / 16 spp; docs/decisions.md, docs/algorithms-eaw-sure.md).
 constexpr int kFireflyDenseRadius = 7;
 constexpr float kFireflyDenseLo = 0.06f, kFireflyDenseHi = 0.12f;
 struct FireflyDense {
