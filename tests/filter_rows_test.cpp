@@ -12,6 +12,7 @@
 #include <cstring>
 #include <limits>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "core/parallel.h"
@@ -282,10 +283,11 @@ TEST(FilterRows, DenseFireflyStepEqualsTheFunctors) {
     // two instantiations of the functor).
     // kSizes, and sizes whose bands of 32 rows start below row 0 (y0 > 0) and whose rows have no
     // middle stretch in the sliding sum (w < 2r + 2 = 16).
-    const int sizes[][2] = {{37, 23}, {64, 19}, {5, 7}, {3, 5}, {2, 4}, {1, 1}, {1, 9}, {40, 1},
-                            {9, 33}, {12, 70}, {15, 40}, {16, 65}, {200, 100}};
-    for (auto& sz : sizes) {
-        const int w = sz[0], h = sz[1];
+    std::vector<std::pair<int, int>> sizes;
+    for (auto& sz : kSizes) sizes.emplace_back(sz[0], sz[1]);
+    for (auto sz : {std::pair{9, 33}, std::pair{12, 70}, std::pair{15, 40}, std::pair{16, 65}, std::pair{200, 100}})
+        sizes.push_back(sz);
+    for (auto [w, h] : sizes) {
         Image c = randomImage(w, h, 3, 21, 0.0f, 1.0f), v = randomImage(w, h, 3, 22, 0.0f, 0.05f);
         std::mt19937 rng(7);
         for (int y = 0; y < h; ++y)

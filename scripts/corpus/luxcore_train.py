@@ -17,13 +17,12 @@ Written in LuxCore's own layout (a folder of RGB.exr, ALBEDO.exr, ... per render
 stills), so train_export.py reads it through the same reader as `atrous denoise --in DIR`.
 About a minute per scene at 128² on 2 cores (the 1024-spp reference).
 """
-import json
 import os
 import time
 
 import numpy as np
 
-from common import TRAIN, parse_train_args, train_jobs, write_manifest  # noqa: E402
+from common import TRAIN, merged_render_seconds, parse_train_args, train_jobs, write_manifest  # noqa: E402
 import luxcore_stills as ls  # noqa: E402  (pyluxcore.Init; its main() does not run)
 
 N_SCENES = 16
@@ -140,18 +139,17 @@ def main():
         d = root / name
         d.mkdir(parents=True, exist_ok=True)
         man_path = d / "manifest.json"
-        old = json.loads(man_path.read_text()).get("render_seconds", {}) if man_path.exists() else {}
-        files, times = {}, dict(old)
+        files, times = {}, {}
         for spp, seed, stem in train_jobs(k):
             files[stem] = {"spp": spp, "seed": seed, "folder": stem, "files": [t + ".exr" for t in ls.OUTPUTS]}
             if not (d / stem / "RGB.exr").exists():
-                times[stem] = round(ls.render(scene, str(d / stem), spp, seed, res, pf), 1)
-                print(f"{time.strftime('%H:%M:%S')} luxcore {name} {stem}: {times[stem]} s ({what})", flush=True)
+                times[stem] = ls.render(scene, str(d / stem), spp, seed, res, pf)
+                print(f"{time.strftime('%H:%M:%S')} luxcore {name} {stem}: {times[stem]:.1f} s ({what})", flush=True)
         write_manifest(man_path, {
             "scene": name, "split": "train", "renderer": "luxcore", "version": ls.pyluxcore.Version(),
             "description": what, "resolution": [res, res], "pixel_filter": pf.lower(),
             "integrator": "PATHCPU depth 8", "layout": "luxcore", "files": files,
-            "reference": f"ref{TRAIN['ref_spp']:04d}", "render_seconds": times})
+            "reference": f"ref{TRAIN['ref_spp']:04d}", "render_seconds": merged_render_seconds(man_path, times)})
     os._exit(0)  # pyluxcore's log callback crashes at interpreter shutdown
 
 

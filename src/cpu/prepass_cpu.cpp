@@ -117,8 +117,8 @@ void runFireflyClamp(const CpuExec& exec, const FireflyClamp& f, int* clamped) {
 }
 
 // The dense-firefly step: each row's window sums of the flags along x by a sliding sum (into tmp),
-// then per band of rows the column sums of those slid down y, and the functor's decision where the
-// window is dense. The flags are 0 or 1, so every partial sum is an exact integer below 2^24 and
+// then per band of rows the column sums of those slid down y, and the functor's decision
+// (FireflyDense::decide) for the clamped pixels whose window may be dense. The flags are 0 or 1, so every partial sum is an exact integer below 2^24 and
 // the sliding sums equal BoxSum's tap-order sums bit for bit. Only clamped pixels are decided again.
 void runFireflyDense(const CpuExec&, const FireflyClamp& f, const ImageView& tmp, const ImageView&) {
     const int w = f.cIn.width, h = f.cIn.height, r = kFireflyDenseRadius;
@@ -162,7 +162,7 @@ void runFireflyDense(const CpuExec&, const FireflyClamp& f, const ImageView& tmp
             const float ny = float(std::min(y + r, h - 1) - std::max(y - r, 0) + 1);
             const float* flag = f.flag.channel(0) + size_t(y) * w;  // rewritten below: no restrict
             // Candidates without branches (clamped, and the window nearly dense: a margin below the
-            // threshold, so that the exact test below, the functor's, decides), then a scan of them.
+            // threshold, so that the functor's exact test decides), then a scan of them.
             unsigned char* ATROUS_RESTRICT cand = candStore.data();
             const float lo = kFireflyDenseLo * (1.0f - 1e-5f) * ny;
             for (int x = 0; x < w; ++x) {
@@ -173,29 +173,8 @@ void runFireflyDense(const CpuExec&, const FireflyClamp& f, const ImageView& tmp
                 std::uint64_t word = 0;
                 std::memcpy(&word, cand + x0, 8);  // candStore has 8 bytes of slack
                 if (word == 0) continue;
-                for (int x = x0; x < std::min(x0 + 8, w); ++x) {
-                    if (!cand[x]) continue;
-                    const float nx = float(std::min(x + r, w - 1) - std::max(x - r, 0) + 1);
-                    const float rho = col[x] / (nx * ny);  // boxTaps(r, x, y, w, h), the functor's
-                    if (rho > kFireflyDenseLo) {
-                        FireflyClamp g = dense.pass;
-                        g.k = dense.pass.k * (1.0f + minSel((rho - kFireflyDenseLo) *
-                                                                (1.0f / (kFireflyDenseHi - kFireflyDenseLo)), 1.0f));
-                        // The 8 neighbours (indices clamped at the border, as the functor's), in
-                        // apply's order.
-                        float l[8], lv[8];
-                        int n = 0;
-                        for (int dy = -1; dy <= 1; ++dy)
-                            for (int dx = -1; dx <= 1; ++dx) {
-                                if (dx == 0 && dy == 0) continue;
-                                const size_t o = size_t(clampIdx(y + dy, h - 1)) * w + size_t(clampIdx(x + dx, w - 1));
-                                l[n] = lum(g.cIn.channel(0)[o], g.cIn.channel(1)[o], g.cIn.channel(2)[o]);
-                                lv[n] = lumVarianceIndependent(g.vIn.channel(0)[o], g.vIn.channel(1)[o], g.vIn.channel(2)[o]);
-                                ++n;
-                            }
-                        g.flag.channel(0)[size_t(y) * w + size_t(x)] = g.apply(x, y, l, lv);
-                    }
-                }
+                for (int x = x0; x < std::min(x0 + 8, w); ++x)
+                    if (cand[x]) dense.decide(x, y, col[x]);
             }
             if (y + 1 < y1) {  // slide the column sums to row y + 1
                 if (y + r + 1 < h) {

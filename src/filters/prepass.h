@@ -284,7 +284,12 @@ struct FireflyDense {
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         // A pixel the pass kept is kept at any larger k (the bound only grows with k): as it was.
         if (!(pass.flag(x, y, 0) > 0.5f)) return;
-        const float rho = sums(x, y, 0) / boxTaps(kFireflyDenseRadius, x, y, sums.width, sums.height);
+        decide(x, y, sums(x, y, 0));
+    }
+    // A clamped pixel whose window holds `windowSum` clamped pixels (shared with the CPU overload).
+    ATROUS_HOST_DEVICE void decide(int x, int y, float windowSum) const {
+        const int w = pass.cIn.width, h = pass.cIn.height;
+        const float rho = windowSum / boxTaps(kFireflyDenseRadius, x, y, w, h);
         const float t = minSel((rho - kFireflyDenseLo) * (1.0f / (kFireflyDenseHi - kFireflyDenseLo)), 1.0f);
         if (!(t > 0.0f)) return;  // the first decision stands
         FireflyClamp g = pass;
