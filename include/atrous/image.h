@@ -28,6 +28,34 @@ struct ImageView {
     ATROUS_INLINE bool sameSize(const ImageView& o) const { return width == o.width && height == o.height; }
 };
 
+// The element types an image in the caller's memory may have (StridedImage).
+enum class DataType : int { Float32 = 0, Float16 = 1 };  // Float16: IEEE 754 binary16 ("half")
+constexpr int dataTypeBytes(DataType t) { return t == DataType::Float16 ? 2 : 4; }
+
+// An image in the caller's memory and layout, borrowed (the memory must outlive its use): float32
+// or float16, 1 to 4 channels, interleaved (channelStride = the element's size) or planar
+// (channelStride = a plane's bytes), with byte strides of any sign. What the C API's
+// atrousSetFilterImage and Python's numpy arrays hand over; an Image is one too (Image::strided():
+// planar float32). Element (x, y, c) is at (const char*)data + y * rowStride + x * pixelStride +
+// c * channelStride. The filters read it where it is; src/core/strided.h has the per-pixel access.
+struct StridedImage {
+    const void* data = nullptr;  // element (0, 0, 0); null = no image
+    DataType type = DataType::Float32;
+    int width = 0, height = 0, channels = 0;
+    int64_t pixelStride = 0, rowStride = 0, channelStride = 0;  // in bytes
+    Device device = Device::Cpu;
+
+    ATROUS_INLINE bool valid() const { return data != nullptr; }
+    // The layout of a planar float32 image of this size (an ImageView's): then view() is that view.
+    ATROUS_INLINE bool planarFloat() const {
+        return type == DataType::Float32 && pixelStride == 4 && rowStride == 4 * int64_t(width) &&
+               (channels == 1 || channelStride == 4 * int64_t(width) * int64_t(height));
+    }
+    ATROUS_INLINE ImageView view() const {
+        return planarFloat() ? ImageView{static_cast<float*>(const_cast<void*>(data)), width, height, channels} : ImageView{};
+    }
+};
+
 // An owning planar float image on the host or on a CUDA device. Move-only; copy with clone().
 class Image {
 public:
@@ -62,6 +90,11 @@ public:
     float* data() { return mData; }
     const float* data() const { return mData; }
     ImageView view() const { return ImageView{mData, mWidth, mHeight, mChannels}; }
+    // The same pixels described as a StridedImage (planar float32; data null when empty).
+    StridedImage strided() const {
+        const int64_t p = int64_t(plane()) * 4;
+        return StridedImage{mData, DataType::Float32, mWidth, mHeight, mChannels, 4, 4 * int64_t(mWidth), p, mDevice};
+    }
     // Host images only (no check on the hot path beyond debug asserts).
     float& operator()(int x, int y, int c) { return mData[size_t(c) * plane() + size_t(y) * mWidth + x]; }
     float operator()(int x, int y, int c) const { return mData[size_t(c) * plane() + size_t(y) * mWidth + x]; }
