@@ -3,6 +3,9 @@
 // conventions are stated here, once; docs/inputs.md says how other renderers' passes are mapped
 // onto them.
 #pragma once
+#include <cstdint>
+#include <initializer_list>
+
 #include "atrous/image.h"
 
 namespace atrous {
@@ -37,6 +40,30 @@ struct BufferInfo {
 //   emission  emitted radiance of the primary hit towards the camera, 0 elsewhere
 //   motion    channel 0 = dx, channel 1 = dy in pixels: the point's image position in the previous
 //             frame minus its position now (previous - current); non-finite = no history
+// A set of buffers: what a method reads (its registry row), what a reader decodes.
+class BufferMask {
+public:
+    constexpr BufferMask() = default;
+    constexpr BufferMask(std::initializer_list<Buffer> buffers) {
+        for (Buffer b : buffers) mBits |= bit(b);
+    }
+    static constexpr BufferMask all() { return BufferMask((1u << kBufferCount) - 1u); }
+    constexpr bool has(Buffer b) const { return (mBits & bit(b)) != 0; }
+    constexpr bool empty() const { return mBits == 0; }
+    constexpr BufferMask with(Buffer b) const { return BufferMask(mBits | bit(b)); }
+    constexpr BufferMask without(Buffer b) const { return BufferMask(mBits & ~bit(b)); }
+    constexpr BufferMask operator|(BufferMask o) const { return BufferMask(mBits | o.mBits); }
+    constexpr BufferMask operator&(BufferMask o) const { return BufferMask(mBits & o.mBits); }
+    constexpr bool operator==(BufferMask o) const { return mBits == o.mBits; }
+    constexpr bool operator!=(BufferMask o) const { return mBits != o.mBits; }
+    constexpr uint32_t bits() const { return mBits; }
+
+private:
+    constexpr explicit BufferMask(uint32_t bits) : mBits(bits) {}
+    static constexpr uint32_t bit(Buffer b) { return 1u << unsigned(b); }
+    uint32_t mBits = 0;
+};
+
 const BufferInfo& bufferInfo(Buffer b);
 const char* bufferName(Buffer b);  // bufferInfo(b).name
 int bufferChannels(Buffer b);      // bufferInfo(b).channels
