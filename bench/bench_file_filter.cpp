@@ -66,12 +66,12 @@ int main(int argc, char** argv) {
             limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(threads));
         DenoiseOptions o;
         o.method = parseDenoiseMethod(method);
-        const DenoiseBufferUse use = denoiseBufferUse(o, o.method);
+        const BufferMask use = denoiseReads(o, o.method);
         io::BufferFiles files;
         files.in = in;
         files.wanted = [&](io::Buffer b, const bool*) {
             if (b == io::Buffer::Variance && noVariance) return false;
-            return io::methodReads(use, b);
+            return use.has(b);
         };
         Timer readTimer;
         io::BufferSet set = io::loadBuffers(files);

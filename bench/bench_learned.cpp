@@ -70,8 +70,8 @@ int main(int argc, char** argv) {
         const bench::BoxScene s(w, h, true);
         // The cascade alone, on the scene's colour as d (the driver's preparation is timed below).
         Image out(w, h, 3);
-        const filters::LearnedPlanes P{s.color.view(), s.variance.view(), s.albedo.view(), s.normal.view(),
-                                       s.depth.view()};
+        const PreparedView P = filters::preparedView(s.color.view(), s.variance.view(), s.albedo.view(), s.normal.view(),
+                                       s.depth.view());
         if (only != "denoise") {
         std::vector<double> total, alloc, ctx, logs, net, levels, cpuCtx, cpuLogs, cpuNet, cpuLevels;
         for (int i = 0; i < 3 + runs; ++i) {

@@ -12,7 +12,7 @@
 #include "atrous/denoise.h"
 #include "atrous/image.h"
 #include "core/parallel.h"
-#include "filters/denoise_driver.h"
+#include "filters/still_pipeline.h"
 #include "filters/safety_net.h"
 
 using namespace atrous;
@@ -68,18 +68,18 @@ Scene makeScene(float S, float sigma, unsigned seed) {
     return s;
 }
 
-// The driver on the CPU with the default options (variance given), the give-back on or off.
+// The still path on the CPU with the default options (variance given), the give-back on or off.
 Image runDriver(const Scene& s, DenoiseMethod method, bool giveBack) {
-    DriverInputs in;
+    StillInputs in;
     in.color = s.noisy.view(), in.variance = s.variance.view();
     in.albedo = s.albedo.view(), in.normal = s.normal.view(), in.depth = s.depth.view();
-    DriverConfig cfg;
+    StillConfig cfg;
     cfg.opts.method = method;
     cfg.albedoGiveBack = giveBack;
     Image out(kW, kH, 3);
-    DriverOutputs o;
+    StillOutputs o;
     o.out = out.view();
-    runDenoise(CpuExec{}, in, cfg, o);
+    runStill(CpuExec{}, in, cfg, o);
     return out;
 }
 

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "core/parallel.h"
-#include "filters/denoise_driver.h"
+#include "filters/still_cascades.h"
 #include "filters/emission_filter.h"
 #include "filters/modulation.h"
 #include "filters/noise_estimate.h"

@@ -20,7 +20,7 @@ struct Fixture {
     int w = 0, h = 0;
     std::vector<std::uint8_t> weights;
     Image d, var, albedo, normal, depth, expect;
-    filters::LearnedPlanes planes() const { return {d.view(), var.view(), albedo.view(), normal.view(), depth.view()}; }
+    PreparedView planes() const { return filters::preparedView(d.view(), var.view(), albedo.view(), normal.view(), depth.view()); }
 };
 
 inline std::uint32_t rd32(const std::uint8_t* p) {

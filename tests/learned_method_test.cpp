@@ -92,7 +92,7 @@ double mse(const Image& a, const Image& ref) {
 }
 
 TEST(LearnedMethod, IsRunLearnedOnThePreparedPlanesThenRemodulate) {
-    // denoise(Learned) must be runLearned on learnedPlanes' planes, then d_out * mod + emission:
+    // denoise(Learned) must be runLearned on preparePlanes' planes, then d_out * modulation + emission:
     // the same code on the same floats, so equal bit for bit (no tolerance). Covers a given and an
     // estimated variance, the emission filter and the firefly pass; a driver that passed other
     // planes (a zero plane for an absent albedo or depth, the colour before demodulation) or
@@ -114,18 +114,17 @@ TEST(LearnedMethod, IsRunLearnedOnThePreparedPlanesThenRemodulate) {
         if (!k.depth) in.depth = nullptr;
         const DenoiseOptions o = learnedOptions(wpath);
         const Image out = denoise(in, o);
-        PreparedPlanes p = learnedPlanes(in, o);
+        PreparedPlanes p = preparePlanes(in, o);
         ASSERT_EQ(p.albedo.empty(), !k.albedo);
         ASSERT_EQ(p.normal.empty(), !k.normal);
         ASSERT_EQ(p.depth.empty(), !k.depth);
-        auto viewOr = [](const Image& i) { return i.empty() ? ImageView{} : i.view(); };
-        const filters::LearnedPlanes P{p.d.view(), p.var.view(), viewOr(p.albedo), viewOr(p.normal), viewOr(p.depth)};
+        const PreparedView P = p.view();
         Image dOut(40, 32, 3);
         filters::runLearned(CpuExec{}, w, P, dOut.view());
         Image expect(40, 32, 3);
         for (int y = 0; y < 32; ++y)
             for (int x = 0; x < 40; ++x)
-                for (int c = 0; c < 3; ++c) expect(x, y, c) = dOut(x, y, c) * p.mod(x, y, c) + p.emission(x, y, c);
+                for (int c = 0; c < 3; ++c) expect(x, y, c) = dOut(x, y, c) * p.modulation(x, y, c) + p.emission(x, y, c);
         const std::string what = std::string("variance ") + char('0' + k.variance) + " albedo " + char('0' + k.albedo) +
                                  " normal " + char('0' + k.normal) + " depth " + char('0' + k.depth);
         EXPECT_EQ(firstDifference(out, expect), -1) << what;
@@ -180,13 +179,13 @@ TEST(LearnedMethod, RunsOnARenderedSceneWithinTheRangeOfItsPlanes) {
     const DenoiseOptions o = learnedOptions(wpath);
     const Image out = denoise(r.inputs(), o);
     ASSERT_TRUE(allFinite(out));
-    const PreparedPlanes p = learnedPlanes(r.inputs(), o);
+    const PreparedPlanes p = preparePlanes(r.inputs(), o);
     for (int c = 0; c < 3; ++c) {
         float lo = INFINITY, hi = -INFINITY;
-        for (size_t i = 0; i < p.d.plane(); ++i) lo = std::fmin(lo, p.d.view().channel(c)[i]), hi = std::fmax(hi, p.d.view().channel(c)[i]);
+        for (size_t i = 0; i < p.color.plane(); ++i) lo = std::fmin(lo, p.color.view().channel(c)[i]), hi = std::fmax(hi, p.color.view().channel(c)[i]);
         const float tol = 1e-5f * (hi - lo);
-        for (size_t i = 0; i < p.d.plane(); ++i) {
-            const float d = (out.data()[c * out.plane() + i] - p.emission.view().channel(c)[i]) / p.mod.view().channel(c)[i];
+        for (size_t i = 0; i < p.color.plane(); ++i) {
+            const float d = (out.data()[c * out.plane() + i] - p.emission.view().channel(c)[i]) / p.modulation.view().channel(c)[i];
             ASSERT_GE(d, lo - tol) << c << " " << i;
             ASSERT_LE(d, hi + tol) << c << " " << i;
         }
@@ -245,7 +244,7 @@ TEST(LearnedMethod, TheMethodListIsWhatTheCliAndTheParserRead) {
         EXPECT_STREQ(denoiseMethodName(m.method), m.name);
         EXPECT_EQ(findDenoiseMethod(m.name), &m);
         const bool network = m.method == DenoiseMethod::Learned || m.method == DenoiseMethod::Blend || m.method == DenoiseMethod::Auto;
-        EXPECT_EQ(m.usesWeights, network) << m.name;
+        EXPECT_EQ(readsWeights(m), network) << m.name;
         EXPECT_EQ(std::count(names.begin(), names.end(), m.name), 0) << m.name;
         names.push_back(m.name);
     }

@@ -36,8 +36,8 @@ LearnedWeights fixtureWeights() {
 }
 
 // The cascade on the CPU: the row engine (fast) or the functors, AVX-512 loops or not.
-Image run(const LearnedPlanes& p, const LearnedWeights& w, bool fast, bool avx512 = filters::atrousCpuAvx512()) {
-    Image out(p.d.width, p.d.height, 3);
+Image run(const PreparedView& p, const LearnedWeights& w, bool fast, bool avx512 = filters::atrousCpuAvx512()) {
+    Image out(p.color.width, p.color.height, 3);
     const bool savedFast = atrousCpuFastPath(), savedAvx = atrousCpuAvx512();
     atrousCpuFastPath() = fast, atrousCpuAvx512() = avx512;
     runLearned(CpuExec{}, w, p, out.view());
@@ -100,7 +100,7 @@ TEST(Learned, RowEngineEqualsFunctors) {
 // the output differs from the full one (the inputs are used).
 TEST(Learned, AbsentFeaturePlanes) {
     const LearnedWeights w = fixtureWeights();
-    LearnedPlanes p = fixture().planes();
+    PreparedView p = fixture().planes();
     p.albedo = p.normal = p.depth = ImageView{};
     const Image fast = run(p, w, true), ref = run(p, w, false);
     for (size_t i = 0; i < fast.size(); ++i) ASSERT_TRUE(std::isfinite(fast.data()[i]));
@@ -118,7 +118,7 @@ TEST(Learned, OddSizesRowEngineEqualsFunctors) {
         for (int c = 0; c < 3; ++c)
             for (int y = 0; y < ch; ++y)
                 for (int x = 0; x < cw; ++x) d(x, y, c) = fx.d(x + 3, y + 2, c), var(x, y, c) = fx.var(x + 3, y + 2, c);
-        const LearnedPlanes p{d.view(), var.view(), {}, {}, {}};
+        const PreparedView p = preparedView(d.view(), var.view(), {}, {}, {});
         EXPECT_LE(worstRel(run(p, w, true), run(p, w, false)), 2e-6) << cw << "x" << ch;
     }
 }
@@ -178,7 +178,7 @@ TEST(Learned, NonFinitePlanesGiveFiniteOutput) {
     // Finite variances whose channel sum overflows: the noise plane v reads +inf there (nu = 0).
     var(9, 9, 0) = var(9, 9, 1) = var(9, 9, 2) = 3e38f;
     albedo(3, 9, 1) = nan, normal(10, 10, 0) = inf, depth(11, 3, 0) = nan, depth(12, 3, 0) = inf;
-    const LearnedPlanes p{d.view(), var.view(), albedo.view(), normal.view(), depth.view()};
+    const PreparedView p = preparedView(d.view(), var.view(), albedo.view(), normal.view(), depth.view());
     for (bool fast : {true, false}) {
         const Image out = run(p, fixtureWeights(), fast);
         for (size_t i = 0; i < out.size(); ++i) ASSERT_TRUE(std::isfinite(out.data()[i])) << fast << " " << i;
@@ -319,7 +319,7 @@ TEST(Learned, BadPlanesAreClearErrors) {
     const LearnedWeights w = fixtureWeights();
     const Fixture& fx = fixture();
     Image small(4, 4, 3), out(fx.w, fx.h, 3), one(fx.w, fx.h, 1);
-    auto msg = [&](const LearnedPlanes& p, const ImageView& o) {
+    auto msg = [&](const PreparedView& p, const ImageView& o) {
         try {
             runLearned(CpuExec{}, w, p, o);
         } catch (const InputError& e) {
@@ -327,14 +327,14 @@ TEST(Learned, BadPlanesAreClearErrors) {
         }
         return std::string("no error");
     };
-    LearnedPlanes p = fx.planes();
+    PreparedView p = fx.planes();
     EXPECT_EQ(msg(p, out.view()), "no error");
     p.albedo = small.view();
-    EXPECT_NE(msg(p, out.view()).find("learned filter: albedo: size 4x4 differs from d's 42x37"), std::string::npos)
+    EXPECT_NE(msg(p, out.view()).find("learned filter: albedo: size 4x4 differs from the colour's 42x37"), std::string::npos)
         << msg(p, out.view());
     p = fx.planes();
-    p.var = ImageView{};
-    EXPECT_NE(msg(p, out.view()).find("learned filter: var: missing"), std::string::npos);
+    p.variance = ImageView{};
+    EXPECT_NE(msg(p, out.view()).find("learned filter: variance: missing"), std::string::npos);
     p = fx.planes();
     p.normal = one.view();
     EXPECT_NE(msg(p, out.view()).find("learned filter: normal: 1 channels, 3 needed"), std::string::npos);
@@ -362,7 +362,7 @@ TEST(Learned, BandsOfRowsEqualTheWholeImage) {
             }
             depth(x, y, 0) = edge ? 2.0f : 5.0f;
         }
-    const LearnedPlanes p{d.view(), var.view(), albedo.view(), normal.view(), depth.view()};
+    const PreparedView p = preparedView(d.view(), var.view(), albedo.view(), normal.view(), depth.view());
     const LearnedWeights wts = LearnedWeights::builtin();
     const int saved = learnedCpuBandRows();
     learnedCpuBandRows() = -1;

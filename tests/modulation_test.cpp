@@ -7,7 +7,7 @@
 #include <random>
 
 #include "core/parallel.h"
-#include "filters/denoise_driver.h"
+#include "filters/still_state.h"
 #include "filters/modulation.h"
 #include "filters/svgf_common.h"
 

@@ -12,7 +12,7 @@
 #include "core/parallel.h"
 #include "denoise_test_util.h"
 #include "param_effect_util.h"
-#include "filters/denoise_driver.h"
+#include "filters/still_cascades.h"
 #include "filters/denoise_internal.h"
 
 using namespace atrous;

@@ -9,7 +9,7 @@
 
 namespace atrous::toy {
 
-void toyCascade(const StillPlanes& p, const DenoiseOptions&, const ImageView& out) {
+void toyCascade(const PreparedView& p, const DenoiseOptions&, const ImageView& out) {
     const int w = p.color.width, h = p.color.height;
     Image tmp = Image::uninitialized(w, h, 3);
     const bool guided = p.albedo.valid();
@@ -26,8 +26,12 @@ void toyCascade(const StillPlanes& p, const DenoiseOptions&, const ImageView& ou
 }
 
 void registerToy() {
-    registerDenoiseMethod({DenoiseMethod::Eaw, "toy", "a toy: three levels of a cross-bilateral a-trous on the albedo (tests/toy_method.cpp)",
-                           false, toyCascade});
+    DenoiseMethodInfo row;
+    row.name = "toy";
+    row.summary = "a toy: three levels of a cross-bilateral a-trous on the albedo (tests/toy_method.cpp)";
+    row.reads.buffers = {Buffer::Albedo};
+    row.cpu = toyCascade;
+    registerDenoiseMethod(row);
 }
 
 DenoiseMethod toyMethod() { return parseDenoiseMethod("toy"); }

@@ -9,7 +9,7 @@ namespace atrous::toy {
 
 // Three levels (steps 1, 2, 4) of ToyStop on the prepared colour, guided by the albedo's green
 // channel (σ² = 0.01) when an albedo is given, else the plain B3 à-trous.
-void toyCascade(const StillPlanes& planes, const DenoiseOptions& options, const ImageView& out);
+void toyCascade(const PreparedView& planes, const DenoiseOptions& options, const ImageView& out);
 
 // Adds the "toy" row (registerDenoiseMethod); the method's value once it is there.
 void registerToy();

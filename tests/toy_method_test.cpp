@@ -41,12 +41,19 @@ std::string renderFolder(const test::TempDir& dir) {
     return in;
 }
 
+// A registry row of a registered method.
+DenoiseMethodInfo row(const char* name, StillCascade cascade, MethodReads reads = {}) {
+    DenoiseMethodInfo m;
+    m.name = name, m.cpu = std::move(cascade), m.reads = std::move(reads);
+    return m;
+}
+
 TEST(ToyMethod, IsARowOfTheRegistry) {
     const DenoiseMethodInfo* m = findDenoiseMethod("toy");
     ASSERT_NE(m, nullptr);
     EXPECT_EQ(m->method, toy::toyMethod());
     EXPECT_TRUE(m->registered());
-    EXPECT_FALSE(m->usesWeights);
+    EXPECT_FALSE(readsWeights(*m));
     EXPECT_EQ(parseDenoiseMethod("toy"), toy::toyMethod());
     EXPECT_STREQ(denoiseMethodName(toy::toyMethod()), "toy");
     EXPECT_NE(denoiseMethodNames().find("toy"), std::string::npos);
@@ -55,23 +62,29 @@ TEST(ToyMethod, IsARowOfTheRegistry) {
     EXPECT_EQ(&denoiseMethodInfo(toy::toyMethod()), m);
     // A taken or malformed name, no cascade, or the weights: an InputError, nothing added.
     const size_t n = denoiseMethods().size();
-    EXPECT_THROW(registerDenoiseMethod({DenoiseMethod::Eaw, "toy", "again", false, toy::toyCascade}), InputError);
-    EXPECT_THROW(registerDenoiseMethod({DenoiseMethod::Eaw, "sure", "again", false, toy::toyCascade}), InputError);
-    EXPECT_THROW(registerDenoiseMethod({DenoiseMethod::Eaw, "a b", "", false, toy::toyCascade}), InputError);
-    EXPECT_THROW(registerDenoiseMethod({DenoiseMethod::Eaw, "", "", false, toy::toyCascade}), InputError);
-    EXPECT_THROW(registerDenoiseMethod({DenoiseMethod::Eaw, "bare", "", false}), InputError);
-    EXPECT_THROW(registerDenoiseMethod({DenoiseMethod::Eaw, "weighted", "", true, toy::toyCascade}), InputError);
+    EXPECT_THROW(registerDenoiseMethod(row("toy", toy::toyCascade)), InputError);
+    EXPECT_THROW(registerDenoiseMethod(row("sure", toy::toyCascade)), InputError);
+    EXPECT_THROW(registerDenoiseMethod(row("a b", toy::toyCascade)), InputError);
+    EXPECT_THROW(registerDenoiseMethod(row("", toy::toyCascade)), InputError);
+    EXPECT_THROW(registerDenoiseMethod(row("bare", {})), InputError);
+    EXPECT_THROW(registerDenoiseMethod(row("weighted", toy::toyCascade, {{}, {}, true, {}})), InputError);
+    EXPECT_THROW(registerDenoiseMethod(row("nogroup", toy::toyCascade, {{}, {"no-such-group"}, false, {}})), InputError);
+    EXPECT_THROW(registerDenoiseMethod(row("combines", toy::toyCascade, {{}, {}, false, {DenoiseMethod::Sure}})), InputError);
+    EXPECT_THROW(registerDenoiseMethod(row("motion", toy::toyCascade, {{Buffer::Motion}, {}, false, {}})), InputError);
     for (const char* reserved : {"temporal", "svgf", "none", "noisy", "oidn"})
-        EXPECT_THROW(registerDenoiseMethod({DenoiseMethod::Eaw, reserved, "", false, toy::toyCascade}), InputError)
-            << reserved;
+        EXPECT_THROW(registerDenoiseMethod(row(reserved, toy::toyCascade)), InputError) << reserved;
     EXPECT_EQ(denoiseMethods().size(), n);
-    // What a row reads tells a reader what to decode (the preparation's buffers always).
-    DenoiseMethodInfo normalOnly{DenoiseMethod::Eaw, "toy-normal-only", "", false, toy::toyCascade};
-    normalOnly.reads = DenoiseBufferUse{false, false, true, false, false, false, false};
-    const DenoiseBufferUse use = denoiseBufferUse(DenoiseOptions{}, registerDenoiseMethod(normalOnly));
-    EXPECT_TRUE(use.normal && use.variance && use.emission && use.albedo && use.depth);
-    EXPECT_FALSE(use.position || use.ids);
-    EXPECT_TRUE(denoiseBufferUse(DenoiseOptions{}, toy::toyMethod()).position);
+    // What a row reads tells a reader what to decode (the preparation's buffers always), and the
+    // report what was unused.
+    const DenoiseMethod normalOnly = registerDenoiseMethod(row("toy-normal-only", toy::toyCascade, {{Buffer::Normal}, {}, false, {}}));
+    const BufferMask use = denoiseReads(DenoiseOptions{}, normalOnly);
+    for (Buffer b : {Buffer::Color, Buffer::Normal, Buffer::Variance, Buffer::Emission, Buffer::Albedo, Buffer::Depth})
+        EXPECT_TRUE(use.has(b)) << bufferName(b);
+    EXPECT_FALSE(use.has(Buffer::Position) || use.has(Buffer::ObjectId) || use.has(Buffer::Motion));
+    EXPECT_EQ(unusedReason(Buffer::Position, DenoiseOptions{}, normalOnly, false), "by toy-normal-only");
+    EXPECT_EQ(unusedReason(Buffer::Normal, DenoiseOptions{}, normalOnly, false), "");
+    EXPECT_EQ(unusedReason(Buffer::Depth, DenoiseOptions{}, normalOnly, true), "");  // the noise estimate's
+    EXPECT_TRUE(denoiseReads(DenoiseOptions{}, toy::toyMethod()).has(Buffer::Albedo));
     // A value no row has is an InputError, not undefined behaviour.
     DenoiseOptions o;
     o.method = static_cast<DenoiseMethod>(999);
@@ -92,17 +105,16 @@ TEST(ToyMethod, IsItsCascadeOnThePreparedPlanesThenRemodulate) {
         bool staged = false;
         for (const StageTime& s : rep.stages) staged = staged || s.name == "toy";
         EXPECT_TRUE(staged) << "no stage 'toy'";
-        const PreparedPlanes p = learnedPlanes(in, o);
-        StillPlanes P;
-        P.color = p.d.view(), P.variance = p.var.view();
-        if (!p.albedo.empty()) P.albedo = p.albedo.view();
+        const PreparedPlanes p = preparePlanes(in, o);
+        PreparedView P = p.view();
+        P.modulation = P.emission = ImageView{};  // what a cascade is given
         Image f(32, 24, 3);
         toy::toyCascade(P, o, f.view());
         long differ = -1, changed = -1;
         for (int y = 0; y < 24 && differ < 0; ++y)
             for (int x = 0; x < 32; ++x)
                 for (int c = 0; c < 3; ++c) {
-                    if (!(out(x, y, c) == f(x, y, c) * p.mod(x, y, c) + p.emission(x, y, c))) differ = long(c) * 1000 + y * 32 + x;
+                    if (!(out(x, y, c) == f(x, y, c) * p.modulation(x, y, c) + p.emission(x, y, c))) differ = long(c) * 1000 + y * 32 + x;
                     if (out(x, y, c) != r.b.color(x, y, c)) changed = 1;
                 }
         EXPECT_EQ(differ, -1) << "albedo " << albedo;
@@ -122,10 +134,9 @@ TEST(ToyMethod, IsItsCascadeOnThePreparedPlanesThenRemodulate) {
 
 // A cascade's exception reaches the caller naming the method, whatever it threw.
 TEST(ToyMethod, ACascadesErrorsNameTheMethod) {
-    registerDenoiseMethod({DenoiseMethod::Eaw, "throws-int", "", false,
-                           [](const StillPlanes&, const DenoiseOptions&, const ImageView&) { throw 42; }});
-    registerDenoiseMethod({DenoiseMethod::Eaw, "throws-input", "", false,
-                           [](const StillPlanes&, const DenoiseOptions&, const ImageView&) { throw InputError("bad"); }});
+    registerDenoiseMethod(row("throws-int", [](const PreparedView&, const DenoiseOptions&, const ImageView&) { throw 42; }));
+    registerDenoiseMethod(
+        row("throws-input", [](const PreparedView&, const DenoiseOptions&, const ImageView&) { throw InputError("bad"); }));
     const Rendered r;
     DenoiseOptions o;
     o.method = parseDenoiseMethod("throws-int");

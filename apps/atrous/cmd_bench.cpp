@@ -92,7 +92,7 @@ nlohmann::json stats(const std::vector<double>& ms) {
 }
 
 // Compulsory DRAM traffic of one CUDA EAW/SURE call, in bytes: each pass of the driver
-// (src/filters/denoise_driver.h, CudaExec) is counted as reading every plane it uses once and
+// (src/filters/still_pipeline.h, CudaExec) is counted as reading every plane it uses once and
 // writing every plane it produces once; the 25 taps of a level are assumed to hit in cache (they
 // reach ±2·step rows: at step 16, 65 rows × 1920 px × 60 B ≈ 7.5 MB, well under an H100's 50 MB
 // L2). This is the floor of the
@@ -137,7 +137,7 @@ void run(const BenchArgs& a) {
                              "), svgf or render)");
     auto wants = [&](const char* k) { return std::find(what.begin(), what.end(), k) != what.end(); };
     bool anyLearned = false;
-    for (const DenoiseMethodInfo& m : denoiseMethods()) anyLearned = anyLearned || (m.usesWeights && wants(m.name));
+    for (const DenoiseMethodInfo& m : denoiseMethods()) anyLearned = anyLearned || (readsWeights(m) && wants(m.name));
     LearnedWeights weights;  // loaded once, before any timing (empty: the built-in weights)
     if (anyLearned && !a.learnedWeights.empty()) {
         try {
@@ -223,7 +223,7 @@ void run(const BenchArgs& a) {
             DenoiseOptions o;
             o.method = parseDenoiseMethod(m);
             o.weights = weights;
-            const bool learned = info.usesWeights;
+            const bool learned = readsWeights(info);
             o.device = device;
             std::vector<double> total;
             StageSamples stages;

@@ -1,5 +1,7 @@
 // `atrous denoise`: EAW, SURE-À-Trous or the learned filter on a render directory or on individual EXR/PFM buffers.
 #include <algorithm>
+#include <utility>
+#include <vector>
 #include <cstdio>
 #include <iterator>
 #include <filesystem>
@@ -40,44 +42,49 @@ struct DenoiseArgs {
 };
 
 // Option groups: the flags of one method are ignored by the others (a note says which).
-const char* const kGroupEawSure = "EAW, SURE and learned (--method eaw|sure|learned|blend|auto; learned: see docs/denoising.md)";
-const char* const kGroupSure = "SURE (--method sure|blend)";
 const char* const kGroupSvgf = "SVGF (--method svgf)";  // addSvgfOptions' group
 const char* const kGroupTemporal = "Temporal (--method temporal, the default with --sequence)";  // addTemporalOptions' group
 const char* const kGroupBuffers = "Buffers (without --sequence)";
-const char* const kGroupLearned = "Learned (--method learned|blend|auto, or svgf --svgf-learned-spatial)";
+const char* const kGroupLearned = "The learned filter's weights (the methods that read them, or svgf --svgf-learned-spatial)";
 
-// A method that reads the learned filter's weights (denoiseMethods()' usesWeights).
-bool learnedMethod(const std::string& method) {
-    const DenoiseMethodInfo* m = findDenoiseMethod(method);
-    return m && m->usesWeights;
+// The help group of a still parameter: its stage's title and the methods that read it, from the
+// registry (readsParamGroup).
+std::string paramHelpGroup(const ParamField<DenoiseOptions>& f) {
+    static const std::pair<const char*, const char*> kTitles[] = {
+        {"", "Albedo demodulation"}, {"firefly", "Fireflies"}, {"emission", "Emission"},
+        {"safety", "Safety net"},    {"eaw", "EAW's edge stops"},  {"sure", "SURE"}};
+    std::string title = f.group;
+    for (const auto& t : kTitles)
+        if (title == t.first) title = t.second;
+    const std::vector<std::string>& stages = stillStageGroups();
+    if (std::find(stages.begin(), stages.end(), std::string(f.group)) != stages.end()) return title + " (every still method)";
+    std::string who;
+    for (const DenoiseMethodInfo& m : denoiseMethods())
+        if (readsParamGroup(m, f.group)) who += (who.empty() ? "" : ", ") + std::string(m.name);
+    return title + " (--method " + who + ")";
 }
 
-// The learned filter runs the still driver's preparation (fireflies, emission filter, albedo rule)
-// and the safety net, not the EAW stops or SURE (include/atrous/denoise.h): the flags it ignores.
-bool ignoredByLearned(const std::string& flag) {
-    for (const ParamField<DenoiseOptions>& f : denoiseParams()) {
-        if (denoiseParams().flag(f) != flag) continue;
-        const std::string g = f.group, name = f.name;
-        return g == "sure" || (g == "eaw" && name.rfind("emission_", 0) != 0);
-    }
-    return false;
+// The row of denoiseParams() whose flag is `flag`, or null.
+const ParamField<DenoiseOptions>* denoiseField(const std::string& flag) {
+    for (const ParamField<DenoiseOptions>& f : denoiseParams())
+        if (denoiseParams().flag(f) == flag) return &f;
+    return nullptr;
 }
 
-// One note line on stderr naming the given flags that the chosen method (or --sequence) ignores.
-// learnedSvgf: --method svgf with --svgf-learned-spatial (which reads --learned-weights).
-// still: the still method that runs (--spatial's with temporal; "svgf" with svgf).
-void noteIgnoredFlags(const CLI::App& cmd, const std::string& method, const std::string& still, bool sequence,
+// One note line on stderr naming the given flags that the chosen method (or --sequence) ignores:
+// a still parameter whose group the still method that runs does not read (its registry row's
+// reads), the weights where it reads none. still: that method (--spatial's with temporal; null
+// with svgf). learnedSvgf: --method svgf with --svgf-learned-spatial (which reads --learned-weights).
+void noteIgnoredFlags(const CLI::App& cmd, const std::string& method, const DenoiseMethodInfo* still, bool sequence,
                       bool learnedSvgf) {
     std::string ignored, ignoredSeq;
     for (const CLI::Option* opt : cmd.get_options()) {
         if (opt->count() == 0) continue;
         const std::string& g = opt->get_group();
-        const bool unused = (g == kGroupEawSure && still == "svgf") ||
-                            (g == kGroupSure && still != "sure" && still != "blend" && still != "auto") ||
-                            (g == kGroupSvgf && method != "svgf") || (g == kGroupTemporal && method != "temporal") ||
-                            (g == kGroupLearned && !learnedMethod(still) && !learnedSvgf) ||
-                            (still == "learned" && ignoredByLearned(opt->get_name()));
+        bool unused = (g == kGroupSvgf && method != "svgf") || (g == kGroupTemporal && method != "temporal") ||
+                      (g == kGroupLearned && !(still && readsWeights(*still)) && !learnedSvgf);
+        if (const ParamField<DenoiseOptions>* f = denoiseField(opt->get_name()))
+            unused = !still || !readsParamGroup(*still, f->group);
         if (unused) ignored += (ignored.empty() ? "" : ", ") + opt->get_name();
         if (g == kGroupBuffers && sequence) ignoredSeq += (ignoredSeq.empty() ? "" : ", ") + opt->get_name();
     }
@@ -160,11 +167,11 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     if (a.method == "temporal") checkParamFlags(a.temporal, temporalParams(), cmd);
     o.device = parseDevice(a.device);
     const bool learnedSvgf = a.method == "svgf" && a.svgf.learnedSpatial;
-    const std::string still = a.method == "temporal" ? a.spatial : a.method;
+    const DenoiseMethodInfo* still = findDenoiseMethod(a.method == "temporal" ? a.spatial : a.method);
     noteIgnoredFlags(cmd, a.method, still, sequence, learnedSvgf);
     // A bad weight file fails here, before any buffer is read or anything written.
     LearnedWeights weights;
-    if ((learnedMethod(still) || learnedSvgf) && !a.learnedWeights.empty())
+    if (((still && readsWeights(*still)) || learnedSvgf) && !a.learnedWeights.empty())
         weights = withFlag("--learned-weights", [&] { return LearnedWeights::load(a.learnedWeights); });
     o.weights = weights;  // loaded once: denoise() does not read the file again
     if (sequence) {
@@ -199,7 +206,7 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     // Only the buffers the method reads are decoded (auto: by the buffers present).
     files.wanted = [&](io::Buffer b, const bool present[io::kBufferCount]) {
         const DenoiseMethod m = resolveDenoiseMethod(o.method, present[int(io::Buffer::Albedo)], present[int(io::Buffer::Normal)]);
-        return io::methodReads(denoiseBufferUse(o, m), b);
+        return denoiseReads(o, m).has(b);
     };
     Timer readTimer;
     io::BufferSet set = io::loadBuffers(files);
@@ -338,9 +345,7 @@ void addDenoiseCommand(CLI::App& app) {
     cmd->add_flag("--clean_aux", a->oidnCleanAux, "oidnDenoise's noise-free-features flag (accepted: atrous's "
                   "features are edge stops, never filtered)")->group(kGroupOidn);
     // One flag per parameter (params.h): --levels, --sigma-normal, --no-firefly, --sure-window, ...
-    addParamOptions(*cmd, a->opt, denoiseParams(), [](const ParamField<DenoiseOptions>& f) {
-        return std::string(f.group) == "sure" ? kGroupSure : kGroupEawSure;
-    });
+    addParamOptions(*cmd, a->opt, denoiseParams(), paramHelpGroup);
     addSvgfOptions(*cmd, a->svgf);
     addTemporalOptions(*cmd, a->temporal);
     cmd->callback([a, cmd] { run(*a, *cmd); });

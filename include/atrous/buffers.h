@@ -3,6 +3,7 @@
 // conventions are stated here, once; docs/inputs.md says how other renderers' passes are mapped
 // onto them.
 #pragma once
+#include <cstddef>
 #include <cstdint>
 #include <initializer_list>
 
@@ -69,29 +70,62 @@ const char* bufferName(Buffer b);  // bufferInfo(b).name
 int bufferChannels(Buffer b);      // bufferInfo(b).channels
 bool bufferTakesGrey(Buffer b);    // bufferInfo(b).takesGrey
 
-// One frame's buffers, not owned, each a planar Image of the colour's size on the host or on the
-// denoiser's device (nullptr = absent; only `color` is required). What every denoiser takes
-// (DenoiseInputs and SvgfFrame are this type): a denoiser reads the buffers it uses and ignores the
-// others (denoise() no motion; SVGF no variance or position; the sequence methods all of them).
-// Non-finite values are treated as missing for that pixel.
+// One buffer of a Frame, not owned: an Image, or an image in the caller's memory and layout
+// (StridedImage: float32 or float16, interleaved or planar, byte strides), or nothing. It reads as
+// the pointer it replaces (`if (f.albedo)`, `f.albedo->width()`, `const Image* a = f.albedo`), and
+// code that needs an Image of a buffer given as strided memory gets an InputError saying so, never
+// a null pointer: denoise() reads strided buffers where they are (the colour) or converts them
+// (the features, counted in DenoiseReport::copies); other denoisers take Images.
+class BufferRef {
+public:
+    BufferRef() = default;
+    BufferRef(std::nullptr_t) {}
+    BufferRef(const Image* image) : mImage(image) {}
+    BufferRef(const StridedImage& strided) : mStrided(strided) {}  // data null: absent
+    explicit operator bool() const { return mImage || mStrided.valid(); }
+    bool operator==(std::nullptr_t) const { return !*this; }
+    bool operator!=(std::nullptr_t) const { return bool(*this); }
+    // The Image (null when absent); InputError for a buffer given as strided memory.
+    operator const Image*() const { return image(); }
+    const Image* operator->() const { return image(); }
+    const Image& operator*() const { return *image(); }
+    const Image* image() const;
+    bool isImage() const { return mImage != nullptr; }  // given as an Image
+    // Either way as a StridedImage (an Image's planar float32 layout); data null when absent.
+    StridedImage strided() const { return mImage ? mImage->strided() : mStrided; }
+    int width() const { return strided().width; }
+    int height() const { return strided().height; }
+    int channels() const { return strided().channels; }
+    Device device() const { return strided().device; }
+
+private:
+    const Image* mImage = nullptr;
+    StridedImage mStrided;
+};
+
+// One frame's buffers, not owned, each of the colour's size on the host or on the denoiser's
+// device: an Image, or (for denoise()) strided memory in the caller's layout; absent = null. What
+// every denoiser takes: a denoiser reads the buffers it uses and ignores the others (denoise() no
+// motion; SVGF no variance or position; the sequence methods all of them). Non-finite values are
+// treated as missing for that pixel.
 struct Frame {
     // Not an aggregate: the buffers are set by name (f.color = &c; ...), never by position, so that
-    // code written for an older order (SvgfFrame's: color, albedo, normal, depth, ids, motion,
-    // emission) does not compile instead of silently taking one buffer for another.
+    // code written for an older order (SVGF's: color, albedo, normal, depth, ids, motion, emission)
+    // does not compile instead of silently taking one buffer for another.
     Frame() {}
-    const Image* color = nullptr;
-    const Image* variance = nullptr;
-    const Image* albedo = nullptr;
-    const Image* normal = nullptr;
-    const Image* position = nullptr;
-    const Image* depth = nullptr;     // 1 channel or more
-    const Image* ids = nullptr;       // object_id, and material_id in channel 1 when it has two
-    const Image* emission = nullptr;
-    const Image* motion = nullptr;    // 2 channels or more
-    // By buffer: ObjectId is `ids`; MaterialId is no slot of its own (get gives nullptr; set
-    // throws InputError for an image, takes none). set() takes an empty image as absent.
-    const Image* get(Buffer b) const;
-    Frame& set(Buffer b, const Image* img);
+    BufferRef color;
+    BufferRef variance;
+    BufferRef albedo;
+    BufferRef normal;
+    BufferRef position;
+    BufferRef depth;     // 1 channel or more
+    BufferRef ids;       // object_id, and material_id in channel 1 when it has two
+    BufferRef emission;
+    BufferRef motion;    // 2 channels or more
+    // By buffer: ObjectId is `ids`; MaterialId is no slot of its own (get gives none; set throws
+    // InputError for an image, takes none). set() takes an empty image as absent.
+    BufferRef get(Buffer b) const;
+    Frame& set(Buffer b, BufferRef buffer);
 };
 
 }  // namespace atrous

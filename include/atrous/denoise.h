@@ -152,11 +152,18 @@ struct DenoiseReport {
     // "give-back" (EAW and SURE with an albedo: the albedo give-back, docs/algorithms.md), "safety
     // net" (when on) and remodulate. CPU: wall clock; CUDA: cudaEvents on the stream (GPU time, no extra syncs).
     std::vector<StageTime> stages;
+    // The buffers given as strided memory (StridedImage) that were copied into planar float32
+    // storage of their own before filtering, e.g. "albedo (float16, 3 channels)". The colour, the
+    // variance and the emission never are: they are converted into the planes the filter works in
+    // (its first pass reads them where they are).
+    std::vector<std::string> copies;
 };
 
 // Denoises inputs.color and returns a 3-channel image of the same size: on the host, except with
 // options.device == Cuda and a colour already on the GPU, when the result stays there. Throws
 // InputError for mismatched sizes, missing colour, negative variance or parameters out of range.
+// A buffer may be given as strided memory in the caller's layout (BufferRef: float32 or float16,
+// interleaved or planar; DenoiseReport::copies says what was copied).
 Image denoise(const DenoiseInputs& inputs, const DenoiseOptions& options);
 
 // The same, with what the run did (the CLI's line, the benchmarks' stage times). The image is bit
@@ -190,17 +197,6 @@ struct DenoiseBuffers {
 Image denoise(DenoiseBuffers& buffers, const DenoiseOptions& options);
 DenoiseResult denoiseWithReport(DenoiseBuffers& buffers, const DenoiseOptions& options);
 
-// The planes every still method is prepared with, as host images: what denoise() does before any
-// filter (validation, noise estimate, sanitise, the emission split and filter, fireflies,
-// demodulation), on the CPU. For training (atrous.learned_planes) and for checking a registered
-// method against its cascade: with the safety net off, denoise()'s output is
-// filtered(d) * mod + emission. albedo (none given, or demodulation off), normal and depth are
-// empty when absent; mod and emission are always there (1 and 0 without an albedo or an emission).
-struct PreparedPlanes {
-    Image d, var, albedo, normal, depth, mod, emission;
-};
-PreparedPlanes learnedPlanes(const DenoiseInputs& inputs, const DenoiseOptions& options);
-
 // denoiseWithReport() with method Sure on the CPU, and SURE's kept fraction s_i(p) of each level's
 // detail (one channel per level; levels below sure.firstLevel are 0): the viewer's debug view.
 // InputError for another method or device.
@@ -215,63 +211,113 @@ SureFractionsResult denoiseWithSureFractions(const DenoiseInputs& inputs, const 
 // parameter is out of range; the ranges are the rows of denoiseParams().
 void validateDenoiseOptions(const DenoiseOptions& options);
 
-// Which buffers a denoise() call with these options reads when they are given, for a resolved
-// method (Eaw, Sure, Learned or Blend): a reader need not decode the others (the CLI skips them and says
-// so). Colour is always read.
-struct DenoiseBufferUse {
-    bool variance = true, albedo = true, normal = true, position = true, depth = true, ids = true, emission = true;
-};
-DenoiseBufferUse denoiseBufferUse(const DenoiseOptions& options, DenoiseMethod resolved);
-
-// A registered method's own cascade (registerDenoiseMethod): given the planes every still method
-// is prepared with, it writes the filtered colour, in the same demodulated units, to `out` (3
-// planes of the colour's size on the planes' device); denoise() then applies the safety net (when
-// on), remodulates and adds the filtered emission back, as for the built-in methods.
-struct StillPlanes {
+// The planes every still method is prepared with (docs/architecture.md, "The still path"): the
+// preparation (sanitise, emission, fireflies, noise estimate, demodulation) writes them, a
+// method's cascade reads them, the finishing (safety net, remodulation) takes the cascade's output
+// back to radiance: out = filtered * modulation + emission. Views on the device the call runs on.
+struct PreparedView {
     Device device = Device::Cpu;
-    ImageView color;     // c_0: sanitised, emission taken out, fireflies clamped, demodulated (3)
+    ImageView color;     // c: sanitised, emission taken out, fireflies clamped, demodulated (3)
     ImageView variance;  // its per-channel variance, given or estimated (3)
-    // The features, sanitised; invalid when not given (albedo also when demodulation is off).
+    // The features the method reads, sanitised; invalid when not given or not read (albedo also
+    // when demodulation is off).
     ImageView albedo, normal, position;  // 3 channels each
     ImageView depth;                     // 1
-    ImageView ids;                       // 2: R object, G material
+    ImageView ids;                       // 2: object, material
+    // What the finishing applies: the remodulation's multiplier (1 where no albedo) and the
+    // filtered emission added back (0 without one), 3 channels each. Invalid in what a cascade is
+    // given; set in PreparedPlanes (the training's targets need them).
+    ImageView modulation, emission;
 };
-using StillCascade = std::function<void(const StillPlanes& planes, const DenoiseOptions& options, const ImageView& out)>;
+
+// The same planes as host images, owned: what preparePlanes() returns.
+struct PreparedPlanes {
+    Image color, variance, albedo, normal, position, depth, ids, modulation, emission;
+    PreparedView view() const;
+};
+// The preparation of a denoise() call with these options, on the CPU, with the features that
+// options.method reads (auto resolved as denoise() resolves it): for training
+// (atrous.prepared_planes) and for checking a registered method against its cascade: with the
+// safety net off, denoise()'s output is cascade(planes) * modulation + emission. A feature not
+// given or not read is an empty image.
+PreparedPlanes preparePlanes(const Frame& frame, const DenoiseOptions& options);
+
+// A registered method's own cascade (registerDenoiseMethod): given the prepared planes of what it
+// reads, it writes the filtered colour, in the same demodulated units, to `out` (3 planes of the
+// colour's size on the planes' device); denoise() then applies the safety net (when on),
+// remodulates and adds the filtered emission back, as for the built-in methods.
+using StillCascade = std::function<void(const PreparedView& planes, const DenoiseOptions& options, const ImageView& out)>;
+
+// What a still method reads, said once in its registry row: the one rule of what a call decodes,
+// prepares and reports (denoiseReads, DenoiseReport::buffersUsed) and of which parameters and
+// flags apply to it (the CLI's notes). Every method's preparation and finishing read the colour,
+// the variance, the emission, the albedo (demodulation) and, when the noise is estimated, the
+// normal and depth, with the parameter groups of stillStageGroups(); `reads` adds what the
+// method's cascade reads.
+struct MethodReads {
+    BufferMask buffers;               // the feature buffers its cascade reads (colour always)
+    std::vector<std::string> params;  // the groups of denoiseParams() its cascade reads ("eaw", "sure")
+    bool weights = false;             // the learned filter's weights (DenoiseOptions::weights)
+    // Rows whose reads this one's adds, each with its own switches (blend: learned and sure; auto:
+    // blend and sure). Registered methods: none.
+    std::vector<DenoiseMethod> combines;
+};
+
+// How a row's cascade runs: one of the still path's own (they share its temporaries), or the
+// row's registered function; auto has none (denoise() resolves it first).
+enum class CascadeKind { Registered, Eaw, Sure, Learned, Blend, Auto };
 
 // The still methods, one row each: the one list the CLI (--method, its help and messages, the
 // sequence check), `atrous bench`, the viewer and Python (atrous.methods(), the farm, the
-// evaluation) read. The built-in methods' rows run the driver's own stages; a registered method
-// is a row with a cascade per device (registerDenoiseMethod), and nothing else needs an edit
-// (docs/architecture.md, "A new denoising method"; tests/toy_method.cpp is one).
+// evaluation) read. A registered method is a row with a cascade per device
+// (registerDenoiseMethod), and nothing else needs an edit (docs/architecture.md, "Where a new piece
+// goes"; tests/toy_method.cpp is one).
 struct DenoiseMethodInfo {
-    DenoiseMethod method;
-    const char* name;     // "eaw", ...: the CLI's --method, Python's method=, the report's column
-    const char* summary;  // one line for --help
-    bool usesWeights;     // reads the learned filter's weights (DenoiseOptions::weights)
-    // A registered method's cascade on the CPU and on CUDA (empty: not on that device); empty
-    // for the built-in methods.
+    DenoiseMethod method = DenoiseMethod::Eaw;  // its value (registerDenoiseMethod assigns it)
+    const char* name = "";     // "eaw", ...: the CLI's --method, Python's method=, the report's column
+    const char* summary = "";  // one line for --help
+    MethodReads reads;
+    // A registered method's cascade on the CPU and on CUDA (empty: not on that device).
     StillCascade cpu = {}, cuda = {};
-    // The feature buffers a registered method's cascade reads: the planes of the others are
-    // invalid, and denoiseBufferUse tells a reader it need not decode them (the preparation reads
-    // the variance, the emission, the albedo for demodulation and depth for the noise estimate
-    // whatever this says). The built-in methods'
-    // use is denoiseBufferUse's own rule.
-    DenoiseBufferUse reads = {};
-    bool registered() const { return bool(cpu) || bool(cuda); }
+    CascadeKind kind = CascadeKind::Registered;
+    bool registered() const { return kind == CascadeKind::Registered; }
 };
 // The rows in order: eaw, sure, learned, blend, auto, then the registered methods. The references
 // stay valid while the program runs.
 const std::deque<DenoiseMethodInfo>& denoiseMethods();
-// Adds a still method: `info.name` (a new name of letters, digits, '_' or '-'), its summary and
-// at least one cascade; `info.method` is ignored, and the method's new value returned (pass it as
-// DenoiseOptions::method, or the name to the CLI and Python). Call it before any denoise() of the
-// program runs (it is not synchronised with them). InputError for a taken or malformed name, or
-// no cascade.
+// Adds a still method: `info.name` (a new name of letters, digits, '_' or '-'), its summary, what
+// it reads and at least one cascade; `info.method` and `info.kind` are ignored and the method's new
+// value returned (pass it as DenoiseOptions::method, or the name to the CLI and Python). Call it
+// before any denoise() of the program runs (it is not synchronised with them). InputError for a
+// taken or malformed name, no cascade, the learned weights, or a parameter group denoiseParams()
+// does not have.
 DenoiseMethod registerDenoiseMethod(DenoiseMethodInfo info);
 const DenoiseMethodInfo* findDenoiseMethod(const std::string& name);  // null when unknown
 const DenoiseMethodInfo& denoiseMethodInfo(DenoiseMethod m);          // the method's row
 // The names in order, "eaw, sure, learned, blend or auto".
 std::string denoiseMethodNames();
+
+// The parameter groups of denoiseParams() that every still method's preparation and finishing
+// read: "" (demodulate, albedo_*), "firefly", "emission", "safety".
+const std::vector<std::string>& stillStageGroups();
+// Whether a call of `method` reads the parameters of `group`, and the learned weights (with the
+// rows it combines: auto, what either of its resolutions reads).
+bool readsParamGroup(const DenoiseMethodInfo& method, const std::string& group);
+bool readsWeights(const DenoiseMethodInfo& method);
+
+// The buffers a call reads, from the rows' `reads` and the options' switches (docs/denoising.md,
+// "What a method reads"):
+// - methodReads: the features the method's cascade reads: its row's buffers less those a
+//   parameter of a group it reads switches off (sigma_depth 0: depth; no use_ids: the ids;
+//   no demodulate: the albedo). Auto: what either of its resolutions reads.
+// - denoiseReads: what a reader decodes for a call: colour, variance and emission, the albedo
+//   when demodulating, the normal and depth (the noise estimate's edges, needed when the variance
+//   turns out absent or empty), and methodReads. Never motion.
+BufferMask methodReads(const DenoiseMethodInfo& method, const DenoiseOptions& options);
+BufferMask denoiseReads(const DenoiseOptions& options, DenoiseMethod resolved);
+// Why a given buffer is not read by a call of a resolved method ("by learned", "--sigma-depth 0"),
+// "" when it is read. noiseEstimated: the call estimated its noise (the normal and depth steer it).
+std::string unusedReason(Buffer b, const DenoiseOptions& options, DenoiseMethod resolved, bool noiseEstimated);
 
 // A name of denoiseMethods(); InputError otherwise.
 DenoiseMethod parseDenoiseMethod(const std::string& name);

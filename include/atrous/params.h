@@ -85,7 +85,7 @@ struct ParamField {
     ParamRef (*at)(S&);  // the field in a struct
     ParamRange range;    // Int, Float and FloatList elements; unused for Bool and Choice
     const char* doc;     // one line: the CLI's help, Python's and the viewer's tooltip
-    const char* group = "";         // the nested struct ("eaw", "sure", ...), "" for S's own fields
+    const char* group = "";  // denoiseParams(): the still stage that reads it ("eaw", "sure", "firefly", "emission", "safety", "" the preparation); others: ""
     const char* flag = nullptr;     // the CLI flag without "--" when it is not the table's rule; "" = none
     bool negated = false;           // Bool: the CLI flag (--no-<name>) clears it; Python accepts no_<name> too
     const char* const* choices = nullptr;      // Choice: the names of the enum's values, in order, null-ended
@@ -155,9 +155,9 @@ inline const ParamField<D> kDenoise[] = {
     {"use_ids", &at2<&D::eaw, &EawParams::useIds>, {}, "weight 0 across mesh or material id changes (the ids buffer)",
      "eaw", "no-ids", true},
     {"emission_levels", &at2<&D::eaw, &EawParams::emissionLevels>, paramIn(0, 10),
-     "levels of the emission buffer's edge-avoiding filter (0 = add the emission back as is)", "eaw"},
+     "levels of the emission buffer's edge-avoiding filter (0 = add the emission back as is)", "emission"},
     {"emission_scale", &at2<&D::eaw, &EawParams::emissionScale>, paramIn(1e-6, 1e6),
-     "k of the emission filter's sigma^2 = k * 2 min(V_p, V_q)", "eaw"},
+     "k of the emission filter's sigma^2 = k * 2 min(V_p, V_q)", "emission"},
     {"sure_mode", &at2<&D::sure, &SureParams::mode>, {}, "discrete | james-stein", "sure", nullptr, false, kSureModes},
     {"sure_candidates", &at2<&D::sure, &SureParams::candidates>, paramIn(0, 1),
      "the fractions of each detail SURE chooses from (comma-separated on the CLI)", "sure", nullptr, false, nullptr,

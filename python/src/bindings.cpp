@@ -153,15 +153,25 @@ nb::dict resolveParams(const ParamTable<S>& t, nb::dict params, const char* what
 
 // A method registry for Python (atrous.denoise_methods(), atrous.sequence_methods()): one dict per
 // row, its name, summary and the registry's one flag under `flagName`.
-template <class Rows, class Info>
-nb::list methodRows(const Rows& infos, const char* flagName, bool Info::*flag) {
+template <class Rows, class Flag>
+nb::list methodRows(const Rows& infos, const char* flagName, Flag flag) {
+    using Info = typename Rows::value_type;
     nb::list rows;
     for (const Info& i : infos) {
         nb::dict d;
         d["name"] = i.name;
         d["summary"] = i.summary;
-        d[flagName] = i.*flag;
-        if constexpr (std::is_same_v<Info, DenoiseMethodInfo>) d["registered"] = i.registered(), d["params"] = "denoise";
+        d[flagName] = flag(i);
+        if constexpr (std::is_same_v<Info, DenoiseMethodInfo>) {
+            d["registered"] = i.registered(), d["params"] = "denoise";
+            nb::list reads, groups;
+            for (int b = 0; b < kBufferCount; ++b)
+                if (methodReads(i, DenoiseOptions{}).has(Buffer(b))) reads.append(bufferName(Buffer(b)));
+            for (const ParamField<DenoiseOptions>& f : denoiseParams())
+                if (readsParamGroup(i, f.group) && !groups.contains(f.group)) groups.append(f.group);
+            d["reads"] = reads;
+            d["param_groups"] = groups;
+        }
         if constexpr (std::is_same_v<Info, SequenceMethodInfo>) {
             d["params"] = i.params;
             nb::list reads;
@@ -214,7 +224,7 @@ nb::object pyDenoise(const Array& color, nb::handle albedo, nb::handle normal, n
            {emission, B::Emission, "emission"}});
     DenoiseOptions o;
     o.method = parseDenoiseMethod(method);
-    if (denoiseMethodInfo(o.method).usesWeights) o.weights = weightsFrom(learnedWeights);  // auto's too
+    if (readsWeights(denoiseMethodInfo(o.method))) o.weights = weightsFrom(learnedWeights);  // auto's too
     o.device = c.device();
     for (auto [k, v] : params) applyParam(o, denoiseParams(), nb::cast<std::string>(k), v, "denoise");
     // The colour, variance and emission are the binding's own copies (toImage): handed over, the
@@ -229,8 +239,8 @@ nb::object pyDenoise(const Array& color, nb::handle albedo, nb::handle normal, n
     return fromImage(std::move(out));
 }
 
-// The learned filter's prepared planes (learnedPlanes): d, var, albedo, normal, depth
-// (the last three only when given), mod and emission, on the host, for training.
+// The learned filter's prepared planes (preparePlanes with method learned): d, var, albedo,
+// normal, depth (the last three only when given), mod and emission, on the host, for training.
 nb::dict pyLearnedPlanes(const Array& color, nb::handle variance, nb::handle albedo, nb::handle normal,
                          nb::handle depth, nb::handle emission, nb::dict params) {
     using B = io::Buffer;
@@ -242,14 +252,15 @@ nb::dict pyLearnedPlanes(const Array& color, nb::handle variance, nb::handle alb
     const DenoiseInputs in = b.refs;
     DenoiseOptions o;
     for (auto [k, v] : params) applyParam(o, denoiseParams(), nb::cast<std::string>(k), v, "denoise");
+    o.method = DenoiseMethod::Learned;  // the planes of the learned method, whatever the keywords say
     PreparedPlanes p;
     {
         nb::gil_scoped_release release;
-        p = learnedPlanes(in, o);
+        p = preparePlanes(in, o);
     }
     nb::dict d;
-    const std::pair<const char*, Image*> planes[] = {{"d", &p.d},           {"var", &p.var},   {"albedo", &p.albedo},
-                                                     {"normal", &p.normal}, {"depth", &p.depth}, {"mod", &p.mod},
+    const std::pair<const char*, Image*> planes[] = {{"d", &p.color},        {"var", &p.variance}, {"albedo", &p.albedo},
+                                                     {"normal", &p.normal}, {"depth", &p.depth},  {"mod", &p.modulation},
                                                      {"emission", &p.emission}};
     for (const auto& [name, img] : planes)
         if (!img->empty()) d[name] = fromImage(std::move(*img));
@@ -357,7 +368,7 @@ nb::object pyDenoiseTemporal(nb::list frames, size_t center, const std::string& 
     for (const auto& b : buffers) window.push_back(b->refs);
     DenoiseOptions o;
     o.method = parseDenoiseMethod(method);
-    if (denoiseMethodInfo(o.method).usesWeights) o.weights = weightsFrom(learnedWeights);  // auto's too
+    if (readsWeights(denoiseMethodInfo(o.method))) o.weights = weightsFrom(learnedWeights);  // auto's too
     o.device = parseDevice(device);
     for (auto [k, v] : params) applyParam(o, denoiseParams(), nb::cast<std::string>(k), v, "denoise");
     Image out;
@@ -384,7 +395,7 @@ nb::dict pyDenoiseSequence(const std::string& input, const std::string& out, con
     for (auto [k, v] : params) applyParam(o.frame, denoiseParams(), nb::cast<std::string>(k), v, "denoise");
     // Read once for the whole sequence, when a method of the run uses it.
     const DenoiseMethodInfo* still = findDenoiseMethod(method == "temporal" ? spatial : method);
-    if (method == "svgf" ? o.svgf.learnedSpatial : still && still->usesWeights)
+    if (method == "svgf" ? o.svgf.learnedSpatial : still && readsWeights(*still))
         o.frame.weights = o.svgfWeights = weightsFrom(learnedWeights);
     o.passes = passes, o.viewLayer = layer, o.addPass = addPass;
     o.start = start, o.end = end, o.step = step;
@@ -538,7 +549,7 @@ NB_MODULE(_core, m) {
     m.def("denoise_params", [] { return paramRows(denoiseParams()); });
     // The still methods (denoiseMethods()): atrous.METHODS and the rows of atrous.denoise_methods().
     m.def("denoise_methods",
-          [] { return methodRows(denoiseMethods(), "uses_weights", &DenoiseMethodInfo::usesWeights); });
+          [] { return methodRows(denoiseMethods(), "uses_weights", [](const DenoiseMethodInfo& i) { return readsWeights(i); }); });
     m.def("svgf_params", [] { return paramRows(svgfParams()); });
     m.def("temporal_params", [] { return paramRows(temporalParams()); });
     m.def("temporal_window_radius", [](nb::dict temporal) {
@@ -548,7 +559,8 @@ NB_MODULE(_core, m) {
         return temporalWindowRadius(tp);
     });
     // The sequence methods (sequenceMethods(), include/atrous/temporal.h): atrous.SEQUENCE_METHODS.
-    m.def("sequence_methods", [] { return methodRows(sequenceMethods(), "causal", &SequenceMethodInfo::causal); });
+    m.def("sequence_methods",
+          [] { return methodRows(sequenceMethods(), "causal", [](const SequenceMethodInfo& i) { return i.causal; }); });
     m.def("denoise_temporal", &pyDenoiseTemporal, nb::arg("frames"), nb::arg("center"), nb::arg("method"),
           nb::arg("learned_weights").none(), nb::arg("device"), nb::arg("temporal"), nb::arg("params"));
     m.def("denoise_sequence", &pyDenoiseSequence, nb::arg("input"), nb::arg("out"), nb::arg("method"), nb::arg("spatial"),

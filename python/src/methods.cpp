@@ -34,7 +34,7 @@ nb::object planarView(const ImageView& v) {
 // reference dropped at interpreter exit (after Python is gone) would crash, so it is never dropped.
 struct PyCascade {
     PyObject* fn;
-    void operator()(const StillPlanes& p, const DenoiseOptions&, const ImageView& out) const {
+    void operator()(const PreparedView& p, const DenoiseOptions&, const ImageView& out) const {
         nb::gil_scoped_acquire gil;
         nb::dict planes;
         planes["color"] = planarView<nb::ro>(p.color);
@@ -67,16 +67,17 @@ void bindMethods(nb::module_& m) {
     });
     m.def("register_method", [](const std::string& name, const std::string& summary, nb::callable cascade,
                                 std::vector<std::string> reads) {
-        DenoiseMethodInfo info{DenoiseMethod::Eaw, name.c_str(), summary.c_str(), false};
-        info.reads = DenoiseBufferUse{false, false, false, false, false, false, false};
+        DenoiseMethodInfo info;
+        info.name = name.c_str(), info.summary = summary.c_str();
         for (const std::string& b : reads) {
-            bool* f = b == "variance" ? &info.reads.variance : b == "albedo" ? &info.reads.albedo
-                      : b == "normal" ? &info.reads.normal : b == "position" ? &info.reads.position
-                      : b == "depth" ? &info.reads.depth : b == "ids" ? &info.reads.ids
-                      : b == "emission" ? &info.reads.emission : nullptr;
-            if (!f) throw InputError("register_method: reads: unknown buffer '" + b +
-                                     "' (variance, albedo, normal, position, depth, ids, emission)");
-            *f = true;
+            // The features a cascade may read, by their frame names ("ids": the object and material ids).
+            bool found = false;
+            for (Buffer f : {Buffer::Variance, Buffer::Albedo, Buffer::Normal, Buffer::Position, Buffer::Depth,
+                             Buffer::ObjectId, Buffer::Emission})
+                if (b == (f == Buffer::ObjectId ? "ids" : bufferName(f))) info.reads.buffers = info.reads.buffers.with(f), found = true;
+            if (!found)
+                throw InputError("register_method: reads: unknown buffer '" + b +
+                                 "' (variance, albedo, normal, position, depth, ids, emission)");
         }
         PyObject* fn = cascade.ptr();
         info.cpu = PyCascade{fn};

@@ -29,7 +29,7 @@ bool bufferTakesGrey(Buffer b) { return bufferInfo(b).takesGrey; }
 
 namespace {
 
-using Slot = const Image* Frame::*;
+using Slot = BufferRef Frame::*;
 
 Slot slot(Buffer b) {
     switch (b) {
@@ -49,14 +49,20 @@ Slot slot(Buffer b) {
 
 }  // namespace
 
-const Image* Frame::get(Buffer b) const {
-    const auto s = slot(b);
-    return s ? this->*s : nullptr;
+const Image* BufferRef::image() const {
+    if (!mImage && mStrided.valid())
+        throw InputError("a buffer given as strided memory where this filter needs an Image (only denoise() reads strided buffers)");
+    return mImage;
 }
 
-Frame& Frame::set(Buffer b, const Image* img) {
+BufferRef Frame::get(Buffer b) const {
+    const auto s = slot(b);
+    return s ? this->*s : BufferRef();
+}
+
+Frame& Frame::set(Buffer b, BufferRef img) {
     const Slot s = slot(b);
-    const Image* given = img && !img->empty() ? img : nullptr;
+    const BufferRef given = img.isImage() ? (img->empty() ? BufferRef() : img) : img;
     if (!s) {
         if (given) throw InputError("a frame holds the material id as channel 1 of its ids, not as a buffer of its own");
         return *this;

@@ -1,15 +1,15 @@
-// CPU pieces of the still driver (filters/denoise_driver.h) that are not stages: the report's
+// CPU pieces of the still path (filters/still_state.h) that are not stages: the report's
 // luminance after the firefly pass and its count of clamped pixels.
 #include <vector>
 
 #include "core/parallel.h"
 #include "cpu/isa_dispatch.h"
 #include "cpu/row_sums.h"
-#include "filters/denoise_driver.h"
+#include "filters/still_state.h"
 
 namespace atrous::filters {
 
-void reportLuminance(const CpuExec&, const ImageView& c, DriverReport& report) {
+void reportLuminance(const CpuExec&, const ImageView& c, StillReport& report) {
     const int w = c.width, h = c.height;
     std::vector<double> sum(static_cast<size_t>(h)), count(static_cast<size_t>(h));
     cpu::parallelForIsa(cpu::activeIsa(), 0, h, 16, [&](int y0, int y1) {
@@ -24,7 +24,7 @@ void reportLuminance(const CpuExec&, const ImageView& c, DriverReport& report) {
     report.lumAfterSum = s, report.lumAfterCount = n;
 }
 
-void reportFireflies(const CpuExec&, const ImageView& flag, DriverReport& report) {
+void reportFireflies(const CpuExec&, const ImageView& flag, StillReport& report) {
     const int w = flag.width, h = flag.height;
     std::vector<int> count(static_cast<size_t>(h));
     cpu::parallelForIsa(cpu::activeIsa(), 0, h, 16, [&](int y0, int y1) {

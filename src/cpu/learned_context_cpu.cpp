@@ -169,9 +169,9 @@ void conv(const LearnedTensor& in, const LearnedTensor& out, const float* k, con
 
 }  // namespace
 
-void runLearnedContextCpu(const CpuExec& exec, const LearnedCtxNet& net, const LearnedPlanes& P,
+void runLearnedContextCpu(const CpuExec& exec, const LearnedCtxNet& net, const PreparedView& P,
                           const LearnedCtxPlanes& C) {
-    cpu::parallelForIsa(cpu::activeIsa(), 0, C.cells.height, 1, CellRows{P.d, P.var, P.albedo, P.normal, P.depth, C.cells});
+    cpu::parallelForIsa(cpu::activeIsa(), 0, C.cells.height, 1, CellRows{P.color, P.variance, P.albedo, P.normal, P.depth, C.cells});
     auto convolutions = [&] {
         conv(C.cells, C.c1, net.k1, net.kb1, 3, true);
         exec.forEachPixel(C.pool.width, C.pool.height, LearnedPool2{C.c1, C.pool});

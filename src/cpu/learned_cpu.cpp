@@ -52,7 +52,7 @@ struct LogRange {
 // band of rows: the band's first row in the image).
 struct NetRows {
     const LearnedNet* net;
-    LearnedPlanes P;
+    PreparedView P;
     LearnedTemps T;
     ImageView acc;
     size_t pOffset = 0;
@@ -121,7 +121,7 @@ struct NetRows {
                 } else {
                     learnedMlp<kLanes>(*net, in, out);
                 }
-                learnedWriteOutputs<kLanes>(out, P.d, T, acc, o + size_t(x0), n, pOffset + o + size_t(x0));
+                learnedWriteOutputs<kLanes>(out, P.color, T, acc, o + size_t(x0), n, pOffset + o + size_t(x0));
             }
         }
     }
@@ -169,10 +169,10 @@ int& learnedCpuBandRows() {
     return rows;
 }
 
-void runLearned(const CpuExec& exec, const LearnedWeights& weights, const LearnedPlanes& in, const ImageView& out,
+void runLearned(const CpuExec& exec, const LearnedWeights& weights, const PreparedView& in, const ImageView& out,
                 LearnedStageTimes* times, LearnedCache* cache) {
     checkLearnedPlanes(weights, in, out);
-    const int w = in.d.width, h = in.d.height;
+    const int w = in.color.width, h = in.color.height;
     StageClock clock;
     double unused = 0;
     const int forced = learnedCpuBandRows();
@@ -241,9 +241,9 @@ void runLearned(const CpuExec& exec, const LearnedWeights& weights, const Learne
         const ImageView acc = banded ? view(bandAcc) : out;
         const size_t pOffset = size_t(r0) * size_t(w);
         cpu::parallelForIsa(cpu::activeIsa(), size_t(0), size_t(rows) * size_t(w), size_t(16384),
-                            LogRange{in.d.channel(0) + pOffset, in.d.channel(1) + pOffset, in.d.channel(2) + pOffset,
-                                     in.var.channel(0) + pOffset, in.var.channel(1) + pOffset,
-                                     in.var.channel(2) + pOffset, B.lg.channel(0), B.lg.channel(1), B.lg.channel(2),
+                            LogRange{in.color.channel(0) + pOffset, in.color.channel(1) + pOffset, in.color.channel(2) + pOffset,
+                                     in.variance.channel(0) + pOffset, in.variance.channel(1) + pOffset,
+                                     in.variance.channel(2) + pOffset, B.lg.channel(0), B.lg.channel(1), B.lg.channel(2),
                                      B.lg.channel(3), B.v.channel(0)});
         clock.mark(logs, cpuLogs);
         sum.logs += logs, sum.cpuLogs += cpuLogs;

@@ -1,4 +1,4 @@
-// CUDA instantiation of the EAW/SURE driver (src/filters/denoise_driver.h) with CudaExec: the same
+// CUDA instantiation of the still path (src/filters/still_pipeline.h) with CudaExec: the same
 // functors as the CPU path, launched as kernels. Inputs already on the GPU (the viewer's running
 // means, Python's DLPack arrays) are read in place and the result stays on the GPU; host inputs
 // are uploaded and the result is downloaded. The report's statistics are reduced on the GPU, so a
@@ -22,6 +22,7 @@
 #include "atrous/cuda_check.cuh"
 #include "cuda/cuda_exec.cuh"
 #include "filters/denoise_internal.h"
+#include "filters/still_pipeline.h"
 #include "filters/stage_clock.h"
 
 namespace atrous::filters {
@@ -32,7 +33,7 @@ namespace {
 struct ReportSums {
     double in = 0, after = 0, emission = 0;
     unsigned long long nIn = 0, nAfter = 0, nEmission = 0, clamped = 0;
-    unsigned long long nonFinite = 0;  // colour pixels with a NaN/Inf channel (prepareInputs' count)
+    unsigned long long nonFinite = 0;  // colour pixels with a NaN/Inf channel (checkInputs' count)
 };
 
 struct AddReportSums {
@@ -78,7 +79,7 @@ struct IsNegative {
     ATROUS_HOST_DEVICE bool operator()(size_t i) const { return data[i] < 0.0f; }
 };
 
-// prepareInputs' negative-variance check for a variance on the GPU: the first negative value in
+// checkInputs' negative-variance check for a variance on the GPU: the first negative value in
 // planar order (as the host scan finds it), read back alone for the message.
 void checkDeviceVariance(const Image& variance) {
     const size_t n = 3 * variance.plane();
@@ -136,12 +137,11 @@ void estimateNoiseSigmaCuda(const Image& color, const Image* albedo, float eps, 
     globalNoiseSigma(CudaExec{}, color.view(), a, eps, floor, sigma);
 }
 
-Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const PreparedInputs& prep, DenoiseReport& rep,
-                  bool timed) {
+Image denoiseCuda(const Frame& in, const DenoiseOptions& o, const CheckedInputs& checked, DenoiseReport& rep, bool timed) {
     const int w = in.color->width(), h = in.color->height();
     if (in.variance && in.variance->device() == Device::Cuda) checkDeviceVariance(*in.variance);
     // A device input is used in place (no copy); a host input is uploaded into its holder, which
-    // lives until the driver has finished (runDenoise synchronises before returning).
+    // lives until the still path has finished (runStill synchronises before returning).
     Image holders[8];
     auto onDevice = [&holders](const Image* img, int slot) -> ImageView {
         if (!img) return ImageView{};
@@ -149,14 +149,14 @@ Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const Prepar
         holders[slot] = img->to(Device::Cuda);
         return holders[slot].view();
     };
-    DriverInputs di;
+    StillInputs di;
     di.color = onDevice(in.color, 0);
     if (in.variance) {
         di.variance = onDevice(in.variance, 1);
-    } else if (!prep.estimatedVariance.empty()) {
-        di.variance = onDevice(&prep.estimatedVariance, 1);  // estimated on the host: uploaded
+    } else if (!checked.estimatedVariance.empty()) {
+        di.variance = onDevice(&checked.estimatedVariance, 1);  // estimated on the host: uploaded
     } else {
-        // Estimated on the GPU (prepareInputs with a GPU colour): the constant σ² filled there.
+        // Estimated on the GPU (checkInputs with a GPU colour): the constant σ² filled there.
         holders[1] = Image(w, h, 3, Device::Cuda);
         FillVariance fill{{rep.noiseSigma[0] * rep.noiseSigma[0], rep.noiseSigma[1] * rep.noiseSigma[1],
                            rep.noiseSigma[2] * rep.noiseSigma[2]},
@@ -171,7 +171,7 @@ Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const Prepar
     di.ids = onDevice(in.ids, 6);
     di.emission = onDevice(in.emission, 7);
     Image out(w, h, 3, Device::Cuda), after(w, h, 3, Device::Cuda), flag(w, h, 1, Device::Cuda);
-    DriverOutputs dout;
+    StillOutputs dout;
     dout.out = out.view();
     dout.afterFirefly = after.view();
     dout.fireflyFlag = flag.view();
@@ -179,12 +179,9 @@ Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const Prepar
     std::unique_ptr<StageClock> clock = timed ? makeStageClock(Device::Cuda) : nullptr;
     dout.clock = clock.get();
     Timer t;
-    DriverConfig cfg{o};
-    cfg.learned = prep.learned;
-    cfg.varianceGiven = in.variance != nullptr;
-    setNoiseEstimate(cfg, rep);
+    const StillConfig cfg = stillConfig(in, o, checked, rep);
     if (clock) clock->start();
-    runDenoise(CudaExec{}, di, cfg, dout);  // ends with a stream synchronisation
+    runStill(CudaExec{}, di, cfg, dout);  // ends with a stream synchronisation
     rep.milliseconds = t.ms();
     if (clock) clock->collect(rep.stages);
 
@@ -205,7 +202,7 @@ Image denoiseCuda(const DenoiseInputs& in, const DenoiseOptions& o, const Prepar
     rep.meanLuminanceAfterFirefly = (sums.nAfter ? sums.after / double(sums.nAfter) : 0.0) +
                                     (in.emission && sums.nEmission ? sums.emission / double(sums.nEmission) : 0.0);
     rep.firefliesClamped = int(sums.clamped);
-    if (in.color->device() == Device::Cuda) rep.nonFinitePixels = int(sums.nonFinite);  // host: prepareInputs
+    if (in.color->device() == Device::Cuda) rep.nonFinitePixels = int(sums.nonFinite);  // host: checkInputs
     if (in.color->device() == Device::Cuda) return out;
     return out.to(Device::Cpu);
 }

@@ -13,10 +13,10 @@
 
 namespace atrous::filters {
 
-void runLearned(const CudaExec& exec, const LearnedWeights& weights, const LearnedPlanes& in, const ImageView& out,
+void runLearned(const CudaExec& exec, const LearnedWeights& weights, const PreparedView& in, const ImageView& out,
                 LearnedStageTimes* times, LearnedCache* cache) {
     checkLearnedPlanes(weights, in, out);
-    const int w = in.d.width, h = in.d.height;
+    const int w = in.color.width, h = in.color.height;
     const auto t0 = std::chrono::steady_clock::now();
     // The network's device copy and the temporaries: made here, or kept in the cache.
     struct Store {

@@ -12,7 +12,7 @@ struct CpuExec;
 
 namespace atrous::filters {
 
-// Per-level constants, derived on the host from EawParams (denoise_driver.h).
+// Per-level constants, derived on the host from EawParams (still_cascades.h).
 struct EawLevelParams {
     int step = 1;               // 2^i: tap spacing of level i
     float colorMul = 1.0f;      // factor^(2i): σ_c,i² = colorMul · 2 min(S(p), S(q))

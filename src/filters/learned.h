@@ -21,6 +21,7 @@
 #include <cstddef>
 #include <memory>
 
+#include "atrous/denoise.h"
 #include "atrous/image.h"
 #include "atrous/learned.h"
 #include "filters/atrous_level.h"
@@ -38,11 +39,14 @@ struct LearnedWeights::Impl {
 
 namespace atrous::filters {
 
-// The prepared planes (views on the executor's device, colour's size): d, var 3 channels;
-// albedo, normal 3 channels and depth (channel 0) invalid views when absent.
-struct LearnedPlanes {
-    ImageView d, var, albedo, normal, depth;
-};
+// The prepared planes the network reads (PreparedView, atrous/denoise.h: views on the executor's
+// device, colour's size): colour and variance 3 channels; albedo, normal 3 channels and depth
+// (channel 0) invalid views when absent. The rest of the view is not read.
+inline PreparedView preparedView(ImageView color, ImageView variance, ImageView albedo, ImageView normal, ImageView depth) {
+    PreparedView p;
+    p.color = color, p.variance = variance, p.albedo = albedo, p.normal = normal, p.depth = depth;
+    return p;
+}
 
 // Per-stage times of one runLearned call on the CPU (seconds; the bench's breakdown): wall clock,
 // and process CPU time (std::clock, all threads: what counts on a shared machine).
@@ -56,19 +60,19 @@ struct LearnedCache;
 // d_out, the filtered demodulated colour, into `out` (3 channels, exec's device); temporaries are
 // allocated on exec's device, or kept in *cache between calls. Throws InputError for missing or
 // mismatched planes.
-void runLearned(const CpuExec& exec, const LearnedWeights& w, const LearnedPlanes& in, const ImageView& out,
+void runLearned(const CpuExec& exec, const LearnedWeights& w, const PreparedView& in, const ImageView& out,
                 LearnedStageTimes* times = nullptr, LearnedCache* cache = nullptr);
-void runLearned(const CudaExec& exec, const LearnedWeights& w, const LearnedPlanes& in, const ImageView& out,
+void runLearned(const CudaExec& exec, const LearnedWeights& w, const PreparedView& in, const ImageView& out,
                 LearnedStageTimes* times = nullptr, LearnedCache* cache = nullptr);
 // The context branch on the CPU (src/cpu/learned_context_cpu.cpp: oneDNN's convolutions): C.z of
 // the planes P.
-void runLearnedContextCpu(const CpuExec& exec, const LearnedCtxNet& net, const LearnedPlanes& P,
+void runLearnedContextCpu(const CpuExec& exec, const LearnedCtxNet& net, const PreparedView& P,
                           const LearnedCtxPlanes& C);
 // The CPU entry point's bands of rows (src/cpu/learned_cpu.cpp): 0 (default) = by size (above 4 Mpixels,
 // without a cache), > 0 = bands of that many rows whenever the image is taller (tests), < 0 = never.
 int& learnedCpuBandRows();
 // The checks both entry points make (src/filters/learned_weights.cpp).
-void checkLearnedPlanes(const LearnedWeights& w, const LearnedPlanes& in, const ImageView& out);
+void checkLearnedPlanes(const LearnedWeights& w, const PreparedView& in, const ImageView& out);
 
 // The cascade's temporaries, carved from one block of kLearnedTempChannels planes.
 struct LearnedTemps {
@@ -129,7 +133,7 @@ struct LearnedLogPass {
 // lanes n .. N - 1 are zeroed. iP: the same pixels' index in P's planes (the CPU's bands of rows
 // index the temporaries from the band's first row, P from the image's).
 template <int N>
-ATROUS_FORCE_INLINE ATROUS_INLINE void learnedPointInputs(const LearnedPlanes& P, const ImageView& lg, size_t i0,
+ATROUS_FORCE_INLINE ATROUS_INLINE void learnedPointInputs(const PreparedView& P, const ImageView& lg, size_t i0,
                                                                int n, float (&x)[kLearnedIn][N], size_t iP) {
     if (n < N)
         for (int k = 0; k < kLearnedIn; ++k)
@@ -158,7 +162,7 @@ ATROUS_FORCE_INLINE ATROUS_INLINE void learnedPointInputs(const LearnedPlanes& P
     } else {
         for (int l = 0; l < n; ++l) x[9][l] = 0.0f;  // log 1
     }
-    const float *vr = P.var.channel(0) + iP, *vg = P.var.channel(1) + iP, *vb = P.var.channel(2) + iP;
+    const float *vr = P.variance.channel(0) + iP, *vg = P.variance.channel(1) + iP, *vb = P.variance.channel(2) + iP;
     for (int l = 0; l < n; ++l) x[10][l] = learnedNoiseIn(vr[l], vg[l], vb[l]);
 }
 
@@ -232,14 +236,14 @@ ATROUS_FORCE_INLINE ATROUS_INLINE void learnedWriteOutputs(const float (&y)[kLea
 // Pass B per pixel (the GPU, and the CPU reference of the row-wise pass in learned_cpu.cpp).
 struct LearnedNetPixel {
     const LearnedNet* net;  // on the executor's device
-    LearnedPlanes P;
+    PreparedView P;
     LearnedTemps T;
     ImageView acc;
     LearnedTensor z;  // the context's z (1/4 resolution); invalid: no context
 
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        const int w = P.d.width, h = P.d.height;
-        const size_t i = P.d.index(x, y);
+        const int w = P.color.width, h = P.color.height;
+        const size_t i = P.color.index(x, y);
         float in[kLearnedIn][1];
         learnedPointInputs<1>(P, T.lg, i, 1, in, i);
         // Column sums of the 3x3 box, in the row loop's order (rows y - 1, y, y + 1 from 0).
@@ -251,7 +255,7 @@ struct LearnedNetPixel {
             for (int dy = -1; dy <= 1; ++dy) {
                 const int yy = y + dy;
                 if (yy < 0 || yy >= h) continue;
-                const size_t j = P.d.index(xx, yy);
+                const size_t j = P.color.index(xx, yy);
                 for (int c = 0; c < 4; ++c) cs[c][dx + 1] += T.lg.channel(c)[j];
                 const float L = T.lg.channel(3)[j];
                 cs[4][dx + 1] += L * L;
@@ -269,7 +273,7 @@ struct LearnedNetPixel {
         } else {
             learnedMlp<1>(*net, in, out);
         }
-        learnedWriteOutputs<1>(out, P.d, T, acc, i, 1, i);
+        learnedWriteOutputs<1>(out, P.color, T, acc, i, 1, i);
     }
 };
 
@@ -366,11 +370,11 @@ struct LearnedStop {
 
 // Level i's policy: reads d_i (d, then lg's first channels and buf alternately), writes d_{i+1}.
 template <bool kLast>
-LearnedStop<kLast> learnedStop(const LearnedPlanes& P, const LearnedTemps& T, const ImageView& acc, int i) {
+LearnedStop<kLast> learnedStop(const PreparedView& P, const LearnedTemps& T, const ImageView& acc, int i) {
     const ImageView lg3{T.lg.data, T.lg.width, T.lg.height, 3};
     LearnedStop<kLast> s;
     s.step_ = 1 << i;
-    s.dIn = i == 0 ? P.d : (i % 2 == 1 ? lg3 : T.buf);
+    s.dIn = i == 0 ? P.color : (i % 2 == 1 ? lg3 : T.buf);
     s.dOut = i % 2 == 0 ? lg3 : T.buf;
     s.feat = T.feat, s.acc = acc;
     s.a = T.a.channel(i), s.m = T.m.channel(i), s.bk = T.bk.channel(i), s.c = T.c.channel(i);
@@ -382,11 +386,11 @@ LearnedStop<kLast> learnedStop(const LearnedPlanes& P, const LearnedTemps& T, co
 // The whole cascade through the functors on exec (the GPU; the CPU reference): every view on
 // exec's device, net too. C: the context's planes, invalid when the weights have none.
 template <class Exec>
-void runLearnedFunctors(const Exec& exec, const LearnedNet* net, const LearnedPlanes& P, const LearnedTemps& T,
+void runLearnedFunctors(const Exec& exec, const LearnedNet* net, const PreparedView& P, const LearnedTemps& T,
                         const ImageView& acc, const LearnedCtxPlanes& C) {
-    const int w = P.d.width, h = P.d.height;
-    if (C.valid()) runLearnedContextFunctors(exec, &net->ctx, P.d, P.var, P.albedo, P.normal, P.depth, C);
-    exec.forEachPixel(w, h, LearnedLogPass{P.d, P.var, T.lg, T.v});
+    const int w = P.color.width, h = P.color.height;
+    if (C.valid()) runLearnedContextFunctors(exec, &net->ctx, P.color, P.variance, P.albedo, P.normal, P.depth, C);
+    exec.forEachPixel(w, h, LearnedLogPass{P.color, P.variance, T.lg, T.v});
     exec.forEachPixel(w, h, LearnedNetPixel{net, P, T, acc, C.z});
     for (int i = 0; i + 1 < kLearnedLevels; ++i) runAtrousLevelFunctor(exec, learnedStop<false>(P, T, acc, i));
     runAtrousLevelFunctor(exec, learnedStop<true>(P, T, acc, kLearnedLevels - 1));

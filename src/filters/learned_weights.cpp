@@ -127,23 +127,23 @@ LearnedWeights LearnedWeights::builtin() {
 
 namespace filters {
 
-void checkLearnedPlanes(const LearnedWeights& w, const LearnedPlanes& in, const ImageView& out) {
+void checkLearnedPlanes(const LearnedWeights& w, const PreparedView& in, const ImageView& out) {
     if (!w.impl) throw InputError("learned filter: no weights loaded");
     auto need = [&](const ImageView& v, const char* field, int channels, bool optional) {
         if (!v.valid()) {
             if (optional) return;
             throw InputError(std::string("learned filter: ") + field + ": missing");
         }
-        if (!v.sameSize(in.d))
+        if (!v.sameSize(in.color))
             throw InputError(std::string("learned filter: ") + field + ": size " + std::to_string(v.width) + "x" +
-                             std::to_string(v.height) + " differs from d's " + std::to_string(in.d.width) + "x" +
-                             std::to_string(in.d.height));
+                             std::to_string(v.height) + " differs from the colour's " + std::to_string(in.color.width) + "x" +
+                             std::to_string(in.color.height));
         if (v.channels < channels)
             throw InputError(std::string("learned filter: ") + field + ": " + std::to_string(v.channels) +
                              " channels, " + std::to_string(channels) + " needed");
     };
-    if (!in.d.valid() || in.d.width <= 0 || in.d.height <= 0) throw InputError("learned filter: d: missing or empty");
-    need(in.d, "d", 3, false), need(in.var, "var", 3, false), need(in.albedo, "albedo", 3, true);
+    if (!in.color.valid() || in.color.width <= 0 || in.color.height <= 0) throw InputError("learned filter: color: missing or empty");
+    need(in.color, "color", 3, false), need(in.variance, "variance", 3, false), need(in.albedo, "albedo", 3, true);
     need(in.normal, "normal", 3, true), need(in.depth, "depth", 1, true), need(out, "out", 3, false);
 }
 

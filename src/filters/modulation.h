@@ -1,5 +1,5 @@
 // The one demodulate/remodulate pair (docs/algorithms.md, "Albedo demodulation"): the still
-// filters (denoise_driver.h), their noise estimate (noise_estimate.h) and SVGF (svgf_pipeline.h)
+// filters (still_prepare.h, still_finish.h), their noise estimate (noise_estimate.h) and SVGF (svgf_pipeline.h)
 // run these two functors. What differs between the callers is data: the albedo rule (AlbedoRule:
 // floor, rim rule, what a non-finite albedo reads as) and which optional buffers they give.
 #pragma once

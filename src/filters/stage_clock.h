@@ -1,4 +1,4 @@
-// Timestamps at the end of each stage of a filter driver (denoise_driver.h, svgf_pipeline.h),
+// Timestamps at the end of each stage of a filter driver (still_pipeline.h, svgf_pipeline.h),
 // turned into per-stage milliseconds once the run has finished. The CPU clock reads the steady
 // clock (the CPU executor's loops return when their work is done); the CUDA clock records a
 // cudaEvent on the stream at each mark and reads the elapsed times after the driver's final

@@ -212,9 +212,9 @@ public:
             if (s.learnedOut.empty()) s.learnedVar = Image(w, h, 3, dev), s.learnedOut = Image(w, h, 3, dev);
             mExec.forEachPixel(w, h, LearnedInputVariance{mParams.alpha, s.variance.view(), s.accLength.view(),
                                                           s.learnedVar.view()});
-            const filters::LearnedPlanes planes{s.accIllum.view(), s.learnedVar.view(), albedo,
+            const PreparedView planes = filters::preparedView(s.accIllum.view(), s.learnedVar.view(), albedo,
                                                 normalIn.valid() ? s.normal.view() : ImageView{},
-                                                depthIn.valid() ? s.depth.view() : ImageView{}};
+                                                depthIn.valid() ? s.depth.view() : ImageView{});
             filters::runLearned(mExec, mLearned, planes, s.learnedOut.view(), nullptr, &s.learnedCache);
             filters::markStage(clock, "learned");
             inIllum = s.learnedOut.view();

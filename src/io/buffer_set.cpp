@@ -103,22 +103,6 @@ Image readBufferFile(const std::string& path, Buffer b, const std::vector<PassRe
     return img;
 }
 
-bool methodReads(const DenoiseBufferUse& use, Buffer b) {
-    switch (b) {
-        case Buffer::Color: return true;
-        case Buffer::Variance: return use.variance;
-        case Buffer::Albedo: return use.albedo;
-        case Buffer::Normal: return use.normal;
-        case Buffer::Position: return use.position;
-        case Buffer::Depth: return use.depth;
-        case Buffer::ObjectId:
-        case Buffer::MaterialId: return use.ids;
-        case Buffer::Emission: return use.emission;
-        case Buffer::Motion: return false;
-    }
-    return true;
-}
-
 std::vector<std::string> inputFiles(const BufferFiles& f) {
     std::vector<std::string> files;
     std::error_code ec;

@@ -33,7 +33,7 @@ double worstRel(const Image& a, const Image& b) {
 }
 
 // The cascade on the GPU, planes copied there (absent ones stay invalid).
-Image runGpu(const LearnedPlanes& host, const LearnedWeights& w) {
+Image runGpu(const PreparedView& host, const LearnedWeights& w) {
     auto up = [](const ImageView& v, Image& store) {
         if (!v.valid()) return ImageView{};
         Image h(v.width, v.height, v.channels);
@@ -42,15 +42,15 @@ Image runGpu(const LearnedPlanes& host, const LearnedWeights& w) {
         return store.view();
     };
     Image d, var, albedo, normal, depth;
-    const LearnedPlanes P{up(host.d, d), up(host.var, var), up(host.albedo, albedo), up(host.normal, normal),
-                          up(host.depth, depth)};
-    Image out(host.d.width, host.d.height, 3, Device::Cuda);
+    const PreparedView P = preparedView(up(host.color, d), up(host.variance, var), up(host.albedo, albedo), up(host.normal, normal),
+                          up(host.depth, depth));
+    Image out(host.color.width, host.color.height, 3, Device::Cuda);
     runLearned(CudaExec{}, w, P, out.view());
     return out.to(Device::Cpu);
 }
 
-Image runCpu(const LearnedPlanes& p, const LearnedWeights& w) {
-    Image out(p.d.width, p.d.height, 3);
+Image runCpu(const PreparedView& p, const LearnedWeights& w) {
+    Image out(p.color.width, p.color.height, 3);
     runLearned(CpuExec{}, w, p, out.view());
     return out;
 }
@@ -74,7 +74,7 @@ TEST(LearnedCuda, GpuEqualsCpuAndJax) {
 // Absent albedo, normal and depth, and the built-in weights: GPU equals CPU.
 TEST(LearnedCuda, AbsentPlanesAndBuiltinWeights) {
     if (!cudaAvailable()) GTEST_SKIP() << "no CUDA device";
-    LearnedPlanes p = fixture().planes();
+    PreparedView p = fixture().planes();
     p.albedo = p.normal = p.depth = ImageView{};
     EXPECT_LE(worstRel(runGpu(p, fixtureWeights()), runCpu(p, fixtureWeights())), 1e-5);
     EXPECT_LE(worstRel(runGpu(fixture().planes(), LearnedWeights::builtin()),

@@ -55,10 +55,6 @@ BufferRefs refsOf(const SequenceFrame& f);  // all but the reference
 // read afterwards; the features are read only. An empty (or null) variance or emission is absent.
 DenoiseBuffers handOver(const BufferRefs& r, Image& color, Image* variance, Image* emission);
 
-// Whether a still denoiser that reads `use` (denoiseBufferUse) reads buffer b (colour always;
-// motion never: it is for sequences).
-bool methodReads(const DenoiseBufferUse& use, Buffer b);
-
 // Every file loadBuffers(files) reads or could read: the explicit files, `in` when it is a file,
 // and for a render directory each buffer's file name in it (color.exr, albedo.exr, ...: present
 // or not, since a file written there would be read as that buffer next time). Outputs are checked
