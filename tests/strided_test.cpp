@@ -4,6 +4,8 @@
 // round-trips exactly and writes no byte outside its elements; halves convert exactly where a value
 // is a half and round to nearest even where not; bad shapes are InputErrors naming the image, with
 // nothing written. The same on the GPU when there is one.
+#include "core/strided.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -15,13 +17,13 @@
 #include "atrous/error.h"
 #include "atrous/interop.h"
 #include "core/memory.h"
-#include "core/strided.h"
 
 namespace atrous {
 namespace {
 
 enum class Layout { Interleaved, Planar, Flipped, Padded, ChannelsReversed };
-const Layout kLayouts[] = {Layout::Interleaved, Layout::Planar, Layout::Flipped, Layout::Padded, Layout::ChannelsReversed};
+const Layout kLayouts[] = {Layout::Interleaved, Layout::Planar, Layout::Flipped, Layout::Padded,
+                           Layout::ChannelsReversed};
 const char* layoutName(Layout l) {
     const char* names[] = {"interleaved", "planar", "flipped", "padded", "channels reversed"};
     return names[int(l)];
@@ -34,7 +36,7 @@ constexpr unsigned char kSentinel = 0xA5;
 struct Buffer {
     std::vector<float> storage;  // float-aligned bytes
     StridedImage image;
-    std::vector<bool> element;   // per byte: part of an element
+    std::vector<bool> element;  // per byte: part of an element
 
     unsigned char* bytes() { return reinterpret_cast<unsigned char*>(storage.data()); }
     size_t size() const { return storage.size() * sizeof(float); }
@@ -45,9 +47,11 @@ Buffer makeBuffer(int w, int h, int c, DataType t, Layout l) {
     StridedImage s;
     s.type = t, s.width = w, s.height = h, s.channels = c;
     s.channelStride = e, s.pixelStride = c * e, s.rowStride = int64_t(w) * c * e;
-    if (l == Layout::Planar) s.pixelStride = e, s.rowStride = w * e, s.channelStride = int64_t(w) * h * e;
+    if (l == Layout::Planar)
+        s.pixelStride = e, s.rowStride = w * e, s.channelStride = int64_t(w) * h * e;
     if (l == Layout::Flipped) s.pixelStride = -s.pixelStride, s.rowStride = -s.rowStride;
-    if (l == Layout::Padded) s.pixelStride = (c + 1) * e, s.rowStride = (int64_t(w) * (c + 1) + 3) * e;
+    if (l == Layout::Padded)
+        s.pixelStride = (c + 1) * e, s.rowStride = (int64_t(w) * (c + 1) + 3) * e;
     if (l == Layout::ChannelsReversed) s.channelStride = -e;
     int64_t origin = 0, span = e;
     const int64_t strides[3] = {s.pixelStride, s.rowStride, s.channelStride};
@@ -66,7 +70,8 @@ Buffer makeBuffer(int w, int h, int c, DataType t, Layout l) {
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)
             for (int k = 0; k < c; ++k) {
-                const size_t at = size_t(stridedAddress(s, x, y, k) - reinterpret_cast<const char*>(b.bytes()));
+                const size_t at =
+                    size_t(stridedAddress(s, x, y, k) - reinterpret_cast<const char*>(b.bytes()));
                 for (int64_t i = 0; i < e; ++i) b.element[at + size_t(i)] = true;
             }
     return b;
@@ -77,7 +82,8 @@ Image reference(int w, int h, int c) {
     Image img(w, h, c);
     for (int k = 0; k < c; ++k)
         for (int y = 0; y < h; ++y)
-            for (int x = 0; x < w; ++x) img(x, y, k) = float((x * 7 + y * 13 + k * 5) % 50 - 20) / 8.0f;
+            for (int x = 0; x < w; ++x)
+                img(x, y, k) = float((x * 7 + y * 13 + k * 5) % 50 - 20) / 8.0f;
     return img;
 }
 
@@ -93,21 +99,31 @@ bool sentinelsKept(Buffer& b) {
     return true;
 }
 
-TEST(Strided, EveryFormatAndLayoutRoundTrips) {
-    const int w = 13, h = 7;  // odd: no layout lines up with a vector width
+// Runs f(type, layout, channels) for every element type, layout and channel count.
+template <class F>
+void forEachFormat(F&& f) {
     for (DataType t : {DataType::Float32, DataType::Float16})
         for (Layout l : kLayouts)
             for (int c = 1; c <= 4; ++c) {
-                SCOPED_TRACE(std::string(t == DataType::Float16 ? "half " : "float ") + layoutName(l) + " " + std::to_string(c));
-                const Image ref = reference(w, h, c);
-                Buffer b = makeBuffer(w, h, c, t, l);
-                exportImage(ref.view(), b.image, "out");
-                EXPECT_TRUE(sentinelsKept(b)) << "a byte outside the elements was written";
-                for (int k = 0; k < c; ++k) EXPECT_EQ(loadStrided(b.image, w - 1, h - 2, k), ref(w - 1, h - 2, k));
-                const Image back = importImage(b.image, c, "in");
-                ASSERT_EQ(back.channels(), c);
-                EXPECT_EQ(firstDifference(back, ref), SIZE_MAX);
+                SCOPED_TRACE(std::string(t == DataType::Float16 ? "half " : "float ") +
+                             layoutName(l) + " " + std::to_string(c));
+                f(t, l, c);
             }
+}
+
+TEST(Strided, EveryFormatAndLayoutRoundTrips) {
+    const int w = 13, h = 7;  // odd: no layout lines up with a vector width
+    forEachFormat([&](DataType t, Layout l, int c) {
+        const Image ref = reference(w, h, c);
+        Buffer b = makeBuffer(w, h, c, t, l);
+        exportImage(ref.view(), b.image, "out");
+        EXPECT_TRUE(sentinelsKept(b)) << "a byte outside the elements was written";
+        for (int k = 0; k < c; ++k)
+            EXPECT_EQ(loadStrided(b.image, w - 1, h - 2, k), ref(w - 1, h - 2, k));
+        const Image back = importImage(b.image, c, "in");
+        ASSERT_EQ(back.channels(), c);
+        EXPECT_EQ(firstDifference(back, ref), SIZE_MAX);
+    });
 }
 
 // The element positions themselves, for the two layouts everyone knows (the fast paths of
@@ -152,8 +168,17 @@ TEST(Strided, AGreyImageRepeatsIntoEveryChannelAndExportTakesTheFirstChannels) {
 }
 
 TEST(Strided, HalvesAreExactWhereRepresentableAndRoundToNearestEvenElsewhere) {
-    const float exact[] = {0.0f, -0.0f, 1.0f, -2.5f, 65504.0f, -65504.0f, 0.333251953125f, 2048.0f, 2050.0f,
-                           std::ldexp(1.0f, -14) /* smallest normal */, std::ldexp(1.0f, -24) /* smallest subnormal */,
+    const float exact[] = {0.0f,
+                           -0.0f,
+                           1.0f,
+                           -2.5f,
+                           65504.0f,
+                           -65504.0f,
+                           0.333251953125f,
+                           2048.0f,
+                           2050.0f,
+                           std::ldexp(1.0f, -14) /* smallest normal */,
+                           std::ldexp(1.0f, -24) /* smallest subnormal */,
                            std::ldexp(3.0f, -24)};
     uint16_t cell = 0;
     StridedImage s = interleavedImage(&cell, DataType::Float16, 1, 1, 1);
@@ -165,10 +190,10 @@ TEST(Strided, HalvesAreExactWhereRepresentableAndRoundToNearestEvenElsewhere) {
     struct {
         float in, out;
     } rounded[] = {
-        {0.1f, 0.0999755859375f},      // to nearest
-        {2049.0f, 2048.0f},            // a tie: to the even mantissa
-        {2051.0f, 2052.0f},            // a tie: to the even mantissa, upwards
-        {1e6f, 65504.0f},              // beyond half's range: clamped, no Inf
+        {0.1f, 0.0999755859375f},  // to nearest
+        {2049.0f, 2048.0f},        // a tie: to the even mantissa
+        {2051.0f, 2052.0f},        // a tie: to the even mantissa, upwards
+        {1e6f, 65504.0f},          // beyond half's range: clamped, no Inf
         {-1e6f, -65504.0f},
         {std::numeric_limits<float>::infinity(), 65504.0f},
         {std::ldexp(1.0f, -26), 0.0f},  // below half the smallest subnormal
@@ -207,7 +232,9 @@ void expectInputError(F&& f, const std::string& what, const std::string& why) {
 TEST(Strided, BadShapesAreInputErrorsAndWriteNothing) {
     const Image ref = reference(6, 4, 3);
     Buffer b = makeBuffer(6, 4, 3, DataType::Float32, Layout::Interleaved);
-    auto import = [&](StridedImage s, int channels) { return [s, channels] { importImage(s, channels, "albedo"); }; };
+    auto import = [&](StridedImage s, int channels) {
+        return [s, channels] { importImage(s, channels, "albedo"); };
+    };
     StridedImage two = b.image;
     two.channels = 2;
     expectInputError(import(two, 3), "albedo", "expected 3 channels (or 1), got 2");
@@ -234,7 +261,9 @@ TEST(Strided, BadShapesAreInputErrorsAndWriteNothing) {
     expectInputError(import(badType, 3), "albedo", "unknown element type");
 
     // Exports: checked before the first byte is written.
-    auto exportTo = [&](StridedImage s, const ImageView& v) { return [s, v] { exportImage(v, s, "output"); }; };
+    auto exportTo = [&](StridedImage s, const ImageView& v) {
+        return [s, v] { exportImage(v, s, "output"); };
+    };
     StridedImage overlap = b.image;
     overlap.pixelStride = 4;  // each pixel's G on the next one's R
     expectInputError(exportTo(overlap, ref.view()), "output", "overlap");
@@ -244,9 +273,11 @@ TEST(Strided, BadShapesAreInputErrorsAndWriteNothing) {
     const Image small = reference(5, 4, 3);
     expectInputError(exportTo(b.image, small.view()), "output", "is 6x4, the image written is 5x4");
     const Image grey = reference(6, 4, 1);
-    expectInputError(exportTo(b.image, grey.view()), "output", "has 3 channels, the image written 1");
+    expectInputError(exportTo(b.image, grey.view()), "output",
+                     "has 3 channels, the image written 1");
     expectInputError(exportTo(b.image, ImageView{}), "output", "no image to write");
-    for (size_t i = 0; i < b.size(); ++i) ASSERT_EQ(b.bytes()[i], kSentinel) << "byte " << i << " was written";
+    for (size_t i = 0; i < b.size(); ++i)
+        ASSERT_EQ(b.bytes()[i], kSentinel) << "byte " << i << " was written";
 }
 
 // The same round trips with the image and the buffer on the GPU (the kernels of
@@ -254,29 +285,27 @@ TEST(Strided, BadShapesAreInputErrorsAndWriteNothing) {
 TEST(Strided, OnTheGpuTheSameBytes) {
     if (!cudaAvailable()) GTEST_SKIP() << "no usable CUDA device";
     const int w = 37, h = 11;
-    for (DataType t : {DataType::Float32, DataType::Float16})
-        for (Layout l : kLayouts)
-            for (int c = 1; c <= 4; ++c) {
-                SCOPED_TRACE(std::string(t == DataType::Float16 ? "half " : "float ") + layoutName(l) + " " + std::to_string(c));
-                const Image ref = reference(w, h, c);
-                Buffer host = makeBuffer(w, h, c, t, l);
-                exportImage(ref.view(), host.image, "host");
-                // A device copy of the sentinel-filled buffer, written by the GPU export.
-                Buffer blank = makeBuffer(w, h, c, t, l);
-                const size_t origin = size_t(static_cast<const unsigned char*>(blank.image.data) - blank.bytes());
-                void* dev = detail::allocateBytes(blank.size(), Device::Cuda);
-                detail::copyBytes(dev, Device::Cuda, blank.bytes(), Device::Cpu, blank.size());
-                StridedImage d = blank.image;
-                d.data = static_cast<unsigned char*>(dev) + origin, d.device = Device::Cuda;
-                const Image devRef = ref.to(Device::Cuda);
-                exportImage(devRef.view(), d, "device");
-                std::vector<unsigned char> back(blank.size());
-                detail::copyBytes(back.data(), Device::Cpu, dev, Device::Cuda, back.size());
-                EXPECT_EQ(std::memcmp(back.data(), host.bytes(), back.size()), 0);
-                const Image imported = importImage(d, c, "device").to(Device::Cpu);
-                EXPECT_EQ(firstDifference(imported, ref), SIZE_MAX);
-                detail::freeBytes(dev, Device::Cuda);
-            }
+    forEachFormat([&](DataType t, Layout l, int c) {
+        const Image ref = reference(w, h, c);
+        Buffer host = makeBuffer(w, h, c, t, l);
+        exportImage(ref.view(), host.image, "host");
+        // A device copy of the sentinel-filled buffer, written by the GPU export.
+        Buffer blank = makeBuffer(w, h, c, t, l);
+        const size_t origin =
+            size_t(static_cast<const unsigned char*>(blank.image.data) - blank.bytes());
+        void* dev = detail::allocateBytes(blank.size(), Device::Cuda);
+        detail::copyBytes(dev, Device::Cuda, blank.bytes(), Device::Cpu, blank.size());
+        StridedImage d = blank.image;
+        d.data = static_cast<unsigned char*>(dev) + origin, d.device = Device::Cuda;
+        const Image devRef = ref.to(Device::Cuda);
+        exportImage(devRef.view(), d, "device");
+        std::vector<unsigned char> back(blank.size());
+        detail::copyBytes(back.data(), Device::Cpu, dev, Device::Cuda, back.size());
+        EXPECT_EQ(std::memcmp(back.data(), host.bytes(), back.size()), 0);
+        const Image imported = importImage(d, c, "device").to(Device::Cpu);
+        EXPECT_EQ(firstDifference(imported, ref), SIZE_MAX);
+        detail::freeBytes(dev, Device::Cuda);
+    });
 }
 
 }  // namespace

@@ -3,9 +3,9 @@
 // (include/atrous/interop.h), shared by the CPU (src/core/strided.cpp) and CUDA
 // (src/cuda/cuda_strided.cu) backends.
 #pragma once
-#include <cstdint>
-
 #include <Imath/half.h>
+
+#include <cstdint>
 
 #include "atrous/image.h"
 #include "atrous/platform.h"
@@ -28,7 +28,8 @@ ATROUS_INLINE float halfToFloat(uint16_t bits) {
 }
 ATROUS_INLINE uint16_t floatToHalf(float v) {
     constexpr float kHalfMax = 65504.0f;
-    const float c = v > kHalfMax ? kHalfMax : (v < -kHalfMax ? -kHalfMax : v);  // NaN passes through
+    const float c =
+        v > kHalfMax ? kHalfMax : (v < -kHalfMax ? -kHalfMax : v);  // NaN passes through
 #if ATROUS_ON_DEVICE
     return __half_as_ushort(__float2half_rn(c));
 #else
@@ -39,8 +40,8 @@ ATROUS_INLINE uint16_t floatToHalf(float v) {
 // The address of element (x, y, c). The caller has checked the image (checkStrided, strided.cpp):
 // the data and the strides are multiples of the element's size, so the typed loads are aligned.
 ATROUS_INLINE const char* stridedAddress(const StridedImage& s, int x, int y, int c) {
-    return static_cast<const char*>(s.data) + int64_t(y) * s.rowStride + int64_t(x) * s.pixelStride +
-           int64_t(c) * s.channelStride;
+    return static_cast<const char*>(s.data) + int64_t(y) * s.rowStride +
+           int64_t(x) * s.pixelStride + int64_t(c) * s.channelStride;
 }
 
 // Element (x, y, c) as a float, of an image whose type is T (the functors' hoisted branch).
@@ -82,7 +83,8 @@ struct ImportStrided {
     StridedImage src;
     ImageView dst;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        for (int c = 0; c < dst.channels; ++c) dst(x, y, c) = loadStridedAs<T>(src, x, y, src.channels == 1 ? 0 : c);
+        for (int c = 0; c < dst.channels; ++c)
+            dst(x, y, c) = loadStridedAs<T>(src, x, y, src.channels == 1 ? 0 : c);
     }
 };
 template <DataType T>

@@ -5,22 +5,27 @@
 
 namespace atrous::detail {
 
-void cudaImportStrided(const StridedImage& src, const ImageView& dst) {
+namespace {
+
+// The functor of the image's element type, over width x height, finished before returning.
+template <template <DataType> class F, class Src, class Dst>
+void launch(DataType type, const Src& src, const Dst& dst, int width, int height) {
     CudaExec exec;
-    if (src.type == DataType::Float16)
-        exec.forEachPixel(dst.width, dst.height, ImportStrided<DataType::Float16>{src, dst});
+    if (type == DataType::Float16)
+        exec.forEachPixel(width, height, F<DataType::Float16>{src, dst});
     else
-        exec.forEachPixel(dst.width, dst.height, ImportStrided<DataType::Float32>{src, dst});
+        exec.forEachPixel(width, height, F<DataType::Float32>{src, dst});
     exec.synchronize();
 }
 
+}  // namespace
+
+void cudaImportStrided(const StridedImage& src, const ImageView& dst) {
+    launch<ImportStrided>(src.type, src, dst, dst.width, dst.height);
+}
+
 void cudaExportStrided(const ImageView& src, const StridedImage& dst) {
-    CudaExec exec;
-    if (dst.type == DataType::Float16)
-        exec.forEachPixel(src.width, src.height, ExportStrided<DataType::Float16>{src, dst});
-    else
-        exec.forEachPixel(src.width, src.height, ExportStrided<DataType::Float32>{src, dst});
-    exec.synchronize();
+    launch<ExportStrided>(dst.type, src, dst, src.width, src.height);
 }
 
 }  // namespace atrous::detail
