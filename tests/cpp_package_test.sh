@@ -8,15 +8,8 @@
 set -euo pipefail
 build=$1 src=$2 cmake=$3 cxx=$4
 
-tmp=$(mktemp -d "${TMPDIR:-/tmp}/atrous_cpp_package.XXXXXX")
-trap 'rm -rf "$tmp"' EXIT
-prefix=$tmp/prefix
-
-fail() { echo "cpp_package_test: FAIL: $*" >&2; exit 1; }
-step() { echo "== $*"; }
-
-step "install into $prefix"
-"$cmake" --install "$build" --prefix "$prefix" > "$tmp/install.log" || { cat "$tmp/install.log"; fail "cmake --install"; }
+. "$(dirname "$0")/package_test_lib.sh"
+install_package cpp_package_test "$build" "$cmake"
 for f in include/atrous/denoise.h include/atrous/io.h include/atrous/io/buffer_set.h bin/atrous; do
   [ -e "$prefix/$f" ] || fail "$f was not installed"
 done

@@ -1,29 +1,31 @@
-// Moving pixels between atrous's planar images and other libraries' interleaved arrays (numpy,
-// PyTorch, CuPy: H x W x C with arbitrary strides), on the host or on the GPU, without a round
-// trip through host memory for GPU arrays.
+// Moving pixels between atrous's planar images and images in other layouts (StridedImage,
+// atrous/image.h: the C API's buffers, numpy / PyTorch / CuPy arrays: float32 or float16, 1 to 4
+// channels, interleaved or planar, byte strides of any sign), on the host or on the GPU, without a
+// round trip through host memory for GPU images.
 #pragma once
-#include <cstdint>
 
 #include "atrous/image.h"
 
 namespace atrous {
 
-// A borrowed H x W x C float32 array. Strides are in elements (not bytes) and may be anything,
-// negative included. `device` says where `data` lives.
-struct StridedArray {
-    const float* data = nullptr;
-    int height = 0, width = 0, channels = 0;
-    int64_t strideY = 0, strideX = 0, strideC = 0;
-    Device device = Device::Cpu;
-};
+// Copies `src` into a new planar float32 image on src.device with `outChannels` (1..4) channels: a
+// 1-channel source is repeated into every output channel; otherwise src.channels must equal
+// outChannels. Float16 elements are converted exactly (every half is a float). Throws InputError
+// naming `what` for no data, a size or channel count out of range, a channel mismatch, or data or
+// strides that are not multiples of the element's size.
+Image importImage(const StridedImage& src, int outChannels, const char* what);
 
-// Copies `a` into a new planar image on a.device() with `outChannels` channels: a 1-channel
-// array is repeated into every output channel; otherwise a.channels must equal outChannels.
-// Throws InputError (naming `what`) on a shape mismatch.
-Image imageFromStrided(const StridedArray& a, int outChannels, const char* what);
+// Writes the planar image `src`, which lives on dst.device, into `dst`, the caller's output memory
+// (StridedImage::data is written through): dst.channels of src's channels (src.channels >=
+// dst.channels), same size. float16 outputs are rounded to nearest even, values beyond half's range
+// clamped to +-65504. Throws InputError naming `what` when the sizes or devices differ, when dst is
+// malformed (as importImage's) or when two of its elements would share memory (overlapping
+// strides); nothing is written then.
+void exportImage(const ImageView& src, const StridedImage& dst, const char* what);
 
-// Writes `img` as a C-contiguous H x W x C array into `dst`, which lives on img.device() and has
-// room for img.size() floats.
-void imageToInterleaved(const Image& img, float* dst);
+// The layout of interleaved pixels of `channels` packed elements in rows of `rowBytes` bytes (0 =
+// packed: width pixels), as a StridedImage over `data`.
+StridedImage interleavedImage(const void* data, DataType type, int width, int height, int channels,
+                              Device device = Device::Cpu, int64_t rowBytes = 0);
 
 }  // namespace atrous

@@ -24,25 +24,28 @@ Image toImage(const Array& a, const char* what, int channels) {
         throw InputError(std::string(what) + ": expected float32 data");
     if (a.ndim() != 2 && a.ndim() != 3)
         throw InputError(std::string(what) + ": expected an array of shape (H, W, 3), got " + std::to_string(a.ndim()) + " dimensions");
-    StridedArray s;
-    s.data = static_cast<const float*>(a.data());
+    // nanobind's strides are in elements; StridedImage's in bytes.
+    StridedImage s;
+    s.data = a.data();
+    s.type = DataType::Float32;
     s.height = int(a.shape(0));
     s.width = int(a.shape(1));
     s.channels = a.ndim() == 3 ? int(a.shape(2)) : 1;
-    s.strideY = a.stride(0);
-    s.strideX = a.stride(1);
-    s.strideC = a.ndim() == 3 ? a.stride(2) : 0;
+    s.rowStride = a.stride(0) * int64_t(sizeof(float));
+    s.pixelStride = a.stride(1) * int64_t(sizeof(float));
+    s.channelStride = a.ndim() == 3 ? a.stride(2) * int64_t(sizeof(float)) : 0;
     s.device = deviceOf(a, what);
     if (a.shape(0) == 0 || a.shape(1) == 0) throw InputError(std::string(what) + ": empty array");
-    return imageFromStrided(s, channels, what);
+    return importImage(s, channels, what);
 }
 
 // Hands an Image to Python as a C-contiguous H x W x C float32 array on the image's device.
 nb::object fromImage(Image&& img) {
     const Device dev = img.device();
-    // Holds H x W x C floats, every one written by imageToInterleaved: no zero fill first.
+    // Holds H x W x C floats, every one written by exportImage: no zero fill first.
     Image* inter = new Image(Image::uninitialized(img.width(), img.height(), img.channels(), dev));
-    imageToInterleaved(img, inter->data());
+    exportImage(img.view(), interleavedImage(inter->data(), DataType::Float32, img.width(), img.height(), img.channels(), dev),
+                "result");
     nb::capsule owner(inter, [](void* p) noexcept { delete static_cast<Image*>(p); });
     const size_t shape[3] = {size_t(img.height()), size_t(img.width()), size_t(img.channels())};
     const int devType = dev == Device::Cuda ? nb::device::cuda::value : nb::device::cpu::value;

@@ -15,7 +15,7 @@ using Array = nb::ndarray<nb::ro>;  // any dtype, shape, strides and device: che
 // The array's device: the CPU or CUDA (InputError for another, or CUDA without a usable backend).
 Device deviceOf(const Array& a, const char* what);
 // Copies a H x W x C (or H x W) float32 array into a planar Image of `channels` on the array's
-// device (imageFromStrided's channel rule). InputError naming `what` otherwise.
+// device (importImage's channel rule). InputError naming `what` otherwise.
 Image toImage(const Array& a, const char* what, int channels = 3);
 // Hands an Image to Python as a C-contiguous H x W x C float32 array on the image's device.
 nb::object fromImage(Image&& img);

@@ -20,8 +20,8 @@ void cudaFillFloats(float*, float, size_t) { noCuda(); }
 bool cudaDevicePresent() { return false; }
 std::string cudaDeviceName() { return "none (no CUDA backend)"; }
 double cudaPeakBandwidthGBs() { return 0.0; }
-void cudaGatherStrided(const GatherStrided&, int, int) { noCuda(); }
-void cudaScatterInterleaved(const ScatterInterleaved&, int, int) { noCuda(); }
+void cudaImportStrided(const StridedImage&, const ImageView&) { noCuda(); }
+void cudaExportStrided(const ImageView&, const StridedImage&) { noCuda(); }
 
 }  // namespace detail
 }  // namespace atrous

@@ -1,31 +1,111 @@
-// Per-pixel functors behind include/atrous/interop.h, shared by the CPU and CUDA backends.
+// Per-pixel access to a StridedImage (include/atrous/image.h: float32 or float16, 1-4 channels,
+// byte strides of any sign) and the functors behind importImage / exportImage
+// (include/atrous/interop.h), shared by the CPU (src/core/strided.cpp) and CUDA
+// (src/cuda/cuda_strided.cu) backends.
 #pragma once
+#include <Imath/half.h>
+
 #include <cstdint>
 
 #include "atrous/image.h"
+#include "atrous/platform.h"
 
-namespace atrous::detail {
+#if ATROUS_DEVICE_COMPILER
+#include <cuda_fp16.h>
+#endif
 
-struct GatherStrided {
-    const float* src;
-    int64_t sy, sx, sc;
-    int srcChannels;
+namespace atrous {
+
+// half <-> float, round to nearest even: Imath's on the host (the library that reads EXR's
+// halves), cuda_fp16's intrinsics on the device. Values beyond half's range are clamped to its
+// largest finite value (65504) first, so that no Inf reaches an output; NaN stays NaN.
+ATROUS_INLINE float halfToFloat(uint16_t bits) {
+#if ATROUS_ON_DEVICE
+    return __half2float(__ushort_as_half(bits));
+#else
+    return imath_half_to_float(bits);
+#endif
+}
+ATROUS_INLINE uint16_t floatToHalf(float v) {
+    constexpr float kHalfMax = 65504.0f;
+    const float c =
+        v > kHalfMax ? kHalfMax : (v < -kHalfMax ? -kHalfMax : v);  // NaN passes through
+#if ATROUS_ON_DEVICE
+    return __half_as_ushort(__float2half_rn(c));
+#else
+    return imath_float_to_half(c);
+#endif
+}
+
+// The address of element (x, y, c). The caller has checked the image (checkStrided, strided.cpp):
+// the data and the strides are multiples of the element's size, so the typed loads are aligned.
+ATROUS_INLINE const char* stridedAddress(const StridedImage& s, int x, int y, int c) {
+    return static_cast<const char*>(s.data) + int64_t(y) * s.rowStride +
+           int64_t(x) * s.pixelStride + int64_t(c) * s.channelStride;
+}
+
+// Element (x, y, c) as a float, of an image whose type is T (the functors' hoisted branch).
+template <DataType T>
+ATROUS_INLINE float loadStridedAs(const StridedImage& s, int x, int y, int c) {
+    const char* p = stridedAddress(s, x, y, c);
+    if constexpr (T == DataType::Float16)
+        return halfToFloat(*reinterpret_cast<const uint16_t*>(p));
+    else
+        return *reinterpret_cast<const float*>(p);
+}
+template <DataType T>
+ATROUS_INLINE void storeStridedAs(const StridedImage& s, int x, int y, int c, float v) {
+    char* p = const_cast<char*>(stridedAddress(s, x, y, c));  // the caller's output memory
+    if constexpr (T == DataType::Float16)
+        *reinterpret_cast<uint16_t*>(p) = floatToHalf(v);
+    else
+        *reinterpret_cast<float*>(p) = v;
+}
+
+// The same for any type.
+ATROUS_INLINE float loadStrided(const StridedImage& s, int x, int y, int c) {
+    return s.type == DataType::Float16 ? loadStridedAs<DataType::Float16>(s, x, y, c)
+                                       : loadStridedAs<DataType::Float32>(s, x, y, c);
+}
+ATROUS_INLINE void storeStrided(const StridedImage& s, int x, int y, int c, float v) {
+    if (s.type == DataType::Float16)
+        storeStridedAs<DataType::Float16>(s, x, y, c, v);
+    else
+        storeStridedAs<DataType::Float32>(s, x, y, c, v);
+}
+
+namespace detail {
+
+// The generic paths, one pixel at a time. Import: a 1-channel source repeats into every channel of
+// dst. Export: dst.channels of src's (src.channels >= dst.channels).
+template <DataType T>
+struct ImportStrided {
+    StridedImage src;
     ImageView dst;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        const float* p = src + y * sy + x * sx;
-        for (int c = 0; c < dst.channels; ++c) dst(x, y, c) = p[(srcChannels == 1 ? 0 : c) * sc];
+        for (int c = 0; c < dst.channels; ++c)
+            dst(x, y, c) = loadStridedAs<T>(src, x, y, src.channels == 1 ? 0 : c);
+    }
+};
+template <DataType T>
+struct ExportStrided {
+    ImageView src;
+    StridedImage dst;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        for (int c = 0; c < dst.channels; ++c) storeStridedAs<T>(dst, x, y, c, src(x, y, c));
     }
 };
 
-// The common host layout, C-contiguous H x W x 3 (numpy's default): a row at a time with the
-// channel stride a constant, so the compiler vectorises the de-interleave. The same values as
-// GatherStrided.
+// The common host layout, interleaved float32 RGB (numpy's C-contiguous H x W x 3, a renderer's
+// FLOAT3 buffer): a row at a time with the channel stride a constant, so the compiler vectorises
+// the de-interleave. The same values as ImportStrided. `row0` is row 0's first element, `rowStride`
+// in floats (any sign).
 struct GatherInterleaved3 {
-    const float* src;
-    int64_t sy;
+    const float* row0;
+    int64_t rowStride;
     ImageView dst;
     void operator()(int y) const {
-        const float* ATROUS_RESTRICT p = src + y * sy;
+        const float* ATROUS_RESTRICT p = row0 + y * rowStride;
         float* ATROUS_RESTRICT r = dst.channel(0) + size_t(y) * size_t(dst.width);
         float* ATROUS_RESTRICT g = dst.channel(1) + size_t(y) * size_t(dst.width);
         float* ATROUS_RESTRICT b = dst.channel(2) + size_t(y) * size_t(dst.width);
@@ -37,25 +117,17 @@ struct GatherInterleaved3 {
     }
 };
 
-struct ScatterInterleaved {
-    ImageView src;
-    float* dst;
-    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        float* p = dst + (size_t(y) * src.width + x) * size_t(src.channels);
-        for (int c = 0; c < src.channels; ++c) p[c] = src(x, y, c);
-    }
-};
-
-// The inverse for 3 channels, a row at a time (imageToInterleaved's host path).
+// The inverse (exportImage's host path for interleaved float32 RGB).
 struct ScatterInterleaved3 {
     ImageView src;
-    float* dst;
+    float* row0;
+    int64_t rowStride;  // in floats
     void operator()(int y) const {
         const size_t w = size_t(src.width);
         const float* ATROUS_RESTRICT r = src.channel(0) + size_t(y) * w;
         const float* ATROUS_RESTRICT g = src.channel(1) + size_t(y) * w;
         const float* ATROUS_RESTRICT b = src.channel(2) + size_t(y) * w;
-        float* ATROUS_RESTRICT p = dst + size_t(y) * w * 3;
+        float* ATROUS_RESTRICT p = row0 + y * rowStride;
         for (size_t x = 0; x < w; ++x) {
             p[3 * x] = r[x];
             p[3 * x + 1] = g[x];
@@ -64,8 +136,9 @@ struct ScatterInterleaved3 {
     }
 };
 
-// CUDA halves (src/cuda/cuda_strided.cu; the no-CUDA build throws).
-void cudaGatherStrided(const GatherStrided& f, int width, int height);
-void cudaScatterInterleaved(const ScatterInterleaved& f, int width, int height);
+// CUDA halves (src/cuda/cuda_strided.cu; the no-CUDA build throws): src and dst on the GPU.
+void cudaImportStrided(const StridedImage& src, const ImageView& dst);
+void cudaExportStrided(const ImageView& src, const StridedImage& dst);
 
-}  // namespace atrous::detail
+}  // namespace detail
+}  // namespace atrous
