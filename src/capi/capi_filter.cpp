@@ -164,13 +164,14 @@ void AtrousFilterImpl::execute() {
         throw Failure{
             ATROUS_ERROR_INVALID_OPERATION,
             "the filter is not committed (call atrousCommitFilter after creating or changing it)"};
-    Image planes[capi::kOutput];
+    // The caller's images as they are: denoise() reads the colour, variance and emission where
+    // they are (converting them into its working planes) and copies the features it needs planar.
     Frame frame;
     for (int s = 0; s < capi::kOutput; ++s) {
         if (!images[s].valid()) continue;
-        planes[s] =
-            importImage(images[s], readChannels(capi::Slot(s), images[s]), kSlotInfo[s].name);
-        frame.set(kSlotInfo[s].buffer, &planes[s]);
+        StridedImage img = images[s];
+        img.channels = std::min(img.channels, readChannels(capi::Slot(s), images[s]));  // the first ones; one repeats
+        frame.set(kSlotInfo[s].buffer, img);
     }
     DenoiseResult r = runFilter(frame, options);
     const Image out =

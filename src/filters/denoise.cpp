@@ -208,9 +208,10 @@ void importStrided(const Frame& given, const DenoiseBuffers* handedOver, Importe
         const Buffer b = Buffer(i);
         const BufferRef r = given.get(b);
         if (!r || r.isImage()) continue;
-        const StridedImage s = r.strided();
+        StridedImage s = r.strided();
         const int channels = b == Buffer::Depth ? 1 : b == Buffer::ObjectId ? std::min(s.channels, 2)
                                                   : b == Buffer::Motion ? 2 : 3;
+        s.channels = s.channels > channels ? channels : s.channels;  // the first ones (RGBA: RGB)
         const char* name = b == Buffer::ObjectId ? "ids" : bufferName(b);
         f.owned[i] = importImage(s, channels, name);
         f.frame.set(b, &f.owned[i]);

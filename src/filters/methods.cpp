@@ -31,11 +31,11 @@ DenoiseMethodInfo builtin(DenoiseMethod m, const char* name, const char* summary
 struct MethodRegistry {
     std::deque<DenoiseMethodInfo> rows = {
         builtin(DenoiseMethod::Eaw, "eaw", "the edge-avoiding a-trous wavelet filter (Dammertz et al. 2010)",
-                {kEawReads, {"eaw"}, false}, CascadeKind::Eaw),
+                {kEawReads, {"eaw"}, false, {}}, CascadeKind::Eaw),
         builtin(DenoiseMethod::Sure, "sure", "EAW's cascade keeping part of each detail, chosen by SURE (Kim, Moon, Yoon 2016)",
-                {kEawReads, {"eaw", "sure"}, false}, CascadeKind::Sure),
+                {kEawReads, {"eaw", "sure"}, false, {}}, CascadeKind::Sure),
         builtin(DenoiseMethod::Learned, "learned", "a small network steering the a-trous cascade (docs/learned.md)",
-                {kLearnedReads, {}, true}, CascadeKind::Learned),
+                {kLearnedReads, {}, true, {}}, CascadeKind::Learned),
         builtin(DenoiseMethod::Blend, "blend", "the mean of learned and sure, from one preparation",
                 {{}, {}, false, {DenoiseMethod::Learned, DenoiseMethod::Sure}}, CascadeKind::Blend),
         builtin(DenoiseMethod::Auto, "auto",
