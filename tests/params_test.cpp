@@ -48,14 +48,17 @@ size_t rowsOf(const ParamTable<S>& t, const std::string& group) {
 
 TEST(ParamTables, EveryStructFieldHasARow) {
     const auto& d = denoiseParams();
-    EXPECT_EQ(rowsOf(d, "eaw"), fieldCount<EawParams>());
+    // EawParams' rows: the EAW stops' group and the emission filter's (the preparation reads it).
+    EXPECT_EQ(rowsOf(d, "eaw") + rowsOf(d, "emission"), fieldCount<EawParams>());
+    EXPECT_EQ(rowsOf(d, "emission"), 2u);
     EXPECT_EQ(rowsOf(d, "sure"), fieldCount<SureParams>());
     EXPECT_EQ(rowsOf(d, "firefly"), fieldCount<FireflyParams>());
     EXPECT_EQ(rowsOf(d, "safety"), fieldCount<SafetyNetParams>());
     // DenoiseOptions' own rows; method, device, the four structs and weights (the loaded network:
     // --learned-weights and learned_weights= name its file) are not parameters.
     EXPECT_EQ(rowsOf(d, "") + 7, fieldCount<DenoiseOptions>());
-    EXPECT_EQ(d.count, rowsOf(d, "eaw") + rowsOf(d, "sure") + rowsOf(d, "firefly") + rowsOf(d, "safety") + rowsOf(d, ""));
+    EXPECT_EQ(d.count, rowsOf(d, "eaw") + rowsOf(d, "emission") + rowsOf(d, "sure") + rowsOf(d, "firefly") +
+                           rowsOf(d, "safety") + rowsOf(d, ""));
     EXPECT_EQ(svgfParams().count, fieldCount<SvgfParams>());
     EXPECT_EQ(temporalParams().count, fieldCount<TemporalParams>());
     EXPECT_EQ(renderParams().count + 1, fieldCount<RenderSettings>());  // samplesDone is no parameter

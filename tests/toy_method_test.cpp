@@ -182,6 +182,13 @@ TEST(ToyMethod, TheCliWithItListsAndRunsItAndTheOneWithoutRefusesIt) {
     EXPECT_EQ(run.exitCode, 0) << run.output;
     EXPECT_NE(run.output.find("method toy"), std::string::npos) << run.output;
     EXPECT_TRUE(std::filesystem::exists(out));
+    // What the row reads is what the CLI says: the toy reads no EAW or SURE parameter (a flag of a
+    // stage every method has, --firefly-k, is no note).
+    const std::string out3 = dir / "o3.exr";
+    test::CliResult noted = test::runShell(toyCli + " denoise --in " + in + " --out " + out3 +
+                                           " --method toy --levels 3 --sure-window 2 --firefly-k 5");
+    EXPECT_EQ(noted.exitCode, 0) << noted.output;
+    EXPECT_NE(noted.output.find("ignored with --method toy: --levels, --sure-window"), std::string::npos) << noted.output;
     // The project's own CLI has no such method: one line, exit 2, nothing written.
     const std::string out2 = dir / "o2.exr";
     test::CliResult plain = test::runCli("denoise --in " + in + " --out " + out2 + " --method toy");
