@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "atrous/sequence_methods.h"
 #include "atrous/error.h"
 #include "atrous/metrics.h"
 #include "atrous/params.h"

@@ -43,5 +43,8 @@ const bool kRegistered = (registerToy(), true);
 
 #if defined(ATROUS_TOY_PLUGIN)
 // Built as a plugin (libatrous_toy_plugin.so): registered when loaded (atrous::loadPlugin).
-extern "C" void atrous_plugin_register() { atrous::toy::registerToy(); }
+extern "C" void atrous_plugin_register() {
+    atrous::toy::registerToy();
+    atrous::toy::registerToySequence();  // tests/toy_sequence_method.cpp
+}
 #endif

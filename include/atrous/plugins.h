@@ -1,6 +1,6 @@
 // Methods from shared libraries: a plugin is a library built against include/atrous with an
 // entry point `extern "C" void atrous_plugin_register()` that calls registerDenoiseMethod
-// (atrous/denoise.h); loading it adds its methods to this process's registry, so every front-end lists and runs them (`atrous --plugin FILE.so ...`,
+// (atrous/denoise.h) or registerSequenceMethod (atrous/sequence_methods.h); loading it adds its methods to this process's registry, so every front-end lists and runs them (`atrous --plugin FILE.so ...`,
 // Python's atrous.load_plugin, the farm's and the evaluation's --plugin). tests/toy_method.cpp is
 // one (build/tests/libatrous_toy_plugin.so). Linux (dlopen); same compiler and atrous version.
 #pragma once

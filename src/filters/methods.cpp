@@ -6,7 +6,7 @@
 
 #include "atrous/denoise.h"
 #include "atrous/error.h"
-#include "atrous/temporal.h"
+#include "atrous/sequence_methods.h"
 
 namespace atrous {
 
