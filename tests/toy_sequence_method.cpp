@@ -86,11 +86,9 @@ void registerToySequence() {
     registerSequenceMethod(m);
 }
 
+// Linked into a program (atrous_toy, toy_method_test) it is registered when the program starts.
 #if !defined(ATROUS_TOY_PLUGIN)
-namespace {
-// Linked into a program (atrous_toy, toy_method_test): registered when it starts.
-const bool kRegistered = (registerToySequence(), true);
-}  // namespace
+static const bool kToySequenceRegistered = (registerToySequence(), true);
 #endif
 
 }  // namespace atrous::toy

@@ -55,6 +55,8 @@ Method parseMethod(const std::string& name) {
 
 namespace {
 
+constexpr float kPi = 3.14159265358979f;
+
 size_t sequenceIndex(const SequenceMethodInfo& m) {
     const auto& rows = sequenceMethods();
     for (size_t i = 0; i < rows.size(); ++i)
@@ -75,12 +77,6 @@ const ParamSet& sequenceParams(const PipelineSettings& s, const SequenceMethodIn
     const size_t i = sequenceIndex(m);
     return i < s.sequence.size() && !s.sequence[i].empty() ? s.sequence[i] : m.params;
 }
-
-namespace {
-
-constexpr float kPi = 3.14159265358979f;
-
-}  // namespace
 
 double processCpuMs() {
     rusage u{};
