@@ -25,6 +25,7 @@
 #include <cstdio>
 #include <algorithm>
 #include <cstring>
+#include <deque>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -197,7 +198,8 @@ int main(int argc, char** argv) {
             app.add_option("--sequence", a.sequenceDir)->required();
             app.add_option("--out", a.outDir)->required();
             app.add_flag("--quiet", a.quiet);
-            atrous::cli::addSvgfOptions(app, a.options.svgf);
+            std::deque<atrous::ParamSet> params;  // each sequence method's flags (--svgf-*, --temporal-*)
+            atrous::cli::addSequenceOptions(app, params);
             try {
                 app.parse(argc - 1, argv + 1);
             } catch (const CLI::CallForHelp& e) {
@@ -206,6 +208,8 @@ int main(int argc, char** argv) {
                 std::fprintf(stderr, "svgf_sequence_tool denoise: error: %s (see --help)\n", e.what());
                 return 2;
             }
+            for (size_t i = 0; i < atrous::sequenceMethods().size(); ++i)
+                if (a.options.method == atrous::sequenceMethods()[i].name) a.options.params = params[i];
             return atrous::cli::runSequenceDenoise(a);
         }
         const bool help = argc == 2 && (std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0);

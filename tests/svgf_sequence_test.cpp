@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "atrous/error.h"
+#include "atrous/params.h"
 #include "atrous/svgf.h"
 #include "core/parallel.h"
 #include "filters/svgf_pipeline.h"
@@ -156,7 +158,10 @@ TEST(SvgfSequence, GapsMissingBuffersAndSizeMismatchesAreNamed) {
 // input (measured ~5-20x; bound 2x).
 static void checkSequenceCommand(const test::TempDir& dir, bool learnedSpatial) {
     cli::SequenceDenoiseArgs args = sequenceArgs(dir, 48, 32, 0.2f, 4);
-    args.options.svgf.learnedSpatial = learnedSpatial;
+    args.options.method = kSvgfMethod;
+    SvgfParams p;
+    p.learnedSpatial = learnedSpatial;
+    args.options.params = ParamSet(svgfParams(), p);
     SceneOptions o;
     o.width = 48, o.height = 32;
     o.noiseSigma = 0.2f;
@@ -181,15 +186,19 @@ TEST(SvgfSequence, DenoiseCommandWritesEveryFrameAndBeatsTheInput) {
 }
 
 TEST(SvgfSequence, EveryParamHasAFlag) {
-    SvgfParams p;
     CLI::App app;
-    cli::addSvgfOptions(app, p);
+    std::deque<ParamSet> sets;  // one per sequence method, in the registry's order
+    cli::addSequenceOptions(app, sets);
     const char* argv[] = {"x", "--svgf-sigma-l", "2", "--svgf-sigma-n", "64", "--svgf-sigma-z", "3", "--svgf-alpha", "0.3",
                           "--svgf-moments-alpha", "0.4", "--svgf-history-cap", "16", "--svgf-levels", "4",
                           "--svgf-feedback-tap", "1", "--svgf-spatial-variance-frames", "2", "--svgf-depth-tolerance", "5",
                           "--svgf-normal-cos", "0.5", "--taa", "--taa-alpha", "0.25", "--svgf-emission-alpha", "0.5",
                           "--svgf-emission-motion-alpha", "0.75", "--svgf-learned-spatial"};
     app.parse(int(sizeof(argv) / sizeof(argv[0])), argv);
+    const SvgfParams* found = nullptr;
+    for (const ParamSet& set : sets) found = found ? found : set.get<SvgfParams>();
+    ASSERT_NE(found, nullptr);
+    const SvgfParams& p = *found;
     EXPECT_EQ(p.sigmaL, 2.0f);
     EXPECT_EQ(p.sigmaN, 64.0f);
     EXPECT_EQ(p.sigmaZ, 3.0f);

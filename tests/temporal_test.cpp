@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "atrous/sequence_methods.h"
 #include "atrous/error.h"
 #include "atrous/metrics.h"
 #include "atrous/params.h"
@@ -356,6 +357,73 @@ TEST(TemporalGather, CacheOverASlidingWindowChangesNothing) {
     EXPECT_THROW(gatherTemporal(window, 1, TemporalParams{}, &cache, nullptr), InputError);
     std::vector<long long> shortIds = {0, 1};
     EXPECT_THROW(gatherTemporal(window, 1, TemporalParams{}, &cache, &shortIds), InputError);
+}
+
+// The temporal row of the registry through the one interface (sequence_methods.h): frame t comes
+// out once frames up to t + radius are in (or at finish()), and is denoiseTemporal on the window
+// t - r .. t + r, bit for bit (the stream's cache changes nothing); skip() passes a frame over
+// without changing its neighbours'; ignore(ObjectId) before any frame is denoised is the frames
+// without ids; reset() starts over; the still methods run frame by frame through the same interface.
+TEST(TemporalStream, IsDenoiseTemporalOverEachWindow) {
+    SceneOptions o;
+    o.noiseSigma = 0.2f;
+    const auto synth = makeFrames(o, 5);
+    TemporalParams p;
+    p.radius = 1, p.staticRadius = 0;
+    SequenceSetup setup;
+    setup.params = ParamSet(temporalParams(), p);
+    setup.still.method = DenoiseMethod::Eaw;
+    const std::unique_ptr<SequenceDenoiser> d = makeSequenceDenoiser(kTemporalMethod, setup);
+    EXPECT_EQ(d->lookahead(), 1);
+    EXPECT_EQ(d->lookbehind(), 1);
+    auto expected = [&](size_t t, bool withIds) {
+        std::vector<SvgfFrame> window;
+        for (size_t i = t > 0 ? t - 1 : 0; i <= std::min(synth.size() - 1, t + 1); ++i) {
+            window.push_back(synth[i].frame());
+            if (!withIds) window.back().ids = nullptr;
+        }
+        DenoiseOptions eaw;
+        eaw.method = DenoiseMethod::Eaw;
+        return denoiseTemporal(window, t > 0 ? 1 : 0, p, eaw);
+    };
+    std::vector<SequenceOutput> outs;
+    for (size_t i = 0; i < synth.size(); ++i) {
+        d->push({synth[i].frame(), nullptr});
+        if (i == 0) d->ignore(Buffer::ObjectId);  // from here on (the frame pushed included): no ids
+        if (i == 1) {
+            ASSERT_TRUE(d->ready());
+            d->skip();  // frame 0
+            continue;
+        }
+        while (d->ready()) outs.push_back(d->next());
+    }
+    EXPECT_FALSE(d->ready());
+    d->finish();
+    outs.push_back(d->next());
+    EXPECT_THROW(d->next(), InputError);
+    EXPECT_THROW(d->push({synth[0].frame(), nullptr}), InputError);  // after finish()
+    ASSERT_EQ(outs.size(), 4u);
+    for (const SequenceOutput& out : outs) {
+        EXPECT_TRUE(sameImages(out.image, expected(out.index, false))) << out.index;
+        EXPECT_EQ(out.methodUsed, "eaw");
+        EXPECT_EQ(out.detail.rfind(" (+-1 frames, ", 0), 0u) << out.detail;
+    }
+    EXPECT_EQ(outs.front().index, 1u);
+    d->reset();
+    d->push({synth[0].frame(), nullptr});
+    d->push({synth[1].frame(), nullptr});
+    const SequenceOutput again = d->next();
+    EXPECT_EQ(again.index, 0u);
+    EXPECT_TRUE(sameImages(again.image, expected(0, true)));  // ids back: reset() forgets ignore()
+    // A still method through the same interface: each frame alone, auto's choice in its words.
+    const std::unique_ptr<SequenceDenoiser> still = makeSequenceDenoiser("auto", setup);
+    EXPECT_EQ(still->lookahead(), 0);
+    still->push({synth[2].frame(), nullptr});
+    const SequenceOutput s = still->next();
+    EXPECT_EQ(s.detail, " -> " + s.methodUsed);
+    EXPECT_THROW(makeSequenceDenoiser("median", setup), InputError);
+    setup.params = ParamSet(svgfParams());
+    EXPECT_THROW(makeSequenceDenoiser(kTemporalMethod, setup), InputError);  // another method's table
 }
 
 TEST(TemporalGather, BadWindowsThrow) {

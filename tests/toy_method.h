@@ -15,4 +15,7 @@ void toyCascade(const PreparedView& planes, const DenoiseOptions& options, const
 void registerToy();
 DenoiseMethod toyMethod();
 
+// Adds the toy sequence method "toyseq" (tests/toy_sequence_method.cpp, registerSequenceMethod).
+void registerToySequence();
+
 }  // namespace atrous::toy

@@ -8,12 +8,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
 #include "atrous/denoise.h"
 #include "atrous/error.h"
+#include "atrous/sequence_methods.h"
 #include "atrous/render.h"
 #include "filters/denoise_internal.h"
 #include "atrous/io/image_io.h"
@@ -150,6 +152,69 @@ TEST(ToyMethod, ACascadesErrorsNameTheMethod) {
     EXPECT_NE(test::inputErrorOf(r.inputs(), o).find("method 'throws-input': bad"), std::string::npos);
 }
 
+// The toy sequence method (tests/toy_sequence_method.cpp): a row of the sequence methods' registry
+// with its own parameter table; the name rules are the still methods', both ways.
+TEST(ToySequenceMethod, IsARowOfTheRegistry) {
+    const SequenceMethodInfo* m = findSequenceMethod("toyseq");
+    ASSERT_NE(m, nullptr);
+    EXPECT_TRUE(m->registered);
+    EXPECT_TRUE(m->causal && m->history);
+    EXPECT_STREQ(m->params.set(), "toyseq");
+    ASSERT_EQ(m->params.rows().size(), 1u);
+    EXPECT_EQ(m->params.rows()[0].flag, "--toyseq-alpha");
+    EXPECT_TRUE(m->reads.has(Buffer::Motion));
+    EXPECT_NE(sequenceMethodNames().find("toyseq"), std::string::npos);
+    EXPECT_STREQ(sequenceMethods().front().name, "temporal");  // the built-in rows first
+    const size_t n = sequenceMethods().size(), still = denoiseMethods().size();
+    SequenceMethodInfo again = *m;
+    for (const char* taken : {"toyseq", "svgf", "temporal", "toy", "eaw", "auto", "none", "noisy", "oidn", "", "a b"}) {
+        again.name = taken;
+        EXPECT_THROW(registerSequenceMethod(again), InputError) << taken;
+    }
+    again.name = "toyseq-bare";
+    again.make = nullptr;
+    EXPECT_THROW(registerSequenceMethod(again), InputError);
+    again.make = m->make;
+    again.weightsParam = "no_such_switch";
+    EXPECT_THROW(registerSequenceMethod(again), InputError);
+    EXPECT_THROW(registerDenoiseMethod({DenoiseMethod::Eaw, "toyseq", "", false, toy::toyCascade}), InputError);
+    EXPECT_EQ(sequenceMethods().size(), n);
+    EXPECT_EQ(denoiseMethods().size(), still);
+}
+
+// Through the one interface: the first frame is its own colour, then where nothing moved the
+// running average alpha * c + (1 - alpha) * previous, elsewhere the frame's colour; reset() starts
+// over; a bad parameter is a ParamError naming the field.
+TEST(ToySequenceMethod, IsTheRunningAverageThroughTheInterface) {
+    const Rendered a;
+    Image still(32, 24, 2), moved(32, 24, 2);
+    moved.fill(1.0f);
+    SequenceSetup setup;
+    ParamSet p = findSequenceMethod("toyseq")->params;
+    *std::get<float*>(p.at(0)) = 0.25f;
+    setup.params = p;
+    std::unique_ptr<SequenceDenoiser> d = makeSequenceDenoiser("toyseq", setup);
+    EXPECT_EQ(d->lookahead(), 0);
+    Frame f0 = a.inputs(), f1 = a.inputs();
+    f0.motion = &still, f1.motion = &still;
+    d->push({f0, nullptr});
+    ASSERT_TRUE(d->ready());
+    const SequenceOutput o0 = d->next();
+    EXPECT_EQ(o0.methodUsed, "toyseq");
+    EXPECT_TRUE(test::sameImages(o0.image, a.b.color));
+    d->push({f1, nullptr});
+    const Image o1 = d->next().image;
+    EXPECT_EQ(o1(3, 4, 1), 0.25f * a.b.color(3, 4, 1) + 0.75f * o0.image(3, 4, 1));
+    f1.motion = &moved;
+    d->push({f1, nullptr});
+    EXPECT_TRUE(test::sameImages(d->next().image, a.b.color));
+    d->reset();
+    d->push({f0, nullptr});
+    EXPECT_TRUE(test::sameImages(d->next().image, a.b.color));
+    *std::get<float*>(setup.params.at(0)) = 2.0f;
+    EXPECT_THROW(makeSequenceDenoiser("toyseq", setup), ParamError);
+}
+
 TEST(ToyMethod, TheViewerListsAndRunsIt) {
     using namespace view;
     const auto& names = methodNames();
@@ -166,6 +231,18 @@ TEST(ToyMethod, TheViewerListsAndRunsIt) {
     EXPECT_TRUE(r.error.empty()) << r.error;
     ASSERT_EQ(r.image.width(), 32);
     EXPECT_EQ(r.method, m);
+    // The toy sequence method too: listed, and run on each frame's own samples.
+    EXPECT_NE(std::find(names.begin(), names.end(), "toyseq"), names.end());
+    const Method seq = parseMethod("toyseq");
+    EXPECT_TRUE(seq.ownSamples());
+    s.methodA = seq;
+    for (int i = 0; i < 2; ++i) pl.step(s);
+    EXPECT_TRUE(pl.slot(0).error.empty()) << pl.slot(0).error;
+    EXPECT_EQ(pl.slot(0).image.width(), 32);
+    EXPECT_STREQ(methodName(pl.slot(0).method), "toyseq");
+    *std::get<float*>(sequenceParams(s, *findSequenceMethod("toyseq")).at(0)) = 5.0f;
+    pl.step(s);
+    EXPECT_NE(pl.slot(0).error.find("alpha"), std::string::npos) << pl.slot(0).error;
 }
 
 #ifdef ATROUS_TOY_CLI
@@ -218,6 +295,30 @@ TEST(ToyMethod, AsAPluginTheCliListsAndRunsIt) {
         EXPECT_TRUE(test::sameImages(io::readImage(dir / "plugin.exr"), io::readImage(dir / "linked.exr")));
     }
 #endif
+    // The toy sequence method of the same plugin: listed (its flags in their group), run on a
+    // sequence, each frame the running average of the frames before where nothing moved; its
+    // flags are ignored (noted) with another method and range-checked with it.
+    test::expectCli(plugin + "denoise --help", 0, {"toyseq (with --sequence): a toy", "Toy sequence (--method toyseq)",
+                                                   "--toyseq-alpha"});
+    test::expectCli(plugin + "view --help", 0, {"| toyseq"});
+    const std::string seq = test::renderSequence(dir, 3);
+    test::expectCli(plugin + "denoise --sequence " + seq + " --method toyseq --toyseq-alpha 0.5 --out " + (dir / "toyseq"), 0,
+                    {"frame_0002: toyseq"});
+    Image avg = io::readImage(seq + "/frame_0000/color.exr");
+    for (int f = 0; f < 3; ++f) {
+        const std::string frame = seq + "/frame_000" + std::to_string(f);
+        const Image c = io::readImage(frame + "/color.exr"), motion = io::readImage(frame + "/motion.exr");
+        for (int y = 0; y < c.height(); ++y)
+            for (int x = 0; x < c.width(); ++x) {
+                const bool still = f > 0 && std::fabs(motion(x, y, 0)) < 0.05f && std::fabs(motion(x, y, 1)) < 0.05f;
+                for (int ch = 0; ch < 3; ++ch) avg(x, y, ch) = still ? 0.5f * c(x, y, ch) + 0.5f * avg(x, y, ch) : c(x, y, ch);
+            }
+        EXPECT_TRUE(test::sameImages(io::readImage(dir / ("toyseq/frame_000" + std::to_string(f) + ".exr")), avg)) << f;
+    }
+    test::expectCli(plugin + "denoise --sequence " + seq + " --method toyseq --toyseq-alpha 2 --out " + (dir / "bad"), 2,
+                    {"--toyseq-alpha: must be in (0, 1] (got 2)"});
+    test::expectCli(plugin + "denoise --sequence " + seq + " --method svgf --toyseq-alpha 0.5 --out " + (dir / "svgf"), 0,
+                    {"ignored with --method svgf: --toyseq-alpha"});
     const test::CliResult missing = test::expectCli(" --plugin " + (dir / "nope.so") + " denoise --help", 2, {"nope.so"});
     EXPECT_EQ(std::count(missing.output.begin(), missing.output.end(), '\n'), 1) << missing.output;
     std::ofstream(dir / "junk.so") << "not a library";

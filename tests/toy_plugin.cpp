@@ -5,4 +5,5 @@
 
 extern "C" void atrous_plugin_register() {
     atrous::toy::registerToy();
+    atrous::toy::registerToySequence();  // tests/toy_sequence_method.cpp
 }

@@ -39,6 +39,9 @@ const Scene& cornell() {
     return s;
 }
 
+Method svgfMethod() { return Method::of(*atrous::findSequenceMethod(atrous::kSvgfMethod)); }
+Method temporalMethod() { return Method::of(*atrous::findSequenceMethod(atrous::kTemporalMethod)); }
+
 PipelineSettings settings(Method a = Method::none(), int spp = 1) {
     PipelineSettings s;
     s.methodA = a;
@@ -107,7 +110,7 @@ TEST(ViewPipeline, MethodNamesRoundTripAndUnknownOnesAreInputErrors) {
     for (const auto& m : atrous::sequenceMethods())
         if (m.causal || m.causalMode) expected.push_back(m.name);
     EXPECT_EQ(methodNames(), expected);
-    EXPECT_EQ(parseMethod("svgf"), Method::svgf());
+    EXPECT_EQ(parseMethod("svgf"), svgfMethod());
     EXPECT_EQ(parseMethod("sure"), Method::of(DenoiseMethod::Sure));
     EXPECT_THROW(parseMethod("bilateral"), InputError);
     EXPECT_THROW(ViewPipeline(cornell(), 0, kH, Device::Cpu, 1), InputError);
@@ -220,7 +223,7 @@ TEST(ViewPipeline, ResetSppChangeAndAccumulationOffRestart) {
     pl.step(off);
     EXPECT_EQ(pl.framesAccumulated(), 1);
     // Nothing reads the running mean: skipped, and restarted when needed again.
-    PipelineSettings skip = settings(Method::svgf(), 2);
+    PipelineSettings skip = settings(svgfMethod(), 2);
     skip.needAccumulated = false;
     pl.step(settings(Method::none(), 2));
     pl.step(settings(Method::none(), 2));
@@ -274,8 +277,8 @@ TEST(ViewPipeline, SlotsFollowTheMethodAndTheSplit) {
 
 TEST(ViewPipeline, EverySlotMethodRunsAndSvgfTakesTheFramesOwnSamples) {
     ViewPipeline pl(cornell(), kW, kH, Device::Cpu, 1);
-    for (Method m : {Method::of(DenoiseMethod::Sure), Method::svgf(), Method::of(DenoiseMethod::Eaw), Method::svgf(),
-                     Method::of(DenoiseMethod::Learned), Method::temporal()}) {
+    for (Method m : {Method::of(DenoiseMethod::Sure), svgfMethod(), Method::of(DenoiseMethod::Eaw), svgfMethod(),
+                     Method::of(DenoiseMethod::Learned), temporalMethod()}) {
         pl.step(settings(m));
         const SlotResult& r = pl.slot(0);
         EXPECT_EQ(r.method, m);
@@ -302,10 +305,10 @@ TEST(ViewPipeline, TemporalRunsCausalOnTheFramesOwnSamples) {
     rs.width = kW, rs.height = kH, rs.spp = 512, rs.maxDepth = 3, rs.seed = 99;
     const Image ref = atrous::render(scene, rs).color;
     auto err = [&](const Image& img) { return atrous::computeMetrics(img, ref).relMse; };
-    PipelineSettings s = settings(Method::temporal());
+    PipelineSettings s = settings(temporalMethod());
     PipelineSettings alone = settings(Method::of(DenoiseMethod::Auto));
     alone.accumulate = false;
-    alone.split = true, alone.methodB = Method::temporal();  // the same frames through both
+    alone.split = true, alone.methodB = temporalMethod();  // the same frames through both
     ViewPipeline pl(scene, kW, kH, Device::Cpu, 1);
     double sumAlone = 0, sumTemporal = 0;
     for (int k = 0; k < 8; ++k) {
@@ -319,7 +322,7 @@ TEST(ViewPipeline, TemporalRunsCausalOnTheFramesOwnSamples) {
     pl.resetAccumulation();
     pl.step(s);
     EXPECT_TRUE(pl.slot(0).error.empty()) << pl.slot(0).error;
-    s.temporal.radius = -1;
+    sequenceParams(s, *atrous::findSequenceMethod(atrous::kTemporalMethod)).get<atrous::TemporalParams>()->radius = -1;
     pl.step(s);
     EXPECT_NE(pl.slot(0).error.find("radius"), std::string::npos) << pl.slot(0).error;
     EXPECT_EQ(pl.slot(0).image.width(), kW);
@@ -336,8 +339,8 @@ TEST(ViewPipeline, RejectedParametersLandInTheSlotAndTheInputIsShown) {
     pl.step(s);
     EXPECT_TRUE(pl.slot(0).error.empty()) << pl.slot(0).error;
 
-    PipelineSettings v = settings(Method::svgf());
-    v.svgf.alpha = -1.0f;
+    PipelineSettings v = settings(svgfMethod());
+    sequenceParams(v, *atrous::findSequenceMethod(atrous::kSvgfMethod)).get<atrous::SvgfParams>()->alpha = -1.0f;
     ASSERT_NO_THROW(pl.step(v));
     EXPECT_FALSE(pl.slot(0).error.empty());
     EXPECT_EQ(pl.slot(0).image.width(), kW);
@@ -375,9 +378,9 @@ TEST(ViewPipeline, DebugBuffersOnlyWhenAsked) {
 
 TEST(ViewPipeline, SvgfGetsMotionVectorsWhenTheCameraMoves) {
     ViewPipeline pl(cornell(), kW, kH, Device::Cpu, 1);
-    pl.step(settings(Method::svgf()));
+    pl.step(settings(svgfMethod()));
     pl.setCamera(turned(pl, 0.1f));
-    pl.step(settings(Method::svgf()));
+    pl.step(settings(svgfMethod()));
     const Image& m = pl.motion();
     int moving = 0;
     for (int y = 0; y < kH; ++y)
@@ -387,7 +390,7 @@ TEST(ViewPipeline, SvgfGetsMotionVectorsWhenTheCameraMoves) {
         }
     EXPECT_GT(moving, kW * kH / 2);
     EXPECT_TRUE(pl.slot(0).error.empty()) << pl.slot(0).error;
-    pl.step(settings(Method::svgf()));  // still again: no motion
+    pl.step(settings(svgfMethod()));  // still again: no motion
     for (size_t i = 0; i < pl.motion().size(); ++i) ASSERT_EQ(pl.motion().data()[i], 0.0f);
 }
 
@@ -396,7 +399,7 @@ TEST(ViewPipeline, SaveBuffersWritesWhatTheStepComputed) {
     ViewPipeline pl(cornell(), kW, kH, Device::Cpu, 1);
     PipelineSettings s = settings(Method::of(DenoiseMethod::Eaw), 2);
     s.split = true;
-    s.methodB = Method::svgf();
+    s.methodB = svgfMethod();
     s.detailLevel = 1;
     pl.step(s);
     const std::vector<std::string> names = pl.saveBuffers(dir / "out");

@@ -12,6 +12,7 @@
 
 #include "atrous/device.h"
 #include "atrous/render.h"
+#include "atrous/svgf.h"
 #include "view/frame_timing.h"
 #include "view/stage_history.h"
 #include "atrous/view_pipeline.h"
@@ -79,7 +80,7 @@ TEST(ViewTiming, JsonLineHasTheKeysInOrderAndLeavesTheWarmupOut) {
     run.width = 64;
     run.height = 48;
     run.settings.methodA = Method::of(atrous::DenoiseMethod::Sure);
-    run.settings.methodB = Method::svgf();
+    run.settings.methodB = Method::of(*atrous::findSequenceMethod(atrous::kSvgfMethod));
     run.settings.split = true;
     run.settings.sppPerFrame = 2;
     run.display = "host upload";

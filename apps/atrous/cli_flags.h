@@ -5,11 +5,15 @@
 #pragma once
 #include <CLI/CLI.hpp>
 
+#include <functional>
+#include <memory>
 #include <string>
 
 #include "atrous/device.h"
 #include "atrous/error.h"
+#include "atrous/param_set.h"
 #include "atrous/params.h"
+#include "atrous/sequence_methods.h"
 
 namespace atrous::cli {
 
@@ -41,19 +45,18 @@ inline std::string givenValue(const CLI::App& cmd, const std::string& flag) {
     return v;
 }
 
-// A ParamError as the user typed it: "--svgf-alpha: must be in (0, 1] (got 2)". The table maps
-// the error's field to its flag (params.h); the message is not read.
-template <class S>
-[[noreturn]] void rethrowAsFlag(const ParamError& e, const ParamTable<S>& t, const CLI::App& cmd) {
-    const ParamField<S>* f = t.find(e.field());
-    if (!f) throw e;
-    const std::string flag = t.flag(*f), got = givenValue(cmd, flag);
+// A ParamError as the user typed it: "--svgf-alpha: must be in (0, 1] (got 2)". The set's table
+// maps the error's field to its flag (params.h); the message is not read.
+[[noreturn]] inline void rethrowAsFlag(const ParamError& e, const ParamSet& set, const CLI::App& cmd) {
+    const int row = set.find(e.field());
+    if (row < 0 || set.rows()[size_t(row)].flag.empty()) throw e;
+    const std::string flag = set.rows()[size_t(row)].flag, got = givenValue(cmd, flag);
     throw InputError(flag + ": " + e.rule() + (got.empty() ? "" : " (got " + got + ")"));
 }
 
-// The flag of a library ParamError's field: the denoise, SVGF and render tables' rows; --device
-// --camera-path and --scene for parseDevice's, parseCameraPath's and Scene::builtin's; "" when the field has none
-// (RenderSettings::firstSample).
+// The flag of a library ParamError's field: the denoise, render and sequence methods' tables'
+// rows (sequenceMethods()' params); --device, --camera-path and --scene for parseDevice's,
+// parseCameraPath's and Scene::builtin's; "" when the field has none (RenderSettings::firstSample).
 inline std::string flagOf(const ParamError& e) {
     auto in = [&](const auto& t) -> std::string {
         const auto* f = t.find(e.field());
@@ -63,9 +66,12 @@ inline std::string flagOf(const ParamError& e) {
     if (e.set() == "camera_path") return "--camera-path";
     if (e.set() == "scene") return "--scene";
     if (e.set() == "render") return in(renderParams());
-    if (e.set() == "svgf") return in(svgfParams());
-    if (e.set() == "temporal") return in(temporalParams());
     if (e.set() == "denoise") return in(denoiseParams());
+    for (const SequenceMethodInfo& m : sequenceMethods()) {
+        if (m.params.empty() || e.set() != m.params.set()) continue;
+        const int row = m.params.find(e.field());
+        return row < 0 ? std::string() : m.params.rows()[size_t(row)].flag;
+    }
     return "";
 }
 
@@ -77,47 +83,48 @@ inline std::string flagMessage(const ParamError& e) {
 }
 
 // validateParams with the flags' names in the message.
-template <class S>
-void checkParamFlags(const S& s, const ParamTable<S>& t, const CLI::App& cmd) {
+inline void checkParamFlags(const ParamSet& set, const CLI::App& cmd) {
     try {
-        validateParams(s, t);
+        set.validate();
     } catch (const ParamError& e) {
-        rethrowAsFlag(e, t, cmd);
+        rethrowAsFlag(e, set, cmd);
     }
 }
+template <class S>
+void checkParamFlags(const S& s, const ParamTable<S>& t, const CLI::App& cmd) {
+    checkParamFlags(ParamSet::bind(t, const_cast<S&>(s)), cmd);  // read only
+}
 
-// One flag per row of the table (rows without a flag, and those `keep` refuses, left out),
-// writing into `s` (which must outlive the parse), in the help group group(field); the defaults
-// shown are the struct's. A negated Bool is a --no-<name> switch, a Choice or FloatList takes its
-// text (setParamFromText). Ranges are checked after the parse (checkParamFlags), when every flag is
-// known.
-template <class S, class GroupOf>
-void addParamOptions(CLI::App& cmd, S& s, const ParamTable<S>& t, GroupOf&& group,
-                     bool (*keep)(const ParamField<S>&) = nullptr) {
-    for (const ParamField<S>& f : t) {
-        const std::string flag = t.flag(f);
-        if (flag.empty() || (keep && !keep(f))) continue;
-        const ParamRef r = f.at(s);
+// One flag per row of the set whose group(row) is not null (rows without a flag left out), in the
+// help group group(row), writing into the set's values: a bound set's (ParamSet::bind, view()),
+// which must outlive the parse. The defaults shown are the values it holds now. A negated Bool is
+// a --no-<name> switch, a Choice or FloatList takes its text (ParamSet::setText). Ranges are
+// checked after the parse (checkParamFlags), when every flag is known.
+inline void addParamOptions(CLI::App& cmd, ParamSet values, const std::function<const char*(const ParamRow&)>& group) {
+    const auto set = std::make_shared<ParamSet>(std::move(values));
+    for (size_t i = 0; i < set->rows().size(); ++i) {
+        const ParamRow& f = set->rows()[i];
+        const char* g = group(f);
+        if (f.flag.empty() || !g) continue;
+        const std::string flag = f.flag;
+        const ParamRef r = set->at(i);
         CLI::Option* opt = nullptr;
         if (bool* const* b = std::get_if<bool*>(&r)) {
             bool* p = *b;
             opt = f.negated ? cmd.add_flag_callback(flag, [p] { *p = false; }, std::string("turn off: ") + f.doc)
                             : cmd.add_flag(flag, *p, f.doc);
-        } else if (int* const* i = std::get_if<int*>(&r)) {
-            opt = cmd.add_option(flag, **i, f.doc)->check(kNonEmptyNumber)->capture_default_str();
+        } else if (int* const* n = std::get_if<int*>(&r)) {
+            opt = cmd.add_option(flag, **n, f.doc)->check(kNonEmptyNumber)->capture_default_str();
         } else if (uint32_t* const* u = std::get_if<uint32_t*>(&r)) {
             opt = cmd.add_option(flag, **u, f.doc)->check(kNonEmptyNumber)->capture_default_str();
         } else if (float* const* x = std::get_if<float*>(&r)) {
             opt = cmd.add_option(flag, **x, f.doc)->check(kNonEmptyNumber)->capture_default_str();
         } else {
-            const ParamField<S>* field = &f;
-            const ParamTable<S>* table = &t;
-            S* target = &s;
             opt = cmd.add_option_function<std::string>(
                        flag,
-                       [field, table, target, flag](const std::string& v) {
+                       [set, i, flag](const std::string& v) {
                            try {
-                               setParamFromText(*target, *table, *field, v);
+                               set->setText(i, v);
                            } catch (const ParamError& e) {
                                throw InputError(flag + ": " + e.rule() + " (got " + v + ")");
                            }
@@ -125,8 +132,18 @@ void addParamOptions(CLI::App& cmd, S& s, const ParamTable<S>& t, GroupOf&& grou
                        f.doc)
                       ->default_str(paramText(r, f.choices));
         }
-        opt->group(group(f));
+        opt->group(g);
     }
+}
+
+// The same for a struct and its table, with group(field) (and the rows `keep` refuses left out).
+template <class S, class GroupOf>
+void addParamOptions(CLI::App& cmd, S& s, const ParamTable<S>& t, GroupOf&& group,
+                     bool (*keep)(const ParamField<S>&) = nullptr) {
+    addParamOptions(cmd, ParamSet::bind(t, s), [&](const ParamRow& row) -> const char* {
+        const ParamField<S>& f = *t.find(row.name);
+        return keep && !keep(f) ? nullptr : group(f);
+    });
 }
 
 }  // namespace atrous::cli

@@ -1,5 +1,5 @@
-// `atrous bench`: timings of every render and denoise path (EAW, SURE, the learned filter, SVGF) at
-// several resolutions, as JSON.
+// `atrous bench`: timings of every render and denoise path (the still methods, the sequence methods)
+// at several resolutions, as JSON.
 // Each figure is the median of --runs timed runs after --warmup untimed ones. Denoiser times are
 // the filter alone (inputs already in place; on CUDA the driver ends with a stream synchronise, so
 // the time covers every kernel); `total_ms` is the whole public denoise() call (validation, the
@@ -19,17 +19,37 @@
 #include "atrous/error.h"
 #include "atrous/learned.h"
 #include "atrous/render.h"
-#include "atrous/svgf.h"
+#include "atrous/sequence_methods.h"
 #include "commands.h"
 #include "atrous/timer.h"
 
 namespace atrous::cli {
 namespace {
 
+// The built-in still methods but auto, the built-in causal sequence methods (a frame as it comes:
+// svgf) and the renderer.
+std::string defaultWhat() {
+    std::string s;
+    for (const DenoiseMethodInfo& m : denoiseMethods())
+        if (!m.registered() && m.method != DenoiseMethod::Auto) s += std::string(m.name) + ",";
+    for (const SequenceMethodInfo& m : sequenceMethods())
+        if (!m.registered && m.causal) s += std::string(m.name) + ",";
+    return s + "render";
+}
+
+// What --what takes: every still method but auto, every sequence method, render.
+std::string whatItems() {
+    std::string s;
+    for (const DenoiseMethodInfo& m : denoiseMethods())
+        if (m.method != DenoiseMethod::Auto) s += std::string(m.name) + ", ";
+    for (const SequenceMethodInfo& m : sequenceMethods()) s += std::string(m.name) + ", ";
+    return s + "render";
+}
+
 struct BenchArgs {
     std::string device = "auto";
     std::string sizes = "512x512,1280x720,1920x1080,3840x2160";
-    std::string what = "eaw,sure,learned,blend,svgf,render";
+    std::string what = defaultWhat();
     std::string learnedWeights;  // "" = the built-in weights
     std::string scene = "cornell";
     int runs = 0;  // 0: 50 on CUDA, 10 on the CPU
@@ -126,15 +146,59 @@ double cudaDenoiseTrafficBytes(const DenoiseOptions& o, const DenoiseInputs& in,
     return planes * 4.0 * double(w) * double(h);
 }
 
+// A sequence method on the scene's buffers as a stream of still frames (zero motion): each timed
+// run pushes one frame and takes out what is ready (a method with a window of later frames fills
+// it during the warm-up). The time is its frame's filter, the output left on the device.
+nlohmann::json benchSequence(const SequenceMethodInfo& m, const RenderBuffers& inputs, Device device,
+                             const LearnedWeights& weights, const BenchArgs& a, int runs, int w, int h) {
+    SequenceSetup setup;
+    setup.device = device;
+    setup.still.weights = weights;
+    setup.timing = true;
+    setup.keepOnDevice = true;
+    std::unique_ptr<SequenceDenoiser> den = makeSequenceDenoiser(m.name, setup);
+    Image motion(w, h, 2);
+    const Image motionIn = device == Device::Cuda ? motion.to(Device::Cuda) : Image();
+    Frame f;
+    f.color = &inputs.color;
+    f.albedo = &inputs.albedo;
+    f.normal = &inputs.normal;
+    f.depth = &inputs.depth;
+    f.ids = &inputs.ids;
+    f.motion = device == Device::Cuda ? &motionIn : &motion;
+    StageSamples stages;
+    int call = 0;
+    auto t = repeat(a.warmup + den->lookahead(), runs, [&] {
+        Timer tt;
+        den->push({f, nullptr});  // the buffers outlive the denoiser
+        double ms = 0;
+        while (den->ready()) {
+            const SequenceOutput out = den->next();
+            ms = tt.ms();
+            if (call >= a.warmup + den->lookahead()) stages.add(out.stages);
+        }
+        ++call;
+        return ms;
+    });
+    nlohmann::json r = stats(t);
+    r["what"] = m.name;
+    r["device"] = deviceToString(device);
+    r["width"] = w;
+    r["height"] = h;
+    r["note"] = std::string("whole ") + m.label + " frame (inputs already on the device)";
+    r["stages"] = stages.json();
+    return r;
+}
+
 void run(const BenchArgs& a) {
     const Device device = parseDevice(a.device);
     const int runs = a.runs > 0 ? a.runs : (device == Device::Cuda ? 50 : 10);
     if (a.warmup < 0) throw InputError("--warmup must be >= 0");
     std::vector<std::string> what = split(a.what);
     for (auto& w : what)
-        if ((!findDenoiseMethod(w) || w == "auto") && w != "svgf" && w != "render")
+        if ((!findDenoiseMethod(w) || w == "auto") && !findSequenceMethod(w) && w != "render")
             throw InputError("--what: unknown item '" + w + "' (expected a denoise method but auto (" + denoiseMethodNames() +
-                             "), svgf or render)");
+                             "), a sequence method (" + sequenceMethodNames() + ") or render)");
     auto wants = [&](const char* k) { return std::find(what.begin(), what.end(), k) != what.end(); };
     bool anyLearned = false;
     for (const DenoiseMethodInfo& m : denoiseMethods()) anyLearned = anyLearned || (readsWeights(m) && wants(m.name));
@@ -205,8 +269,9 @@ void run(const BenchArgs& a) {
         // On CUDA the inputs are uploaded once, outside the timed calls: the filters then read
         // them in place (as the viewer and DLPack callers do) and total_ms covers no transfer.
         RenderBuffers onDevice;
-        bool anyFilter = wants("svgf");
+        bool anyFilter = false;
         for (const DenoiseMethodInfo& m : denoiseMethods()) anyFilter = anyFilter || wants(m.name);
+        for (const SequenceMethodInfo& m : sequenceMethods()) anyFilter = anyFilter || wants(m.name);
         if (device == Device::Cuda && anyFilter) {
             for (auto [dst, src] : {std::pair<Image*, const Image*>{&onDevice.color, &b.color},
                                     {&onDevice.variance, &b.variance}, {&onDevice.albedo, &b.albedo},
@@ -261,36 +326,8 @@ void run(const BenchArgs& a) {
             }
             doc["results"].push_back(r);
         }
-        if (wants("svgf")) {
-            SvgfDenoiser sv(SvgfParams{}, device);
-            Image motion(w, h, 2);
-            SvgfFrame f;
-            const Image motionIn = device == Device::Cuda ? motion.to(Device::Cuda) : Image();
-            f.color = &inputs.color;
-            f.albedo = &inputs.albedo;
-            f.normal = &inputs.normal;
-            f.depth = &inputs.depth;
-            f.ids = &inputs.ids;
-            f.motion = device == Device::Cuda ? &motionIn : &motion;
-            sv.setTiming(true);
-            StageSamples stages;
-            int call = 0;
-            auto t = repeat(a.warmup, runs, [&] {
-                Timer tt;
-                sv.denoiseFrameOnDevice(f);
-                const double ms = tt.ms();
-                if (call++ >= a.warmup) stages.add(sv.lastReport().stages);
-                return ms;
-            });
-            nlohmann::json r = stats(t);
-            r["what"] = "svgf";
-            r["device"] = deviceToString(device);
-            r["width"] = w;
-            r["height"] = h;
-            r["note"] = "whole SVGF frame (inputs already on the device)";
-            r["stages"] = stages.json();
-            doc["results"].push_back(r);
-        }
+        for (const SequenceMethodInfo& m : sequenceMethods())
+            if (wants(m.name)) doc["results"].push_back(benchSequence(m, inputs, device, weights, a, runs, w, h));
     }
     if (a.json) {
         std::printf("%s\n", doc.dump(2).c_str());
@@ -313,7 +350,7 @@ void addBenchCommand(CLI::App& app) {
     auto* cmd = app.add_subcommand("bench", "Time every render and denoise path at several resolutions");
     cmd->add_option("--device", args->device, "cpu, cuda or auto (cuda when a GPU is present)")->capture_default_str();
     cmd->add_option("--sizes", args->sizes, "comma-separated WxH list")->capture_default_str();
-    cmd->add_option("--what", args->what, "comma-separated: eaw, sure, learned, blend, svgf, render")->capture_default_str();
+    cmd->add_option("--what", args->what, "comma-separated: " + whatItems())->capture_default_str();
     cmd->add_option("--learned-weights", args->learnedWeights,
                     "weight file of the learned filter (default: the built-in weights)");
     cmd->add_option("--scene", args->scene, "scene whose buffers are denoised")->capture_default_str();

@@ -3,6 +3,7 @@
 #include <utility>
 #include <vector>
 #include <cstdio>
+#include <deque>
 #include <iterator>
 #include <filesystem>
 #include <memory>
@@ -11,6 +12,7 @@
 #include "atrous/denoise.h"
 #include "atrous/error.h"
 #include "atrous/learned.h"
+#include "atrous/sequence_methods.h"
 #include "cli_flags.h"
 #include "commands.h"
 #include "atrous/timer.h"
@@ -33,29 +35,49 @@ struct DenoiseArgs {
     std::string oidnFilter = "RT", oidnQuality;  // oidnDenoise's -f, -q (accepted; see addOidnFlags)
     bool oidnCleanAux = false;
     std::string method = "auto", device = "auto";
-    std::string spatial = "auto";  // --spatial: the still method of --method temporal
+    std::string spatial = "auto";  // --spatial: the still method of a sequence method that ends with one
     io::FrameRange range;  // --start, --end, --step (with --sequence)
     DenoiseOptions opt;  // the filter parameters' flags write here (params.h's table)
     std::string learnedWeights;  // --learned-weights: loaded once into opt.weights
-    SvgfParams svgf;
-    TemporalParams temporal;
+    std::deque<ParamSet> sequenceParams;  // each sequence method's parameters (sequenceMethods()' order): their flags write here
 };
 
 // Option groups: the flags of one method are ignored by the others (a note says which).
-const char* const kGroupSvgf = "SVGF (--method svgf)";  // addSvgfOptions' group
-const char* const kGroupTemporal = "Temporal (--method temporal, the default with --sequence)";  // addTemporalOptions' group
 const char* const kGroupBuffers = "Buffers (without --sequence)";
-const char* const kGroupLearned = "The learned filter's weights (the methods that read them, or svgf --svgf-learned-spatial)";
+
+// The learned filter's group: the still methods that read its weights, and the sequence methods
+// whose parameters make them read it (svgf --svgf-learned-spatial); from the registries.
+std::string learnedGroup() {
+    std::string g;
+    for (const DenoiseMethodInfo& m : denoiseMethods())
+        if (readsWeights(m)) g += (g.empty() ? "" : "|") + std::string(m.name);
+    g = "Learned (--method " + g;
+    for (const SequenceMethodInfo& m : sequenceMethods()) {
+        const int row = m.weightsParam ? m.params.find(m.weightsParam) : -1;
+        if (row >= 0) g += std::string(", or ") + m.name + " " + m.params.rows()[size_t(row)].flag;
+    }
+    return g + ")";
+}
+
+// The sequence methods that end with a still method (--spatial's), by name ("a or b" for two).
+std::string spatialMethods() {
+    std::string s;
+    for (const SequenceMethodInfo& m : sequenceMethods())
+        if (m.stillMethod) s += (s.empty() ? "" : " or ") + std::string(m.name);
+    return s;
+}
+
+// Whether a flag's group is a sequence method's other than `method` (its flags are then ignored).
+bool otherSequenceGroup(const std::string& group, const std::string& method) {
+    for (const SequenceMethodInfo& m : sequenceMethods())
+        if (group == sequenceGroup(m, true)) return method != m.name;
+    return false;
+}
 
 // The help group of a still parameter: its stage's title and the methods that read it, from the
 // registry (readsParamGroup).
 std::string paramHelpGroup(const ParamField<DenoiseOptions>& f) {
-    static const std::pair<const char*, const char*> kTitles[] = {
-        {"", "Albedo demodulation"}, {"firefly", "Fireflies"}, {"emission", "Emission"},
-        {"safety", "Safety net"},    {"eaw", "EAW's edge stops"},  {"sure", "SURE"}};
-    std::string title = f.group;
-    for (const auto& t : kTitles)
-        if (title == t.first) title = t.second;
+    const std::string title = denoiseGroupTitle(f.group);
     const std::vector<std::string>& stages = stillStageGroups();
     if (std::find(stages.begin(), stages.end(), std::string(f.group)) != stages.end()) return title + " (every still method)";
     std::string who;
@@ -73,16 +95,19 @@ const ParamField<DenoiseOptions>* denoiseField(const std::string& flag) {
 
 // One note line on stderr naming the given flags that the chosen method (or --sequence) ignores:
 // a still parameter whose group the still method that runs does not read (its registry row's
-// reads), the weights where it reads none. still: that method (--spatial's with temporal; null
-// with svgf). learnedSvgf: --method svgf with --svgf-learned-spatial (which reads --learned-weights).
+// reads), the weights where nothing reads them, a sequence method's flags with another method.
+// still: the still method that runs (--spatial's with a sequence method that ends with one; null
+// with one that does not). learnedSequence: a sequence method whose parameters read
+// --learned-weights (svgf --svgf-learned-spatial).
 void noteIgnoredFlags(const CLI::App& cmd, const std::string& method, const DenoiseMethodInfo* still, bool sequence,
-                      bool learnedSvgf) {
+                      bool learnedSequence) {
+    const std::string groupLearned = learnedGroup();
     std::string ignored, ignoredSeq;
     for (const CLI::Option* opt : cmd.get_options()) {
         if (opt->count() == 0) continue;
         const std::string& g = opt->get_group();
-        bool unused = (g == kGroupSvgf && method != "svgf") || (g == kGroupTemporal && method != "temporal") ||
-                      (g == kGroupLearned && !(still && readsWeights(*still)) && !learnedSvgf);
+        bool unused = otherSequenceGroup(g, method) ||
+                      (g == groupLearned && !(still && readsWeights(*still)) && !learnedSequence);
         if (const ParamField<DenoiseOptions>* f = denoiseField(opt->get_name()))
             unused = !still || !readsParamGroup(*still, f->group);
         if (unused) ignored += (ignored.empty() ? "" : ", ") + opt->get_name();
@@ -134,6 +159,40 @@ void clampUnit(Image& img) {
         img.data()[i] = std::min(std::max(img.data()[i], 0.0f), 1.0f);
 }
 
+// --spatial, the still method of a sequence method that ends with one (`row`): whether it applies;
+// InputError when it was given to another method or names no still method.
+bool checkSpatial(const DenoiseArgs& a, const CLI::App& cmd, const SequenceMethodInfo* row) {
+    const bool spatial = row && row->stillMethod;
+    if (cmd.count("--spatial") > 0 && !spatial)
+        throw InputError("--spatial: the still method of --method " + spatialMethods() +
+                         (sequenceMethods().front().stillMethod ? " (the default with --sequence)" : "") +
+                         "; --method is " + a.method);
+    if (spatial && !findDenoiseMethod(a.spatial))
+        throw InputError("--spatial: unknown still method '" + a.spatial + "' (expected " + denoiseMethodNames() + ")");
+    return spatial;
+}
+
+// --sequence DIR: the library's session with the still options a.opt and the sequence method's
+// parameters (null for a still method).
+void runSequence(const DenoiseArgs& a, const ParamSet* params) {
+    if (!a.inDir.empty() || !a.color.empty())
+        throw InputError("--sequence DIR denoises the frames of DIR: drop --in/--color");
+    SequenceDenoiseArgs s;
+    s.sequenceDir = a.sequence;
+    s.outDir = a.out;
+    SequenceDenoiseOptions& so = s.options;
+    so.method = a.method;
+    so.device = a.opt.device;
+    if (params) so.params = *params;
+    so.frame = a.opt;
+    withFlag("--pass", [&] { return io::parsePassRequests(a.passes); });  // its own message first
+    so.passes = a.passes;
+    so.viewLayer = a.layer;
+    so.addPass = a.addPass;
+    so.start = a.range.start, so.end = a.range.end, so.step = a.range.step;
+    runSequenceDenoise(s);
+}
+
 void run(DenoiseArgs& a, const CLI::App& cmd) {
     if (!a.ldrColor.empty()) {
         if (!a.color.empty()) throw InputError("--ldr: give the colour once (--color/--hdr or --ldr)");
@@ -149,50 +208,30 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
         if (!sequence && cmd.count(f) > 0) throw InputError(std::string(f) + ": picks frames of a --sequence; give one");
     // A sequence without --method: the first sequence method (temporal: the frames around each one).
     if (sequence && cmd.count("--method") == 0) a.method = sequenceMethods().front().name;
-    const bool sequenceMethod = findSequenceMethod(a.method) != nullptr;
-    if (!sequenceMethod && !findDenoiseMethod(a.method))
+    const SequenceMethodInfo* row = findSequenceMethod(a.method);
+    if (!row && !findDenoiseMethod(a.method))
         throw InputError("--method: unknown denoise method '" + a.method + "' (expected " + denoiseMethodNames() +
                          ", or with --sequence " + sequenceMethodNames() + ")");
-    if (sequenceMethod && !sequence)
+    if (row && !sequence)
         throw InputError("--method " + a.method + " denoises animated sequences: give --sequence DIR (and an output directory)");
-    if (cmd.count("--spatial") > 0 && a.method != "temporal")
-        throw InputError("--spatial: the still method of --method temporal (the default with --sequence); --method is " +
-                         a.method);
-    if (a.method == "temporal" && !findDenoiseMethod(a.spatial))
-        throw InputError("--spatial: unknown still method '" + a.spatial + "' (expected " + denoiseMethodNames() + ")");
-    o.method = a.method == "svgf" ? DenoiseMethod::Sure
-                                  : parseDenoiseMethod(a.method == "temporal" ? a.spatial : a.method);
+    const bool spatial = checkSpatial(a, cmd, row);
+    o.method = row && !spatial ? DenoiseMethod::Sure : parseDenoiseMethod(spatial ? a.spatial : a.method);
     checkParamFlags(o, denoiseParams(), cmd);
-    if (a.method == "svgf") checkParamFlags(a.svgf, svgfParams(), cmd);
-    if (a.method == "temporal") checkParamFlags(a.temporal, temporalParams(), cmd);
+    const ParamSet* params = nullptr;  // the row's, as its flags set them
+    for (size_t i = 0; row && i < sequenceMethods().size(); ++i)
+        if (&sequenceMethods()[i] == row) params = &a.sequenceParams[i];
+    if (params) checkParamFlags(*params, cmd);
     o.device = parseDevice(a.device);
-    const bool learnedSvgf = a.method == "svgf" && a.svgf.learnedSpatial;
-    const DenoiseMethodInfo* still = findDenoiseMethod(a.method == "temporal" ? a.spatial : a.method);
-    noteIgnoredFlags(cmd, a.method, still, sequence, learnedSvgf);
+    const bool learnedSequence = row && sequenceMethodReadsWeights(*row, *params);
+    const DenoiseMethodInfo* still = row && !spatial ? nullptr : findDenoiseMethod(spatial ? a.spatial : a.method);
+    noteIgnoredFlags(cmd, a.method, still, sequence, learnedSequence);
     // A bad weight file fails here, before any buffer is read or anything written.
     LearnedWeights weights;
-    if (((still && readsWeights(*still)) || learnedSvgf) && !a.learnedWeights.empty())
+    if (((still && readsWeights(*still)) || learnedSequence) && !a.learnedWeights.empty())
         weights = withFlag("--learned-weights", [&] { return LearnedWeights::load(a.learnedWeights); });
     o.weights = weights;  // loaded once: denoise() does not read the file again
     if (sequence) {
-        if (!a.inDir.empty() || !a.color.empty())
-            throw InputError("--sequence DIR denoises the frames of DIR: drop --in/--color");
-        SequenceDenoiseArgs s;
-        s.sequenceDir = a.sequence;
-        s.outDir = a.out;
-        SequenceDenoiseOptions& so = s.options;
-        so.method = a.method;
-        so.device = o.device;
-        so.svgf = a.svgf;
-        so.temporal = a.temporal;
-        so.frame = o;
-        so.svgfWeights = weights;
-        withFlag("--pass", [&] { return io::parsePassRequests(a.passes); });  // its own message first
-        so.passes = a.passes;
-        so.viewLayer = a.layer;
-        so.addPass = a.addPass;
-        so.start = a.range.start, so.end = a.range.end, so.step = a.range.step;
-        runSequenceDenoise(s);
+        runSequence(a, params);
         return;
     }
     const std::string ext = io::extensionOf(a.out);
@@ -329,12 +368,16 @@ void addDenoiseCommand(CLI::App& app) {
         methodHelp += std::string(m.name) + " (with --sequence): " + m.summary + "; ";
     cmd->add_option("--method", a->method, methodHelp + "the output line says which method ran")
         ->capture_default_str();
-    cmd->add_option("--spatial", a->spatial, "With --method temporal: the still method run on the averaged frame")
-        ->capture_default_str()
-        ->group(kGroupTemporal);
+    for (const SequenceMethodInfo& m : sequenceMethods())
+        if (m.stillMethod) {  // in the first such method's group
+            cmd->add_option("--spatial", a->spatial, "With --method " + spatialMethods() + ": the still method it ends with")
+                ->capture_default_str()
+                ->group(sequenceGroup(m, true));
+            break;
+        }
     cmd->add_option("--learned-weights", a->learnedWeights,
                     "Weight file of the learned filter (version 4, or 3; docs/learned.md; default: the built-in weights)")
-        ->group(kGroupLearned);
+        ->group(learnedGroup());
     cmd->add_option("--device,-d", a->device, "cpu | cuda | auto (cuda when a GPU is present; oidnDenoise's 'default' = auto)")
         ->capture_default_str()
         ->transform([](std::string v) { return v == "default" ? std::string("auto") : v; });
@@ -346,8 +389,7 @@ void addDenoiseCommand(CLI::App& app) {
                   "features are edge stops, never filtered)")->group(kGroupOidn);
     // One flag per parameter (params.h): --levels, --sigma-normal, --no-firefly, --sure-window, ...
     addParamOptions(*cmd, a->opt, denoiseParams(), paramHelpGroup);
-    addSvgfOptions(*cmd, a->svgf);
-    addTemporalOptions(*cmd, a->temporal);
+    addSequenceOptions(*cmd, a->sequenceParams);
     cmd->callback([a, cmd] { run(*a, *cmd); });
 }
 

@@ -7,6 +7,7 @@
 #if defined(ATROUS_HAVE_VIEWER)
 #include "atrous/params.h"
 #include "cli_flags.h"
+#include "denoise_sequence.h"
 #include "atrous/view_pipeline.h"
 #include "view/viewer.h"
 #endif
@@ -15,7 +16,7 @@ namespace atrous::cli {
 
 #if defined(ATROUS_HAVE_VIEWER)
 namespace {
-// "none | eaw | ... | svgf": the viewer's list, which is the library's (view::methodNames()).
+// "none | eaw | ...": the viewer's list, which is the library's (view::methodNames()).
 std::string methodList() {
     std::string s;
     for (const std::string& n : view::methodNames()) s += (s.empty() ? "" : " | ") + n;
@@ -42,8 +43,9 @@ void addViewCommand(CLI::App& app) {
                     });
     cmd->add_option("--method", o.method, "Denoiser of the main view: " + methodList())
         ->capture_default_str();
-    // --svgf-* (and --taa) from the SVGF parameter table: start values of the panel's SVGF section.
-    addParamOptions(*cmd, o.svgf, svgfParams(), [](const ParamField<SvgfParams>&) { return "SVGF (--method svgf)"; });
+    // --svgf-* (and --taa), --temporal-*: the tables of the sequence methods the viewer runs, start
+    // values of the panel's sections.
+    addSequenceOptions(*cmd, o.sequence, +[](const SequenceMethodInfo& m) { return m.causal || m.causalMode; }, false);
     cmd->add_option("--compare", o.compare, "Split screen: the method shown on the right half");
     cmd->add_flag("--no-accumulate", o.noAccumulate,
                   "Filter each frame on its own (no running mean)");

@@ -6,14 +6,20 @@
 
 namespace atrous::cli {
 
-void addSvgfOptions(CLI::App& cmd, SvgfParams& p) {
-    addParamOptions(cmd, p, svgfParams(), [](const ParamField<SvgfParams>&) { return "SVGF (--method svgf)"; });
+std::string sequenceGroup(const SequenceMethodInfo& m, bool sequenceDefault) {
+    const bool first = sequenceDefault && &m == &sequenceMethods().front();
+    return std::string(m.label) + " (--method " + m.name + (first ? ", the default with --sequence" : "") + ")";
 }
 
-void addTemporalOptions(CLI::App& cmd, TemporalParams& p) {
-    addParamOptions(cmd, p, temporalParams(), [](const ParamField<TemporalParams>&) {
-        return "Temporal (--method temporal, the default with --sequence)";
-    });
+void addSequenceOptions(CLI::App& cmd, std::deque<ParamSet>& params, bool (*keep)(const SequenceMethodInfo&),
+                        bool sequenceDefault) {
+    params.clear();
+    for (const SequenceMethodInfo& m : sequenceMethods()) {
+        params.push_back(m.params);
+        if (keep && !keep(m)) continue;
+        const std::string group = sequenceGroup(m, sequenceDefault);
+        addParamOptions(cmd, params.back().view(), [&](const ParamRow&) { return group.c_str(); });
+    }
 }
 
 int runSequenceDenoise(const SequenceDenoiseArgs& args) {

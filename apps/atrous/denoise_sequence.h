@@ -1,12 +1,15 @@
-// `atrous denoise --sequence DIR --out OUTDIR [--method temporal|svgf|a still method]`: the CLI's
+// `atrous denoise --sequence DIR --out OUTDIR [--method a sequence or still method]`: the CLI's
 // side of the library's sequence session (include/atrous/sequence.h): it prints the session's
 // notes and one line per frame, then a summary.
 #pragma once
 #include <CLI/CLI.hpp>
 
+#include <deque>
 #include <string>
 
+#include "atrous/param_set.h"
 #include "atrous/sequence.h"
+#include "atrous/sequence_methods.h"
 
 namespace atrous::cli {
 
@@ -21,12 +24,16 @@ struct SequenceDenoiseArgs {
 // exit code 2). Returns 0.
 int runSequenceDenoise(const SequenceDenoiseArgs& args);
 
-// Registers one flag per row of svgfParams() (params.h) on `cmd`: --svgf-<name> (--svgf-sigma-l,
-// --svgf-alpha, ...; --svgf-depth-tolerance, --svgf-normal-cos, --taa and --taa-alpha keep their
-// spellings), writing into `params`; the defaults shown are the struct's. Ranges are checked later
-// (checkParamFlags, or validateSvgfParams: a ParamError naming the field).
-void addSvgfOptions(CLI::App& cmd, SvgfParams& params);
-// The same for temporalParams(): --temporal-radius, --temporal-color-sigmas, ...
-void addTemporalOptions(CLI::App& cmd, TemporalParams& params);
+// The help group of a sequence method's flags: "SVGF (--method svgf)"; with sequenceDefault, the
+// first row's says it is the default with --sequence.
+std::string sequenceGroup(const SequenceMethodInfo& method, bool sequenceDefault);
+// One set per row of sequenceMethods() (its defaults), in the registry's order, into `params`, and
+// for each row that `keep` takes (all when null) one flag per row of its table in its help group:
+// --svgf-<name> (--svgf-sigma-l, ...; --svgf-depth-tolerance, --svgf-normal-cos, --taa and
+// --taa-alpha keep their spellings), --temporal-<name>, a plugin's. The defaults shown are the
+// row's. Ranges are checked later (checkParamFlags, or the method's factory: a ParamError naming
+// the field).
+void addSequenceOptions(CLI::App& cmd, std::deque<ParamSet>& params, bool (*keep)(const SequenceMethodInfo&) = nullptr,
+                        bool sequenceDefault = true);
 
 }  // namespace atrous::cli

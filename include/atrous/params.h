@@ -20,6 +20,7 @@
 #include <iterator>
 #include <limits>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -257,6 +258,15 @@ inline const ParamField<R> kRender[] = {
 inline const ParamTable<DenoiseOptions>& denoiseParams() {
     static const ParamTable<DenoiseOptions> t{"denoise", "", params_detail::kDenoise, std::size(params_detail::kDenoise)};
     return t;
+}
+// The title of a group of denoiseParams() (the CLI's help groups, the viewer's sections).
+inline const char* denoiseGroupTitle(const std::string& group) {
+    static const std::pair<const char*, const char*> kTitles[] = {
+        {"", "Albedo demodulation"}, {"firefly", "Fireflies"}, {"emission", "Emission"},
+        {"safety", "Safety net"},    {"eaw", "EAW's edge stops"},  {"sure", "SURE's choice of details"}};
+    for (const auto& t : kTitles)
+        if (group == t.first) return t.second;
+    return "";
 }
 inline const ParamTable<SvgfParams>& svgfParams() {
     static const ParamTable<SvgfParams> t{"svgf", "svgf-", params_detail::kSvgf, std::size(params_detail::kSvgf)};

@@ -3,8 +3,9 @@
 // run. It reads any layout src/io/sequence.h lists (atrous's frame_NNNN folders, one folder per
 // frame with a renderer's own file names such as LuxCore's, numbered files per buffer, numbered
 // layered EXRs such as Blender's renderNNNN.exr, or a pattern render####.exr / render%04d.exr),
-// checks every frame's headers before anything is written, denoises each frame (temporal: with
-// the frames around it; svgf: with its history; a still method: on its own), and moves
+// checks every frame's headers before anything is written, denoises each frame through its
+// method's SequenceDenoiser (atrous/sequence_methods.h: temporal with the frames around it, svgf
+// with its history; a still method on its own), and moves
 // OUTDIR/frame_NNNN.exr (+ .png previews, + preview.mp4 through ffmpeg when it is on PATH) into
 // place only when every frame is done. Bad input throws InputError naming the frame's file.
 #pragma once
@@ -14,23 +15,23 @@
 
 #include "atrous/denoise.h"
 #include "atrous/device.h"
-#include "atrous/learned.h"
-#include "atrous/svgf.h"
-#include "atrous/temporal.h"
+#include "atrous/param_set.h"
 
 namespace atrous {
 
 struct SequenceDenoiseOptions {
-    // A sequence method (sequenceMethods(): temporal, svgf) or a still method (denoiseMethods(),
-    // each frame on its own; auto is resolved per frame by the buffers it has).
-    std::string method = "temporal";
+    // A sequence method (sequenceMethods(), atrous/sequence_methods.h: temporal, svgf, a
+    // registered one) or a still method (denoiseMethods(), each frame on its own; auto is resolved
+    // per frame by the buffers it has). "" = the first sequence method (temporal).
+    std::string method;
     Device device = Device::Cpu;
     // The still method's options (its method field is overwritten by `method` for a still method;
-    // with temporal it is the still method run on the average, the CLI's --spatial).
+    // with a sequence method that ends with a still method it is that one, the CLI's --spatial).
+    // Their weights serve a sequence method whose parameters read the learned weights too.
     DenoiseOptions frame;
-    TemporalParams temporal;      // method temporal
-    SvgfParams svgf;              // method svgf
-    LearnedWeights svgfWeights;   // svgf.learnedSpatial's network; empty = the built-in one
+    // The sequence method's parameters: a set of its row's table (SequenceMethodInfo::params);
+    // empty = the row's defaults.
+    ParamSet params;
     // Layered frames: "BUFFER=NAME" requests (the CLI's --pass) and the view layer (--layer),
     // applied to every frame; a sequence of plain EXR folders refuses both.
     std::vector<std::string> passes;
@@ -49,8 +50,8 @@ struct SequenceFrameReport {
     int index = 0;          // the frame's number in the input
     std::string input;      // the frame's file or folder
     std::string output;     // OUTDIR/frame_NNNN.exr (where it will be once the run is done)
-    std::string method;     // e.g. "temporal (+-3 frames, 3.8 averaged per pixel in 6 ms; then auto -> blend)"
-    std::string methodUsed; // the still method that ran (blend, sure, ...); "svgf" for SVGF
+    std::string method;     // the method and its SequenceOutput::detail: "temporal (+-3 frames, 3.8 averaged per pixel in 6 ms; then auto -> blend)"
+    std::string methodUsed; // the still method that ran (blend, sure, ...), else the sequence method's name
     double milliseconds = 0;
     double reprojected = -1;  // fraction of the frame that reprojects onto the previous one (-1: not tested)
     bool hasReference = false;  // the frame has a reference.exr: then the MSEs below

@@ -73,6 +73,9 @@ struct SvgfParams {
     float safetyNet = 0.05f;
 };
 
+// The row of SVGF in the registry of sequence methods (atrous/sequence_methods.h).
+constexpr const char* kSvgfMethod = "svgf";
+
 // Throws ParamError (atrous/params.h: an InputError naming the field, `sigma_l`) when a
 // parameter is out of range.
 void validateSvgfParams(const SvgfParams& p);

@@ -173,22 +173,28 @@ struct MotionEstimateParams {
 };
 Image estimateMotion(const Image& current, const Image* previous, const MotionEstimateParams& params = {});
 
-// The methods that denoise a sequence as a sequence, beside the still methods (denoiseMethods(),
-// which `atrous denoise --sequence` also runs frame by frame): one row each, the one list the
-// CLI's --method help and messages and Python (atrous.SEQUENCE_METHODS) read.
-struct SequenceMethodInfo {
-    const char* name;     // "temporal", "svgf": the CLI's --method
-    const char* summary;  // one line: the CLI's help
-    bool causal;          // each frame from the frames before it only (real time, the viewer)
-    bool causalMode;      // not causal itself, but has a causal mode (temporal's TemporalParams::causal),
-                          // which a viewer runs
-    // Its parameter table: "temporal" (temporalParams(), the CLI's --temporal-* flags; the still
-    // method it ends with takes denoiseParams()) or "svgf" (svgfParams(), --svgf-*).
-    const char* params;
-    std::vector<Buffer> reads;  // the frame's buffers it reads (atrous/buffers.h); colour required
+// Motion for a stream of frames that have no motion vectors, frame by frame in order (the
+// sequence session, Python's denoise_temporal): from the frame's Position pass, through each
+// frame's fitted camera (motionFromPositions against the previous frame's), or without one from its
+// colour (estimateMotion against the previous frame's). A first frame, and one whose previous
+// frame has another size, has no history: NaN. Host images.
+class StreamMotion {
+public:
+    enum class From { Positions, Colours };
+    // `frame`'s motion; `previous`: the frame before it in the stream, null for the first.
+    Image next(const Frame& frame, const Frame* previous);
+    From from() const { return mFrom; }  // what the last next() used
+    // Positions: the camera fitted to the frame before the last one (null before two frames), which
+    // its motion was measured against.
+    const CameraFit* previousCamera() const { return mFrames > 1 ? &mPrevious : nullptr; }
+
+private:
+    From mFrom = From::Positions;
+    CameraFit mCamera, mPrevious;
+    size_t mFrames = 0;
 };
-const std::vector<SequenceMethodInfo>& sequenceMethods();  // temporal (the --sequence default) first
-const SequenceMethodInfo* findSequenceMethod(const std::string& name);  // null when unknown
-std::string sequenceMethodNames();  // "temporal, svgf"
+
+// The row of this method in the registry of sequence methods (atrous/sequence_methods.h).
+constexpr const char* kTemporalMethod = "temporal";
 
 }  // namespace atrous

@@ -15,8 +15,8 @@
 #include "atrous/image.h"
 #include "atrous/render.h"
 #include "atrous/stage_time.h"
-#include "atrous/svgf.h"
-#include "atrous/temporal.h"
+#include "atrous/param_set.h"
+#include "atrous/sequence_methods.h"
 #include "atrous/camera.h"
 #include "atrous/math.h"
 
@@ -29,20 +29,22 @@ namespace atrous::view {
 
 // A method of the viewer's list, which is the library's lists: "none" (the noisy input), each still
 // method (denoiseMethods(), include/atrous/denoise.h; auto included), each causal sequence method
-// (sequenceMethods(), include/atrous/temporal.h: svgf) and each one with a causal mode, run in it
-// (temporal: frames t-3..t, since the viewer has no later frames).
+// (sequenceMethods(), include/atrous/sequence_methods.h: svgf) and each one with a causal mode, run
+// in it (temporal: frames t-3..t, since the viewer has no later frames).
 struct Method {
-    enum class Kind : unsigned char { None, Still, Svgf, Temporal };
+    enum class Kind : unsigned char { None, Still, Sequence };
     Kind kind = Kind::None;
-    DenoiseMethod still = DenoiseMethod::Auto;  // Kind::Still: the still method
+    DenoiseMethod still = DenoiseMethod::Auto;      // Kind::Still: the still method
+    const SequenceMethodInfo* sequence = nullptr;  // Kind::Sequence: its row
     static Method none() { return {}; }
-    static Method svgf() { return {Kind::Svgf, DenoiseMethod::Auto}; }
-    static Method temporal() { return {Kind::Temporal, DenoiseMethod::Auto}; }
-    static Method of(DenoiseMethod m) { return {Kind::Still, m}; }
-    // SVGF and the temporal method take each frame's own samples (with motion and emission), not
-    // the running mean the still methods filter.
-    bool ownSamples() const { return kind == Kind::Svgf || kind == Kind::Temporal; }
-    bool operator==(const Method& o) const { return kind == o.kind && (kind != Kind::Still || still == o.still); }
+    static Method of(DenoiseMethod m) { return {Kind::Still, m, nullptr}; }
+    static Method of(const SequenceMethodInfo& m) { return {Kind::Sequence, DenoiseMethod::Auto, &m}; }
+    // A sequence method takes each frame's own samples (with motion and emission), not the running
+    // mean the still methods filter.
+    bool ownSamples() const { return kind == Kind::Sequence; }
+    bool operator==(const Method& o) const {
+        return kind == o.kind && (kind != Kind::Still || still == o.still) && (kind != Kind::Sequence || sequence == o.sequence);
+    }
     bool operator!=(const Method& o) const { return !(*this == o); }
 };
 // The names of the list in order (the panel's combo boxes, `atrous view --method`'s help).
@@ -51,13 +53,15 @@ std::vector<std::string> methodNames();
 const char* methodName(const Method& m);
 Method parseMethod(const std::string& name);  // a name of methodNames(); InputError otherwise
 
+
 // Everything the user can change between frames.
 struct PipelineSettings {
     int sppPerFrame = 1;
     bool accumulate = true;  // EAW/SURE/none filter the running mean over frames
-    // False when nothing will read the accumulated buffers this frame (only SVGF slots, which take
-    // each frame's own samples, and the result or motion view): the accumulation is skipped (about
-    // 10% of an SVGF frame's CPU time at 256x256) and the running mean restarts when needed again.
+    // False when nothing will read the accumulated buffers this frame (only sequence-method slots,
+    // which take each frame's own samples, and the result or motion view): the accumulation is
+    // skipped (about 10% of an SVGF frame's CPU time at 256x256) and the running mean restarts
+    // when needed again.
     bool needAccumulated = true;
     int maxDepth = 8;
     Method methodA = Method::of(DenoiseMethod::Blend);  // what auto picks with the renderer's albedo and normal
@@ -66,12 +70,14 @@ struct PipelineSettings {
     // EAW's and SURE's parameters (SURE runs on the EAW cascade); the slot sets method, device
     // and report. The panel's controls are their tables' rows (params.h).
     DenoiseOptions denoise;
-    SvgfParams svgf;
-    // The temporal method (run causal: TemporalParams::causal is forced), its still method auto.
-    TemporalParams temporal;
-    // SVGF on camera motion: true = feed reprojection motion vectors computed from the depth buffer
-    // and the previous camera (history survives the move); false = reset the history instead.
-    bool svgfMotionVectors = true;
+    // Each sequence method's parameters, by its place in sequenceMethods() (sequenceParams() below:
+    // the row's defaults until set). A method with a causal mode runs in it; one that ends with a
+    // still method ends with auto, with `denoise`'s parameters.
+    std::vector<ParamSet> sequence;
+    // The sequence methods on camera motion: true = feed reprojection motion vectors computed from
+    // the depth buffer and the previous camera (history survives the move); false = reset the
+    // history instead.
+    bool sequenceMotionVectors = true;
     // Debug buffers, computed only when asked for (they cost extra filter runs).
     int detailLevel = -1;        // >= 0: compute d_i for this level
     bool sureFractions = false;  // capture SURE's s_i(p) (CPU only)
@@ -79,6 +85,11 @@ struct PipelineSettings {
     // interop display; host copies are made only when something asks for them (resultHost()).
     bool deviceResults = false;
 };
+
+// The parameters of sequence method m in s: the row's defaults until set (the panel's controls and
+// the viewer's flags write there).
+ParamSet& sequenceParams(PipelineSettings& s, const SequenceMethodInfo& m);
+const ParamSet& sequenceParams(const PipelineSettings& s, const SequenceMethodInfo& m);
 
 // Milliseconds spent in each stage of the last step(): wall clock, and CPU time of the whole
 // process (user + system over all threads, getrusage), which other tenants of a shared machine
@@ -101,7 +112,7 @@ struct SlotResult {
     Image deviceImage;
     std::string error;    // non-empty when the filter refused its parameters (image = input then)
     double filterMs = 0;  // wall clock of the slot's filter call (uploads and checks included)
-    // The filter's own per-stage times (DenoiseReport::stages / SvgfReport::stages); their sum is
+    // The filter's own per-stage times (DenoiseReport::stages / SequenceOutput::stages); their sum is
     // at most filterMs, the rest being validation, noise estimation and transfers.
     std::vector<StageTime> stages;
 };
@@ -123,9 +134,9 @@ class ViewPipeline {
     Vec3 sceneCenter() const { return mSceneCenter; }
     float sceneRadius() const { return mSceneRadius; }
 
-    // Moves the camera: accumulation restarts; SVGF gets motion vectors (or a reset).
+    // Moves the camera: accumulation restarts; the sequence methods get motion vectors (or a reset).
     void setCamera(const pt::Camera& c);
-    // Drops the accumulated frames (and SVGF histories).
+    // Drops the accumulated frames (and the sequence methods' histories).
     void resetAccumulation();
 
     // Renders one frame, accumulates it and runs the slots' filters. Throws InputError only for
@@ -151,7 +162,7 @@ class ViewPipeline {
     const Image& depth() const { return hostBuffer(kDepth); }
     const Image& ids() const { return hostBuffer(kIds); }
     const Image& motion() const { return hostBuffer(kMotion); }  // x = dx, y = dy (previous - current), pixels
-    const Image& emission() const { return hostBuffer(kEmission); }  // this frame's (SVGF's input)
+    const Image& emission() const { return hostBuffer(kEmission); }  // this frame's (the sequence methods' input)
     const Image& emissionMean() const { return hostBuffer(kEmissionMean); }  // running mean (EAW/SURE)
     // The same buffers where they live, on device() (no copy; for GPU consumers).
     const Image& deviceBuffer(Buffer b) const { return *buffer(b); }
@@ -213,18 +224,18 @@ class ViewPipeline {
     bool mEmissionValid = false;
     bool mVarianceValid = false;
     mutable SlotResult mSlots[2];  // mutable: resultHost() fills the host copy on demand
-    std::unique_ptr<SvgfDenoiser> mSvgf[2];
-    // The temporal slots' last frames (their own samples, on the host), oldest first, with their
-    // frame numbers for the cache; cleared with the SVGF histories.
-    struct HistoryFrame {
-        long long index = 0;
-        RenderBuffers b;  // motion and emission: the pipeline's (mMotion, mEmission)
+    // A slot's sequence method: its denoiser and what it was made with (a change makes a new one).
+    struct SequenceSlot {
+        std::unique_ptr<SequenceDenoiser> denoiser;
+        const SequenceMethodInfo* method = nullptr;
+        ParamSet params;
+        DenoiseOptions still;
+        bool onDevice = false;
     };
-    std::deque<HistoryFrame> mHistory[2];
-    TemporalCache mTemporalCache[2];
-    void runTemporal(int i, const PipelineSettings& s, SlotResult& r);
-    SvgfParams mSvgfParams[2];
-    bool mSvgfResetPending = false;
+    SequenceSlot mSequence[2];
+    SequenceDenoiser& sequenceDenoiser(int i, const SequenceMethodInfo& m, const PipelineSettings& s, bool onDevice);
+    void runSequence(int i, const SequenceMethodInfo& m, const PipelineSettings& s, SlotResult& r);
+    bool mHistoryResetPending = false;
     Image mDetail, mSureS;
     int mDetailLevelShown = -1;
     StageTimes mTimes;

@@ -55,7 +55,10 @@ __all__ = [
     "temporal_params",
     "temporal_window_radius",
     "denoise_temporal",
+    "denoise_window",
     "denoise_sequence",
+    "SequenceDenoiser",
+    "sequence_params",
     "render_params",
     "METHODS",
     "SEQUENCE_METHODS",
@@ -73,7 +76,7 @@ __all__ = [
 __version__ = "0.1.0"
 
 # METHODS (the still methods), SEQUENCE_METHODS (those that denoise a sequence as a sequence:
-# temporal, svgf) and WEIGHTED_METHODS (those that read the learned filter's weights) are read from
+# the built-in ones and a plugin's) and WEIGHTED_METHODS (those that read the learned filter's weights) are read from
 # the library's registry when asked for (module __getattr__), so a method added with
 # register_method is in them from then on.
 def __getattr__(name: str) -> Any:
@@ -87,14 +90,15 @@ def __getattr__(name: str) -> Any:
 
 
 def methods() -> list:
-    """Every method, one dict each, from the library's registry: name, kind ("still": a method of
-    :func:`denoise`; "sequence": of :func:`denoise_sequence` / :class:`Svgf`), summary, registered
-    (added with :func:`register_method`) and params (its parameter table: "denoise",
-    "temporal" or "svgf", i.e. :func:`denoise_params` ...). The still methods come first, in the
+    """Every method, one dict each, from the library's registries: name, kind ("still": a method of
+    :func:`denoise`; "sequence": of :class:`SequenceDenoiser` and :func:`denoise_sequence`),
+    summary, registered (added with :func:`register_method` or by a plugin) and params (its
+    parameter table: "denoise" for the still methods, i.e. :func:`denoise_params`; a sequence
+    method's own, :func:`sequence_params`; "" for none). The still methods come first, in the
     order of the CLI's ``--method`` help."""
     rows = [dict(name=str(r["name"]), kind="still", summary=str(r["summary"]), registered=bool(r["registered"]),
                  params=str(r["params"])) for r in _core.denoise_methods()]
-    rows += [dict(name=str(r["name"]), kind="sequence", summary=str(r["summary"]), registered=False,
+    rows += [dict(name=str(r["name"]), kind="sequence", summary=str(r["summary"]), registered=bool(r["registered"]),
                   params=str(r["params"])) for r in _core.sequence_methods()]
     return rows
 
@@ -123,8 +127,9 @@ def register_method(name: str, cascade: Any, summary: str = "",
 
 def load_plugin(path: "PathLike") -> None:
     """Loads a C++ plugin, a shared library built against include/atrous whose entry point
-    registers still methods (include/atrous/plugins.h): they are then in :func:`methods` and run
-    through :func:`denoise`, as in the CLI with ``atrous --plugin FILE.so``. Loading one twice does
+    registers still and sequence methods (include/atrous/plugins.h): they are then in
+    :func:`methods`, :data:`METHODS` / :data:`SEQUENCE_METHODS`, and run through :func:`denoise`,
+    :class:`SequenceDenoiser` and :func:`denoise_sequence`, as in the CLI with ``atrous --plugin FILE.so``. Loading one twice does
     nothing; a missing or unloadable file, or a name already taken, raises ValueError."""
     _core.load_plugin(os.fsdecode(os.fspath(path)))
 
@@ -132,12 +137,6 @@ def load_plugin(path: "PathLike") -> None:
 def denoise_methods() -> list:
     """The still methods, one dict per method: name, summary, uses_weights, registered (the library's list)."""
     return [dict(r) for r in _core.denoise_methods()]
-
-
-def sequence_methods() -> list:
-    """The sequence methods, one dict per method: name, summary, causal, params (its parameter table)
-    and reads (the buffers it reads, :func:`buffers`), the library's list."""
-    return [dict(r) for r in _core.sequence_methods()]
 
 
 def builtin_scenes() -> list:
@@ -159,7 +158,7 @@ def denoise_params() -> list:
 
 
 def svgf_params() -> list:
-    """The keywords of :class:`Svgf`, in the form of :func:`denoise_params`."""
+    """The keywords of :class:`Svgf` (:func:`sequence_params` of its row), in the form of :func:`denoise_params`."""
     return [dict(r) for r in _core.svgf_params()]
 
 
@@ -466,116 +465,6 @@ def write_image(path: PathLike, image: Any) -> None:
     _core.write_image(p, _prepare(image, p))
 
 
-_FRAME_KEYS = ("color", "albedo", "normal", "position", "depth", "variance", "ids", "emission", "motion")
-
-
-def denoise_temporal(frames: Sequence[Dict[str, Any]], center: int, *, method: str = "auto",
-                     device: str = "auto", learned_weights: Union["PathLike", "Weights", None] = None,
-                     temporal: Optional[Dict[str, Any]] = None, **params: Any) -> Any:
-    """Denoises frames[center] of an animation with the frames around it (docs/temporal.md): the
-    offline sequence denoiser that `atrous denoise --sequence` runs by default.
-
-    frames: a window of consecutive frames, each a dict of H x W x C numpy arrays with the keys of
-    :func:`denoise` (color required; albedo, normal, position, depth, variance, ids, emission) and
-    motion (H x W x 2 or 3: dx, dy in pixels, previous - current); every frame has the same keys.
-    The items of :func:`render_sequence` are such dicts. Without motion in any frame but with a
-    position in every one, the motion comes from each frame's fitted camera (as the CLI does).
-    temporal: the rows of :func:`temporal_params` (radius: frames on each side, 3; ...).
-    method, learned_weights and params: the still method run on the average, as in :func:`denoise`.
-    device: where that still method runs ("auto", "cpu", "cuda"); the averaging runs on the CPU.
-    Returns the denoised H x W x 3 float32 array. Raises ValueError for bad input."""
-    if not isinstance(frames, (list, tuple)) or not frames:
-        raise ValueError("frames must be a non-empty list of dicts")
-    core_frames = []
-    for i, f in enumerate(frames):
-        if not isinstance(f, dict):
-            raise ValueError(f"frame {i} must be a dict of arrays")
-        unknown = sorted(set(f) - set(_FRAME_KEYS) - {"time"})  # render_sequence's items carry their time
-        if unknown:
-            raise ValueError(f"frame {i}: unknown buffer {unknown[0]!r} (expected {', '.join(_FRAME_KEYS)})")
-        core_frames.append({k: _prepare(v, f"frames[{i}].{k}", allow_gray=k != "color",
-                                        channels=(2, 3) if k in ("motion", "ids") else (3,))
-                            for k, v in f.items() if v is not None and k != "time"})
-    if isinstance(center, bool) or not isinstance(center, (int, np.integer)) or not 0 <= int(center) < len(frames):
-        raise ValueError(f"center must be a frame index in 0..{len(frames) - 1}, got {center!r}")
-    weights = _weights_arg(learned_weights)
-    out = _core.denoise_temporal(core_frames, int(center), method, weights, device, dict(temporal or {}), dict(params))
-    return _wrap_like(out, frames[int(center)]["color"])
-
-
-def denoise_sequence(input: "PathLike", out: "PathLike", *, method: str = "temporal", spatial: str = "auto",
-                     device: str = "auto", learned_weights: Union["PathLike", "Weights", None] = None,
-                     passes: Optional[Dict[str, str]] = None, layer: str = "", add_pass: str = "",
-                     start: Optional[int] = None, end: Optional[int] = None, step: int = 1,
-                     exposure: float = 1.0, pngs: bool = True, preview: bool = True,
-                     temporal: Optional[Dict[str, Any]] = None, svgf: Optional[Dict[str, Any]] = None,
-                     on_frame: Any = None, **params: Any) -> Dict[str, Any]:
-    """Denoises an animation from its files into the folder `out`: what `atrous denoise --sequence
-    INPUT --out OUT` does (docs/temporal.md), from Python and the Blender add-on.
-
-    input: a folder in any layout the CLI reads (atrous's frame_NNNN folders, one folder per frame
-    with a renderer's own names such as LuxCore's, color_0001.exr-style numbered files, Blender's
-    numbered multilayer renderNNNN.exr) or a pattern ("renders/render####.exr", "%04d").
-    method: "temporal" (frames t-3..t+3, t-6..t+6 where still; the default), "svgf", or a method of :data:`METHODS`
-    run on each frame alone. spatial: the still method temporal runs on its average.
-    passes: {buffer: pass name} for layered frames (the CLI's --pass); layer: the view layer.
-    start/end/step: the frames to denoise (None: the first / the last).
-    temporal, svgf: rows of :func:`temporal_params` / :func:`svgf_params`; params: the still
-    method's rows (:func:`denoise_params`). on_frame(dict) is called as each frame is done.
-    Writes out/frame_NNNN.exr (+ .png and preview.mp4 unless pngs/preview are False) only when
-    every frame is done; `out` must not be inside the input's folder. Returns the run's report:
-    width, height, buffers (the names every frame has), frames (one dict each: index, input,
-    output, method, method_used, ms, reprojected, mse, mse_input, line), filter_ms_per_frame,
-    wall_ms_per_frame, preview (the video's path, or None) and notes.
-    Raises ValueError for bad input (nothing is written then)."""
-    pass_specs = [f"{k}={v}" for k, v in (passes or {}).items()]
-    weights = _weights_arg(learned_weights)
-    return _core.denoise_sequence(os.fsdecode(os.fspath(input)), os.fsdecode(os.fspath(out)), method, spatial,
-                                  device, weights, pass_specs, layer, add_pass,
-                                  -1 if start is None else int(start), -1 if end is None else int(end), int(step),
-                                  float(exposure), bool(pngs), bool(preview), dict(temporal or {}),
-                                  dict(svgf or {}), dict(params), on_frame)
-
-
-class Svgf:
-    """Spatiotemporal variance-guided filtering of a stream of 1-spp frames (keeps history).
-
-    params: the rows of :func:`svgf_params` (docs/svgf.md gives their meaning):
-
-{params}
-    """
-
-    def __init__(self, device: str = "auto", *, learned_weights: Union["PathLike", "Weights", None] = None,
-                 **params: Any) -> None:
-        """device: "auto" (CUDA when this build has a usable GPU, else the CPU, as everywhere in
-        atrous), "cpu" or "cuda". Frames on another device than the filter's are copied over.
-        learned_weights: for learned_spatial=True, a Weights (:func:`load_weights`) or a weight
-        file (version 4, or 3); None = the built-in weights; a bad file raises ValueError naming it;
-        unused without learned_spatial."""
-        weights = _weights_arg(learned_weights)
-        self._impl = _core.Svgf(device, weights, dict(params))
-
-    def denoise_frame(self, color: Any, *, albedo: Any = None, normal: Any = None, depth: Any = None,
-                      ids: Any = None, motion: Any = None, emission: Any = None, position: Any = None,
-                      variance: Any = None) -> Any:
-        """Denoises the next frame; motion is (dx, dy) in pixels, previous - current. position and
-        variance reach the per-frame safety net's still filter (safety_net; SVGF itself has no use
-        for them)."""
-        c = _prepare(color, "color", allow_gray=False)
-        b = [_prepare(v, n, channels=(2, 3) if n in ("motion", "ids") else (3,))
-             for n, v in (("albedo", albedo), ("normal", normal), ("depth", depth), ("ids", ids),
-                          ("motion", motion), ("emission", emission), ("position", position), ("variance", variance))]
-        return _wrap_like(self._impl.denoise_frame(c, *b), color)
-
-    def reset(self) -> None:
-        """Forgets the history: the next frame starts a new sequence."""
-        self._impl.reset()
-
-    @property
-    def device(self) -> str:
-        return self._impl.device
-
-
 def _list_params(rows) -> str:
     out = []
     for r in rows:
@@ -588,11 +477,11 @@ def _list_params(rows) -> str:
 # The docstrings list the keywords from the library's table, so they cannot fall behind it.
 if denoise.__doc__:
     denoise.__doc__ = denoise.__doc__.replace("{params}", _list_params(denoise_params()))
-if Svgf.__doc__:
-    Svgf.__doc__ = Svgf.__doc__.replace("{params}", _list_params(svgf_params()))
 if render.__doc__:
     render.__doc__ = render.__doc__.replace("{params}", _list_params(render_params()))
 
 
-# The metrics (measure.py) use _prepare above.
+# The metrics (measure.py) and the sequence methods (sequence.py) use _prepare above.
 from .measure import metrics, relmse, temporal_metrics, tonemap  # noqa: E402
+from .sequence import (SequenceDenoiser, Svgf, denoise_sequence, denoise_temporal, denoise_window,  # noqa: E402
+                       sequence_methods, sequence_params)

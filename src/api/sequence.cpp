@@ -16,6 +16,8 @@
 #include <memory>
 
 #include "atrous/error.h"
+#include "atrous/sequence_methods.h"
+#include "atrous/temporal.h"
 #include "atrous/timer.h"
 #include "atrous/io/buffer_set.h"
 #include "atrous/io/image_io.h"
@@ -82,262 +84,283 @@ std::string writeAnimatedPreview(const std::string& stage, int firstIndex, const
     return "";
 }
 
+// The method's row, null for a still method run frame by frame.
+const SequenceMethodInfo* rowOf(const std::string& method) { return findSequenceMethod(method); }
+
 // What is checked before any frame is read.
-void checkOptions(const std::string& input, const std::string& outDir, const SequenceDenoiseOptions& o) {
-    const bool svgf = o.method == "svgf", temporal = o.method == "temporal";
-    if (!findSequenceMethod(o.method) && !findDenoiseMethod(o.method))
-        throw InputError("--method '" + o.method + "' cannot denoise a sequence (expected " + sequenceMethodNames() +
+void checkOptions(const std::string& input, const std::string& outDir, const SequenceDenoiseOptions& o,
+                  const std::string& method) {
+    const SequenceMethodInfo* row = rowOf(method);
+    if (!row && !findDenoiseMethod(method))
+        throw InputError("--method '" + method + "' cannot denoise a sequence (expected " + sequenceMethodNames() +
                          ", " + denoiseMethodNames() + ")");
     if (input.empty()) throw InputError("--sequence: no directory given");
     if (o.step < 1) throw InputError("--step " + std::to_string(o.step) + ": must be at least 1");
-    if ((svgf || temporal) && o.step > 1)
-        throw InputError("--step " + std::to_string(o.step) + ": " +
-                         (svgf ? "SVGF carries its history from one frame to the next"
-                               : "the temporal method averages neighbouring frames") +
+    if (row && o.step > 1)
+        throw InputError("--step " + std::to_string(o.step) + ": " + row->acrossFrames +
                          ", and the motion vectors do not span skipped frames (use --step 1, or a per-frame --method)");
     if (outDir.empty()) throw InputError("--out: no output directory given");
     if (!(o.exposure > 0.0f)) throw InputError("--exposure must be > 0");
-    if (temporal) validateTemporalParams(o.temporal);
-    if (svgf) validateSvgfParams(o.svgf);
+    if (row && !o.params.empty()) {
+        if (std::string(o.params.set()) != row->params.set())
+            throw InputError("--method " + method + ": its parameters are the table '" + row->params.set() + "', not '" +
+                             o.params.set() + "'");
+        o.params.validate();
+    } else if (row) {
+        row->params.validate();
+    }
+}
+
+// The InputError of a frame's buffer, naming the frame's file too (the library names the buffer).
+[[noreturn]] void rethrowNamingFile(const InputError& e, const io::SequenceFrame& f) {
+    throw InputError(io::withSourceFile(e.what(), [&](const std::string& b) { return f.fileOf(b); }, f.dir));
+}
+
+// One run: frames are read in order (the next one on another thread), given motion where they have
+// none, checked against the previous frame, pushed into the method's denoiser, and each frame it
+// hands back is written (on a third thread) into the staged folder.
+class Session {
+public:
+    Session(const std::string& input, const std::string& outDir, const SequenceDenoiseOptions& args,
+            const SequenceEvents& events)
+        : mInput(input), mOutDir(outDir), mArgs(args), mEvents(events),
+          mMethod(args.method.empty() ? sequenceMethods().front().name : args.method), mRow(rowOf(mMethod)) {}
+
+    SequenceReport run();
+
+private:
+    using FramePtr = std::shared_ptr<io::SequenceFrame>;
+    void note(const std::string& line) {
+        mReport.notes.push_back(line);
+        if (mEvents.note) mEvents.note(line);
+    }
+    void start();
+    bool fillMotion(io::SequenceFrame& f, size_t i);
+    void checkAgainstPrevious(const io::SequenceFrame& f, size_t i, bool estimated);
+    void push(FramePtr f);
+    void outputFrame();
+    void writeFrame(const std::string& name, std::shared_ptr<io::ExrInfo> layered, Image out);
+    void finishFrame(SequenceFrameReport& r, const SequenceOutput& out, const std::string& name);
+    void writePreviewAndCommit();
+
+    const std::string mInput, mOutDir;
+    const SequenceDenoiseOptions& mArgs;
+    const SequenceEvents& mEvents;
+    const std::string mMethod;
+    const SequenceMethodInfo* mRow;
+    SequenceReport mReport;
+    io::SequenceOptions mLayers;
+    std::vector<std::string> mFrames, mPresent;
+    std::unique_ptr<io::StagedDir> mStaged;
+    std::unique_ptr<SequenceDenoiser> mDenoiser;
+    bool mUsesMotion = false;
+    std::deque<FramePtr> mPending;  // pushed, not yet handed back: the front is the next to come out
+    FramePtr mPrev;                 // the last frame read (motion from colours, the reprojection check)
+    std::vector<io::ReprojectionCheck> mChecks;
+    StreamMotion mMotion;  // frames without motion vectors
+    bool mIdsTrusted = true, mWarnedSign = false, mNotedMotion = false;
+    int mFirstIndex = 0;
+    std::future<void> mWriting;
+    double mFilterMs = 0.0;
+};
+
+// Everything that can be checked before writing is checked first; what only decoding finds (a
+// truncated EXR) fails inside the loop, before anything reaches OUTDIR (StagedDir).
+void Session::start() {
+    checkOptions(mInput, mOutDir, mArgs, mMethod);
+    mLayers.passes = io::parsePassRequests(mArgs.passes);
+    mLayers.viewLayer = mArgs.viewLayer;
+    io::FrameRange range;
+    range.start = mArgs.start, range.end = mArgs.end, range.step = mArgs.step;
+    // OUTDIR in the sequence directory would take its frame_NNNN.exr names (io/paths.h). (A
+    // pattern's frames are in its directory.)
+    io::refuseOutputInside("--out", mOutDir, io::sequenceFolder(mInput));
+    mFrames = io::listSequenceFrames(mInput, range);
+    if (!mArgs.addPass.empty() && !io::isLayeredSequenceFrame(mFrames.front()))
+        throw InputError("--add-pass '" + mArgs.addPass + "': copies a layered EXR frame, and " + mInput +
+                         " holds frames of plain EXRs");
+    mPresent = io::validateSequence(mFrames, mReport.width, mReport.height, mLayers);
+    mReport.buffers = mPresent;
+    SequenceSetup setup;
+    setup.device = mArgs.device;
+    setup.params = mArgs.params;
+    setup.still = mArgs.frame;
+    // The static window (TemporalParams::staticRadius) needs the renderer's own motion vectors:
+    // motion fitted to positions or estimated from colours (below) sees a moving object as still.
+    setup.motionGiven = std::find(mPresent.begin(), mPresent.end(), "motion") != mPresent.end();
+    mDenoiser = makeSequenceDenoiser(mMethod, setup);
+    mUsesMotion = mDenoiser->reads().has(Buffer::Motion);
+    mStaged = std::make_unique<io::StagedDir>("--out", mOutDir);
+    mChecks.resize(mFrames.size());
+}
+
+// No motion vectors but a Position pass (LuxCore): motion from each frame's fitted camera; neither
+// (a renderer that writes colour, albedo and normal): motion from the colours themselves, block
+// matching against the previous frame (the first has none: no history; the frames' sizes were
+// checked above). Returns whether the motion was estimated from the colours against a previous
+// frame (not the user's vectors to judge).
+bool Session::fillMotion(io::SequenceFrame& f, size_t i) {
+    if (!mUsesMotion || !f.motion.empty() || f.color.empty()) return false;
+    const Frame prev = mPrev ? io::refsOf(*mPrev) : Frame();
+    f.motion = mMotion.next(io::refsOf(f), mPrev ? &prev : nullptr);  // frame 0: no previous, NaN (no history)
+    if (mMotion.from() == StreamMotion::From::Positions) {
+        if (i > 0 && !mNotedMotion) {
+            const CameraFit& camera = *mMotion.previousCamera();
+            if (camera.ok)
+                note(format("denoise: note: the frames have no motion vectors: motion from the Position pass (a "
+                            "camera fitted per frame, median reprojection error %.2f px)",
+                            camera.medianErrorPx));
+            else
+                note(format("denoise: note: the frames have no motion vectors, and no pinhole camera fits their "
+                            "Position pass (median reprojection error %.2g px): no motion",
+                            camera.medianErrorPx));
+            mNotedMotion = true;
+        }
+        return false;
+    }
+    const bool estimated = mPrev != nullptr;
+    if (estimated && !mNotedMotion)
+        note("denoise: note: the frames have no motion vectors and no Position pass: motion estimated "
+             "from the frames' colours (block matching, docs/temporal.md)");
+    mNotedMotion = mNotedMotion || estimated;
+    return estimated;
+}
+
+// Other renderers' sequences: how much reprojects, with which sign, and whether ids hold (ids that
+// change between frames are left out of every frame from here on).
+void Session::checkAgainstPrevious(const io::SequenceFrame& f, size_t i, bool estimated) {
+    const std::string name = io::sequenceFrameName(f.index);
+    io::ReprojectionCheck& check = mChecks[i];
+    if (mPrev && !estimated)
+        check = io::checkReprojection(f.depth, f.normal, f.ids, f.motion, mPrev->depth, mPrev->normal, mPrev->ids);
+    if (mUsesMotion && f.motion.empty() && !mNotedMotion) {
+        note(std::string("denoise: note: the frames have no motion vectors: ") +
+             (mRow ? mRow->withoutMotion : "they are taken as still"));
+        mNotedMotion = true;
+    }
+    if (check.tested >= 64 && !mWarnedSign && check.keptNegated > check.kept + 0.2 && check.keptNegated > 0.5) {
+        note(format("denoise: warning: %s: the motion vectors look like the opposite sign convention (%.0f%% of the "
+                    "frame reprojects as given, %.0f%% negated); atrous wants previous - current, in pixels, y down",
+                    name.c_str(), 100 * check.kept, 100 * check.keptNegated));
+        mWarnedSign = true;
+    }
+    if (mIdsTrusted && !f.ids.empty() && check.tested >= 64 && check.kept > 0.2 && check.idsAgree < 0.9) {
+        note(format("denoise: note: %s: the ids change between frames (%.0f%% agree after reprojection): not used "
+                    "from here on (Mitsuba renumbers shapes when a scene is loaded)",
+                    name.c_str(), 100 * check.idsAgree));
+        mIdsTrusted = false;
+        mDenoiser->ignore(Buffer::ObjectId);
+    }
+}
+
+// The frame into the denoiser (which checks it as it arrives, so that a bad value is named by its
+// own file), then every frame it can hand back.
+void Session::push(FramePtr f) {
+    try {
+        mDenoiser->push({io::refsOf(*f), f});  // every buffer the frame has, through the one input assembly
+    } catch (const InputError& e) {
+        rethrowNamingFile(e, *f);
+    }
+    mPending.push_back(std::move(f));
+    while (mDenoiser->ready()) outputFrame();
+}
+
+void Session::writeFrame(const std::string& name, std::shared_ptr<io::ExrInfo> layered, Image out) {
+    if (mWriting.valid()) mWriting.get();  // frame N-1's files, and its errors, before frame N's
+    const std::string stage = mStaged->stage();
+    mWriting = std::async(std::launch::async, [this, stage, name, layered, img = std::make_shared<Image>(std::move(out))] {
+        const std::string exrOut = (fs::path(stage) / (name + ".exr")).string();
+        if (!mArgs.addPass.empty())
+            io::writeExrWithLayers(exrOut, *layered, {io::ExrOutLayer{mArgs.addPass, img.get()}});
+        else
+            io::writeImage(exrOut, *img);
+        if (mArgs.pngs) io::writePng((fs::path(stage) / (name + ".png")).string(), *img, mArgs.exposure);
+    });
+}
+
+// The frame's report: what the method says it did, the reprojection check, the line.
+void Session::finishFrame(SequenceFrameReport& r, const SequenceOutput& out, const std::string& name) {
+    const io::ReprojectionCheck& check = mChecks[out.index];
+    r.methodUsed = out.methodUsed;
+    r.method = mMethod + out.detail;
+    if (check.tested > 0) r.reprojected = check.kept;
+    r.line = name + ": " + r.method + format(" %.1f ms", r.milliseconds);
+    if (check.tested > 0) r.line += format(", %.0f%% reprojects onto the previous frame", 100 * check.kept);
+    if (r.hasReference) r.line += format(", MSE vs reference %.6g (input %.6g)", r.mse, r.mseInput);
+    mReport.frames.push_back(r);
+    if (mEvents.frame) mEvents.frame(mReport.frames.back());
+}
+
+// The next frame out of the denoiser, written and reported.
+void Session::outputFrame() {
+    const FramePtr f = mPending.front();
+    const std::string name = io::sequenceFrameName(f->index);
+    SequenceFrameReport r;
+    r.index = f->index;
+    r.input = f->dir;
+    r.output = (fs::path(mOutDir) / (name + ".exr")).string();
+    r.hasReference = !f->reference.empty();
+    r.mseInput = r.hasReference ? meanSquaredError(f->color, f->reference) : 0.0;
+    Timer timer;
+    SequenceOutput out;
+    try {
+        out = mDenoiser->next();
+    } catch (const InputError& e) {
+        rethrowNamingFile(e, *f);
+    }
+    r.milliseconds = timer.ms();
+    mFilterMs += r.milliseconds;
+    if (r.hasReference) r.mse = meanSquaredError(out.image, f->reference);
+    mPending.pop_front();
+    writeFrame(name, f->layered, std::move(out.image));
+    finishFrame(r, out, name);
+}
+
+void Session::writePreviewAndCommit() {
+    if (mArgs.preview && mArgs.pngs) {
+        const std::string problem = writeAnimatedPreview(mStaged->stage(), mFirstIndex, mOutDir);
+        if (problem.empty())
+            mReport.preview = (fs::path(mOutDir) / "preview.mp4").string();
+        else
+            note(problem);
+    }
+    const std::string removed = mStaged->commit();
+    if (!removed.empty()) {
+        mReport.notes.push_back("denoise: " + removed);
+        if (mEvents.warning) mEvents.warning(mReport.notes.back());
+    }
+}
+
+SequenceReport Session::run() {
+    start();
+    auto load = [&](size_t i) { return io::loadSequenceFrame(mFrames[i], mPresent, mLayers); };
+    std::future<io::SequenceFrame> next = std::async(std::launch::async, load, size_t(0));
+    Timer wall;
+    for (size_t i = 0; i < mFrames.size(); ++i) {
+        FramePtr f = std::make_shared<io::SequenceFrame>(next.get());
+        if (i + 1 < mFrames.size()) next = std::async(std::launch::async, load, i + 1);
+        if (i == 0) mFirstIndex = f->index;
+        const bool estimated = fillMotion(*f, i);
+        checkAgainstPrevious(*f, i, estimated);
+        mPrev = f;
+        push(std::move(f));
+    }
+    // The frames left, without the later neighbours they would have had.
+    mDenoiser->finish();
+    while (mDenoiser->ready()) outputFrame();
+    if (mWriting.valid()) mWriting.get();
+    mReport.filterMsPerFrame = mFilterMs / double(mFrames.size());
+    mReport.wallMsPerFrame = wall.ms() / double(mFrames.size());
+    writePreviewAndCommit();
+    return mReport;
 }
 
 }  // namespace
 
 SequenceReport denoiseSequence(const std::string& input, const std::string& outDir, const SequenceDenoiseOptions& args,
                                const SequenceEvents& events) {
-    checkOptions(input, outDir, args);
-    const bool svgf = args.method == "svgf", temporal = args.method == "temporal";
-    SequenceReport report;
-    auto note = [&](const std::string& line) {
-        report.notes.push_back(line);
-        if (events.note) events.note(line);
-    };
-    io::SequenceOptions layers;
-    layers.passes = io::parsePassRequests(args.passes);
-    layers.viewLayer = args.viewLayer;
-    io::FrameRange range;
-    range.start = args.start, range.end = args.end, range.step = args.step;
-
-    // Everything that can be checked before writing is checked first; what only decoding finds
-    // (a truncated EXR) fails inside the loop, before anything reaches OUTDIR (StagedDir).
-    // OUTDIR in the sequence directory would take its frame_NNNN.exr names (io/paths.h).
-    // (A pattern's frames are in its directory.)
-    io::refuseOutputInside("--out", outDir, io::sequenceFolder(input));
-    std::vector<std::string> frames = io::listSequenceFrames(input, range);
-    if (!args.addPass.empty() && !io::isLayeredSequenceFrame(frames.front()))
-        throw InputError("--add-pass '" + args.addPass + "': copies a layered EXR frame, and " + input +
-                         " holds frames of plain EXRs");
-    const std::vector<std::string> present = io::validateSequence(frames, report.width, report.height, layers);
-    report.buffers = present;
-    std::unique_ptr<SvgfDenoiser> svgfDenoiser;
-    DenoiseOptions options = args.frame;
-    if (svgf) {
-        svgfDenoiser = std::make_unique<SvgfDenoiser>(args.svgf, args.device, args.svgfWeights);
-    } else {
-        // (temporal: frame.method is the still method run on the average)
-        if (!temporal) options.method = parseDenoiseMethod(args.method);
-        options.device = args.device;
-        validateDenoiseOptions(options);
-    }
-    DenoiseReport frameReport;
-    io::StagedDir staged("--out", outDir);
-    const std::string stage = staged.stage();
-
-    // The static window (TemporalParams::staticRadius) needs the renderer's own motion vectors:
-    // motion fitted to positions or estimated from colours (below) sees a moving object as still.
-    TemporalParams temporalParams = args.temporal;
-    if (std::find(present.begin(), present.end(), "motion") == present.end()) temporalParams.staticRadius = 0;
-    // Frames are read in order; frame i is denoised once frames up to i + lookahead are in
-    // (temporal: its window's radius, 0 when causal; the other methods: 0). `window` holds frames
-    // winFirst .. the last read, at most radius behind the one denoised.
-    const size_t radius = temporal ? size_t(temporalWindowRadius(temporalParams)) : 0;
-    const size_t lookahead = temporal && !args.temporal.causal ? radius : 0;
-    std::deque<io::SequenceFrame> window;
-    size_t winFirst = 0;
-    int firstIndex = 0;
-    std::vector<io::ReprojectionCheck> checks(frames.size());
-    TemporalCache temporalCache;  // each frame prepared once for all the windows it is in
-    bool idsTrusted = true, warnedSign = false, notedMotion = false;
-    CameraFit prevCamera;  // the previous frame's, for motion from positions
-    auto load = [&](size_t i) { return io::loadSequenceFrame(frames[i], present, layers); };
-    std::future<io::SequenceFrame> next = std::async(std::launch::async, load, size_t(0));
-    std::future<void> writing;
-    Timer wall;
-    double filterMs = 0.0;
-
-    auto refsOf = [&](const io::SequenceFrame& f) {
-        io::BufferRefs refs = io::refsOf(f);  // every buffer the frame has, through the one input assembly
-        if (!idsTrusted) refs.set(io::Buffer::ObjectId, nullptr);
-        return refs;
-    };
-    auto denoiseOne = [&](size_t i) {
-        io::SequenceFrame& f = window[i - winFirst];
-        const std::string name = io::sequenceFrameName(f.index);
-        const io::ReprojectionCheck& check = checks[i];
-        Timer timer;
-        Image out;
-        TemporalReport temporalReport;
-        SequenceFrameReport r;
-        r.index = f.index;
-        r.input = f.dir;
-        r.output = (fs::path(outDir) / (name + ".exr")).string();
-        r.hasReference = !f.reference.empty();
-        r.mseInput = r.hasReference ? meanSquaredError(f.color, f.reference) : 0.0;
-        try {
-            if (svgf) {
-                out = svgfDenoiser->denoiseFrame(refsOf(f));
-            } else if (temporal) {
-                std::vector<Frame> frameSet;
-                for (const io::SequenceFrame& w : window) frameSet.push_back(refsOf(w));
-                std::vector<long long> ids;
-                for (size_t j = 0; j < window.size(); ++j) ids.push_back((long long)(winFirst + j));
-                TemporalResult tr =
-                    denoiseTemporalWithReport(frameSet, i - winFirst, temporalParams, options, &temporalCache, &ids);
-                out = std::move(tr.image);
-                temporalReport = std::move(tr.report);
-                frameReport = temporalReport.spatial;
-            } else {
-                // The frame's colour, variance and emission are not read after this: handed over.
-                DenoiseBuffers bufs = io::handOver(refsOf(f), f.color, &f.variance, &f.emission);
-                DenoiseResult dr = denoiseWithReport(bufs, options);
-                out = std::move(dr.image);
-                frameReport = std::move(dr.report);
-            }
-        } catch (const InputError& e) {
-            // The library names the buffer; the message names the frame's file too.
-            throw InputError(io::withSourceFile(e.what(), [&](const std::string& b) { return f.fileOf(b); }, f.dir));
-        }
-        r.milliseconds = timer.ms();
-        filterMs += r.milliseconds;
-        if (r.hasReference) r.mse = meanSquaredError(out, f.reference);
-        if (writing.valid()) writing.get();  // frame N-1's files, and its errors, before frame N's
-        writing = std::async(std::launch::async, [&, name, layered = f.layered, img = std::make_shared<Image>(std::move(out))] {
-            const std::string exrOut = (fs::path(stage) / (name + ".exr")).string();
-            if (!args.addPass.empty())
-                io::writeExrWithLayers(exrOut, *layered, {io::ExrOutLayer{args.addPass, img.get()}});
-            else
-                io::writeImage(exrOut, *img);
-            if (args.pngs) io::writePng((fs::path(stage) / (name + ".png")).string(), *img, args.exposure);
-        });
-        const bool resolved = args.method == "auto" || (temporal && options.method == DenoiseMethod::Auto);
-        r.methodUsed = svgf ? "svgf" : denoiseMethodName(frameReport.methodUsed);
-        r.method = args.method;
-        if (temporal)
-            r.method += format(" (%s%d frames%s, %.1f averaged per pixel in %.0f ms; then %s%s%s)",
-                               args.temporal.causal ? "causal, -" : "+-", args.temporal.radius,
-                               radius > size_t(args.temporal.radius)
-                                   ? format(" (+-%zu where nothing moves)", radius).c_str()
-                                   : "",
-                               temporalReport.meanFrames, temporalReport.gatherMs, denoiseMethodName(options.method),
-                               resolved ? " -> " : "", resolved ? r.methodUsed.c_str() : "");
-        else if (resolved)
-            r.method += " -> " + r.methodUsed;
-        else if (svgf && args.svgf.learnedSpatial)
-            r.method += " (learned spatial)";
-        if (check.tested > 0) r.reprojected = check.kept;
-        r.line = name + ": " + r.method + format(" %.1f ms", r.milliseconds);
-        if (check.tested > 0) r.line += format(", %.0f%% reprojects onto the previous frame", 100 * check.kept);
-        if (r.hasReference) r.line += format(", MSE vs reference %.6g (input %.6g)", r.mse, r.mseInput);
-        report.frames.push_back(r);
-        if (events.frame) events.frame(report.frames.back());
-    };
-
-    size_t nextOut = 0;
-    for (size_t i = 0; i < frames.size(); ++i) {
-        io::SequenceFrame f = next.get();
-        if (i + 1 < frames.size()) next = std::async(std::launch::async, load, i + 1);
-        const std::string name = io::sequenceFrameName(f.index);
-        if (i == 0) firstIndex = f.index;
-        // No motion vectors but a Position pass (LuxCore): motion from each frame's fitted camera.
-        bool estimated = false;  // motion from the colours (below): not the user's vectors to judge
-        const bool usesMotion = svgf || (temporal && radius > 0);
-        if (usesMotion && f.motion.empty() && !f.position.empty()) {
-            const CameraFit fit = fitCamera(f.position);
-            f.motion = motionFromPositions(f.position, fit, prevCamera);  // frame 0: no previous, NaN (no history)
-            if (i > 0 && !notedMotion) {
-                if (prevCamera.ok)
-                    note(format("denoise: note: the frames have no motion vectors: motion from the Position pass (a "
-                                "camera fitted per frame, median reprojection error %.2f px)",
-                                prevCamera.medianErrorPx));
-                else
-                    note(format("denoise: note: the frames have no motion vectors, and no pinhole camera fits their "
-                                "Position pass (median reprojection error %.2g px): no motion",
-                                prevCamera.medianErrorPx));
-                notedMotion = true;
-            }
-            prevCamera = fit;
-        } else if (usesMotion && f.motion.empty() && !f.color.empty()) {
-            // Neither vectors nor positions (a renderer that writes colour, albedo and normal):
-            // motion from the colours themselves, block matching against the previous frame (the
-            // first has none: no history; the frames' sizes were checked above).
-            f.motion = estimateMotion(f.color, window.empty() ? nullptr : &window.back().color);
-            estimated = !window.empty();
-            if (estimated && !notedMotion)
-                note("denoise: note: the frames have no motion vectors and no Position pass: motion estimated "
-                     "from the frames' colours (block matching, docs/temporal.md)");
-            notedMotion = notedMotion || estimated;
-        }
-        // Other renderers' sequences: how much reprojects, with which sign, and whether ids hold.
-        io::ReprojectionCheck& check = checks[i];
-        if (!window.empty() && !estimated) {
-            const io::SequenceFrame& prev = window.back();
-            check = io::checkReprojection(f.depth, f.normal, f.ids, f.motion, prev.depth, prev.normal, prev.ids);
-        }
-        if (usesMotion && f.motion.empty() && !notedMotion) {
-            note(std::string("denoise: note: the frames have no motion vectors: ") +
-                 (svgf ? "SVGF assumes nothing moves on screen"
-                       : "the temporal method takes them as still and leaves out what the depth, normal and colour "
-                         "tests find moved"));
-            notedMotion = true;
-        }
-        if (check.tested >= 64 && !warnedSign && check.keptNegated > check.kept + 0.2 && check.keptNegated > 0.5) {
-            note(format("denoise: warning: %s: the motion vectors look like the opposite sign convention (%.0f%% of the "
-                        "frame reprojects as given, %.0f%% negated); atrous wants previous - current, in pixels, y down",
-                        name.c_str(), 100 * check.kept, 100 * check.keptNegated));
-            warnedSign = true;
-        }
-        if (idsTrusted && !f.ids.empty() && check.tested >= 64 && check.kept > 0.2 && check.idsAgree < 0.9) {
-            note(format("denoise: note: %s: the ids change between frames (%.0f%% agree after reprojection): not used "
-                        "from here on (Mitsuba renumbers shapes when a scene is loaded)",
-                        name.c_str(), 100 * check.idsAgree));
-            idsTrusted = false;
-        }
-        if (temporal) {
-            // Each frame is checked as it arrives, so a bad value is named by its own file (the
-            // window's checks would name the frame being denoised).
-            try {
-                checkTemporalFrame(refsOf(f));
-            } catch (const InputError& e) {
-                throw InputError(io::withSourceFile(e.what(), [&](const std::string& b) { return f.fileOf(b); }, f.dir));
-            }
-        }
-        window.push_back(std::move(f));
-        // Denoise every frame whose window is complete (at the end: all that are left).
-        for (; nextOut < frames.size() && (nextOut + lookahead <= i || i + 1 == frames.size()); ++nextOut) {
-            denoiseOne(nextOut);
-            // Keep the frames the next one's window needs, and always the last read (the next check's).
-            while (winFirst + radius < nextOut + 1 && window.size() > 1) {
-                window.pop_front();
-                ++winFirst;
-            }
-        }
-    }
-    if (writing.valid()) writing.get();
-    report.filterMsPerFrame = filterMs / double(frames.size());
-    report.wallMsPerFrame = wall.ms() / double(frames.size());
-    if (args.preview && args.pngs) {
-        const std::string problem = writeAnimatedPreview(stage, firstIndex, outDir);
-        if (problem.empty())
-            report.preview = (fs::path(outDir) / "preview.mp4").string();
-        else
-            note(problem);
-    }
-    const std::string removed = staged.commit();
-    if (!removed.empty()) {
-        report.notes.push_back("denoise: " + removed);
-        if (events.warning) events.warning(report.notes.back());
-    }
-    return report;
+    Session session(input, outDir, args, events);
+    return session.run();
 }
 
 }  // namespace atrous

@@ -13,7 +13,6 @@
 
 #include "atrous/error.h"
 #include "atrous/params.h"
-#include "atrous/temporal.h"
 #include "atrous/timer.h"
 #include "atrous/io/buffer_set.h"
 #include "atrous/io/image_io.h"
@@ -36,10 +35,8 @@ const char* methodName(const Method& m) {
     switch (m.kind) {
         case Method::Kind::None:
             return "none";
-        case Method::Kind::Svgf:
-            return "svgf";
-        case Method::Kind::Temporal:
-            return "temporal";
+        case Method::Kind::Sequence:
+            return m.sequence->name;
         case Method::Kind::Still:
             return denoiseMethodName(m.still);
     }
@@ -48,9 +45,9 @@ const char* methodName(const Method& m) {
 
 Method parseMethod(const std::string& name) {
     if (name == "none") return Method::none();
-    if (name == "svgf") return Method::svgf();
-    if (name == "temporal") return Method::temporal();
     if (const DenoiseMethodInfo* m = findDenoiseMethod(name)) return Method::of(m->method);
+    if (const SequenceMethodInfo* m = findSequenceMethod(name))
+        if (m->causal || m->causalMode) return Method::of(*m);
     std::string list;
     for (const std::string& n : methodNames()) list += (list.empty() ? "" : ", ") + n;
     throw InputError("unknown method \"" + name + "\" (expected " + list + ")");
@@ -60,7 +57,26 @@ namespace {
 
 constexpr float kPi = 3.14159265358979f;
 
+size_t sequenceIndex(const SequenceMethodInfo& m) {
+    const auto& rows = sequenceMethods();
+    for (size_t i = 0; i < rows.size(); ++i)
+        if (&rows[i] == &m) return i;
+    throw InputError(std::string("sequence method '") + m.name + "' is not a row of sequenceMethods()");
+}
+
 }  // namespace
+
+ParamSet& sequenceParams(PipelineSettings& s, const SequenceMethodInfo& m) {
+    const size_t i = sequenceIndex(m);
+    if (s.sequence.size() <= i) s.sequence.resize(sequenceMethods().size());
+    if (s.sequence[i].empty()) s.sequence[i] = m.params;
+    return s.sequence[i];
+}
+
+const ParamSet& sequenceParams(const PipelineSettings& s, const SequenceMethodInfo& m) {
+    const size_t i = sequenceIndex(m);
+    return i < s.sequence.size() && !s.sequence[i].empty() ? s.sequence[i] : m.params;
+}
 
 double processCpuMs() {
     rusage u{};
@@ -150,7 +166,7 @@ void ViewPipeline::setCamera(const pt::Camera& c) {
 
 void ViewPipeline::resetAccumulation() {
     mAccumulating = false;
-    mSvgfResetPending = true;
+    mHistoryResetPending = true;
 }
 
 void ViewPipeline::renderFrame(const PipelineSettings& s, bool ownSamples) {
@@ -357,37 +373,8 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
             r.image = hostCopy(mColor);
         return;
     }
-    if (m == Method::svgf()) {
-        try {
-            if (!mSvgf[i] || !sameParams(mSvgfParams[i], s.svgf, svgfParams())) {
-                mSvgf[i] = std::make_unique<SvgfDenoiser>(s.svgf, mDevice);  // validates
-                mSvgfParams[i] = s.svgf;
-                mSvgf[i]->setTiming(true);
-            }
-            if (mSvgfResetPending || (mCameraMoved && !s.svgfMotionVectors)) mSvgf[i]->reset();
-            // SVGF does its own temporal accumulation, so it takes this frame's samples, not the
-            // running mean. On CUDA all of them are device images, which the SVGF pipeline reads
-            // in place (svgf_pipeline.h copies only inputs that are not on its device).
-            const RenderBuffers& fr = frame();
-            io::BufferRefs refs = io::refsOf(fr);
-            refs.set(io::Buffer::Motion, &mMotion).set(io::Buffer::Emission, &mEmission);
-            const SvgfFrame f = refs;
-            Timer t;
-            if (onDevice)
-                r.deviceImage = mSvgf[i]->denoiseFrameOnDevice(f).clone();  // valid until next frame
-            else
-                r.image = mSvgf[i]->denoiseFrame(f);
-            r.filterMs = t.ms();
-            r.stages = mSvgf[i]->lastReport().stages;
-        } catch (const InputError& e) {
-            mSvgf[i].reset();
-            r.error = e.what();
-            r.image = hostCopy(frame().color);
-        }
-        return;
-    }
-    if (m == Method::temporal()) {
-        runTemporal(i, s, r);
+    if (m.kind == Method::Kind::Sequence) {
+        runSequence(i, *m.sequence, s, r);
         return;
     }
     DenoiseInputs in = accumulatedInputs();
@@ -418,41 +405,65 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
     }
 }
 
-// The temporal method in its causal mode: this frame and the last radius ones (their own samples,
-// kept on the host), reprojected through the motion and averaged, then the still method auto
-// (include/atrous/temporal.h). CPU only: the gather has no CUDA path yet.
-void ViewPipeline::runTemporal(int i, const PipelineSettings& s, SlotResult& r) {
-    std::deque<HistoryFrame>& h = mHistory[i];
+// The slot's denoiser of sequence method m, made anew when the method, its parameters, the still
+// method's options or where the results go changed (a new history), and reset when the
+// accumulation restarts or the camera moved without motion vectors.
+SequenceDenoiser& ViewPipeline::sequenceDenoiser(int i, const SequenceMethodInfo& m, const PipelineSettings& s,
+                                                bool onDevice) {
+    SequenceSlot& slot = mSequence[i];
+    const ParamSet& params = sequenceParams(s, m);
+    const DenoiseOptions still = denoiseOptions(Method::of(DenoiseMethod::Auto), s);
+    if (!slot.denoiser || slot.method != &m || !slot.params.same(params) || slot.onDevice != onDevice ||
+        (m.stillMethod && !sameParams(slot.still, still, denoiseParams()))) {
+        slot = SequenceSlot{};
+        SequenceSetup setup;
+        setup.device = mDevice;
+        setup.params = params;
+        setup.still = still;
+        setup.causal = true;  // the viewer has no later frames
+        setup.timing = true;
+        setup.keepOnDevice = onDevice;
+        slot.denoiser = makeSequenceDenoiser(m.name, setup);  // validates
+        slot.method = &m, slot.params = params, slot.still = still, slot.onDevice = onDevice;
+    }
+    if (mHistoryResetPending || (mCameraMoved && !s.sequenceMotionVectors)) slot.denoiser->reset();
+    return *slot.denoiser;
+}
+
+// A sequence method takes this frame's own samples, not the running mean, with the pipeline's
+// motion and emission. On CUDA all of them are device images, which a method that reads them there
+// (SVGF) reads in place. A method that holds frames beyond this step (a window: temporal) gets its
+// own copy of the frame.
+void ViewPipeline::runSequence(int i, const SequenceMethodInfo& m, const PipelineSettings& s, SlotResult& r) {
     try {
-        if (mDevice != Device::Cpu) throw InputError("temporal runs on the CPU in the viewer (its gather has no CUDA path)");
-        TemporalParams p = s.temporal;
-        p.causal = true;
-        validateTemporalParams(p);
-        if (mSvgfResetPending || (mCameraMoved && !s.svgfMotionVectors)) h.clear();
-        HistoryFrame f;
-        f.index = (long long)mFrameIndex;
-        for (const RenderBufferField& field : kRenderBufferFields) {
-            const bool pipelines = field.image == &RenderBuffers::motion || field.image == &RenderBuffers::emission;
-            if (!pipelines && !(frame().*field.image).empty()) f.b.*field.image = (frame().*field.image).clone();
+        SequenceDenoiser& den = sequenceDenoiser(i, m, s, s.deviceResults && mDevice == Device::Cuda);
+        SequenceInput in;
+        if (den.lookbehind() + den.lookahead() > 0) {
+            auto own = std::make_shared<RenderBuffers>();
+            for (const RenderBufferField& field : kRenderBufferFields) {
+                const bool pipelines = field.image == &RenderBuffers::motion || field.image == &RenderBuffers::emission;
+                if (!pipelines && !(frame().*field.image).empty()) own.get()->*field.image = (frame().*field.image).clone();
+            }
+            own->motion = mMotion.clone();
+            own->emission = mEmission.clone();
+            in.buffers = io::refsOf(*own);
+            in.owner = own;
+        } else {
+            io::BufferRefs refs = io::refsOf(frame());
+            refs.set(io::Buffer::Motion, &mMotion).set(io::Buffer::Emission, &mEmission);
+            in.buffers = refs;
         }
-        f.b.motion = mMotion.clone();  // the pipeline's, as SVGF reads them
-        f.b.emission = mEmission.clone();
-        h.push_back(std::move(f));
-        while (h.size() > size_t(p.radius) + 1) h.pop_front();
-        std::vector<SvgfFrame> window;
-        std::vector<long long> ids;
-        for (const HistoryFrame& x : h) {
-            window.push_back(io::refsOf(x.b));
-            ids.push_back(x.index);
-        }
-        DenoiseOptions o = denoiseOptions(Method::of(DenoiseMethod::Auto), s);
         Timer t;
-        TemporalResult tr = denoiseTemporalWithReport(window, window.size() - 1, p, o, &mTemporalCache[i], &ids);
+        den.push(std::move(in));
+        SequenceOutput out = den.next();
         r.filterMs = t.ms();
-        r.image = std::move(tr.image);
-        r.stages = std::move(tr.report.spatial.stages);
+        r.stages = std::move(out.stages);
+        if (out.image.device() == Device::Cpu)
+            r.image = std::move(out.image);
+        else
+            r.deviceImage = std::move(out.image);  // valid until the slot changes
     } catch (const InputError& e) {
-        h.clear();
+        mSequence[i] = SequenceSlot{};
         r.error = e.what();
         r.image = mDevice == Device::Cpu ? frame().color.clone() : frame().color.to(Device::Cpu);
     }
@@ -539,7 +550,7 @@ void ViewPipeline::step(const PipelineSettings& s) {
 
     mPrevCamera = mCamera;
     mCameraMoved = false;
-    mSvgfResetPending = false;
+    mHistoryResetPending = false;
 }
 
 std::vector<std::string> ViewPipeline::saveBuffers(const std::string& dir) const {

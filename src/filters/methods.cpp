@@ -9,7 +9,7 @@
 #include "atrous/denoise.h"
 #include "atrous/error.h"
 #include "atrous/params.h"
-#include "atrous/temporal.h"
+#include "atrous/sequence_methods.h"
 
 namespace atrous {
 

@@ -180,3 +180,23 @@ Image estimateMotion(const Image& current, const Image* previousFrame, const Mot
 }
 
 }  // namespace atrous
+
+namespace atrous {
+
+Image StreamMotion::next(const Frame& frame, const Frame* previous) {
+    if (!frame.color || frame.color->empty()) throw InputError("motion of a frame: its color buffer is missing");
+    mFrames = previous ? mFrames + 1 : 1;
+    if (frame.position && !frame.position->empty()) {
+        mFrom = From::Positions;
+        const CameraFit fit = fitCamera(*frame.position);
+        mPrevious = previous ? mCamera : CameraFit{};  // a first frame: no previous camera, NaN (no history)
+        mCamera = fit;
+        return motionFromPositions(*frame.position, fit, mPrevious);
+    }
+    mFrom = From::Colours;
+    const Image* before = previous ? previous->color : nullptr;
+    const bool usable = before && !before->empty() && before->view().sameSize(frame.color->view());
+    return estimateMotion(*frame.color, usable ? before : nullptr);
+}
+
+}  // namespace atrous

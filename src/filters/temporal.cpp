@@ -32,39 +32,6 @@ int temporalWindowRadius(const TemporalParams& p) {
 
 void checkTemporalFrame(const SvgfFrame& frame) { svgf::checkFrame(frame); }
 
-const std::vector<SequenceMethodInfo>& sequenceMethods() {
-    static const std::vector<SequenceMethodInfo> rows = {
-        {"temporal",
-         "the default with --sequence: frames t-3..t+3 (t-6..t+6 where nothing moves) reprojected onto t and "
-         "averaged, then the still method --spatial (docs/temporal.md)",
-         false, true, "temporal",
-         {Buffer::Color, Buffer::Variance, Buffer::Albedo, Buffer::Normal, Buffer::Position, Buffer::Depth,
-          Buffer::ObjectId, Buffer::Emission, Buffer::Motion}},
-        {"svgf", "spatiotemporal variance-guided filtering, causal: each frame from the ones before it (docs/svgf.md)",
-         true, false, "svgf",
-         // Variance and position: for the safety net's still filter (SVGF itself does not read them).
-         {Buffer::Color, Buffer::Variance, Buffer::Albedo, Buffer::Normal, Buffer::Position, Buffer::Depth,
-          Buffer::ObjectId, Buffer::Emission, Buffer::Motion}},
-    };
-    return rows;
-}
-
-const SequenceMethodInfo* findSequenceMethod(const std::string& name) {
-    for (const SequenceMethodInfo& m : sequenceMethods())
-        if (name == m.name) return &m;
-    return nullptr;
-}
-
-std::string sequenceMethodNames() {
-    std::string s;
-    for (const SequenceMethodInfo& m : sequenceMethods()) s += (s.empty() ? "" : ", ") + std::string(m.name);
-    return s;
-}
-
-namespace {
-
-}  // namespace
-
 // A frame as the hops read it: its sanitised G-buffer and colour statistics, owned here.
 struct PreparedFrame {
     Image depth, normal, ids, motion, grad, stats, color, emission, still;
@@ -147,6 +114,131 @@ void prepare(const CpuExec& exec, const SvgfFrame& f, bool stats, float fireflyK
 
 Image cloneOrEmpty(const Image* img) { return img ? img->clone() : Image(); }
 
+// The frames lo .. hi of a window and what gatherTemporal reads of them.
+struct WindowSpan {
+    const std::vector<SvgfFrame>& frames;
+    size_t center, lo, hi;
+    const std::vector<long long>* ids;
+    TemporalCache::Impl* cache;  // null: no cache
+    // In the cache: it passed svgf::checkFrame (sizes, channels, the colour's range: a scan of
+    // every value) when it was prepared, and an id names unchanged buffers: not scanned again.
+    bool known(size_t i) const { return cache && cache->frames.count((*ids)[i]) > 0; }
+};
+
+// The cache holds what a frame's id was prepared into, for this size and these settings only.
+void keepCacheFor(TemporalCache::Impl* cache, int w, int h, bool stats, float fireflyK) {
+    if (!cache || (cache->width == w && cache->height == h && cache->stats == stats && cache->fireflyK == fireflyK))
+        return;
+    cache->frames.clear();
+    cache->width = w, cache->height = h, cache->stats = stats, cache->fireflyK = fireflyK;
+}
+
+// The variance and position of frame i against the centre's: the same size and channels.
+void checkExtraBuffers(const SvgfFrame& f, const SvgfFrame& c, size_t i, int w, int h) {
+    for (const Image* extra : {f.variance, f.position}) {
+        if (!extra) continue;
+        const bool variance = extra == f.variance;
+        const Image* theirs = variance ? c.variance : c.position;
+        if (extra->width() != w || extra->height() != h || extra->channels() < 1 || extra->channels() != theirs->channels())
+            throw InputError("temporal window: frame " + std::to_string(i) + ": its " + (variance ? "variance" : "position") +
+                             " buffer differs in size or channels from the centre frame's colour or " +
+                             (variance ? "variance" : "position"));
+    }
+}
+
+// Every frame of the span is checked (unless the cache knows it) and must carry the centre's
+// buffers (a missing one would read as a neutral default) at the centre's size.
+void checkSpan(const WindowSpan& s, int w, int h) {
+    const SvgfFrame& c = s.frames[s.center];
+    if (!s.known(s.center)) svgf::checkFrame(c);
+    auto same = [&](const Image* a, const Image* b) { return (a == nullptr) == (b == nullptr); };
+    for (size_t i = s.lo; i <= s.hi; ++i) {
+        const SvgfFrame& f = s.frames[i];
+        if (i != s.center && !s.known(i)) svgf::checkFrame(f);
+        if (f.color->width() != w || f.color->height() != h)
+            throw InputError("temporal window: frame " + std::to_string(i) + " is " + std::to_string(f.color->width()) +
+                             "x" + std::to_string(f.color->height()) + ", the centre frame " + std::to_string(w) + "x" +
+                             std::to_string(h));
+        if (!same(f.albedo, c.albedo) || !same(f.normal, c.normal) || !same(f.depth, c.depth) ||
+            !same(f.ids, c.ids) || !same(f.motion, c.motion) || !same(f.emission, c.emission) ||
+            !same(f.variance, c.variance) || !same(f.position, c.position))
+            throw InputError("temporal window: frame " + std::to_string(i) + " has other buffers than the centre frame");
+        checkExtraBuffers(f, c, i, w, h);
+    }
+}
+
+// The span's prepared frames, from the cache where it has them, else prepared now (into `local`
+// without a cache, else into the cache, which then drops the frames outside the span: windows
+// only move forward).
+std::vector<PreparedFrame*> prepareSpan(const CpuExec& exec, const WindowSpan& s, bool stats, float fireflyK,
+                                        std::vector<PreparedFrame>& local) {
+    std::vector<PreparedFrame*> prepared(s.hi - s.lo + 1);
+    if (!s.cache) local.resize(s.hi - s.lo + 1);
+    for (size_t i = s.lo; i <= s.hi; ++i) {
+        if (!s.cache) {
+            prepare(exec, s.frames[i], stats, fireflyK, local[i - s.lo]);
+            prepared[i - s.lo] = &local[i - s.lo];
+            continue;
+        }
+        auto it = s.cache->frames.find((*s.ids)[i]);
+        if (it == s.cache->frames.end()) {
+            it = s.cache->frames.emplace((*s.ids)[i], PreparedFrame{}).first;
+            prepare(exec, s.frames[i], stats, fireflyK, it->second);
+        } else {
+            // The derived planes are the cache's; the caller's own buffers are read where they are now.
+            temporal::FrameViews& v = it->second.views;
+            if (it->second.color.empty()) v.color = viewOf(s.frames[i].color);
+            v.albedo = viewOf(s.frames[i].albedo), v.normalRaw = viewOf(s.frames[i].normal);
+            v.emission = it->second.emission.empty() ? viewOf(s.frames[i].emission) : it->second.emission.view();
+        }
+        prepared[i - s.lo] = &it->second;
+    }
+    if (s.cache) {
+        for (auto it = s.cache->frames.begin(); it != s.cache->frames.end();) {
+            bool in = false;
+            for (size_t i = s.lo; i <= s.hi && !in; ++i) in = (*s.ids)[i] == it->first;
+            it = in ? std::next(it) : s.cache->frames.erase(it);
+        }
+    }
+    return prepared;
+}
+
+// The weights and tests of hop k (from frame `from` to `to`, k frames from the centre).
+void setHopWeights(temporal::Hop& hop, const TemporalParams& params, int staticRadius, size_t k, bool still) {
+    const float fo = params.causal ? params.causalFalloff : params.falloff;
+    hop.weight = k > size_t(params.radius) ? 0.0f : fo > 0.0f ? std::exp(-float(k * k) / (2.0f * fo * fo)) : 1.0f;
+    // Static tracks: equal weights out to staticRadius (offline), else as the others. Both frames'
+    // motion must show a still camera: a hop reads the motion of one of them and the G-buffers of both.
+    hop.staticWeight = !params.causal && still && k <= size_t(staticRadius) ? 1.0f : hop.weight;
+    // ... and whose G-buffer test also accepts the static surfaces next to the pixel.
+    hop.stillHop = !params.causal && still && staticRadius > 0;
+    hop.depthTolerance = params.depthTolerance, hop.normalCos = params.normalCos;
+    hop.colorSigmas = params.colorSigmas;
+}
+
+// The tracks of one side of the centre (dir -1: the frames before it, +1: after), hop by hop out
+// to r frames, each hop adding what it keeps to the sums in g.
+void gatherSide(const CpuExec& exec, const WindowSpan& s, const std::vector<PreparedFrame*>& prepared, int dir,
+                size_t r, const TemporalParams& params, int staticRadius, TemporalGather& g, Image& track, Image& alive) {
+    const size_t center = s.center, lo = s.lo, hi = s.hi;
+    if ((dir < 0 && center == lo) || (dir > 0 && center == hi)) return;
+    const int w = g.color.width(), h = g.color.height();
+    exec.forEachPixel(w, h, temporal::StartTracks{track.view(), alive.view()});
+    for (size_t k = 1; k <= r; ++k) {
+        if (dir < 0 ? center < lo + k : center + k > hi) break;
+        const size_t from = dir < 0 ? center - k + 1 : center + k - 1, to = dir < 0 ? center - k : center + k;
+        temporal::Hop hop;
+        hop.from = prepared[from - lo]->views, hop.to = prepared[to - lo]->views, hop.centre = prepared[center - lo]->views;
+        hop.to.variance = viewOf(s.frames[to].variance);
+        hop.backward = dir < 0;
+        setHopWeights(hop, params, staticRadius, k, prepared[from - lo]->stillCamera && prepared[to - lo]->stillCamera);
+        hop.track = track.view(), hop.alive = alive.view();
+        hop.sumColor = g.color.view(), hop.sumAlbedo = g.albedo.view(), hop.sumNormal = g.normal.view();
+        hop.sumEmission = g.emission.view(), hop.sumVariance = g.variance.view(), hop.count = g.frames.view();
+        exec.forEachPixel(w, h, hop);
+    }
+}
+
 }  // namespace
 
 TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t center, const TemporalParams& params,
@@ -165,38 +257,10 @@ TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t cente
     const size_t r = size_t(temporalWindowRadius(own));
     const size_t lo = center > r ? center - r : 0, hi = params.causal ? center : std::min(window.size() - 1, center + r);
     const bool stats = params.colorSigmas > 0.0f;
-    // The cache holds what a frame's id was prepared into, for this size and these settings only.
     TemporalCache::Impl* cached = cache ? cache->mImpl.get() : nullptr;
-    if (cached && (cached->width != w || cached->height != h || cached->stats != stats ||
-                   cached->fireflyK != params.fireflyK)) {
-        cached->frames.clear();
-        cached->width = w, cached->height = h, cached->stats = stats, cached->fireflyK = params.fireflyK;
-    }
-    // A frame in the cache passed svgf::checkFrame (sizes, channels, the colour's range: a scan of
-    // every value) when it was prepared, and an id names unchanged buffers: not scanned again.
-    auto known = [&](size_t i) { return cached && cached->frames.count((*ids)[i]) > 0; };
-    if (!known(center)) svgf::checkFrame(c);
-    // Every frame must carry the centre's buffers (a missing one would read as a neutral default).
-    auto same = [&](const Image* a, const Image* b) { return (a == nullptr) == (b == nullptr); };
-    for (size_t i = lo; i <= hi; ++i) {
-        const SvgfFrame& f = window[i];
-        if (i != center && !known(i)) svgf::checkFrame(f);
-        if (f.color->width() != w || f.color->height() != h)
-            throw InputError("temporal window: frame " + std::to_string(i) + " is " + std::to_string(f.color->width()) +
-                             "x" + std::to_string(f.color->height()) + ", the centre frame " + std::to_string(w) + "x" +
-                             std::to_string(h));
-        if (!same(f.albedo, c.albedo) || !same(f.normal, c.normal) || !same(f.depth, c.depth) ||
-            !same(f.ids, c.ids) || !same(f.motion, c.motion) || !same(f.emission, c.emission) ||
-            !same(f.variance, c.variance) || !same(f.position, c.position))
-            throw InputError("temporal window: frame " + std::to_string(i) + " has other buffers than the centre frame");
-        for (const Image* extra : {f.variance, f.position})
-            if (extra && (extra->width() != w || extra->height() != h || extra->channels() < 1 ||
-                          extra->channels() != (extra == f.variance ? c.variance : c.position)->channels()))
-                throw InputError("temporal window: frame " + std::to_string(i) + ": its " +
-                                 (extra == f.variance ? "variance" : "position") +
-                                 " buffer differs in size or channels from the centre frame's colour or " +
-                                 (extra == f.variance ? "variance" : "position"));
-    }
+    keepCacheFor(cached, w, h, stats, params.fireflyK);
+    const WindowSpan span{window, center, lo, hi, ids, cached};
+    checkSpan(span, w, h);
     const CpuExec exec;
     TemporalGather g;
     g.albedo = cloneOrEmpty(c.albedo);
@@ -209,69 +273,14 @@ TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t cente
         g.color = c.color->clone();
         return g;
     }
-    // The window's prepared frames: from the cache where it has them, else prepared now (and kept
-    // there for the next window).
     std::vector<PreparedFrame> local;
-    std::vector<PreparedFrame*> prepared(hi - lo + 1);
-    if (!cached) local.resize(hi - lo + 1);
-    for (size_t i = lo; i <= hi; ++i) {
-        if (!cached) {
-            prepare(exec, window[i], stats, params.fireflyK, local[i - lo]);
-            prepared[i - lo] = &local[i - lo];
-            continue;
-        }
-        auto it = cached->frames.find((*ids)[i]);
-        if (it == cached->frames.end()) {
-            it = cached->frames.emplace((*ids)[i], PreparedFrame{}).first;
-            prepare(exec, window[i], stats, params.fireflyK, it->second);
-        } else {
-            // The derived planes are the cache's; the caller's own buffers are read where they are now.
-            temporal::FrameViews& v = it->second.views;
-            if (it->second.color.empty()) v.color = viewOf(window[i].color);
-            v.albedo = viewOf(window[i].albedo), v.normalRaw = viewOf(window[i].normal);
-            v.emission = it->second.emission.empty() ? viewOf(window[i].emission) : it->second.emission.view();
-        }
-        prepared[i - lo] = &it->second;
-    }
-    if (cached) {  // frames outside this window are not needed again (windows only move forward)
-        for (auto it = cached->frames.begin(); it != cached->frames.end();) {
-            bool in = false;
-            for (size_t i = lo; i <= hi && !in; ++i) in = (*ids)[i] == it->first;
-            it = in ? std::next(it) : cached->frames.erase(it);
-        }
-    }
+    const std::vector<PreparedFrame*> prepared = prepareSpan(exec, span, stats, params.fireflyK, local);
     // The centre's colour as its neighbours' is taken (after the firefly pass).
     const PreparedFrame& pc = *prepared[center - lo];
     g.color = pc.color.empty() ? c.color->clone() : pc.color.clone();
     if (!pc.emission.empty()) g.emission = pc.emission.clone();  // scaled with the colour's firefly clamp
     Image track(w, h, 2), alive(w, h, 1);
-    for (int dir = -1; dir <= 1; dir += 2) {
-        if ((dir < 0 && center == lo) || (dir > 0 && center == hi)) continue;
-        exec.forEachPixel(w, h, temporal::StartTracks{track.view(), alive.view()});
-        for (size_t k = 1; k <= r; ++k) {
-            if (dir < 0 ? center < lo + k : center + k > hi) break;
-            const size_t from = dir < 0 ? center - k + 1 : center + k - 1, to = dir < 0 ? center - k : center + k;
-            temporal::Hop hop;
-            hop.from = prepared[from - lo]->views, hop.to = prepared[to - lo]->views, hop.centre = pc.views;
-            hop.to.variance = viewOf(window[to].variance);
-            hop.backward = dir < 0;
-            const float fo = params.causal ? params.causalFalloff : params.falloff;
-            hop.weight = k > size_t(params.radius) ? 0.0f : fo > 0.0f ? std::exp(-float(k * k) / (2.0f * fo * fo)) : 1.0f;
-            // Static tracks: equal weights out to staticRadius (offline), else as the others.
-            // Both frames' motion must show a still camera: a hop reads the motion of one of them
-            // and the G-buffers of both.
-            const bool still = prepared[from - lo]->stillCamera && prepared[to - lo]->stillCamera;
-            hop.staticWeight = !params.causal && still && k <= size_t(own.staticRadius) ? 1.0f : hop.weight;
-            // ... and whose G-buffer test also accepts the static surfaces next to the pixel.
-            hop.stillHop = !params.causal && still && own.staticRadius > 0;
-            hop.depthTolerance = params.depthTolerance, hop.normalCos = params.normalCos;
-            hop.colorSigmas = params.colorSigmas;
-            hop.track = track.view(), hop.alive = alive.view();
-            hop.sumColor = g.color.view(), hop.sumAlbedo = g.albedo.view(), hop.sumNormal = g.normal.view();
-            hop.sumEmission = g.emission.view(), hop.sumVariance = g.variance.view(), hop.count = g.frames.view();
-            exec.forEachPixel(w, h, hop);
-        }
-    }
+    for (int dir = -1; dir <= 1; dir += 2) gatherSide(exec, span, prepared, dir, r, params, own.staticRadius, g, track, alive);
     exec.forEachPixel(w, h, temporal::Finish{g.color.view(), g.albedo.view(), g.normal.view(), g.emission.view(),
                                              g.variance.view(), g.frames.view()});
     return g;

@@ -122,6 +122,22 @@ def test_frames_and_svgf_equal_the_cli(cluster, tmp_path):
     for f in range(3):
         name = f"frame_{f:04d}.exr"
         assert (dt / "cornell-moving_spp1" / name).read_bytes() == (tmp_path / "cli-temporal" / name).read_bytes()
+    # A plugin's sequence method (tests/toy_sequence_method.cpp in the C++ toy plugin): loaded in
+    # every worker, one item per sequence (it carries history), what the CLI with the plugin writes.
+    so = toy_plugin_so()
+    if so is not None:
+        dq = tmp_path / "toyseq"
+        r = farm(["denoise", "--in", str(got), "--method", "toyseq", "--param", "alpha=0.5", "--plugin", so,
+                  "--address", cluster.address, "--out", str(dq), "--quiet"], env=cluster.env)
+        assert r.returncode == 0, r.stderr
+        assert len(manifest(dq)["items"]) == 1
+        c = subprocess.run([cli, "--plugin", so, "denoise", "--sequence", str(seq), "--method", "toyseq",
+                            "--toyseq-alpha", "0.5", "--device", "cpu", "--out", str(tmp_path / "cli-toyseq")],
+                           capture_output=True, text=True, timeout=120)
+        assert c.returncode == 0, c.stderr
+        for f in range(3):
+            name = f"frame_{f:04d}.exr"
+            assert (dq / "cornell-moving_spp1" / name).read_bytes() == (tmp_path / "cli-toyseq" / name).read_bytes()
 
 
 def test_a_killed_worker_costs_a_retry_not_the_job(cluster, tmp_path):

@@ -23,9 +23,15 @@ def test_the_toy_is_in_every_list():
     assert [r["name"] for r in atrous.methods()][:5] == ["eaw", "sure", "learned", "blend", "auto"]
     assert "pytoy" in atrous.METHODS and "pytoy" not in atrous.WEIGHTED_METHODS
     assert "pytoy" in all_methods() and "pytoy" in denoise_choices() and "pytoy" in eval_choices()
-    # Each row names its parameter table, which Python can read: the still methods share denoise's.
+    # Each row names its parameter table, which Python can read: the still methods share denoise's,
+    # a sequence method has its own (sequence_params; svgf_params and temporal_params are the same).
     for r in atrous.methods():
-        assert callable(getattr(atrous, r["params"] + "_params")), r
+        if r["kind"] == "still":
+            assert callable(getattr(atrous, r["params"] + "_params")), r
+        else:
+            assert [p["name"] for p in atrous.sequence_params(r["name"])], r
+    assert atrous.sequence_params("svgf") == atrous.svgf_params()
+    assert atrous.sequence_params("temporal") == atrous.temporal_params()
     assert rows["pytoy"]["params"] == "denoise" and rows["svgf"]["params"] == "svgf"
     assert rows["temporal"]["params"] == "temporal"
     seq = {r["name"]: r for r in atrous.sequence_methods()}
@@ -184,6 +190,92 @@ def test_the_cpp_toy_plugin_is_one_method_for_the_cli_and_python(tmp_path):
     np.testing.assert_array_equal(atrous.read_image(tmp_path / "py.exr"), atrous.read_image(tmp_path / "cli.exr"))
     with pytest.raises(ValueError, match="no such plugin file"):
         atrous.load_plugin(tmp_path / "nope.so")
+
+
+def test_the_cpp_toy_sequence_method_is_one_method_for_the_cli_and_python(tmp_path):
+    """tests/toy_sequence_method.cpp, registered by the same plugin's entry point: in another Python
+    process atrous.load_plugin puts "toyseq" in SEQUENCE_METHODS and sequence_methods() with its
+    table; denoise_sequence writes the CLI's bytes (`atrous --plugin ... denoise --sequence
+    --method toyseq`), and a SequenceDenoiser over the same frames gives the same images."""
+    import subprocess
+    import sys
+
+    from atrous_cli import atrous_cli, toy_plugin_so
+
+    so, cli = toy_plugin_so(), atrous_cli()
+    if so is None or cli is None:
+        pytest.skip("no C++ build with the toy plugin")
+    seq = tmp_path / "seq"
+    r = subprocess.run([cli, "render", "--scene", "cornell-moving", "--frames", "3", "--spp", "1", "--width", "24",
+                        "--height", "16", "--quiet", "--out", str(seq)], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    r = subprocess.run([cli, "--plugin", so, "denoise", "--sequence", str(seq), "--method", "toyseq", "--toyseq-alpha",
+                        "0.5", "--out", str(tmp_path / "cli")], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    code = ("import sys, atrous\n"
+            "from atrous.eval.sequence import list_frames, load_frame\n"
+            "atrous.load_plugin(sys.argv[1])\n"
+            "assert 'toyseq' in atrous.SEQUENCE_METHODS and 'toyseq' not in atrous.METHODS\n"
+            "row = {r['name']: r for r in atrous.sequence_methods()}['toyseq']\n"
+            "assert row['registered'] and row['causal'] and row['history'] and row['params'] == 'toyseq', row\n"
+            "assert [p['name'] for p in atrous.sequence_params('toyseq')] == ['alpha']\n"
+            "rep = atrous.denoise_sequence(sys.argv[2], sys.argv[3], method='toyseq', toyseq={'alpha': 0.5}, "
+            "preview=False)\n"
+            "assert [f['method_used'] for f in rep['frames']] == ['toyseq'] * 3, rep\n"
+            "d = atrous.SequenceDenoiser('toyseq', params={'alpha': 0.5}, device='cpu')\n"
+            "for i, p in enumerate(list_frames(sys.argv[2])):\n"
+            "    d.push({k: v for k, v in load_frame(p).items() if k != 'reference'})\n"
+            "    assert d.ready\n"
+            "    atrous.write_image(f'{sys.argv[4]}/{i}.exr', d.next())\n")
+    (tmp_path / "stream").mkdir()
+    r = subprocess.run([sys.executable, "-c", code, so, str(seq), str(tmp_path / "py"), str(tmp_path / "stream")],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    for i in range(3):
+        name = f"frame_{i:04d}.exr"
+        assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), name
+        np.testing.assert_array_equal(atrous.read_image(tmp_path / "stream" / f"{i}.exr"),
+                                      atrous.read_image(tmp_path / "cli" / name))
+
+
+def test_sequence_denoiser_is_the_one_interface(tmp_path):
+    """svgf through SequenceDenoiser is Svgf; temporal's stream gives denoise_temporal's frames bit
+    for bit (each window the same, each frame prepared once); a frame comes out once the frames
+    after it that it reads are in; bad names and keywords are ValueErrors."""
+    frames = list(atrous.render_sequence("cornell-moving", 4, width=24, height=16, spp=1, seed=4))
+    s, g = atrous.Svgf(device="cpu", levels=3), atrous.SequenceDenoiser("svgf", device="cpu", params={"levels": 3})
+    assert g.lookahead == 0 and g.lookbehind == 0
+    for f in frames:
+        a = s.denoise_frame(f["color"], albedo=f["albedo"], normal=f["normal"], depth=f["depth"], ids=f["ids"],
+                            motion=f["motion"], emission=f["emission"], position=f["position"],
+                            variance=f["variance"])
+        g.push(f)
+        assert g.ready
+        np.testing.assert_array_equal(g.next(), a)
+        assert g.method_used == "svgf"
+    t = atrous.SequenceDenoiser("temporal", spatial="eaw", device="cpu", params={"radius": 1, "static_radius": 0})
+    assert t.lookahead == 1 and t.lookbehind == 1
+    outs = []
+    for f in frames:
+        t.push(f)
+        while t.ready:
+            outs.append(t.next())
+    assert len(outs) == 3 and not t.ready
+    t.finish()
+    outs.append(t.next())
+    for i in range(4):
+        lo, hi = max(0, i - 1), min(3, i + 1)
+        want = atrous.denoise_temporal(frames[lo:hi + 1], i - lo, method="eaw", device="cpu",
+                                       temporal={"radius": 1, "static_radius": 0})
+        np.testing.assert_array_equal(outs[i], want)
+    with pytest.raises(ValueError, match="unknown method 'median'"):
+        atrous.SequenceDenoiser("median")
+    with pytest.raises(ValueError, match="unknown SVGF parameter 'sigma_q'"):
+        atrous.SequenceDenoiser("svgf", params={"sigma_q": 1})
+    with pytest.raises(ValueError, match="still method"):
+        atrous.SequenceDenoiser("eaw", params={"radius": 1})
+    with pytest.raises(ValueError, match="no frame is ready"):
+        atrous.SequenceDenoiser("temporal").next()
 
 
 def test_names_the_front_ends_use_are_taken_and_reads_takes_one_name():

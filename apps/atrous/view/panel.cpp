@@ -10,9 +10,12 @@
 #include <cstdint>
 #include <initializer_list>
 #include <string>
+#include <vector>
 
 #include "atrous/device.h"
+#include "atrous/param_set.h"
 #include "atrous/params.h"
+#include "atrous/sequence_methods.h"
 
 namespace atrous::view {
 namespace {
@@ -77,21 +80,21 @@ void statusSection(const ViewPipeline& pl, const StageHistory& history, const Pa
 }
 
 // One control per row of a parameter table (params.h), labelled with the row's name, its doc
-// line as the tooltip, limited to its range. Out-of-range values the drags can still reach (the
-// open end of (0, 1]) and cross-field rules surface as the slot's error.
-template <class S>
-void paramControl(S& s, const ParamTable<S>& t, const ParamField<S>& f, ViewerState& st) {
-    const ParamRef r = f.at(s);
+// line as the tooltip, limited to its range; the drag speed of a float follows its default (row i
+// of `defaults`). Out-of-range values the drags can still reach (the open end of (0, 1]) and
+// cross-field rules surface as the slot's error.
+void paramControl(ParamSet& s, size_t i, const ParamSet& defaults, ViewerState& st) {
+    const ParamRow& f = s.rows()[i];
+    const ParamRef r = s.at(i);
     const auto finite = [](double v, float inf) { return std::isinf(v) ? inf : float(v); };
-    if (int* const* i = std::get_if<int*>(&r)) {
+    if (int* const* n = std::get_if<int*>(&r)) {
         const int lo = int(f.range.lo), hi = std::isinf(f.range.hi) ? INT_MAX : int(f.range.hi);
         if (hi - lo <= 64)
-            ImGui::SliderInt(f.name, *i, lo, hi);
+            ImGui::SliderInt(f.name, *n, lo, hi);
         else
-            ImGui::DragInt(f.name, *i, 0.2f, lo, hi);
+            ImGui::DragInt(f.name, *n, 0.2f, lo, hi);
     } else if (float* const* x = std::get_if<float*>(&r)) {
-        static const S defaults{};
-        const float d = *std::get<float*>(f.at(const_cast<S&>(defaults)));
+        const float d = *std::get<float*>(defaults.at(i));
         const float speed = std::max(std::fabs(d), 0.01f) * 0.01f;
         ImGui::DragFloat(f.name, *x, speed, f.range.zero ? 0.0f : finite(f.range.lo, -FLT_MAX), finite(f.range.hi, FLT_MAX),
                          "%.4g");
@@ -103,12 +106,18 @@ void paramControl(S& s, const ParamTable<S>& t, const ParamField<S>& f, ViewerSt
         if (ImGui::Combo(f.name, &v, f.choices, n)) **m = SureMode(v);
     } else if (ImGui::InputText(f.name, st.candidatesText, sizeof(st.candidatesText))) {
         try {
-            setParamFromText(s, t, f, st.candidatesText);
+            s.setText(i, st.candidatesText);
         } catch (const ParamError&) {
             // half-typed: keep the last list that parsed
         }
     }
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", f.doc);
+}
+template <class S>
+void paramControl(S& s, const ParamTable<S>& t, const ParamField<S>& f, ViewerState& st) {
+    static const ParamSet defaults(t);
+    ParamSet set = ParamSet::bind(t, s);
+    paramControl(set, size_t(&f - t.first), defaults, st);
 }
 
 // Samples, depth, accumulation, pause, exposure, camera.
@@ -159,27 +168,39 @@ void methodSection(ViewerState& st, const ViewPipeline& pl) {
                                pl.slot(i).error.c_str());
 }
 
-// The rows of `groups` (a row's group is one of them) under a collapsing header.
-template <class S>
-void paramSection(const char* header, S& s, const ParamTable<S>& t, std::initializer_list<const char*> groups,
-                  ViewerState& st, ImGuiTreeNodeFlags flags = 0) {
-    if (!ImGui::CollapsingHeader(header, flags)) return;
-    ImGui::PushID(header);  // "levels" is a row of both tables
-    for (const ParamField<S>& f : t)
-        for (const char* g : groups)
-            if (std::string(f.group) == g) paramControl(s, t, f, st);
+// The still parameters of one group (denoiseParams()' `group`) under a collapsing header: its title.
+void paramSection(const std::string& group, DenoiseOptions& s, ViewerState& st, ImGuiTreeNodeFlags flags = 0) {
+    const std::string header = denoiseGroupTitle(group);
+    if (!ImGui::CollapsingHeader(header.c_str(), flags)) return;
+    ImGui::PushID(header.c_str());  // "levels" is a row of two tables
+    for (const ParamField<DenoiseOptions>& f : denoiseParams())
+        if (group == f.group) paramControl(s, denoiseParams(), f, st);
+    ImGui::PopID();
+}
+
+// Every row of a set under a collapsing header (a sequence method's table).
+void paramSection(const char* header, ParamSet& s, const ParamSet& defaults, ViewerState& st) {
+    if (!ImGui::CollapsingHeader(header)) return;
+    ImGui::PushID(header);
+    for (size_t i = 0; i < s.rows().size(); ++i) paramControl(s, i, defaults, st);
     ImGui::PopID();
 }
 
 void filterSections(ViewerState& st) {
     PipelineSettings& ps = st.ps;
-    paramSection("EAW (also SURE's cascade)", ps.denoise, denoiseParams(), {"eaw"}, st, ImGuiTreeNodeFlags_DefaultOpen);
-    paramSection("SURE", ps.denoise, denoiseParams(), {"sure"}, st);
-    paramSection("Firefly / demodulation / safety net", ps.denoise, denoiseParams(), {"firefly", "", "safety"}, st);
-    paramSection("SVGF", ps.svgf, svgfParams(), {""}, st);
-    if (ImGui::CollapsingHeader("SVGF camera motion")) {
-        ImGui::Checkbox("motion vectors on camera move", &ps.svgfMotionVectors);
-        ImGui::TextDisabled(ps.svgfMotionVectors ? "(history reprojected)" : "(history reset on move)");
+    // One section per group of the still parameters, in the table's order (the first open).
+    std::vector<std::string> groups;
+    for (const ParamField<DenoiseOptions>& f : denoiseParams())
+        if (std::find(groups.begin(), groups.end(), std::string(f.group)) == groups.end()) groups.push_back(f.group);
+    for (size_t i = 0; i < groups.size(); ++i) paramSection(groups[i], ps.denoise, st, i == 0 ? ImGuiTreeNodeFlags_DefaultOpen : 0);
+    // Each sequence method the viewer runs, its table's rows.
+    for (const SequenceMethodInfo& m : sequenceMethods()) {
+        ParamSet& p = sequenceParams(ps, m);
+        if ((m.causal || m.causalMode) && !p.empty()) paramSection(m.label, p, m.params, st);
+    }
+    if (ImGui::CollapsingHeader("Sequence methods on camera motion")) {
+        ImGui::Checkbox("motion vectors on camera move", &ps.sequenceMotionVectors);
+        ImGui::TextDisabled(ps.sequenceMotionVectors ? "(history reprojected)" : "(history reset on move)");
     }
 }
 

@@ -45,8 +45,10 @@ ViewerState checkOptions(const ViewerOptions& opt) {
     ps.sppPerFrame = opt.render.spp;
     ps.maxDepth = opt.render.maxDepth;
     ps.accumulate = !opt.noAccumulate;
-    validateSvgfParams(opt.svgf);  // ParamError naming the field; main.cpp shows its flag
-    ps.svgf = opt.svgf;
+    for (const ParamSet& p : opt.sequence) {
+        p.validate();  // ParamError naming the field; main.cpp shows its flag
+        ps.sequence.push_back(p);
+    }
     st.view = parseBufferView(opt.bufferView);
     if (opt.frames < 0) throw InputError("--frames: must be 0 (interactive) or more");
     if (!opt.screenshot.empty()) {

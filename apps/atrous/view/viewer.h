@@ -2,10 +2,11 @@
 // when GLFW, OpenGL and imgui are found (ATROUS_HAVE_VIEWER); docs/viewer.md.
 #pragma once
 #include <cstdint>
+#include <deque>
 #include <string>
 
+#include "atrous/param_set.h"
 #include "atrous/render.h"
-#include "atrous/svgf.h"
 
 namespace atrous::view {
 
@@ -19,7 +20,7 @@ struct ViewerOptions {
         r.spp = 1;
         return r;
     }();
-    std::string method = "blend";  // slot A: none | eaw | sure | svgf | learned | blend (the renderer gives every buffer: auto's choice)
+    std::string method = "blend";  // slot A: a name of methodNames() (blend: auto's choice, the renderer gives every buffer)
     std::string compare;         // slot B for the split screen (empty: no split)
     bool noAccumulate = false;
     std::string bufferView = "result";  // initial buffer view (see docs/viewer.md)
@@ -32,7 +33,9 @@ struct ViewerOptions {
     float orbitDegPerFrame = 0.0f;       // turntable: yaw the orbit camera by this much every frame
     bool hideUi = false;                 // no control panel: the window is exactly width x height
     bool benchmark = false;              // print a JSON line with frame and stage timings at exit
-    SvgfParams svgf;                     // --svgf-* flags (the svgf parameter table): SVGF's start values
+    // The sequence methods' flags (--svgf-*, --temporal-*: their tables), by their place in
+    // sequenceMethods(): the start values of the panel's sections.
+    std::deque<ParamSet> sequence;
 };
 
 // Opens the window and runs until it is closed (or --frames are done). Throws InputError for bad

@@ -30,12 +30,12 @@ _STILL = _still_items()
 class AtrousSettings(bpy.types.PropertyGroup):
     method: bpy.props.EnumProperty(
         name="Method", items=_METHODS, default=atrous.SEQUENCE_METHODS[0],
-        description="temporal: each frame with the frames around it (the default); svgf: causal; a still "
-                    "method: each frame alone")
+        description="A sequence method: each frame with the frames around it or before it (the first, "
+                    "the default); a still method: each frame alone")
     spatial: bpy.props.EnumProperty(
         name="Spatial", items=_STILL, default="auto",
-        description="The still method: what the temporal method runs on its average, and what denoises the "
-                    "Render Result (auto: by the passes given)")
+        description="The still method: what a sequence method that ends with one runs (on "
+                    "its average), and what denoises the Render Result (auto: by the passes given)")
     output: bpy.props.StringProperty(
         name="Output", subtype="DIR_PATH", default="",
         description="Folder for frame_NNNN.exr (empty: FRAMES_denoised beside the rendered frames' folder)")

@@ -269,7 +269,9 @@ def main(argv=None):
 def eval_sequence(sd, man, oidn, want, cols):
     """Per-frame 1-spp relMSE against the per-frame references, averaged; plus SVGF with the motion."""
     import atrous
-    per = {m: [] for m in cols + ["svgf"]}
+    from atrous.sequence import SVGF
+
+    per = {m: [] for m in cols + [SVGF]}
     svgf = atrous.Svgf("cpu")
     for fr in man["frames"]:
         b = load_frame(sd, man, fr)
@@ -280,14 +282,14 @@ def eval_sequence(sd, man, oidn, want, cols):
         s = svgf.denoise_frame(b["color"], albedo=b["albedo"], normal=b["normal"],
                                depth=np.ascontiguousarray(np.repeat(b["depth"][..., None], 3, -1)),
                                ids=b.get("ids"), motion=b["motion"], emission=b.get("emission"))
-        per["svgf"].append(relmse(np.asarray(s, np.float32), ref))
+        per[SVGF].append(relmse(np.asarray(s, np.float32), ref))
     half = len(man["frames"]) // 2
     row = {"scene": man["scene"], "renderer": man["renderer"], "layout": man["layout"], "spp": 1,
            "ref_spp": man["reference_spp"], "resolution": man["resolution"], "frames": len(man["frames"]),
            "relmse": {m: float(np.mean(v)) for m, v in per.items()},
            "relmse_second_half": {m: float(np.mean(v[half:])) for m, v in per.items()},
            "relmse_per_frame": per}
-    print(fmt_row(row, cols + ["svgf"]), flush=True)
+    print(fmt_row(row, cols + [SVGF]), flush=True)
     return row
 
 
@@ -298,7 +300,9 @@ def fmt_row(r, cols):
 
 
 def table(results, cols):
-    allc = cols + (["svgf"] if any("frames" in r for r in results) else [])
+    from atrous.sequence import SVGF
+
+    allc = cols + ([SVGF] if any("frames" in r for r in results) else [])
     lines = ["| scene | spp | ref spp | " + " | ".join(allc) + " |",
              "|---|---|---|" + "---|" * len(allc)]
     lines += [fmt_row(r, allc) for r in results]

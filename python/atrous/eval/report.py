@@ -13,8 +13,11 @@ import numpy as np
 import atrous
 
 COLORS = {"noisy": "#7f7f7f", "eaw": "#1f77b4", "sure": "#2ca02c", "learned": "#ff7f0e", "blend": "#17becf", "auto": "#8c564b",
-          "oidn": "#d62728", "svgf": "#9467bd", "temporal": "#e377c2",
-          "render 1 spp": "#000000"}
+          "oidn": "#d62728", "render 1 spp": "#000000"}
+# The sequence methods' colours, in the registry's order (temporal, svgf, then a plugin's).
+_SEQUENCE_COLORS = ("#e377c2", "#9467bd", "#bcbd22", "#8c564b", "#aec7e8")
+COLORS.update({str(r["name"]): _SEQUENCE_COLORS[i % len(_SEQUENCE_COLORS)]
+               for i, r in enumerate(atrous.sequence_methods())})
 
 
 def _geomean(xs: List[float]) -> Optional[float]:

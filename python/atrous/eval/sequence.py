@@ -1,4 +1,4 @@
-"""Frame sequences for the evaluation: SVGF (temporal) next to the per-frame methods.
+"""Frame sequences for the evaluation: the sequence methods (temporal, SVGF, ...) next to the per-frame methods.
 
 Layout (the one include/atrous/io/sequence.h reads): DIR/frame_0000/, frame_0001/, ... each holding
 color.exr albedo.exr normal.exr position.exr depth.exr ids.exr motion.exr and optionally
@@ -69,18 +69,43 @@ def write_static_sequence(seq_dir: str, scene: str, frames: int, width: int, hei
         atrous.write_image(f / "reference.exr", ref)
 
 
-def temporal_window(count: int, index: int, temporal: Optional[Dict[str, Any]] = None) -> Tuple[int, int]:
-    """The first and last frame (inclusive) that atrous.denoise_temporal reads for frame `index` of
-    `count` frames with the `temporal` parameters (None: the defaults): index ± the window's radius
-    (radius, or static_radius when larger), clipped to the sequence."""
-    r = atrous.temporal_window_radius(temporal)
-    return max(0, index - r), min(count - 1, index + r)
+def sequence_window(count: int, index: int, method: str, *, motion_given: bool = True, params: Optional[Dict[str, Any]] = None,
+                    **still: Any) -> Tuple[int, int]:
+    """The first and last frame (inclusive) that sequence method `method` reads for frame `index` of
+    `count` frames with these parameters (its own table's, `params`; `still`: the still method's):
+    index - its lookbehind .. index + its lookahead (temporal: the window's radius, static_radius
+    when larger and the motion is the renderer's), clipped to the sequence."""
+    d = atrous.SequenceDenoiser(method, device="cpu", motion_given=motion_given, params=params, **still)
+    return max(0, index - d.lookbehind), min(count - 1, index + d.lookahead)
+
+
+def sequence_outputs(method: str, frames: List[Dict[str, Any]]) -> Tuple[List[Any], List[float]]:
+    """Every frame through one stream of `method` (its defaults, on the CPU), in order: the outputs
+    and the milliseconds of each (its next(): a window method's frame is denoised once the frames
+    after it it reads are in)."""
+    d = atrous.SequenceDenoiser(method, device="cpu")
+    outs: List[Any] = []
+    times: List[float] = []
+
+    def drain() -> None:
+        while d.ready:
+            t0 = time.perf_counter()
+            outs.append(d.next())
+            times.append((time.perf_counter() - t0) * 1e3)
+
+    for f in frames:
+        d.push(f)
+        drain()
+    d.finish()
+    drain()
+    return outs, times
 
 
 def evaluate_sequence(seq_dir: str, methods: Dict[str, Optional[Callable]],
                       log: Callable[[str], None] = print) -> Dict[str, Any]:
-    """The temporal method (frames t-3..t+3, t-6..t+6 where still: the CLI's --sequence default), SVGF (history carried
-    over frames) and every per-frame method on each frame.
+    """Every sequence method of the library (atrous.SEQUENCE_METHODS: the temporal method, frames
+    t-3..t+3, t-6..t+6 where still, the CLI's --sequence default; SVGF, history carried over
+    frames; a plugin's) through one stream each, and every per-frame method on each frame.
 
     Metrics per frame against reference.exr when present (FLIP on the last frame only: it costs
     ~0.5 s an image); temporal relMSE = relMSE of frame-to-frame differences against the
@@ -90,13 +115,15 @@ def evaluate_sequence(seq_dir: str, methods: Dict[str, Optional[Callable]],
     from . import score
 
     paths = list_frames(seq_dir)
-    names = ["temporal", "svgf"] + [m for m in methods]
-    # The temporal method reads the frames around each one: every frame is loaded first.
+    streams = list(atrous.SEQUENCE_METHODS)
+    names = streams + [m for m in methods]
+    # The sequence methods read the frames around each one, or their history: every frame is loaded
+    # first, and each method's stream runs over all of them.
     loaded = [load_frame(p) for p in paths]
     window = [{k: v for k, v in b.items() if k != "reference"} for b in loaded]
-    svgf = atrous.Svgf("cpu")
+    sequence_outs = {m: sequence_outputs(m, window) for m in streams}
     frames_out: List[Dict[str, Any]] = []
-    times: Dict[str, List[float]] = {m: [] for m in names}
+    times: Dict[str, List[float]] = {m: list(sequence_outs[m][1]) if m in sequence_outs else [] for m in names}
     prev: Dict[str, np.ndarray] = {}
     prev_ref: Optional[np.ndarray] = None
     temporal: Dict[str, List[float]] = {m: [] for m in names}
@@ -106,15 +133,7 @@ def evaluate_sequence(seq_dir: str, methods: Dict[str, Optional[Callable]],
         b = loaded[i]
         height, width = b["color"].shape[:2]
         b.setdefault("variance", None)
-        outs: Dict[str, np.ndarray] = {}
-        lo, hi = temporal_window(len(paths), i)
-        t0 = time.perf_counter()
-        outs["temporal"] = atrous.denoise_temporal(window[lo:hi + 1], i - lo, device="cpu")
-        times["temporal"].append((time.perf_counter() - t0) * 1e3)
-        t0 = time.perf_counter()
-        outs["svgf"] = svgf.denoise_frame(b["color"], albedo=b["albedo"], normal=b["normal"], depth=b["depth"],
-                                          ids=b["ids"], motion=b["motion"], emission=b.get("emission"))
-        times["svgf"].append((time.perf_counter() - t0) * 1e3)
+        outs: Dict[str, np.ndarray] = {m: sequence_outs[m][0][i] for m in streams}
         for m, fn in methods.items():
             if fn is None:
                 outs[m] = b["color"]

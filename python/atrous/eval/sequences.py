@@ -10,7 +10,7 @@ measures per frame
             frame, dilated by 1 px): at 1 spp their jittered edges flicker and dominate `temporal`
             unless the emission is accumulated (SVGF); this column is the rest of the image
 Prints JSON (and writes it with --json), a Markdown section with --markdown, SVG plots with --plots.
-Python 3 standard library only.
+Python's standard library, the CLI, and the atrous package for SVGF's name in the registry.
 """
 import argparse
 import json
@@ -19,7 +19,9 @@ import subprocess
 import sys
 import time
 
-METHODS = ["svgf", "eaw", "sure"]
+from atrous.sequence import SVGF
+
+METHODS = [SVGF, "eaw", "sure"]
 
 
 def run(cmd, quiet=True):
@@ -49,7 +51,7 @@ def mean(v):
 def svg_plot(path, title, series, key):
     """A small line plot (per frame, log-free, y from 0) written as plain SVG."""
     w, h, ml, mb, mt, mr = 520, 240, 60, 30, 24, 90
-    colors = {"noisy": "#999999", "svgf": "#d62728", "eaw": "#1f77b4", "sure": "#2ca02c"}
+    colors = {"noisy": "#999999", SVGF: "#d62728", "eaw": "#1f77b4", "sure": "#2ca02c"}
     ys = [y for s in series.values() for y in s[key] if y is not None]
     n = max(len(s[key]) for s in series.values())
     ymax = max(ys) * 1.05 if ys else 1.0
@@ -91,7 +93,7 @@ def markdown(result, plots_rel):
                                                              sc["temporal_no_emitters_eaw_over_svgf"], sc["temporal_eaw_over_svgf"]))
         out.append("")
     for sc in result["scenes"]:
-        n = len(sc["methods"]["svgf"]["relmse"])
+        n = len(sc["methods"][SVGF]["relmse"])
         out.append("Per frame, %s (%s camera): relMSE / temporal error without emitter pixels" % (sc["scene"], sc["camera_path"]))
         out.append("")
         out.append("| frame | " + " | ".join("%s relMSE" % k for k in ["noisy"] + METHODS) + " | " +
@@ -154,13 +156,13 @@ def main(argv=None):
         scene = {"scene": name, "camera_path": path, "render_seconds": round(render_s, 1), "methods": {}}
         outs = {}
         for m in METHODS:
-            out = os.path.join(a.work, "%s_%s_%d_%s" % (name, path, a.size, m + (a.svgf_tag if m == "svgf" else "")))
+            out = os.path.join(a.work, "%s_%s_%d_%s" % (name, path, a.size, m + (a.svgf_tag if m == SVGF else "")))
             outs[m] = out
             frames_in = sorted(d for d in os.listdir(seq) if d.startswith("frame_"))
-            if m != "svgf" and a.reuse_baselines and not fresh and \
+            if m != SVGF and a.reuse_baselines and not fresh and \
                     all(os.path.exists(os.path.join(out, f + ".exr")) for f in frames_in):
                 continue
-            extra = a.svgf_args.split() if m == "svgf" else []
+            extra = a.svgf_args.split() if m == SVGF else []
             if use_cli:
                 run(nice([a.atrous, "denoise", "--method", m, "--sequence", seq, "--out", out] + extra))
             else:
@@ -192,12 +194,12 @@ def main(argv=None):
                 "mean_relmse_after_skip": mean(series[k]["relmse"][s:]),
                 "mean_temporal_after_skip": mean(series[k]["temporal"][s:]),
                 "mean_temporal_no_emitters_after_skip": mean(series[k]["temporal_no_emitters"][s:])}
-        sv, ea = series["svgf"]["relmse"][s:], series["eaw"]["relmse"][s:]
+        sv, ea = series[SVGF]["relmse"][s:], series["eaw"]["relmse"][s:]
         scene["svgf_beats_eaw_frames"] = "%d/%d" % (sum(1 for x, y in zip(sv, ea) if x < y), len(sv))
         scene["temporal_eaw_over_svgf"] = scene["methods"]["eaw"]["mean_temporal_after_skip"] / \
-            scene["methods"]["svgf"]["mean_temporal_after_skip"]
+            scene["methods"][SVGF]["mean_temporal_after_skip"]
         scene["temporal_no_emitters_eaw_over_svgf"] = scene["methods"]["eaw"]["mean_temporal_no_emitters_after_skip"] / \
-            scene["methods"]["svgf"]["mean_temporal_no_emitters_after_skip"]
+            scene["methods"][SVGF]["mean_temporal_no_emitters_after_skip"]
         if a.plots:
             os.makedirs(a.plots, exist_ok=True)
             for key in ["relmse", "temporal_no_emitters"]:

@@ -20,18 +20,21 @@ import numpy as np
 import atrous
 
 __all__ = ["Item", "FarmInputError", "scene_label", "check_scenes", "parse_value", "check_denoise_params",
-           "discover_inputs", "denoise_choices", "EVAL_METHODS", "eval_choices", "split_temporal_params"]
+           "discover_inputs", "denoise_choices", "EVAL_METHODS", "eval_choices", "sequence_row",
+           "split_sequence_params"]
 
 
 def denoise_choices() -> tuple:
-    """The still methods, OIDN, and the sequence methods (temporal, svgf): the library's lists as
-    they are now (with the methods a plugin registered)."""
+    """The still methods, OIDN, and the sequence methods: the library's lists as they are now (with
+    the methods a plugin registered)."""
     return atrous.METHODS + ("oidn",) + atrous.SEQUENCE_METHODS
 
 
-# The temporal method's own parameters travel as temporal_<name> (the CLI's --temporal-<name>), and
-# its still method as spatial=...; the rest are the still method's.
-TEMPORAL_PREFIX = "temporal_"
+def sequence_row(method: str) -> Optional[Dict[str, Any]]:
+    """The registry's row of a sequence method (atrous.sequence_methods()), None for another name."""
+    return next((r for r in atrous.sequence_methods() if r["name"] == method), None)
+
+
 EVAL_METHODS = ("noisy", "eaw", "sure", "oidn")  # the default set
 
 
@@ -155,26 +158,29 @@ def parse_assignments(pairs: Iterable[str], flag: str, lists: bool) -> Dict[str,
 _PROBE = np.full((8, 8, 3), 0.5, np.float32)
 
 
-def split_temporal_params(params: Dict[str, Any]):
-    """The temporal method's parameters: (its own table's, with the prefix dropped; the still method
-    (spatial=..., default auto); the still method's)."""
-    own = {k[len(TEMPORAL_PREFIX):]: v for k, v in params.items() if k.startswith(TEMPORAL_PREFIX)}
-    still = {k: v for k, v in params.items() if not k.startswith(TEMPORAL_PREFIX) and k != "spatial"}
+def split_sequence_params(method: str, params: Dict[str, Any]):
+    """A sequence method's parameters: (its own table's; the still method it ends with, spatial=...,
+    default auto; that still method's). A method that ends with a still method takes its own as
+    <table>_<name> (the CLI's --<table>-<name>: temporal_radius), the rest being the still
+    method's; one that does not takes its own table's names as they are."""
+    row = sequence_row(method) or {}
+    if not row.get("still_method"):
+        return dict(params), "auto", {}
+    prefix = f"{row['params']}_"
+    own = {k[len(prefix):]: v for k, v in params.items() if k.startswith(prefix)}
+    still = {k: v for k, v in params.items() if not k.startswith(prefix) and k != "spatial"}
     return own, str(params.get("spatial", "auto")), still
 
 
 def check_denoise_params(method: str, params: Dict[str, Any], flag: str) -> None:
-    """Denoises an 8x8 grey image with these parameters, so that an unknown name or an
-    out-of-range value fails here, once, instead of in every item."""
+    """Denoises an 8x8 grey image with these parameters (a sequence method: makes its denoiser), so
+    that an unknown name or an out-of-range value fails here, once, instead of in every item."""
     try:
         if method in atrous.METHODS:
             atrous.denoise(_PROBE, albedo=_PROBE, normal=_PROBE, method=method, **params)
-        elif method == "svgf":
-            atrous.Svgf(device="cpu", **params)
-        elif method == "temporal":
-            own, spatial, still = split_temporal_params(params)
-            probe = {"color": _PROBE, "albedo": _PROBE, "normal": _PROBE}
-            atrous.denoise_temporal([probe, probe], 0, temporal=own, method=spatial, **still)
+        elif method in atrous.SEQUENCE_METHODS:
+            own, spatial, still = split_sequence_params(method, params)
+            atrous.SequenceDenoiser(method, device="cpu", spatial=spatial, params=own, **still)
         elif params:
             raise FarmInputError(f"{flag}: {method} takes no parameters (got {', '.join(params)})")
     except FarmInputError:

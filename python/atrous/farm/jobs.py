@@ -10,7 +10,7 @@ from typing import Any, Dict, List, Optional, Sequence, Union
 import atrous
 
 from . import dataset as _dataset
-from .items import (EVAL_METHODS, FarmInputError, Item, check_denoise_params, check_scenes, denoise_choices,
+from .items import (EVAL_METHODS, FarmInputError, Item, check_denoise_params, check_scenes, denoise_choices, sequence_row,
                     discover_inputs, eval_choices, grid_points, int_list, name_list, params_label, positive_int, scene_label)
 from .manifest import Manifest
 from ..plugins import PluginError, load_plugins, resolve_plugins
@@ -83,11 +83,12 @@ def render_dataset(out: PathLike, spec: Union[Dict[str, Any], PathLike], **run: 
 def denoise(out: PathLike, inputs: Any, method: str = "auto", params: Optional[Dict[str, Any]] = None,
             plugins: Any = None, **run: Any) -> JobResult:
     """Render directories and frame sequences through one method: OUT/<name>/denoised_<method>.exr
-    and .png per render directory, OUT/<sequence>/frame_NNNN.exr and .png per frame (svgf: one
-    item per sequence, its frames in order; temporal: one item per frame, which reads the frames
-    around it: params temporal_<name> are its own, spatial=METHOD its still method). plugins: Python
-    files or modules that register still methods (atrous.register_method), loaded here and in every
-    worker (atrous/plugins.py)."""
+    and .png per render directory, OUT/<sequence>/frame_NNNN.exr and .png per frame (a sequence
+    method with history, svgf: one item per sequence, its frames in order; one without, temporal:
+    one item per frame, which reads the frames around it: params <table>_<name> are its own,
+    spatial=METHOD its still method; farm/items.py split_sequence_params). plugins: shared
+    libraries, Python files or modules that register methods (atrous.load_plugin,
+    atrous.register_method), loaded here and in every worker (atrous/plugins.py)."""
     try:
         plugins = resolve_plugins(plugins)
         load_plugins(plugins)
@@ -102,15 +103,16 @@ def denoise(out: PathLike, inputs: Any, method: str = "auto", params: Optional[D
     items = []
     for f in found:
         base = {"method": method, "params": params, **({"plugins": plugins} if plugins else {})}
-        if method in atrous.SEQUENCE_METHODS and f["kind"] != "sequence":
+        row = sequence_row(method)
+        if row is not None and f["kind"] != "sequence":
             raise FarmInputError(f"inputs: {f['path']}: {method} denoises frame sequences (frame_NNNN/), "
                                  "this is a single render")
-        if method == "svgf":
-            items.append(Item(f["name"], "svgf", dict(base, input=f["path"], frames=f["frames"]), [f["name"]]))
-        elif method == "temporal":  # one item per frame, each reading the frames around it
+        if row is not None and row["history"]:  # one item per sequence, its frames in order
+            items.append(Item(f["name"], "sequence", dict(base, input=f["path"], frames=f["frames"]), [f["name"]]))
+        elif row is not None:  # one item per frame, each reading the frames around it
             for i, fr in enumerate(f["frames"]):
                 iid = f"{f['name']}/{fr}"
-                items.append(Item(iid, "temporal", dict(base, input=f["path"], frames=f["frames"], index=i),
+                items.append(Item(iid, "window", dict(base, input=f["path"], frames=f["frames"], index=i),
                                   [iid + ".exr", iid + ".png"]))
         elif f["kind"] == "render":
             iid = f"{f['name']}/denoised_{method}"

@@ -199,40 +199,53 @@ def publish_denoised(item: Dict[str, Any], out: Path, img: np.ndarray, ref: Path
     return result
 
 
-def run_svgf(item: Dict[str, Any], out: Path, threads: int, device: str) -> Dict[str, Any]:
-    """A whole sequence through SVGF (each frame needs the ones before): OUT/<sequence>/frame_NNNN.exr/.png."""
+def run_sequence(item: Dict[str, Any], out: Path, threads: int, device: str) -> Dict[str, Any]:
+    """A whole sequence through a sequence method with history (svgf: each frame needs the ones
+    before), one stream in order: OUT/<sequence>/frame_NNNN.exr/.png."""
     from atrous.eval.sequence import load_frame
 
+    from .items import split_sequence_params
+
     p = item["params"]
-    s = atrous.Svgf(device="cuda" if device == "cuda" else "cpu", **p["params"])
+    own, spatial, still = split_sequence_params(p["method"], p["params"])
+    s = atrous.SequenceDenoiser(p["method"], device="cuda" if device == "cuda" else "cpu", spatial=spatial,
+                                params=own, **still)
+    pending = list(p["frames"])  # pushed, not yet out: the next to come out first
     with staged(out, item["id"]) as stage:
+        def drain() -> None:
+            while s.ready:
+                img = s.next()
+                name = pending.pop(0)
+                atrous.write_image(stage / f"{name}.exr", img)
+                atrous.write_image(stage / f"{name}.png", img)
+
         for name in p["frames"]:
-            b = load_frame(Path(p["input"]) / name)
-            img = s.denoise_frame(b["color"], albedo=b["albedo"], normal=b["normal"], depth=b["depth"],
-                                  ids=b["ids"], motion=b["motion"], emission=b.get("emission"),
-                                  position=b.get("position"), variance=b.get("variance"))
-            atrous.write_image(stage / f"{name}.exr", img)
-            atrous.write_image(stage / f"{name}.png", img)
+            s.push({k: v for k, v in load_frame(Path(p["input"]) / name).items() if k != "reference"})
+            drain()
+        s.finish()
+        drain()
         publish_dir(stage, out / item["outputs"][0])
     return {"frames": len(p["frames"])}
 
 
-def run_temporal(item: Dict[str, Any], out: Path, threads: int, device: str) -> Dict[str, Any]:
-    """One frame of a sequence through the temporal method, with the frames around it:
-    OUT/<sequence>/frame_NNNN.exr/.png (what `atrous denoise --sequence` writes for it)."""
-    from atrous.eval.sequence import load_frame, temporal_window
+def run_window(item: Dict[str, Any], out: Path, threads: int, device: str) -> Dict[str, Any]:
+    """One frame of a sequence through a sequence method without history (temporal), with the
+    frames around it that it reads: OUT/<sequence>/frame_NNNN.exr/.png (what `atrous denoise
+    --sequence` writes for it)."""
+    from atrous.eval.sequence import load_frame, sequence_window
 
-    from .items import split_temporal_params
+    from .items import split_sequence_params
 
     p = item["params"]
-    own, spatial, still = split_temporal_params(p["params"])
+    method = p["method"]
+    own, spatial, still = split_sequence_params(method, p["params"])
     i, names = int(p["index"]), p["frames"]
-    if not (Path(p["input"]) / names[i] / "motion.exr").exists():
-        own = dict(own, static_radius=0)  # the static window needs the renderer's vectors (docs/temporal.md)
-    lo, hi = temporal_window(len(names), i, own)
+    # The static window needs the renderer's vectors (docs/temporal.md).
+    motion = (Path(p["input"]) / names[i] / "motion.exr").exists()
+    lo, hi = sequence_window(len(names), i, method, motion_given=motion, params=own, spatial=spatial, **still)
     frames = [{k: v for k, v in load_frame(Path(p["input"]) / n).items() if k != "reference"} for n in names[lo:hi + 1]]
     t0 = time.perf_counter()
-    img = atrous.denoise_temporal(frames, i - lo, temporal=own, method=spatial, device=device, **still)
+    img = atrous.denoise_window(method, frames, i - lo, device=device, spatial=spatial, params=own, **still)
     ms = (time.perf_counter() - t0) * 1e3
     return publish_denoised(item, out, img, Path(p["input"]) / names[i] / "reference.exr",
                             {"denoise_ms": ms, "frames_read": hi - lo + 1})
@@ -286,7 +299,7 @@ def run_score(item: Dict[str, Any], out: Path, threads: int, device: str) -> Dic
 
 
 RUNNERS = {"render": run_render, "frame": run_frame, "dataset": run_dataset, "denoise": run_denoise,
-           "svgf": run_svgf, "temporal": run_temporal, "reference": run_reference, "evaluate": run_score, "sweep": run_score}
+           "sequence": run_sequence, "window": run_window, "reference": run_reference, "evaluate": run_score, "sweep": run_score}
 
 
 def run_item(item: Dict[str, Any], out_root: str, threads: int, device: str, tracker: Any = None,
