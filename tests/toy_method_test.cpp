@@ -177,7 +177,7 @@ TEST(ToySequenceMethod, IsARowOfTheRegistry) {
     again.make = m->make;
     again.weightsParam = "no_such_switch";
     EXPECT_THROW(registerSequenceMethod(again), InputError);
-    EXPECT_THROW(registerDenoiseMethod({DenoiseMethod::Eaw, "toyseq", "", false, toy::toyCascade}), InputError);
+    EXPECT_THROW(registerDenoiseMethod(row("toyseq", toy::toyCascade)), InputError);
     EXPECT_EQ(sequenceMethods().size(), n);
     EXPECT_EQ(denoiseMethods().size(), still);
 }

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <deque>
 #include <iterator>
+#include <map>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -75,15 +76,19 @@ bool otherSequenceGroup(const std::string& group, const std::string& method) {
 }
 
 // The help group of a still parameter: its stage's title and the methods that read it, from the
-// registry (readsParamGroup).
-std::string paramHelpGroup(const ParamField<DenoiseOptions>& f) {
-    const std::string title = denoiseGroupTitle(f.group);
+// registry (readsParamGroup); kept for the program's life (CLI11 copies it, the flag helpers take
+// a C string).
+const char* paramHelpGroup(const ParamField<DenoiseOptions>& f) {
+    static std::map<std::string, std::string> titles;
+    std::string& text = titles[f.group];
+    if (!text.empty()) return text.c_str();
+    text = denoiseGroupTitle(f.group);
     const std::vector<std::string>& stages = stillStageGroups();
-    if (std::find(stages.begin(), stages.end(), std::string(f.group)) != stages.end()) return title + " (every still method)";
+    if (std::find(stages.begin(), stages.end(), std::string(f.group)) != stages.end()) return (text += " (every still method)").c_str();
     std::string who;
     for (const DenoiseMethodInfo& m : denoiseMethods())
         if (readsParamGroup(m, f.group)) who += (who.empty() ? "" : ", ") + std::string(m.name);
-    return title + " (--method " + who + ")";
+    return (text += " (--method " + who + ")").c_str();
 }
 
 // The row of denoiseParams() whose flag is `flag`, or null.
