@@ -12,6 +12,7 @@
 
 #include "../apps/atrous/cli_flags.h"
 #include "atrous/params.h"
+#include "atrous/render.h"
 
 using namespace atrous;
 

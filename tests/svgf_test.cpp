@@ -199,7 +199,7 @@ TEST(SvgfVariance, SpatialEstimateIsUsedWhileTheHistoryIsShort) {
     // (fewer taps at the border); ±6% covers the sampling error of 3072 correlated estimates.
     EXPECT_NEAR(meanVariance(SvgfParams{}) / sigma2, 48.0 / 49.0, 0.06);
     // Forcing the temporal estimate at history 1 gives μ2 - μ1² = l² - l² = 0, up to the rounding
-    // of l²: on the FMA targets (AVX2, AVX-512: src/cpu/isa_dispatch.h) μ2 - μ1·μ1 is contracted
+    // of l²: on the FMA targets (AVX2, AVX-512: src/core/isa_dispatch.h) μ2 - μ1·μ1 is contracted
     // into one fused multiply-add, which leaves l²'s rounding error, at most half an ulp of l²
     // (l ≈ 1 here: 6e-8; measured mean 1.2e-8). The bound, 1e-5 σ² = 1e-7, is 1e5 times below
     // the spatial estimate this test tells it from (σ² = 1e-2).

@@ -10,6 +10,7 @@
 #include "atrous/device.h"
 #include "atrous/error.h"
 #include "atrous/params.h"
+#include "atrous/render.h"
 
 namespace atrous::cli {
 

@@ -73,7 +73,7 @@ struct SvgfParams {
     float safetyNet = 0.05f;
 };
 
-// Throws ParamError (atrous/params.h: an InputError naming the field, `sigma_l`) when a
+// Throws ParamError (atrous/error.h: an InputError naming the field, `sigma_l`) when a
 // parameter is out of range.
 void validateSvgfParams(const SvgfParams& p);
 

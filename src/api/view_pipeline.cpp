@@ -369,7 +369,7 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
             // running mean. On CUDA all of them are device images, which the SVGF pipeline reads
             // in place (svgf_pipeline.h copies only inputs that are not on its device).
             const RenderBuffers& fr = frame();
-            io::BufferRefs refs = io::refsOf(fr);
+            io::BufferRefs refs = fr.frame();
             refs.set(io::Buffer::Motion, &mMotion).set(io::Buffer::Emission, &mEmission);
             const SvgfFrame f = refs;
             Timer t;
@@ -442,7 +442,7 @@ void ViewPipeline::runTemporal(int i, const PipelineSettings& s, SlotResult& r) 
         std::vector<SvgfFrame> window;
         std::vector<long long> ids;
         for (const HistoryFrame& x : h) {
-            window.push_back(io::refsOf(x.b));
+            window.push_back(x.b.frame());
             ids.push_back(x.index);
         }
         DenoiseOptions o = denoiseOptions(Method::of(DenoiseMethod::Auto), s);

@@ -21,7 +21,7 @@
 #include "atrous/params.h"
 #include "core/parallel.h"
 #include "atrous/timer.h"
-#include "cpu/isa_dispatch.h"
+#include "core/isa_dispatch.h"
 #include "cpu/row_sums.h"
 #include "filters/denoise_driver.h"
 #include "filters/denoise_internal.h"

@@ -13,6 +13,7 @@
 
 #include "atrous/device.h"
 #include "atrous/params.h"
+#include "atrous/render.h"
 
 namespace atrous::view {
 namespace {
