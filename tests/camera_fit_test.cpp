@@ -163,8 +163,8 @@ struct CliSequence {
     double relmse(const std::string& name) const {
         double sum = 0;
         for (int f = 0; f < frames; ++f)
-            sum += computeMetrics(io::readImage(dir / name + "/frame_000" + std::to_string(f) + ".exr"),
-                                  io::readImage(frame(f) + "/reference.exr"))
+            sum += computeMetrics(atrous::readImage(dir / name + "/frame_000" + std::to_string(f) + ".exr"),
+                                  atrous::readImage(frame(f) + "/reference.exr"))
                        .relMse;
         return sum / frames;
     }

@@ -64,7 +64,7 @@ TEST(DenoiseCli, RenderDirectoryWithAllBuffers) {
         ASSERT_EQ(r.exitCode, 0) << r.output;
         EXPECT_NE(r.output.find("buffers used: color,variance,albedo,normal,position"), std::string::npos) << r.output;
         EXPECT_NE(r.output.find(" ms"), std::string::npos);
-        Image d = io::readImage(o);
+        Image d = atrous::readImage(o);
         EXPECT_TRUE(allFinite(d));
         // Same bound as the library quality test's (EAW/SURE reduce the MSE at least 10x here).
         EXPECT_LT(mse(d, s.truth), mse(s.noisy, s.truth) / 10) << m;
@@ -93,7 +93,7 @@ TEST(DenoiseCli, NanInputGivesFiniteOutput) {
     CliResult r = runCli("denoise --in " + in.str() + " --out " + (out / "d.exr"));
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_NE(r.output.find("2 pixels had NaN/Inf"), std::string::npos) << r.output;
-    EXPECT_TRUE(allFinite(io::readImage(out / "d.exr")));
+    EXPECT_TRUE(allFinite(atrous::readImage(out / "d.exr")));
 }
 
 TEST(DenoiseCli, BadInput) {

@@ -208,7 +208,7 @@ TEST(InputPaths, SequenceAppliesLayerPassAndAddPassToEveryFrame) {
             auto s = runCli("denoise --method eaw --device cpu --in " + seq + "/render000" + std::to_string(f) + ".exr --layer " +
                             layer + " --out " + one);
             ASSERT_EQ(s.exitCode, 0) << s.output;
-            const Image a = io::readImage(one), b = io::readImage(out + "/frame_000" + std::to_string(f) + ".exr");
+            const Image a = atrous::readImage(one), b = atrous::readImage(out + "/frame_000" + std::to_string(f) + ".exr");
             ASSERT_EQ(a.size(), b.size());
             EXPECT_TRUE(std::equal(a.data(), a.data() + a.size(), b.data())) << layer << " frame " << f;
         }

@@ -117,7 +117,7 @@ TEST(LayeredInput, PartsArePlacedByTheirDataWindowsOrRefused) {
         writeExrParts(dir / "wide.exr", {colour, albedo});
         const auto r = runCli("inspect " + (dir / "wide.exr") + " --export " + (dir / "e2"));
         ASSERT_EQ(r.exitCode, 0) << r.output;
-        const Image a = io::readImage(dir / "e2/albedo.exr"), c = io::readImage(dir / "e2/color.exr");
+        const Image a = atrous::readImage(dir / "e2/albedo.exr"), c = atrous::readImage(dir / "e2/color.exr");
         ASSERT_EQ(a.width(), 8);
         ASSERT_EQ(a.height(), 6);
         for (int y = 0; y < 6; ++y)
@@ -133,7 +133,7 @@ TEST(LayeredInput, PartsArePlacedByTheirDataWindowsOrRefused) {
         ExrPart over = simplePart("", 8, 6, kRgb, colourAt);
         over.dataWindow = box(-1, -2, 9, 7);
         writeExrParts(dir / "overscan.exr", {over});
-        const Image img = io::readImage(dir / "overscan.exr");
+        const Image img = atrous::readImage(dir / "overscan.exr");
         ASSERT_EQ(img.width(), 8);
         ASSERT_EQ(img.height(), 6);
         EXPECT_FLOAT_EQ(img(0, 0, 0), colourAt(0, 0, 0));
@@ -210,7 +210,7 @@ TEST(LayeredInput, AddPassPlacesThePassOnTheImage) {
         EXPECT_EQ(info.width, 8);
         EXPECT_EQ(info.height, 6);
         const io::PassMap m = io::mapPasses(info, {io::parsePassRequest("color=Denoised")}, "");
-        const Image added = io::readPass(info, m[io::Buffer::Color], io::Buffer::Color), want = io::readImage(plain);
+        const Image added = io::readPass(info, m[io::Buffer::Color], io::Buffer::Color), want = atrous::readImage(plain);
         ASSERT_EQ(added.size(), want.size());
         EXPECT_TRUE(std::equal(want.data(), want.data() + want.size(), added.data())) << (multipart ? "multipart" : "single part");
     }

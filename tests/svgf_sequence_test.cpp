@@ -164,7 +164,7 @@ static void checkSequenceCommand(const test::TempDir& dir, bool learnedSpatial) 
     for (int t = 0; t < 4; ++t) {
         std::string name = io::sequenceFrameName(t);
         ASSERT_TRUE(std::filesystem::exists(dir / ("out/" + name + ".png"))) << name;
-        Image out = io::readImage(dir / ("out/" + name + ".exr"));
+        Image out = atrous::readImage(dir / ("out/" + name + ".exr"));
         SynthFrame f = makeFrame(o, t);
         ASSERT_TRUE(allFinite(out)) << name;
         EXPECT_LT(mse(out, f.truth), 0.5 * mse(f.color, f.truth)) << name << (learnedSpatial ? " learned" : "");
@@ -234,7 +234,7 @@ TEST(SvgfSequence, LearnedWeightsReachTheLearnedSpatialFilter) {
     EXPECT_EQ(r.output.find("ignored"), std::string::npos) << r.output;
     for (int t = 0; t < 3; ++t) {
         const std::string name = io::sequenceFrameName(t) + ".exr";
-        const Image a = io::readImage(dir / ("builtin/" + name)), b = io::readImage(dir / ("fixture/" + name));
+        const Image a = atrous::readImage(dir / ("builtin/" + name)), b = atrous::readImage(dir / ("fixture/" + name));
         ASSERT_TRUE(allFinite(b)) << name;
         // Outputs are O(1); random weights against trained ones differ far above rounding.
         EXPECT_GT(maxAbsDiff(a, b), 1e-2f) << name;

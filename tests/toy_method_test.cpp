@@ -197,7 +197,7 @@ TEST(ToyMethod, AsAPluginTheCliListsAndRunsIt) {
 #ifdef ATROUS_TOY_CLI
     if (std::filesystem::exists(ATROUS_TOY_CLI)) {
         test::runShell(std::string(ATROUS_TOY_CLI) + " denoise --in " + in + " --method toy --out " + (dir / "linked.exr"));
-        EXPECT_TRUE(test::sameImages(io::readImage(dir / "plugin.exr"), io::readImage(dir / "linked.exr")));
+        EXPECT_TRUE(test::sameImages(atrous::readImage(dir / "plugin.exr"), atrous::readImage(dir / "linked.exr")));
     }
 #endif
     const test::CliResult missing = test::expectCli(" --plugin " + (dir / "nope.so") + " denoise --help", 2, {"nope.so"});

@@ -355,12 +355,12 @@ void run(const CompareArgs& a) {
         if (ext == ".png") notes.push_back("note: " + p + " is an 8-bit PNG preview, compared as its [0,1] values, not HDR radiance");
     };
     notePng(a.ref);
-    Image ref = io::readImage(a.ref);
+    Image ref = atrous::readImage(a.ref);
     std::vector<ImageMetrics> ms;
     std::vector<Image> imgs;
     for (const auto& p : a.images) {
         notePng(p);
-        imgs.push_back(io::readImage(p));
+        imgs.push_back(atrous::readImage(p));
         try {
             ms.push_back(computeMetrics(imgs.back(), ref));
         } catch (const InputError& e) {

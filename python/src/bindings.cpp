@@ -488,7 +488,7 @@ nb::object pyReadImage(const std::string& path) {
     Image img;
     {
         nb::gil_scoped_release release;
-        img = io::readImage(path);
+        img = atrous::readImage(path);
     }
     return fromImage(std::move(img));
 }

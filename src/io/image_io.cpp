@@ -364,17 +364,6 @@ static Image readStb(const std::string& path, int* sourceChannels) {
     return img;
 }
 
-Image readImage(const std::string& path, int* sourceChannels, int channels) {
-    requireFile(path);
-    if (channels < 1 || channels > 3) throw InputError(path + ": readImage takes 1 to 3 channels");
-    const std::string ext = extensionOf(path);
-    if (ext == ".exr") return namingFile(path, [&] { return readExr(path, sourceChannels, channels); });
-    if (ext == ".pfm") return namingFile(path, [&] { return firstChannels(readPfm(path, sourceChannels), channels); });
-    if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".hdr" || ext == ".bmp" || ext == ".tga")
-        return namingFile(path, [&] { return firstChannels(readStb(path, sourceChannels), channels); });
-    throw InputError(path + ": unsupported image format '" + ext + "' (expected .exr, .pfm, .png, .jpg or .hdr)");
-}
-
 void writeImage(const std::string& path, const Image& img) {
     requireNoNul(path);
     const std::string ext = extensionOf(path);
@@ -422,3 +411,20 @@ void writeFileAtomically(const std::string& path, const std::function<void(const
 }
 
 }  // namespace atrous::io
+
+namespace atrous {
+
+// The one image reader (atrous/io.h), by the file's extension.
+Image readImage(const std::string& path, int* sourceChannels, int channels) {
+    using namespace io;
+    requireFile(path);
+    if (channels < 1 || channels > 3) throw InputError(path + ": readImage takes 1 to 3 channels");
+    const std::string ext = extensionOf(path);
+    if (ext == ".exr") return namingFile(path, [&] { return readExr(path, sourceChannels, channels); });
+    if (ext == ".pfm") return namingFile(path, [&] { return firstChannels(readPfm(path, sourceChannels), channels); });
+    if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".hdr" || ext == ".bmp" || ext == ".tga")
+        return namingFile(path, [&] { return firstChannels(readStb(path, sourceChannels), channels); });
+    throw InputError(path + ": unsupported image format '" + ext + "' (expected .exr, .pfm, .png, .jpg or .hdr)");
+}
+
+}  // namespace atrous

@@ -286,7 +286,7 @@ void loadObj(const std::string& referencedBy, SceneBuilder& b, const std::string
         if (!t.diffuse_texname.empty()) {
             std::string tex = (fs::path(path).parent_path() / t.diffuse_texname).lexically_normal().string();
             try {
-                m.texture = b.addTexture(io::readImage(tex), /*reflectance=*/true);
+                m.texture = b.addTexture(atrous::readImage(tex), /*reflectance=*/true);
             } catch (const InputError& e) {
                 throw InputError(std::string(e.what()) + " (map_Kd of material \"" + t.name + "\" in " + mtlNames +
                                  ", used by " + path + ")");

@@ -6,17 +6,12 @@
 #include <string>
 
 #include "atrous/image.h"
+#include "atrous/io.h"
 
 namespace atrous::io {
 
-// Reads an image file as a planar host Image (linear RGB; 3 channels unless asked for fewer). EXR needs R,G,B channels
-// (A is ignored), or Y, or exactly one channel (grey, repeated into R,G,B); PFM may be colour or
-// grey; 8-bit formats are converted from sRGB to linear. Throws InputError naming the file and the
-// problem for a missing, unreadable, truncated or oddly-shaped file (exr_limits.h: the size rule
-// every EXR reader shares). `sourceChannels`, when given, receives how many distinct channels the
-// file held: 1 for grey (one EXR channel, Y, a grey PFM or PNG), else 3. `channels` (1..3) keeps
-// the first channels only (a depth file's R, an ids file's R and G): an EXR decodes no others.
-Image readImage(const std::string& path, int* sourceChannels = nullptr, int channels = 3);
+// Reading an image file is atrous::readImage (atrous/io.h), the one reader of the library, the
+// CLI, Python and installed users alike.
 
 // Writes `img` (1 or 3 channels on the host) by the file's extension: .exr (32-bit float R,G,B,
 // ZIP compressed), .pfm, or .png (tonemapped preview: exposure, clamp, sRGB). Atomic.
