@@ -170,7 +170,7 @@ struct CliSequence {
     }
     // All-zero motion vectors: the frames taken as still.
     void zeroMotion(int w, int h) const {
-        for (int f = 0; f < frames; ++f) io::writeImage(frame(f) + "/motion.exr", Image(w, h, 3));
+        for (int f = 0; f < frames; ++f) atrous::writeImage(frame(f) + "/motion.exr", Image(w, h, 3));
     }
 };
 

@@ -128,7 +128,7 @@ TEST(Reliability, RadianceIsBounded) {
     Image env(4, 2, 3);
     for (size_t i = 0; i < env.plane() * 3; ++i) env.data()[i] = 1.0f;
     env(1, 1, 0) = 3e38f;
-    io::writeImage(dir / "env.pfm", env);
+    atrous::writeImage(dir / "env.pfm", env);
     const std::string msg = errorOf([&] {
         Scene::parse(sceneWith(kCam, "{}", R"(, "lights": [{"type": "environment", "file": "env.pfm"}])"), dir.str(), "r.json");
     });
@@ -136,7 +136,7 @@ TEST(Reliability, RadianceIsBounded) {
     // NaN and Inf texels are missing data (0); allowed extremes render finite buffers.
     env(1, 1, 0) = NAN;
     env(2, 0, 1) = INFINITY;
-    io::writeImage(dir / "env.pfm", env);
+    atrous::writeImage(dir / "env.pfm", env);
     RenderBuffers b = render(Scene::parse(sceneWith(kCam, R"({"emission": 1e8})",
                                                     R"(, "lights": [{"type": "environment", "file": "env.pfm", "scale": 1e7},)"
                                                     R"( {"type": "point", "position": [0, 1.001, 0], "intensity": 1e8}])"),
@@ -373,7 +373,7 @@ TEST(Reliability, NulInAPathIsRefused) {
     TempDir dir;
     const std::string path = dir / std::string("a\0b.exr", 7);
     Image img(2, 2, 3);
-    EXPECT_NE(errorOf([&] { io::writeImage(path, img); }).find("NUL byte"), std::string::npos);
+    EXPECT_NE(errorOf([&] { atrous::writeImage(path, img); }).find("NUL byte"), std::string::npos);
     EXPECT_FALSE(fs::exists(dir / "a"));
     EXPECT_NE(errorOf([&] { atrous::readImage(path); }).find("NUL byte"), std::string::npos);
     EXPECT_NE(errorOf([&] { Scene::load(dir / std::string("s\0.json", 7)); }).find("NUL byte"), std::string::npos);

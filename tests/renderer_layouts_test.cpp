@@ -72,8 +72,8 @@ TEST(RendererLayouts, LuxCoreStillFolderIsReadUnderItsOwnNames) {
     // atrous's own name wins where a folder has both: a black color.exr beside RGB.exr gives what the
     // black colour gives with atrous's names.
     const atrous::Image black(32, 24, 3);
-    atrous::io::writeImage(lux + "/color.exr", black);
-    atrous::io::writeImage(ours + "/color.exr", black);
+    atrous::writeImage(lux + "/color.exr", black);
+    atrous::writeImage(ours + "/color.exr", black);
     r = runCli("denoise --in " + lux + " --method eaw --out " + dir / "both.exr");
     ASSERT_EQ(r.exitCode, 0) << r.output;
     r = runCli("denoise --in " + ours + " --method eaw --out " + dir / "black.exr");

@@ -43,14 +43,14 @@ void writeSequence(const std::string& dir, const SceneOptions& o, int count, int
         std::string fd = dir + "/" + io::sequenceFrameName(first + t);
         std::filesystem::create_directories(fd);
         Image position(o.width, o.height, 3);
-        io::writeImage(fd + "/color.exr", f.color);
-        io::writeImage(fd + "/albedo.exr", f.albedo);
-        io::writeImage(fd + "/normal.exr", f.normal);
-        io::writeImage(fd + "/position.exr", position);
-        io::writeImage(fd + "/depth.exr", f.depth);
-        io::writeImage(fd + "/ids.exr", f.ids);
-        io::writeImage(fd + "/motion.exr", f.motion);
-        if (reference) io::writeImage(fd + "/reference.exr", f.truth);
+        atrous::writeImage(fd + "/color.exr", f.color);
+        atrous::writeImage(fd + "/albedo.exr", f.albedo);
+        atrous::writeImage(fd + "/normal.exr", f.normal);
+        atrous::writeImage(fd + "/position.exr", position);
+        atrous::writeImage(fd + "/depth.exr", f.depth);
+        atrous::writeImage(fd + "/ids.exr", f.ids);
+        atrous::writeImage(fd + "/motion.exr", f.motion);
+        if (reference) atrous::writeImage(fd + "/reference.exr", f.truth);
     }
 }
 
@@ -144,7 +144,7 @@ TEST(SvgfSequence, GapsMissingBuffersAndSizeMismatchesAreNamed) {
         EXPECT_NE(msg.find("frame_0001/color.exr"), std::string::npos) << msg;
         EXPECT_NE(msg.find("frame_0000/color.exr"), std::string::npos) << msg;
         // Within one frame as well.
-        io::writeImage(dir / "frame_0000/ids.exr", Image(20, 12, 3));
+        atrous::writeImage(dir / "frame_0000/ids.exr", Image(20, 12, 3));
         msg = errorOf([&] { io::loadSequenceFrame(frames[0]); });
         EXPECT_NE(msg.find("ids.exr"), std::string::npos) << msg;
         EXPECT_NE(msg.find("color.exr"), std::string::npos) << msg;

@@ -35,9 +35,9 @@ std::string renderFolder(const test::TempDir& dir) {
     const Rendered r;
     const std::string in = dir / "r";
     std::filesystem::create_directories(in);
-    io::writeImage(in + "/color.exr", r.b.color);
-    io::writeImage(in + "/albedo.exr", r.b.albedo);
-    io::writeImage(in + "/normal.exr", r.b.normal);
+    atrous::writeImage(in + "/color.exr", r.b.color);
+    atrous::writeImage(in + "/albedo.exr", r.b.albedo);
+    atrous::writeImage(in + "/normal.exr", r.b.normal);
     return in;
 }
 

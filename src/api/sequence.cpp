@@ -216,7 +216,7 @@ SequenceReport denoiseSequence(const std::string& input, const std::string& outD
             if (!args.addPass.empty())
                 io::writeExrWithLayers(exrOut, *layered, {io::ExrOutLayer{args.addPass, img.get()}});
             else
-                io::writeImage(exrOut, *img);
+                atrous::writeImage(exrOut, *img);
             if (args.pngs) io::writePng((fs::path(stage) / (name + ".png")).string(), *img, args.exposure);
         });
         const bool resolved = args.method == "auto" || (temporal && options.method == DenoiseMethod::Auto);

@@ -548,7 +548,7 @@ std::vector<std::string> ViewPipeline::saveBuffers(const std::string& dir) const
     std::vector<std::string> names;
     auto put = [&](const std::string& name, const Image& img) {
         if (img.empty()) return;
-        io::writeImage((fs::path(dir) / name).string(), img);
+        atrous::writeImage((fs::path(dir) / name).string(), img);
         names.push_back(name);
     };
     // The host accessors: on CUDA each buffer is downloaded here (once per step).

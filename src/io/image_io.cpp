@@ -364,15 +364,6 @@ static Image readStb(const std::string& path, int* sourceChannels) {
     return img;
 }
 
-void writeImage(const std::string& path, const Image& img) {
-    requireNoNul(path);
-    const std::string ext = extensionOf(path);
-    if (ext == ".exr") return writeExr(path, img);
-    if (ext == ".pfm") return writePfm(path, img);
-    if (ext == ".png") return writePng(path, img);
-    throw InputError(path + ": unsupported output format '" + ext + "' (expected .exr, .pfm or .png)");
-}
-
 // ------------------------------------------------------------------------------------ helpers
 
 void ensureWritableDirectory(const std::string& dir) {
@@ -414,7 +405,7 @@ void writeFileAtomically(const std::string& path, const std::function<void(const
 
 namespace atrous {
 
-// The one image reader (atrous/io.h), by the file's extension.
+// The one image reader and writer (atrous/io.h), by the file's extension.
 Image readImage(const std::string& path, int* sourceChannels, int channels) {
     using namespace io;
     requireFile(path);
@@ -425,6 +416,19 @@ Image readImage(const std::string& path, int* sourceChannels, int channels) {
     if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".hdr" || ext == ".bmp" || ext == ".tga")
         return namingFile(path, [&] { return firstChannels(readStb(path, sourceChannels), channels); });
     throw InputError(path + ": unsupported image format '" + ext + "' (expected .exr, .pfm, .png, .jpg or .hdr)");
+}
+
+// The one image writer (atrous/io.h), by the file's extension.
+void writeImage(const std::string& path, const Image& img) {
+    using namespace io;
+    // The writers read host memory; a denoise() result may live on the GPU.
+    if (img.device() != Device::Cpu) return writeImage(path, img.to(Device::Cpu));
+    requireNoNul(path);
+    const std::string ext = extensionOf(path);
+    if (ext == ".exr") return writeExr(path, img);
+    if (ext == ".pfm") return writePfm(path, img);
+    if (ext == ".png") return writePng(path, img);
+    throw InputError(path + ": unsupported output format '" + ext + "' (expected .exr, .pfm or .png)");
 }
 
 }  // namespace atrous

@@ -10,12 +10,9 @@
 
 namespace atrous::io {
 
-// Reading an image file is atrous::readImage (atrous/io.h), the one reader of the library, the
-// CLI, Python and installed users alike.
-
-// Writes `img` (1 or 3 channels on the host) by the file's extension: .exr (32-bit float R,G,B,
-// ZIP compressed), .pfm, or .png (tonemapped preview: exposure, clamp, sRGB). Atomic.
-void writeImage(const std::string& path, const Image& img);
+// Reading and writing an image file by its extension are atrous::readImage and atrous::writeImage
+// (atrous/io.h), the one reader and writer of the library, the CLI, Python and installed users
+// alike. The writers of one format (host images, 1 or 3 channels; atomic):
 void writeExr(const std::string& path, const Image& img);
 void writePfm(const std::string& path, const Image& img);
 // 8-bit sRGB preview of linear HDR: out = srgb(clamp(exposure * v, 0, 1)).
