@@ -199,8 +199,8 @@ TEST(SvgfSequence, EveryParamHasAFlag) {
     EXPECT_EQ(p.levels, 4);
     EXPECT_EQ(p.feedbackTap, 1);
     EXPECT_EQ(p.spatialVarianceFrames, 2);
-    EXPECT_EQ(p.reprojectDepthTolerance, 5.0f);
-    EXPECT_EQ(p.reprojectNormalCos, 0.5f);
+    EXPECT_EQ(p.depthTolerance, 5.0f);
+    EXPECT_EQ(p.normalCos, 0.5f);
     EXPECT_TRUE(p.taa);
     EXPECT_EQ(p.taaAlpha, 0.25f);
     EXPECT_EQ(p.emissionAlpha, 0.5f);

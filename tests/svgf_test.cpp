@@ -285,8 +285,8 @@ TEST(SvgfRobustness, BadFramesAndParamsAreInputErrors) {
     bad([](SvgfParams& p) { p.levels = 11; });
     bad([](SvgfParams& p) { p.feedbackTap = 5; });
     bad([](SvgfParams& p) { p.spatialVarianceFrames = 0; });
-    bad([](SvgfParams& p) { p.reprojectDepthTolerance = -1; });
-    bad([](SvgfParams& p) { p.reprojectNormalCos = 2; });
+    bad([](SvgfParams& p) { p.depthTolerance = -1; });
+    bad([](SvgfParams& p) { p.normalCos = 2; });
     bad([](SvgfParams& p) { p.taaAlpha = 0; });
     bad([](SvgfParams& p) { p.emissionAlpha = 0; });
     bad([](SvgfParams& p) { p.emissionAlpha = std::numeric_limits<float>::quiet_NaN(); });
@@ -363,8 +363,8 @@ TEST(SvgfParamsTest, EveryFieldChangesTheOutput) {
         {"levels", [](SvgfParams& p) { p.levels = 3; }, &base},
         {"feedbackTap", [](SvgfParams& p) { p.feedbackTap = 2; }, &base},
         {"spatialVarianceFrames", [](SvgfParams& p) { p.spatialVarianceFrames = 1; }, &base},
-        {"reprojectDepthTolerance", [](SvgfParams& p) { p.reprojectDepthTolerance = 0.4f; }, &base},
-        {"reprojectNormalCos", [](SvgfParams& p) { p.reprojectNormalCos = 0.9999f; }, &base},
+        {"depthTolerance", [](SvgfParams& p) { p.depthTolerance = 0.4f; }, &base},
+        {"normalCos", [](SvgfParams& p) { p.normalCos = 0.9999f; }, &base},
         {"taa", [](SvgfParams& p) { p.taa = true; }, &base},
         {"taaAlpha", [](SvgfParams& p) { p.taa = true, p.taaAlpha = 0.5f; }, &taaOut},
         {"emissionAlpha", [](SvgfParams& p) { p.emissionAlpha = 0.5f; }, &base},

@@ -22,8 +22,8 @@ struct SequenceDenoiseArgs {
 int runSequenceDenoise(const SequenceDenoiseArgs& args);
 
 // Registers one flag per row of svgfParams() (params.h) on `cmd`: --svgf-<name> (--svgf-sigma-l,
-// --svgf-alpha, ...; --svgf-depth-tolerance, --svgf-normal-cos, --taa and --taa-alpha keep their
-// spellings), writing into `params`; the defaults shown are the struct's. Ranges are checked later
+// --svgf-alpha, --svgf-depth-tolerance, ...; --taa and --taa-alpha keep their spellings), writing
+// into `params`; the defaults shown are the struct's. Ranges are checked later
 // (checkParamFlags, or validateSvgfParams: a ParamError naming the field).
 void addSvgfOptions(CLI::App& cmd, SvgfParams& params);
 // The same for temporalParams(): --temporal-radius, --temporal-color-sigmas, ...

@@ -41,10 +41,11 @@ struct SvgfParams {
     // instead of the temporal moments (the paper: 4). >= 1.
     int spatialVarianceFrames = 4;
     // Reprojection consistency: a previous-frame tap is kept when its depth differs by at most
-    // reprojectDepthTolerance * (|dz/dx| + |dz/dy| + 0.01 z) (relative to the local depth gradient),
-    // its normal's cosine to the current one is at least reprojectNormalCos, and the mesh ids agree.
-    float reprojectDepthTolerance = 2.0f;
-    float reprojectNormalCos = 0.9f;
+    // depthTolerance * (|dz/dx| + |dz/dy| + 0.01 z) (relative to the local depth gradient), its
+    // normal's cosine to the current one is at least normalCos, and the mesh ids agree (the same
+    // test and names as TemporalParams', atrous/temporal.h).
+    float depthTolerance = 2.0f;
+    float normalCos = 0.9f;
     // Optional temporal anti-aliasing on the remodulated output: reprojected previous output,
     // clamped to the current 3x3 neighbourhood's colour box, blended with weight taaAlpha.
     bool taa = false;
