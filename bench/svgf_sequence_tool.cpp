@@ -67,7 +67,7 @@ double relMseMasked(const Image& x, const Image& r, const std::vector<char>& kee
 std::vector<char> nonEmitters(const std::string& frameDir) {
     std::string p = (std::filesystem::path(frameDir) / "emission.exr").string();
     if (!std::filesystem::exists(p)) return {};
-    Image e = io::readImage(p);
+    Image e = atrous::readImage(p);
     const size_t plane = size_t(e.width()) * e.height();
     std::vector<char> emits(plane, 0);
     for (int c = 0; c < e.channels(); ++c)
@@ -100,8 +100,8 @@ int metrics(const std::string& seqDir, const std::string& outDir) {
     std::vector<char> prevKeep;
     for (const std::string& dir : frames) {
         std::string name = std::filesystem::path(dir).filename().string();
-        Image r = io::readImage((std::filesystem::path(dir) / "reference.exr").string());
-        Image x = io::readImage((std::filesystem::path(outDir) / (name + ".exr")).string());
+        Image r = atrous::readImage((std::filesystem::path(dir) / "reference.exr").string());
+        Image x = atrous::readImage((std::filesystem::path(outDir) / (name + ".exr")).string());
         nlohmann::json f;
         f["frame"] = name;
         f["relmse"] = relMse(x, r);
@@ -126,7 +126,7 @@ int metrics(const std::string& seqDir, const std::string& outDir) {
 }
 
 int crop(int argc, char** argv) {
-    Image in = io::readImage(argv[2]);
+    Image in = atrous::readImage(argv[2]);
     const int x0 = std::stoi(argv[4]), y0 = std::stoi(argv[5]), w = std::stoi(argv[6]), h = std::stoi(argv[7]);
     const int scale = std::stoi(argv[8]);
     const float exposure = argc > 9 ? std::stof(argv[9]) : 1.0f;
@@ -142,7 +142,7 @@ int crop(int argc, char** argv) {
 }
 
 int errmap(int argc, char** argv) {
-    Image x = io::readImage(argv[2]), r = io::readImage(argv[3]);
+    Image x = atrous::readImage(argv[2]), r = atrous::readImage(argv[3]);
     if (x.width() != r.width() || x.height() != r.height()) throw InputError("errmap: the images differ in size");
     const float scale = argc > 5 ? std::stof(argv[5]) : 10.0f;
     Image e(x.width(), x.height(), 3);
@@ -170,7 +170,7 @@ int errmap(int argc, char** argv) {
 }
 
 int probe(int argc, char** argv) {
-    Image img = io::readImage(argv[2]);
+    Image img = atrous::readImage(argv[2]);
     const int x0 = std::stoi(argv[3]), y0 = std::stoi(argv[4]), w = std::stoi(argv[5]), h = std::stoi(argv[6]);
     const int channel = argc > 7 ? std::stoi(argv[7]) : 0;
     if (channel < 0 || channel >= img.channels()) throw InputError("probe: no channel " + std::to_string(channel));

@@ -219,8 +219,8 @@ TEST(AnimationCli, WritesOneFolderPerFrameWithEveryBuffer) {
         // 1 spp: no variance.exr (unknown at one sample; a zero one would read as noise-free).
         EXPECT_EQ(countEntries((tmp.path() / frame).string()), 10);
     }
-    Image m0 = io::readImage((tmp.path() / "frame_0000" / "motion.exr").string());
-    Image m1 = io::readImage((tmp.path() / "frame_0001" / "motion.exr").string());
+    Image m0 = atrous::readImage((tmp.path() / "frame_0000" / "motion.exr").string());
+    Image m1 = atrous::readImage((tmp.path() / "frame_0001" / "motion.exr").string());
     EXPECT_EQ(m0(8, 6, 0), 0.0f);  // frame 0 has no previous frame
     EXPECT_NE(m1(8, 6, 0), 0.0f);  // the orbit moves everything sideways
 }

@@ -163,14 +163,14 @@ struct CliSequence {
     double relmse(const std::string& name) const {
         double sum = 0;
         for (int f = 0; f < frames; ++f)
-            sum += computeMetrics(io::readImage(dir / name + "/frame_000" + std::to_string(f) + ".exr"),
-                                  io::readImage(frame(f) + "/reference.exr"))
+            sum += computeMetrics(atrous::readImage(dir / name + "/frame_000" + std::to_string(f) + ".exr"),
+                                  atrous::readImage(frame(f) + "/reference.exr"))
                        .relMse;
         return sum / frames;
     }
     // All-zero motion vectors: the frames taken as still.
     void zeroMotion(int w, int h) const {
-        for (int f = 0; f < frames; ++f) io::writeImage(frame(f) + "/motion.exr", Image(w, h, 3));
+        for (int f = 0; f < frames; ++f) atrous::writeImage(frame(f) + "/motion.exr", Image(w, h, 3));
     }
 };
 

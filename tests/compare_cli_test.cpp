@@ -38,8 +38,8 @@ TEST(CompareCli, ReportsNonFinitePixels) {
     bad(2, 3, 0) = NAN;
     bad(2, 3, 2) = INFINITY;  // the same pixel: one pixel
     bad(9, 9, 1) = -INFINITY;
-    io::writeImage(dir / "ref.exr", ref);
-    io::writeImage(dir / "bad.exr", bad);
+    atrous::writeImage(dir / "ref.exr", ref);
+    atrous::writeImage(dir / "bad.exr", bad);
     CliResult text = compare(dir, "ref.exr", "bad.exr");
     ASSERT_EQ(text.exitCode, 0) << text.output;
     EXPECT_NE(text.output.find("bad.exr has 2 non-finite"), std::string::npos) << text.output;
@@ -59,8 +59,8 @@ TEST(CompareCli, ReportsNonFinitePixels) {
 TEST(CompareCli, NotesThatAPngIsNotHdr) {
     TempDir dir;
     Image ref = ramp(8, 8);
-    io::writeImage(dir / "ref.exr", ref);
-    io::writeImage(dir / "ref.png", ref);
+    atrous::writeImage(dir / "ref.exr", ref);
+    atrous::writeImage(dir / "ref.png", ref);
     CliResult r = compare(dir, "ref.exr", "ref.png");
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_NE(r.output.find("ref.png is an 8-bit PNG"), std::string::npos) << r.output;

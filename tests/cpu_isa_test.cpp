@@ -1,4 +1,4 @@
-// The CPU ISA dispatch (src/cpu/cpu_isa.h): every ISA this CPU has gives the same EAW, SURE,
+// The CPU ISA dispatch (src/core/cpu_isa.h): every ISA this CPU has gives the same EAW, SURE,
 // SVGF and render outputs; the ATROUS_CPU_ISA override and its errors; and, under qemu-user on a
 // CPU model without AVX, that the binary runs, picks the baseline loops by itself and gives the
 // bits the baseline loops give natively.
@@ -25,7 +25,7 @@
 #include "atrous/error.h"
 #include "atrous/io.h"
 #include "atrous/render.h"
-#include "cpu/cpu_isa.h"
+#include "core/cpu_isa.h"
 #include "denoise_test_util.h"
 #include "filters/atrous_level.h"
 #include "svgf_test_util.h"

@@ -17,13 +17,13 @@ using namespace atrous::test;
 namespace {
 
 void writeScene(const SyntheticScene& s, const TempDir& dir) {
-    io::writeImage(dir / "color.exr", s.noisy);
-    io::writeImage(dir / "variance.exr", s.variance);
-    io::writeImage(dir / "albedo.exr", s.albedo);
-    io::writeImage(dir / "normal.exr", s.normal);
-    io::writeImage(dir / "position.exr", s.position);
-    io::writeImage(dir / "depth.exr", s.depth);
-    io::writeImage(dir / "ids.exr", s.ids);
+    atrous::writeImage(dir / "color.exr", s.noisy);
+    atrous::writeImage(dir / "variance.exr", s.variance);
+    atrous::writeImage(dir / "albedo.exr", s.albedo);
+    atrous::writeImage(dir / "normal.exr", s.normal);
+    atrous::writeImage(dir / "position.exr", s.position);
+    atrous::writeImage(dir / "depth.exr", s.depth);
+    atrous::writeImage(dir / "ids.exr", s.ids);
 }
 
 int lineCount(const std::string& s) {
@@ -64,7 +64,7 @@ TEST(DenoiseCli, RenderDirectoryWithAllBuffers) {
         ASSERT_EQ(r.exitCode, 0) << r.output;
         EXPECT_NE(r.output.find("buffers used: color,variance,albedo,normal,position"), std::string::npos) << r.output;
         EXPECT_NE(r.output.find(" ms"), std::string::npos);
-        Image d = io::readImage(o);
+        Image d = atrous::readImage(o);
         EXPECT_TRUE(allFinite(d));
         // Same bound as the library quality test's (EAW/SURE reduce the MSE at least 10x here).
         EXPECT_LT(mse(d, s.truth), mse(s.noisy, s.truth) / 10) << m;
@@ -74,8 +74,8 @@ TEST(DenoiseCli, RenderDirectoryWithAllBuffers) {
 TEST(DenoiseCli, SingleBuffersPfmAndPngAndNoiseEstimate) {
     TempDir in, out;
     SyntheticScene s = makeScene(32, 32, 0.3f, 22);
-    io::writeImage(in / "c.pfm", s.noisy);
-    io::writeImage(in / "n.pfm", s.normal);
+    atrous::writeImage(in / "c.pfm", s.noisy);
+    atrous::writeImage(in / "n.pfm", s.normal);
     CliResult r = runCli("denoise --color " + (in / "c.pfm") + " --normal " + (in / "n.pfm") +
                          " --method sure --sure-mode james-stein --levels 4 --out " + (out / "d.png"));
     ASSERT_EQ(r.exitCode, 0) << r.output;
@@ -93,7 +93,7 @@ TEST(DenoiseCli, NanInputGivesFiniteOutput) {
     CliResult r = runCli("denoise --in " + in.str() + " --out " + (out / "d.exr"));
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_NE(r.output.find("2 pixels had NaN/Inf"), std::string::npos) << r.output;
-    EXPECT_TRUE(allFinite(io::readImage(out / "d.exr")));
+    EXPECT_TRUE(allFinite(atrous::readImage(out / "d.exr")));
 }
 
 TEST(DenoiseCli, BadInput) {
@@ -102,7 +102,7 @@ TEST(DenoiseCli, BadInput) {
     writeScene(s, in);
     const std::string o = " --out " + (out / "d.exr");
     SyntheticScene small = makeScene(8, 16, 0.3f, 25);
-    io::writeImage(in / "small.exr", small.normal);
+    atrous::writeImage(in / "small.exr", small.normal);
     expectBadInput("denoise --in " + in.str() + " --normal " + (in / "small.exr") + o, "small.exr", out);
     expectBadInput("denoise --color " + (in / "missing.exr") + o, "missing.exr", out);
     // Truncated EXR and garbage PFM.
@@ -120,7 +120,7 @@ TEST(DenoiseCli, BadInput) {
     {
         Image v = s.variance.clone();
         v(3, 3, 1) = -1.0f;
-        io::writeImage(in / "negvar.exr", v);
+        atrous::writeImage(in / "negvar.exr", v);
     }
     expectBadInput("denoise --in " + in.str() + " --variance " + (in / "negvar.exr") + o, "negvar.exr", out);
     expectBadInput("denoise --in " + in.str() + " --method bilateral" + o, "bilateral", out);
@@ -137,8 +137,8 @@ TEST(DenoiseCli, BadInput) {
 TEST(CompareCli, MetricsJsonAndErrorMaps) {
     TempDir in, maps;
     SyntheticScene s = makeScene(32, 32, 0.3f, 26);
-    io::writeImage(in / "ref.exr", s.truth);
-    io::writeImage(in / "noisy.exr", s.noisy);
+    atrous::writeImage(in / "ref.exr", s.truth);
+    atrous::writeImage(in / "noisy.exr", s.noisy);
     CliResult r = runCli("compare --ref " + (in / "ref.exr") + " " + (in / "ref.exr") + " " + (in / "noisy.exr") +
                          " --json --error-maps " + maps.str());
     ASSERT_EQ(r.exitCode, 0) << r.output;
@@ -153,7 +153,7 @@ TEST(CompareCli, MetricsJsonAndErrorMaps) {
     EXPECT_EQ(text.exitCode, 0);
     EXPECT_NE(text.output.find("PSNR"), std::string::npos);
     SyntheticScene small = makeScene(16, 32, 0.3f, 27);
-    io::writeImage(in / "small.exr", small.noisy);
+    atrous::writeImage(in / "small.exr", small.noisy);
     CliResult bad = runCli("compare --ref " + (in / "ref.exr") + " " + (in / "small.exr"));
     EXPECT_EQ(bad.exitCode, 2);
     EXPECT_NE(bad.output.find("small.exr"), std::string::npos) << bad.output;

@@ -59,7 +59,7 @@ TEST(InputPaths, OutputsNeverOverwriteInputs) {
     for (int f = 0; f < 3; ++f) blenderFrame(seq + "/frame_000" + std::to_string(f) + ".exr", 0.2f + 0.1f * f);
     const std::string rd = dir / "render";
     fs::create_directories(rd);
-    io::writeImage(rd + "/color.exr", Image(12, 8, 3));
+    atrous::writeImage(rd + "/color.exr", Image(12, 8, 3));
     const auto before = snapshot(dir.str());
     const std::vector<std::string> commands = {
         "denoise --method eaw --sequence " + seq + " --out " + seq,
@@ -97,7 +97,7 @@ TEST(InputPaths, LayeredSequenceBufferInSomeFramesIsRefused) {
     for (int f = 1; f <= 3; ++f) {
         blenderFrame(seq + "/render000" + std::to_string(f) + ".exr", 0.3f, f != 3);
         blenderFrame(seq2 + "/render000" + std::to_string(f) + ".exr", 0.3f);
-        if (f != 2) io::writeImage(seq2 + "/render000" + std::to_string(f) + "_motion.exr", Image(12, 8, 3));
+        if (f != 2) atrous::writeImage(seq2 + "/render000" + std::to_string(f) + "_motion.exr", Image(12, 8, 3));
     }
     auto r = runCli("denoise --method eaw --sequence " + seq + " --out " + (dir / "o1"));
     EXPECT_EQ(r.exitCode, 2) << r.output;
@@ -123,7 +123,7 @@ TEST(InputPaths, SequenceErrorsNameTheFrame) {
         Image img(12, 8, 3);
         img.fill(0.5f);
         if (f == 1) img(0, 0, 0) = 1e20f;
-        io::writeImage(folders + "/" + name + "/color.exr", img);
+        atrous::writeImage(folders + "/" + name + "/color.exr", img);
     }
     for (const char* method : {"eaw", "sure", "svgf"}) {
         auto r = runCli(std::string("denoise --method ") + method + " --sequence " + layered + " --out " + (dir / "o"));
@@ -141,12 +141,12 @@ TEST(InputPaths, FlagsThatCannotApplyAreRefused) {
     TempDir dir;
     const std::string rd = dir / "render", f = dir / "render.exr";
     fs::create_directories(rd);
-    io::writeImage(rd + "/color.exr", Image(12, 8, 3));
-    io::writeImage(rd + "/albedo.exr", Image(12, 8, 3));
-    io::writeImage(dir / "c.pfm", Image(12, 8, 3));
+    atrous::writeImage(rd + "/color.exr", Image(12, 8, 3));
+    atrous::writeImage(rd + "/albedo.exr", Image(12, 8, 3));
+    atrous::writeImage(dir / "c.pfm", Image(12, 8, 3));
     blenderFrame(f, 0.3f);
     fs::create_directories(dir / "seq/frame_0000");
-    io::writeImage(dir / "seq/frame_0000/color.exr", Image(12, 8, 3));
+    atrous::writeImage(dir / "seq/frame_0000/color.exr", Image(12, 8, 3));
     const std::vector<std::pair<std::string, std::string>> cases = {
         {"denoise --in " + rd + " --pass color=Nope --out " + (dir / "o.exr"), "--pass color=Nope"},
         {"denoise --in " + rd + " --pass albedo=Nope --out " + (dir / "o.exr"), "--pass albedo=Nope"},
@@ -173,7 +173,7 @@ TEST(InputPaths, FlagsThatCannotApplyAreRefused) {
 // Case 9: a directory as --learned-weights gave "basic_filebuf::underflow error reading the file".
 TEST(InputPaths, DirectoryAsWeightFileIsOneClearLine) {
     TempDir dir;
-    io::writeImage(dir / "c.exr", Image(12, 8, 3));
+    atrous::writeImage(dir / "c.exr", Image(12, 8, 3));
     fs::create_directories(dir / "weights");
     const auto r = runCli("denoise --method learned --learned-weights " + (dir / "weights") + " --color " + (dir / "c.exr") +
                           " --out " + (dir / "o.exr"));
@@ -208,7 +208,7 @@ TEST(InputPaths, SequenceAppliesLayerPassAndAddPassToEveryFrame) {
             auto s = runCli("denoise --method eaw --device cpu --in " + seq + "/render000" + std::to_string(f) + ".exr --layer " +
                             layer + " --out " + one);
             ASSERT_EQ(s.exitCode, 0) << s.output;
-            const Image a = io::readImage(one), b = io::readImage(out + "/frame_000" + std::to_string(f) + ".exr");
+            const Image a = atrous::readImage(one), b = atrous::readImage(out + "/frame_000" + std::to_string(f) + ".exr");
             ASSERT_EQ(a.size(), b.size());
             EXPECT_TRUE(std::equal(a.data(), a.data() + a.size(), b.data())) << layer << " frame " << f;
         }

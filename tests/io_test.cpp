@@ -28,15 +28,15 @@ static void expectSame(const Image& a, const Image& b) {
 TEST(ImageIo, ExrRoundTripIsExact) {
     TempDir dir;
     Image img = ramp(13, 7);
-    io::writeImage(dir / "a.exr", img);
-    expectSame(img, io::readImage(dir / "a.exr"));
+    atrous::writeImage(dir / "a.exr", img);
+    expectSame(img, atrous::readImage(dir / "a.exr"));
 }
 
 TEST(ImageIo, PfmRoundTripIsExactAndRowOrderIsTopDown) {
     TempDir dir;
     Image img = ramp(9, 4);
-    io::writeImage(dir / "a.pfm", img);
-    expectSame(img, io::readImage(dir / "a.pfm"));
+    atrous::writeImage(dir / "a.pfm", img);
+    expectSame(img, atrous::readImage(dir / "a.pfm"));
     // The first pixel row stored in the file is the bottom row of the image.
     std::ifstream in(dir / "a.pfm", std::ios::binary);
     std::string magic;
@@ -51,45 +51,45 @@ TEST(ImageIo, PfmRoundTripIsExactAndRowOrderIsTopDown) {
 
 TEST(ImageIo, PngPreviewIsWritten) {
     TempDir dir;
-    io::writeImage(dir / "a.png", ramp(8, 8));
-    Image back = io::readImage(dir / "a.png");
+    atrous::writeImage(dir / "a.png", ramp(8, 8));
+    Image back = atrous::readImage(dir / "a.png");
     EXPECT_EQ(back.width(), 8);
     EXPECT_EQ(atrous::test::countEntries(dir.str()), 1);  // no temporary left behind
 }
 
 TEST(ImageIo, BadFilesGiveInputErrorsNamingTheFile) {
     TempDir dir;
-    EXPECT_THROW(io::readImage(dir / "missing.exr"), InputError);
+    EXPECT_THROW(atrous::readImage(dir / "missing.exr"), InputError);
     {
         std::ofstream(dir / "garbage.exr") << "this is not an exr file";
     }
     try {
-        io::readImage(dir / "garbage.exr");
+        atrous::readImage(dir / "garbage.exr");
         FAIL();
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("garbage.exr"), std::string::npos);
     }
     // A truncated EXR: the first half of a valid file.
-    io::writeImage(dir / "full.exr", ramp(64, 64));
+    atrous::writeImage(dir / "full.exr", ramp(64, 64));
     std::ifstream in(dir / "full.exr", std::ios::binary);
     std::string bytes((std::istreambuf_iterator<char>(in)), {});
     std::ofstream(dir / "trunc.exr", std::ios::binary).write(bytes.data(), std::streamsize(bytes.size() / 2));
-    EXPECT_THROW(io::readImage(dir / "trunc.exr"), InputError);
+    EXPECT_THROW(atrous::readImage(dir / "trunc.exr"), InputError);
     // A truncated PFM.
     std::ofstream(dir / "trunc.pfm", std::ios::binary) << "PF\n4 4\n-1.0\n" << std::string(10, 'x');
-    EXPECT_THROW(io::readImage(dir / "trunc.pfm"), InputError);
-    EXPECT_THROW(io::readImage(dir / "a.xyz"), InputError);
+    EXPECT_THROW(atrous::readImage(dir / "trunc.pfm"), InputError);
+    EXPECT_THROW(atrous::readImage(dir / "a.xyz"), InputError);
 }
 
 TEST(ImageIo, FailedWriteLeavesNothing) {
     TempDir dir;
-    EXPECT_THROW(io::writeImage(dir / "nodir/a.exr", ramp(4, 4)), InputError);
-    EXPECT_THROW(io::writeImage(dir / "a.bmp", ramp(4, 4)), InputError);
+    EXPECT_THROW(atrous::writeImage(dir / "nodir/a.exr", ramp(4, 4)), InputError);
+    EXPECT_THROW(atrous::writeImage(dir / "a.bmp", ramp(4, 4)), InputError);
     EXPECT_EQ(atrous::test::countEntries(dir.str()), 0);
     // A parent that is a regular file is named as such, not as missing.
     { std::ofstream(dir / "afile") << "x"; }
     try {
-        io::writeImage(dir / "afile/a.exr", ramp(4, 4));
+        atrous::writeImage(dir / "afile/a.exr", ramp(4, 4));
         ADD_FAILURE() << "no error";
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("is not a directory"), std::string::npos) << e.what();
@@ -115,7 +115,7 @@ TEST(ImageIo, ExrWithTheWrongChannelsIsRejected) {
         file.writePixels(h);
     }
     try {
-        io::readImage(path);
+        atrous::readImage(path);
         FAIL() << "a U,V file was accepted";
     } catch (const InputError& e) {
         const std::string msg = e.what();

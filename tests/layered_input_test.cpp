@@ -50,7 +50,7 @@ TEST(LayeredInput, LyingFirstPartFailsAtOnceOnEveryPath) {
     ExrPart colour = simplePart("ViewLayer.Combined", 16384, 16384, kRgb, nullptr);
     writeExrParts(lie, {colour, simplePart("ViewLayer.Denoising Albedo", 8, 6, kRgb, albedoAt)});
     ASSERT_LT(fs::file_size(lie), 64u * 1024u);
-    io::writeImage(dir / "plain.exr", Image(8, 6, 3));
+    atrous::writeImage(dir / "plain.exr", Image(8, 6, 3));
     fs::create_directories(dir / "seq");
     fs::copy_file(lie, dir / "seq/render0001.exr");
     fs::copy_file(lie, dir / "seq/render0002.exr");
@@ -117,7 +117,7 @@ TEST(LayeredInput, PartsArePlacedByTheirDataWindowsOrRefused) {
         writeExrParts(dir / "wide.exr", {colour, albedo});
         const auto r = runCli("inspect " + (dir / "wide.exr") + " --export " + (dir / "e2"));
         ASSERT_EQ(r.exitCode, 0) << r.output;
-        const Image a = io::readImage(dir / "e2/albedo.exr"), c = io::readImage(dir / "e2/color.exr");
+        const Image a = atrous::readImage(dir / "e2/albedo.exr"), c = atrous::readImage(dir / "e2/color.exr");
         ASSERT_EQ(a.width(), 8);
         ASSERT_EQ(a.height(), 6);
         for (int y = 0; y < 6; ++y)
@@ -133,7 +133,7 @@ TEST(LayeredInput, PartsArePlacedByTheirDataWindowsOrRefused) {
         ExrPart over = simplePart("", 8, 6, kRgb, colourAt);
         over.dataWindow = box(-1, -2, 9, 7);
         writeExrParts(dir / "overscan.exr", {over});
-        const Image img = io::readImage(dir / "overscan.exr");
+        const Image img = atrous::readImage(dir / "overscan.exr");
         ASSERT_EQ(img.width(), 8);
         ASSERT_EQ(img.height(), 6);
         EXPECT_FLOAT_EQ(img(0, 0, 0), colourAt(0, 0, 0));
@@ -148,7 +148,7 @@ TEST(LayeredInput, SameBufferTwiceInPassIsRefusedOnEveryPath) {
     writeExrParts(f, {simplePart("ViewLayer.Combined", 8, 6, kRgb, colourAt),
                       simplePart("ViewLayer.DiffCol", 8, 6, kRgb, albedoAt),
                       simplePart("ViewLayer.Denoising Albedo", 8, 6, kRgb, albedoAt)});
-    io::writeImage(dir / "plain.exr", Image(8, 6, 3));
+    atrous::writeImage(dir / "plain.exr", Image(8, 6, 3));
     const std::string twice = " --pass albedo=DiffCol --pass 'albedo=Denoising Albedo'";
     for (const std::string& args : {"denoise --in " + f + twice + " --out " + (dir / "a.exr"),
                                     "denoise --color " + (dir / "plain.exr") + " --albedo " + f + twice + " --out " + (dir / "b.exr"),
@@ -181,7 +181,7 @@ TEST(LayeredInput, OneChannelNeverStandsForADirection) {
         const std::vector<float> px(48, 0.5f);
         pfm.write(reinterpret_cast<const char*>(px.data()), std::streamsize(px.size() * sizeof(float)));
     }
-    io::writeImage(dir / "c.exr", Image(8, 6, 3));
+    atrous::writeImage(dir / "c.exr", Image(8, 6, 3));
     auto r = runCli("denoise --color " + (dir / "c.exr") + " --normal " + (dir / "grey.pfm") + " --out " + (dir / "o.exr"));
     EXPECT_EQ(r.exitCode, 2) << r.output;
     EXPECT_NE(r.output.find("grey.pfm has 1 channel; normal needs 3"), std::string::npos) << r.output;
@@ -210,7 +210,7 @@ TEST(LayeredInput, AddPassPlacesThePassOnTheImage) {
         EXPECT_EQ(info.width, 8);
         EXPECT_EQ(info.height, 6);
         const io::PassMap m = io::mapPasses(info, {io::parsePassRequest("color=Denoised")}, "");
-        const Image added = io::readPass(info, m[io::Buffer::Color], io::Buffer::Color), want = io::readImage(plain);
+        const Image added = io::readPass(info, m[io::Buffer::Color], io::Buffer::Color), want = atrous::readImage(plain);
         ASSERT_EQ(added.size(), want.size());
         EXPECT_TRUE(std::equal(want.data(), want.data() + want.size(), added.data())) << (multipart ? "multipart" : "single part");
     }
@@ -246,7 +246,7 @@ TEST(LayeredInput, FileWithoutChannelsIsRefused) {
     TempDir dir;
     // OpenEXR will not write such a file: the libFuzzer target's reproducer (1386 bytes).
     fs::copy_file(std::string(ATROUS_SOURCE_DIR) + "/tests/data/exr_regressions/no_channels.exr", dir / "empty.exr");
-    io::writeImage(dir / "c.exr", Image(8, 6, 3));
+    atrous::writeImage(dir / "c.exr", Image(8, 6, 3));
     for (const std::string& args : {"denoise --color " + (dir / "empty.exr") + " --out " + (dir / "o.exr"),
                                     "denoise --color " + (dir / "c.exr") + " --albedo " + (dir / "empty.exr") + " --out " + (dir / "o.exr")}) {
         const auto r = runCli(args);

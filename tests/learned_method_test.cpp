@@ -325,9 +325,9 @@ TEST(LearnedMethodCli, MethodsWeightsAndExitCodes) {
     const RenderBuffers b = render(scene, test::smallRender(32, 24, 4, 3));
     const std::string in = dir / "r";
     std::filesystem::create_directories(in);
-    io::writeImage(in + "/color.exr", b.color);
-    io::writeImage(in + "/albedo.exr", b.albedo);
-    io::writeImage(in + "/normal.exr", b.normal);
+    atrous::writeImage(in + "/color.exr", b.color);
+    atrous::writeImage(in + "/albedo.exr", b.albedo);
+    atrous::writeImage(in + "/normal.exr", b.normal);
     const std::string out = dir / "o.exr";
     test::CliResult r = test::runCli("denoise --in " + in + " --out " + out + " --method learned --learned-weights " + wpath);
     EXPECT_EQ(r.exitCode, 0) << r.output;

@@ -19,7 +19,7 @@
 #include "atrous/error.h"
 #include "atrous/learned.h"
 #include "core/parallel.h"
-#include "cpu/cpu_isa.h"
+#include "core/cpu_isa.h"
 #include "filters/learned.h"
 #include "learned_fixture.h"
 

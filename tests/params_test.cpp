@@ -12,6 +12,7 @@
 
 #include "../apps/atrous/cli_flags.h"
 #include "atrous/params.h"
+#include "atrous/render.h"
 
 using namespace atrous;
 
@@ -188,7 +189,7 @@ TEST(ParamTables, NegatedSwitchesKeepTheirFlags) {
     for (const auto& f : denoiseParams())
         if (f.negated) negated.push_back(denoiseParams().flag(f));
     EXPECT_EQ(negated, (std::vector<std::string>{"--no-ids", "--no-correlated-variance", "--no-firefly", "--no-demodulate"}));
-    EXPECT_EQ(svgfParams().flag(*svgfParams().find("reproject_depth_tolerance")), "--svgf-depth-tolerance");
+    EXPECT_EQ(svgfParams().flag(*svgfParams().find("depth_tolerance")), "--svgf-depth-tolerance");
     EXPECT_EQ(svgfParams().flag(*svgfParams().find("taa_alpha")), "--taa-alpha");
     EXPECT_EQ(denoiseParams().flag(*denoiseParams().find("sure_window")), "--sure-window");
 }

@@ -128,7 +128,7 @@ TEST(Reliability, RadianceIsBounded) {
     Image env(4, 2, 3);
     for (size_t i = 0; i < env.plane() * 3; ++i) env.data()[i] = 1.0f;
     env(1, 1, 0) = 3e38f;
-    io::writeImage(dir / "env.pfm", env);
+    atrous::writeImage(dir / "env.pfm", env);
     const std::string msg = errorOf([&] {
         Scene::parse(sceneWith(kCam, "{}", R"(, "lights": [{"type": "environment", "file": "env.pfm"}])"), dir.str(), "r.json");
     });
@@ -136,7 +136,7 @@ TEST(Reliability, RadianceIsBounded) {
     // NaN and Inf texels are missing data (0); allowed extremes render finite buffers.
     env(1, 1, 0) = NAN;
     env(2, 0, 1) = INFINITY;
-    io::writeImage(dir / "env.pfm", env);
+    atrous::writeImage(dir / "env.pfm", env);
     RenderBuffers b = render(Scene::parse(sceneWith(kCam, R"({"emission": 1e8})",
                                                     R"(, "lights": [{"type": "environment", "file": "env.pfm", "scale": 1e7},)"
                                                     R"( {"type": "point", "position": [0, 1.001, 0], "intensity": 1e8}])"),
@@ -242,7 +242,7 @@ TEST(Reliability, LyingPfmHeaderFailsBeforeAllocating) {
     TempDir dir;
     writeText(dir / "lie.pfm", "PF\n16384 16384\n-1.0\n");
     const long before = peakRssMb();
-    const std::string msg = errorOf([&] { io::readImage(dir / "lie.pfm"); });
+    const std::string msg = errorOf([&] { atrous::readImage(dir / "lie.pfm"); });
     EXPECT_NE(msg.find("lie.pfm: truncated PFM"), std::string::npos) << msg;
     EXPECT_LT(peakRssMb() - before, 64) << "MB of peak memory for a 20-byte file";
 }
@@ -261,7 +261,7 @@ TEST(Reliability, LyingExrDataWindowFailsBeforeAllocating) {
     ASSERT_LT(fs::file_size(dir / "lie.exr"), 64u * 1024u);
     const long before = peakRssMb();
     const auto t0 = std::chrono::steady_clock::now();
-    const std::string msg = errorOf([&] { io::readImage(dir / "lie.exr"); });
+    const std::string msg = errorOf([&] { atrous::readImage(dir / "lie.exr"); });
     EXPECT_NE(msg.find("lie.exr: truncated or corrupt EXR"), std::string::npos) << msg;
     EXPECT_LT(peakRssMb() - before, 64) << "MB of peak memory for a small file";
     EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 2.0);
@@ -323,10 +323,10 @@ void writeGreyPng(const std::string& path, int w, int h) {
 TEST(Reliability, OversizedStbImageNamesTheFile) {
     TempDir dir;
     writeGreyPng(dir / "wide.png", 16385, 1);
-    const std::string msg = errorOf([&] { io::readImage(dir / "wide.png"); });
+    const std::string msg = errorOf([&] { atrous::readImage(dir / "wide.png"); });
     EXPECT_NE(msg.find("wide.png: unsupported image size 16385x1"), std::string::npos) << msg;
     writeGreyPng(dir / "ok.png", 20, 3);
-    EXPECT_EQ(io::readImage(dir / "ok.png").width(), 20);
+    EXPECT_EQ(atrous::readImage(dir / "ok.png").width(), 20);
 }
 
 // 12. A truncated .hdr was read with black where its pixels were missing.
@@ -339,13 +339,13 @@ TEST(Reliability, TruncatedHdrIsAnError) {
         for (int c = 0; c < 4; ++c) rle += std::string(1, char(128 + 16)) + std::string(1, char(c == 3 ? 128 : 100));
     }
     writeText(dir / "full.hdr", header + rle);
-    EXPECT_EQ(io::readImage(dir / "full.hdr").height(), 4);
+    EXPECT_EQ(atrous::readImage(dir / "full.hdr").height(), 4);
     writeText(dir / "cut.hdr", header + rle.substr(0, rle.size() - 5));
-    std::string msg = errorOf([&] { io::readImage(dir / "cut.hdr"); });
+    std::string msg = errorOf([&] { atrous::readImage(dir / "cut.hdr"); });
     EXPECT_NE(msg.find("cut.hdr: truncated HDR"), std::string::npos) << msg;
     const std::string flatHeader = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4 +X 4\n";
     writeText(dir / "flat.hdr", flatHeader + std::string(4 * 4 * 4 - 10, char(100)));
-    msg = errorOf([&] { io::readImage(dir / "flat.hdr"); });
+    msg = errorOf([&] { atrous::readImage(dir / "flat.hdr"); });
     EXPECT_NE(msg.find("flat.hdr: truncated HDR"), std::string::npos) << msg;
 }
 
@@ -361,7 +361,7 @@ TEST(Reliability, LuminanceChromaExrKeepsItsColour) {
         f.setFrameBuffer(&px[0][0], 1, w);
         f.writePixels(h);
     }
-    const Image img = io::readImage(dir / "yc.exr");
+    const Image img = atrous::readImage(dir / "yc.exr");
     // Chroma is subsampled and stored in half: a tolerance of 0.05.
     EXPECT_NEAR(img(4, 4, 0), 0.9f, 0.05f);
     EXPECT_NEAR(img(4, 4, 1), 0.1f, 0.05f);
@@ -373,9 +373,9 @@ TEST(Reliability, NulInAPathIsRefused) {
     TempDir dir;
     const std::string path = dir / std::string("a\0b.exr", 7);
     Image img(2, 2, 3);
-    EXPECT_NE(errorOf([&] { io::writeImage(path, img); }).find("NUL byte"), std::string::npos);
+    EXPECT_NE(errorOf([&] { atrous::writeImage(path, img); }).find("NUL byte"), std::string::npos);
     EXPECT_FALSE(fs::exists(dir / "a"));
-    EXPECT_NE(errorOf([&] { io::readImage(path); }).find("NUL byte"), std::string::npos);
+    EXPECT_NE(errorOf([&] { atrous::readImage(path); }).find("NUL byte"), std::string::npos);
     EXPECT_NE(errorOf([&] { Scene::load(dir / std::string("s\0.json", 7)); }).find("NUL byte"), std::string::npos);
 }
 
@@ -469,10 +469,10 @@ TEST(Reliability, TruncatedPngIsAnError) {
     const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
     std::ofstream(dir / "cut.png", std::ios::binary).write(bytes.data(), std::streamsize(bytes.size() - 2));
     std::ofstream(dir / "tail.png", std::ios::binary) << bytes << "appended data";
-    EXPECT_EQ(io::readImage(dir / "ok.png").width(), 6);
-    EXPECT_EQ(io::readImage(dir / "tail.png").width(), 6);
+    EXPECT_EQ(atrous::readImage(dir / "ok.png").width(), 6);
+    EXPECT_EQ(atrous::readImage(dir / "tail.png").width(), 6);
     try {
-        io::readImage(dir / "cut.png");
+        atrous::readImage(dir / "cut.png");
         FAIL() << "a truncated PNG was accepted";
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("cut.png: truncated PNG"), std::string::npos) << e.what();

@@ -43,14 +43,14 @@ TEST(RenderCli, WritesAllBuffersAndASummary) {
         EXPECT_TRUE(fs::exists(tmp / f)) << f;
     EXPECT_EQ(countEntries(tmp.str()), 9);  // and no temporary files left behind
     // The camera sees the ceiling light: its emission is in emission.exr, and nowhere else is.
-    Image emission = io::readImage(tmp / "emission.exr");
+    Image emission = atrous::readImage(tmp / "emission.exr");
     float maxE = 0.0f;
     for (size_t i = 0; i < emission.size(); ++i) maxE = std::max(maxE, emission.data()[i]);
     EXPECT_GT(maxE, 1.0f);
-    Image ids = io::readImage(tmp / "ids.exr");
+    Image ids = atrous::readImage(tmp / "ids.exr");
     EXPECT_EQ(ids.width(), 24);
     EXPECT_EQ(ids.height(), 16);
-    Image depth = io::readImage(tmp / "depth.exr");
+    Image depth = atrous::readImage(tmp / "depth.exr");
     EXPECT_GT(depth(12, 8, 0), 0.0f);
 }
 
@@ -151,11 +151,11 @@ TEST(RenderCli, DenoiseEqualsDenoiseOfTheWrittenBuffers) {
         r = runCli("denoise --in " + dir + " --method " + m + " --device cpu --out " + out);
         ASSERT_EQ(r.exitCode, 0) << r.output;
         EXPECT_NE(r.output.find("emission"), std::string::npos) << r.output;  // "buffers used: ..."
-        const Image fromRender = io::readImage(dir + "/denoised_" + m + ".exr");
-        EXPECT_TRUE(sameImages(fromRender, io::readImage(out))) << m;
+        const Image fromRender = atrous::readImage(dir + "/denoised_" + m + ".exr");
+        EXPECT_TRUE(sameImages(fromRender, atrous::readImage(out))) << m;
         r = runCli("denoise --in " + noEmission + " --method " + m + " --device cpu --out " + out2);
         ASSERT_EQ(r.exitCode, 0) << r.output;
-        EXPECT_FALSE(sameImages(fromRender, io::readImage(out2))) << m << ": emission.exr made no difference";
+        EXPECT_FALSE(sameImages(fromRender, atrous::readImage(out2))) << m << ": emission.exr made no difference";
     }
 }
 

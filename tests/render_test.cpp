@@ -94,7 +94,7 @@ TEST(RenderFurnace, DiffuseSphereUnderEnvironmentMap) {
     test::TempDir tmp;
     Image env(64, 32, 3);
     env.fill(1.0f);
-    io::writeImage(tmp / "white.exr", env);
+    atrous::writeImage(tmp / "white.exr", env);
     checkFurnace(furnaceScene(R"({"type": "environment", "file": ")" + (tmp / "white.exr") + R"("})"));
 }
 
@@ -432,7 +432,7 @@ TEST(RenderLightSampling, NeeMisAgreesWithBsdfSamplingOnGlossyMaterials) {
     for (int y = 0; y < 16; ++y)
         for (int x = 0; x < 32; ++x)
             for (int c = 0; c < 3; ++c) env(x, y, c) = (y < 8 ? 2.0f : 0.5f) * (x < 16 ? 1.0f : 0.25f);  // uneven
-    io::writeImage(tmp / "env.exr", env);
+    atrous::writeImage(tmp / "env.exr", env);
     const std::string envJson = R"({"type": "environment", "file": ")" + (tmp / "env.exr") + R"("})";
     for (const char* material : {R"({"type": "conductor", "albedo": [0.9, 0.6, 0.3], "roughness": 0.3})",
                                  R"({"type": "plastic", "albedo": [0.2, 0.4, 0.8], "roughness": 0.15})"}) {

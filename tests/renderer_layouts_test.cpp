@@ -67,19 +67,19 @@ TEST(RendererLayouts, LuxCoreStillFolderIsReadUnderItsOwnNames) {
         EXPECT_NE(r.output.find("buffers used: color,albedo,normal,position,depth"), std::string::npos) << r.output;
         auto r2 = runCli("denoise --in " + ours + " --method " + method + " --out " + b);
         ASSERT_EQ(r2.exitCode, 0) << r2.output;
-        EXPECT_TRUE(sameImages(atrous::io::readImage(a), atrous::io::readImage(b))) << method;
+        EXPECT_TRUE(sameImages(atrous::readImage(a), atrous::readImage(b))) << method;
     }
     // atrous's own name wins where a folder has both: a black color.exr beside RGB.exr gives what the
     // black colour gives with atrous's names.
     const atrous::Image black(32, 24, 3);
-    atrous::io::writeImage(lux + "/color.exr", black);
-    atrous::io::writeImage(ours + "/color.exr", black);
+    atrous::writeImage(lux + "/color.exr", black);
+    atrous::writeImage(ours + "/color.exr", black);
     r = runCli("denoise --in " + lux + " --method eaw --out " + dir / "both.exr");
     ASSERT_EQ(r.exitCode, 0) << r.output;
     r = runCli("denoise --in " + ours + " --method eaw --out " + dir / "black.exr");
     ASSERT_EQ(r.exitCode, 0) << r.output;
-    EXPECT_TRUE(sameImages(atrous::io::readImage(dir / "both.exr"), atrous::io::readImage(dir / "black.exr")));
-    EXPECT_FALSE(sameImages(atrous::io::readImage(dir / "both.exr"), atrous::io::readImage(dir / "lux_sure.exr")));
+    EXPECT_TRUE(sameImages(atrous::readImage(dir / "both.exr"), atrous::readImage(dir / "black.exr")));
+    EXPECT_FALSE(sameImages(atrous::readImage(dir / "both.exr"), atrous::readImage(dir / "lux_sure.exr")));
     // The output may not overwrite any of LuxCore's inputs either.
     r = runCli("denoise --in " + lux + " --method eaw --out " + lux + "/ALBEDO.exr");
     EXPECT_EQ(r.exitCode, 2) << r.output;
@@ -102,7 +102,7 @@ TEST(RendererLayouts, NumberedFrameFoldersWithLuxCoreNamesAreASequence) {
         const std::string want = dir / ("one_" + std::to_string(f) + ".exr");
         auto r1 = runCli("denoise --in " + lux + "/000" + std::to_string(f) + " --method eaw --out " + want);
         ASSERT_EQ(r1.exitCode, 0) << r1.output;
-        EXPECT_TRUE(sameImages(atrous::io::readImage(got), atrous::io::readImage(want))) << f;
+        EXPECT_TRUE(sameImages(atrous::readImage(got), atrous::readImage(want))) << f;
     }
     // `inspect` shows what the sequence gives per buffer, from the renderer's own files.
     r = runCli("inspect " + lux);
@@ -153,7 +153,7 @@ TEST(RendererLayouts, NumberedFilesPerBufferAreASequence) {
         ASSERT_EQ(r1.exitCode, 0) << r1.output;
         const std::string got = out + "/frame_000" + std::to_string(f) + ".exr";
         ASSERT_TRUE(fs::exists(got)) << r.output;
-        EXPECT_TRUE(sameImages(atrous::io::readImage(got), atrous::io::readImage(one + ".exr"))) << f;
+        EXPECT_TRUE(sameImages(atrous::readImage(got), atrous::readImage(one + ".exr"))) << f;
     }
     // --add-pass copies layered frames only; a buffer missing in one frame is named.
     r = runCli("denoise --sequence " + per + " --method sure --add-pass denoised --out " + dir / "out3");

@@ -87,7 +87,7 @@ TEST(SceneJson, TextureAndMaterialOverride) {
     test::TempDir tmp;
     Image tex(4, 4, 3);
     tex.fill(0.25f);
-    io::writeImage(tmp / "tex.exr", tex);
+    atrous::writeImage(tmp / "tex.exr", tex);
     writeText(tmp / "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n");
     writeText(tmp / "s.json", R"({"camera": {"position": [0,0,3], "lookAt": [0,0,0]},
       "materials": {"t": {"type": "diffuse", "texture": "tex.exr"}},
@@ -99,7 +99,7 @@ TEST(SceneJson, TextureAndMaterialOverride) {
     // An albedo texture is a reflectance: texels above 1 are clamped (an environment map is not).
     Image hot(2, 2, 3);
     hot.fill(50.0f);
-    io::writeImage(tmp / "hot.exr", hot);
+    atrous::writeImage(tmp / "hot.exr", hot);
     writeText(tmp / "h.json", R"({"camera": {"position": [0,0,3], "lookAt": [0,0,0]},
       "materials": {"t": {"type": "diffuse", "texture": "hot.exr"}},
       "objects": [{"type": "mesh", "file": "tri.obj", "material": "t"}],
@@ -149,7 +149,7 @@ TEST(SceneJson, MtlMaterialsTexturesAndSky) {
     test::TempDir tmp;
     Image tex(2, 2, 3);
     tex.fill(0.5f);
-    io::writeImage(tmp / "kd.exr", tex);
+    atrous::writeImage(tmp / "kd.exr", tex);
     writeText(tmp / "m.mtl", "newmtl lamp\nKd 0 0 0\nKe 5 5 5\nnewmtl chrome\nKs 0.9 0.9 0.9\nillum 3\n"
                              "newmtl tex\nKd 1 1 1\nmap_Kd kd.exr\nnewmtl glass\nNi 1.33\nillum 7\n");
     writeText(tmp / "m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n"

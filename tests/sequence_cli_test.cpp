@@ -27,7 +27,7 @@ TEST(SequenceCli, SvgfEawAndSureDenoiseEveryFrame) {
         for (int f = 0; f < 3; ++f) {
             const std::string exr = out + "/frame_000" + std::to_string(f) + ".exr";
             ASSERT_TRUE(fs::exists(exr)) << exr;
-            atrous::Image img = atrous::io::readImage(exr);
+            atrous::Image img = atrous::readImage(exr);
             EXPECT_EQ(img.width(), 32);
             EXPECT_EQ(img.height(), 24);
         }
@@ -51,8 +51,8 @@ TEST(SequenceCli, PerFrameMethodsEqualDenoiseOfEachFrame) {
             const std::string one = dir / "one.exr";
             r = runCli(std::string("denoise --method ") + method + " --device cpu --in " + frame + " --out " + one);
             ASSERT_EQ(r.exitCode, 0) << r.output;
-            const atrous::Image fromSequence = atrous::io::readImage(out + "/frame_000" + std::to_string(f) + ".exr");
-            EXPECT_TRUE(sameImages(fromSequence, atrous::io::readImage(one))) << method << " frame " << f;
+            const atrous::Image fromSequence = atrous::readImage(out + "/frame_000" + std::to_string(f) + ".exr");
+            EXPECT_TRUE(sameImages(fromSequence, atrous::readImage(one))) << method << " frame " << f;
             const std::string bare = dir / "bare";
             fs::remove_all(bare);
             fs::create_directories(bare);
@@ -60,7 +60,7 @@ TEST(SequenceCli, PerFrameMethodsEqualDenoiseOfEachFrame) {
                 if (e.path().filename() != "emission.exr") fs::copy_file(e.path(), fs::path(bare) / e.path().filename());
             r = runCli(std::string("denoise --method ") + method + " --device cpu --in " + bare + " --out " + one);
             ASSERT_EQ(r.exitCode, 0) << r.output;
-            EXPECT_FALSE(sameImages(fromSequence, atrous::io::readImage(one))) << method << " frame " << f;
+            EXPECT_FALSE(sameImages(fromSequence, atrous::readImage(one))) << method << " frame " << f;
         }
     }
 }

@@ -63,7 +63,7 @@ atrous::Image frame(float base, float offset) {
 void writeSequence(const std::string& dir, int frames, float offset, bool alternate) {
     fs::create_directories(dir);
     for (int f = 1; f <= frames; ++f)
-        atrous::io::writeImage(dir + "/frame_000" + std::to_string(f) + ".exr",
+        atrous::writeImage(dir + "/frame_000" + std::to_string(f) + ".exr",
                                frame(0.5f, alternate && f % 2 ? -offset : offset));
 }
 
@@ -108,7 +108,7 @@ TEST(SequenceCompare, FramesThatDoNotMatchAreOneLineAndExit2) {
     EXPECT_NE(r.output.find("frame 3 is missing"), std::string::npos) << r.output;
     // A frame of another size names the frame.
     writeSequence(dir / "odd", 3, 0.1f, false);
-    atrous::io::writeImage(dir / "odd/frame_0002.exr", atrous::Image(8, 8, 3));
+    atrous::writeImage(dir / "odd/frame_0002.exr", atrous::Image(8, 8, 3));
     r = runCli("compare --sequence " + dir / "ref" + " " + dir / "odd");
     EXPECT_EQ(r.exitCode, 2) << r.output;
     EXPECT_NE(r.output.find("frame 2"), std::string::npos) << r.output;

@@ -22,7 +22,7 @@ namespace {
 
 std::string errorOf(const std::string& path) {
     try {
-        io::readImage(path);
+        atrous::readImage(path);
     } catch (const InputError& e) {
         return e.what();
     }
@@ -72,13 +72,13 @@ TEST(StbInputs, LegalPngPartsStillRead) {
         for (int y = 0; y < 5; ++y)
             for (int x = 0; x < 9; ++x) img(x, y, c) = 0.1f * float((x + y + c) % 10);
     io::writePng(dir / "a.png", img);
-    const Image want = io::readImage(dir / "a.png");
+    const Image want = atrous::readImage(dir / "a.png");
     // Split the file into its chunks, then add an empty IDAT before the first one and bytes after IEND.
     const std::string bytes = fileBytes(dir / "a.png");
     const size_t firstIdat = bytes.find("IDAT") - 4;
     const std::string edited = bytes.substr(0, firstIdat) + chunk("IDAT", "") + bytes.substr(firstIdat) + "trailing bytes";
     std::ofstream(dir / "b.png", std::ios::binary) << edited;
-    const Image got = io::readImage(dir / "b.png");
+    const Image got = atrous::readImage(dir / "b.png");
     ASSERT_EQ(got.size(), want.size());
     EXPECT_TRUE(std::equal(want.data(), want.data() + want.size(), got.data()));
     // A flipped byte inside the pixel data fails its CRC (stb would decode it without a word).
@@ -107,12 +107,12 @@ TEST(StbInputs, AFileIsReadOnlyAsTheFormatItsNameSays) {
 TEST(StbInputs, JpegIsReadByLibjpegTurbo) {
     const std::string data = std::string(ATROUS_SOURCE_DIR) + "/tests/data/images/";
     int channels = 0;
-    const Image grey = io::readImage(data + "grey_16x8.jpg", &channels);  // (YCbCr: ffmpeg writes no grey JPEG)
+    const Image grey = atrous::readImage(data + "grey_16x8.jpg", &channels);  // (YCbCr: ffmpeg writes no grey JPEG)
     ASSERT_EQ(grey.width(), 16);
     ASSERT_EQ(grey.height(), 8);
     const float g = std::pow(128.0f / 255.0f, 2.2f);  // 0x80, give or take one code value of the codec
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(grey(5, 3, c), g, 0.01f) << c;
-    const Image colour = io::readImage(data + "colour_16x8.jpg", &channels);
+    const Image colour = atrous::readImage(data + "colour_16x8.jpg", &channels);
     EXPECT_EQ(channels, 3);
     EXPECT_NEAR(colour(8, 4, 0), 1.0f, 0.03f);                                 // 0xff
     EXPECT_NEAR(colour(8, 4, 1), std::pow(64.0f / 255.0f, 2.2f), 0.02f);       // 0x40
@@ -207,7 +207,7 @@ TEST(StbInputs, BmpAndTgaCutShortAreRefused) {
     for (const Case& c : cases) {
         const std::string path = dir / c.name;
         std::ofstream(path, std::ios::binary) << c.bytes;
-        expectPattern(io::readImage(path), c.name);
+        expectPattern(atrous::readImage(path), c.name);
         // The BMP's last row has 3 bytes of padding nobody reads: cutting those is harmless.
         const size_t lastUsed = std::string(c.name) == "rows.bmp" ? c.bytes.size() - 3 : c.bytes.size();
         for (size_t keep : {c.pixelStart + 1, (c.pixelStart + lastUsed) / 2, lastUsed - 1}) {
@@ -240,7 +240,7 @@ TEST(StbInputs, BmpPalettesAndTopDownRowsAndFlatHdrAsStbReadsThem) {
     // Top-down 2x2, 24 bits: rows red/green, then blue/white, first row on top.
     const std::string rows = std::string("\x00\x00\xff\x00\xff\x00", 6) + std::string(2, '\0') +
                              std::string("\xff\x00\x00\xff\xff\xff", 6) + std::string(2, '\0');
-    const Image td = io::readImage(write("topdown.bmp", header(40, 2, -2, 24, 54, 70) + rows));
+    const Image td = atrous::readImage(write("topdown.bmp", header(40, 2, -2, 24, 54, 70) + rows));
     ASSERT_EQ(td.height(), 2);
     EXPECT_EQ(td(0, 0, 0), 1.0f);  // red on top
     EXPECT_EQ(td(1, 0, 1), 1.0f);  // green
@@ -248,7 +248,7 @@ TEST(StbInputs, BmpPalettesAndTopDownRowsAndFlatHdrAsStbReadsThem) {
     EXPECT_EQ(td(1, 1, 0), 1.0f);  // white
     // 8 bits, a 2-entry palette (black, white): indices 0 and 1 read; an index of 5 is refused.
     const std::string pal = std::string(4, '\0') + std::string("\xff\xff\xff\x00", 4);
-    const Image ok = io::readImage(write("pal2.bmp", header(40, 4, 1, 8, 62, 66) + pal + std::string("\x00\x01\x01\x00", 4)));
+    const Image ok = atrous::readImage(write("pal2.bmp", header(40, 4, 1, 8, 62, 66) + pal + std::string("\x00\x01\x01\x00", 4)));
     EXPECT_EQ(ok(1, 0, 0), 1.0f);
     EXPECT_EQ(ok(0, 0, 0), 0.0f);
     const std::string bad = write("pal2_index5.bmp", header(40, 4, 1, 8, 62, 66) + pal + std::string("\x00\x05\x01\x00", 4));

@@ -45,14 +45,14 @@ void writeSequence(const std::string& dir, const SceneOptions& o, int count, int
         std::string fd = dir + "/" + io::sequenceFrameName(first + t);
         std::filesystem::create_directories(fd);
         Image position(o.width, o.height, 3);
-        io::writeImage(fd + "/color.exr", f.color);
-        io::writeImage(fd + "/albedo.exr", f.albedo);
-        io::writeImage(fd + "/normal.exr", f.normal);
-        io::writeImage(fd + "/position.exr", position);
-        io::writeImage(fd + "/depth.exr", f.depth);
-        io::writeImage(fd + "/ids.exr", f.ids);
-        io::writeImage(fd + "/motion.exr", f.motion);
-        if (reference) io::writeImage(fd + "/reference.exr", f.truth);
+        atrous::writeImage(fd + "/color.exr", f.color);
+        atrous::writeImage(fd + "/albedo.exr", f.albedo);
+        atrous::writeImage(fd + "/normal.exr", f.normal);
+        atrous::writeImage(fd + "/position.exr", position);
+        atrous::writeImage(fd + "/depth.exr", f.depth);
+        atrous::writeImage(fd + "/ids.exr", f.ids);
+        atrous::writeImage(fd + "/motion.exr", f.motion);
+        if (reference) atrous::writeImage(fd + "/reference.exr", f.truth);
     }
 }
 
@@ -146,7 +146,7 @@ TEST(SvgfSequence, GapsMissingBuffersAndSizeMismatchesAreNamed) {
         EXPECT_NE(msg.find("frame_0001/color.exr"), std::string::npos) << msg;
         EXPECT_NE(msg.find("frame_0000/color.exr"), std::string::npos) << msg;
         // Within one frame as well.
-        io::writeImage(dir / "frame_0000/ids.exr", Image(20, 12, 3));
+        atrous::writeImage(dir / "frame_0000/ids.exr", Image(20, 12, 3));
         msg = errorOf([&] { io::loadSequenceFrame(frames[0]); });
         EXPECT_NE(msg.find("ids.exr"), std::string::npos) << msg;
         EXPECT_NE(msg.find("color.exr"), std::string::npos) << msg;
@@ -169,7 +169,7 @@ static void checkSequenceCommand(const test::TempDir& dir, bool learnedSpatial) 
     for (int t = 0; t < 4; ++t) {
         std::string name = io::sequenceFrameName(t);
         ASSERT_TRUE(std::filesystem::exists(dir / ("out/" + name + ".png"))) << name;
-        Image out = io::readImage(dir / ("out/" + name + ".exr"));
+        Image out = atrous::readImage(dir / ("out/" + name + ".exr"));
         SynthFrame f = makeFrame(o, t);
         ASSERT_TRUE(allFinite(out)) << name;
         EXPECT_LT(mse(out, f.truth), 0.5 * mse(f.color, f.truth)) << name << (learnedSpatial ? " learned" : "");
@@ -208,8 +208,8 @@ TEST(SvgfSequence, EveryParamHasAFlag) {
     EXPECT_EQ(p.levels, 4);
     EXPECT_EQ(p.feedbackTap, 1);
     EXPECT_EQ(p.spatialVarianceFrames, 2);
-    EXPECT_EQ(p.reprojectDepthTolerance, 5.0f);
-    EXPECT_EQ(p.reprojectNormalCos, 0.5f);
+    EXPECT_EQ(p.depthTolerance, 5.0f);
+    EXPECT_EQ(p.normalCos, 0.5f);
     EXPECT_TRUE(p.taa);
     EXPECT_EQ(p.taaAlpha, 0.25f);
     EXPECT_EQ(p.emissionAlpha, 0.5f);
@@ -243,7 +243,7 @@ TEST(SvgfSequence, LearnedWeightsReachTheLearnedSpatialFilter) {
     EXPECT_EQ(r.output.find("ignored"), std::string::npos) << r.output;
     for (int t = 0; t < 3; ++t) {
         const std::string name = io::sequenceFrameName(t) + ".exr";
-        const Image a = io::readImage(dir / ("builtin/" + name)), b = io::readImage(dir / ("fixture/" + name));
+        const Image a = atrous::readImage(dir / ("builtin/" + name)), b = atrous::readImage(dir / ("fixture/" + name));
         ASSERT_TRUE(allFinite(b)) << name;
         // Outputs are O(1); random weights against trained ones differ far above rounding.
         EXPECT_GT(maxAbsDiff(a, b), 1e-2f) << name;

@@ -199,7 +199,7 @@ TEST(SvgfVariance, SpatialEstimateIsUsedWhileTheHistoryIsShort) {
     // (fewer taps at the border); ±6% covers the sampling error of 3072 correlated estimates.
     EXPECT_NEAR(meanVariance(SvgfParams{}) / sigma2, 48.0 / 49.0, 0.06);
     // Forcing the temporal estimate at history 1 gives μ2 - μ1² = l² - l² = 0, up to the rounding
-    // of l²: on the FMA targets (AVX2, AVX-512: src/cpu/isa_dispatch.h) μ2 - μ1·μ1 is contracted
+    // of l²: on the FMA targets (AVX2, AVX-512: src/core/isa_dispatch.h) μ2 - μ1·μ1 is contracted
     // into one fused multiply-add, which leaves l²'s rounding error, at most half an ulp of l²
     // (l ≈ 1 here: 6e-8; measured mean 1.2e-8). The bound, 1e-5 σ² = 1e-7, is 1e5 times below
     // the spatial estimate this test tells it from (σ² = 1e-2).
@@ -285,8 +285,8 @@ TEST(SvgfRobustness, BadFramesAndParamsAreInputErrors) {
     bad([](SvgfParams& p) { p.levels = 11; });
     bad([](SvgfParams& p) { p.feedbackTap = 5; });
     bad([](SvgfParams& p) { p.spatialVarianceFrames = 0; });
-    bad([](SvgfParams& p) { p.reprojectDepthTolerance = -1; });
-    bad([](SvgfParams& p) { p.reprojectNormalCos = 2; });
+    bad([](SvgfParams& p) { p.depthTolerance = -1; });
+    bad([](SvgfParams& p) { p.normalCos = 2; });
     bad([](SvgfParams& p) { p.taaAlpha = 0; });
     bad([](SvgfParams& p) { p.emissionAlpha = 0; });
     bad([](SvgfParams& p) { p.emissionAlpha = std::numeric_limits<float>::quiet_NaN(); });
@@ -363,8 +363,8 @@ TEST(SvgfParamsTest, EveryFieldChangesTheOutput) {
         {"levels", [](SvgfParams& p) { p.levels = 3; }, &base},
         {"feedbackTap", [](SvgfParams& p) { p.feedbackTap = 2; }, &base},
         {"spatialVarianceFrames", [](SvgfParams& p) { p.spatialVarianceFrames = 1; }, &base},
-        {"reprojectDepthTolerance", [](SvgfParams& p) { p.reprojectDepthTolerance = 0.4f; }, &base},
-        {"reprojectNormalCos", [](SvgfParams& p) { p.reprojectNormalCos = 0.9999f; }, &base},
+        {"depthTolerance", [](SvgfParams& p) { p.depthTolerance = 0.4f; }, &base},
+        {"normalCos", [](SvgfParams& p) { p.normalCos = 0.9999f; }, &base},
         {"taa", [](SvgfParams& p) { p.taa = true; }, &base},
         {"taaAlpha", [](SvgfParams& p) { p.taa = true, p.taaAlpha = 0.5f; }, &taaOut},
         {"emissionAlpha", [](SvgfParams& p) { p.emissionAlpha = 0.5f; }, &base},

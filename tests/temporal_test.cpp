@@ -475,11 +475,11 @@ TEST(TemporalCli, RadiusZeroEqualsThePerFrameMethod) {
     }
     for (int f = 0; f < 3; ++f) {
         const std::string name = "/frame_000" + std::to_string(f) + ".exr";
-        EXPECT_TRUE(sameImages(io::readImage(dir / "t" + name), io::readImage(dir / "e" + name))) << name;
+        EXPECT_TRUE(sameImages(atrous::readImage(dir / "t" + name), atrous::readImage(dir / "e" + name))) << name;
     }
     EXPECT_NE(causalOutput.find("frame_0001: temporal (causal, -3 frames"), std::string::npos) << causalOutput;
-    EXPECT_TRUE(sameImages(io::readImage(dir / "c/frame_0000.exr"), io::readImage(dir / "e/frame_0000.exr")));
-    EXPECT_FALSE(sameImages(io::readImage(dir / "c/frame_0002.exr"), io::readImage(dir / "e/frame_0002.exr")));
+    EXPECT_TRUE(sameImages(atrous::readImage(dir / "c/frame_0000.exr"), atrous::readImage(dir / "e/frame_0000.exr")));
+    EXPECT_FALSE(sameImages(atrous::readImage(dir / "c/frame_0002.exr"), atrous::readImage(dir / "e/frame_0002.exr")));
 }
 
 TEST(TemporalCli, BadFlagsExitTwoAndWriteNothing) {
@@ -565,8 +565,8 @@ TEST(TemporalCli, FirefliesOnTheSunLeaveNoNegativeOutput) {
     ASSERT_EQ(runCli("denoise --sequence " + dir / "seq" + " --method auto --out " + dir / "f").exitCode, 0);
     for (int i = 0; i < 6; ++i) {
         const std::string n = "frame_000" + std::to_string(i);
-        const Image ref = io::readImage(dir / "seq" + "/" + n + "/reference.exr");
-        const Image t = io::readImage(dir / "t" + "/" + n + ".exr"), f = io::readImage(dir / "f" + "/" + n + ".exr");
+        const Image ref = atrous::readImage(dir / "seq" + "/" + n + "/reference.exr");
+        const Image t = atrous::readImage(dir / "t" + "/" + n + ".exr"), f = atrous::readImage(dir / "f" + "/" + n + ".exr");
         EXPECT_LE(computeMetrics(t, ref).relMse, 1.25 * computeMetrics(f, ref).relMse) << n;
         float lo = 0;
         for (size_t k = 0; k < t.size(); ++k) lo = std::min(lo, t.data()[k]);

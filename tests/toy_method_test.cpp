@@ -37,9 +37,9 @@ std::string renderFolder(const test::TempDir& dir) {
     const Rendered r;
     const std::string in = dir / "r";
     std::filesystem::create_directories(in);
-    io::writeImage(in + "/color.exr", r.b.color);
-    io::writeImage(in + "/albedo.exr", r.b.albedo);
-    io::writeImage(in + "/normal.exr", r.b.normal);
+    atrous::writeImage(in + "/color.exr", r.b.color);
+    atrous::writeImage(in + "/albedo.exr", r.b.albedo);
+    atrous::writeImage(in + "/normal.exr", r.b.normal);
     return in;
 }
 
@@ -292,7 +292,7 @@ TEST(ToyMethod, AsAPluginTheCliListsAndRunsIt) {
 #ifdef ATROUS_TOY_CLI
     if (std::filesystem::exists(ATROUS_TOY_CLI)) {
         test::runShell(std::string(ATROUS_TOY_CLI) + " denoise --in " + in + " --method toy --out " + (dir / "linked.exr"));
-        EXPECT_TRUE(test::sameImages(io::readImage(dir / "plugin.exr"), io::readImage(dir / "linked.exr")));
+        EXPECT_TRUE(test::sameImages(atrous::readImage(dir / "plugin.exr"), atrous::readImage(dir / "linked.exr")));
     }
 #endif
     // The toy sequence method of the same plugin: listed (its flags in their group), run on a

@@ -158,10 +158,10 @@ TEST(ViewHeadless, DenoisedScreenshotIsCloserToTheReferenceThanTheNoisyOne) {
         // Headless runs print one JSON line of timings.
         EXPECT_NE(r.output.find("\"frame_ms_median\""), std::string::npos) << r.output;
     }
-    const Image ref = atrous::io::readImage(dir / "ref.png");
-    const Image noisy = atrous::io::readImage(dir / "none.png");
-    const Image eaw = atrous::io::readImage(dir / "eaw.png");
-    const Image svgf = atrous::io::readImage(dir / "svgf.png");
+    const Image ref = atrous::readImage(dir / "ref.png");
+    const Image noisy = atrous::readImage(dir / "none.png");
+    const Image eaw = atrous::readImage(dir / "eaw.png");
+    const Image svgf = atrous::readImage(dir / "svgf.png");
     for (const Image* img : {&ref, &noisy, &eaw, &svgf}) {
         ASSERT_EQ(img->width(), 128);
         ASSERT_EQ(img->height(), 128);
@@ -200,7 +200,7 @@ TEST(ViewHeadless, SplitScreenAndBufferDump) {
         runUnderXvfb(std::string(kBase) + " --method eaw --compare none --frames 3 --screenshot " +
                      (dir / "split.png") + " --dump " + dump);
     ASSERT_EQ(r.exitCode, 0) << r.output;
-    const Image s = atrous::io::readImage(dir / "split.png");
+    const Image s = atrous::readImage(dir / "split.png");
     ASSERT_EQ(s.width(), 128);
     // Left half EAW, right half noisy: the left is far smoother (noise dominates the local variance
     // at 3 spp; the box edges are present in both halves).
@@ -208,7 +208,7 @@ TEST(ViewHeadless, SplitScreenAndBufferDump) {
     for (const char* f : {"color.exr", "variance.exr", "albedo.exr", "normal.exr", "position.exr",
                           "depth.exr", "ids.exr", "denoised_a_eaw.exr"})
         EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(dump) / f)) << f;
-    const Image color = atrous::io::readImage((std::filesystem::path(dump) / "color.exr").string());
+    const Image color = atrous::readImage((std::filesystem::path(dump) / "color.exr").string());
     EXPECT_EQ(color.width(), 128);
     EXPECT_GT(meanValue(color), 0.01);
 }
@@ -257,7 +257,7 @@ TEST(ViewHeadless, SureFractionsAndDetailBuffers) {
         const std::string f =
             (std::filesystem::path(d1) / ("sure_s_level" + std::to_string(l) + ".exr")).string();
         ASSERT_TRUE(std::filesystem::exists(f)) << f;
-        const Image s = atrous::io::readImage(f);
+        const Image s = atrous::readImage(f);
         float lo = 1e9f, hi = -1e9f;
         for (size_t i = 0; i < s.size(); ++i)
             lo = std::min(lo, s.data()[i]), hi = std::max(hi, s.data()[i]);
@@ -272,7 +272,7 @@ TEST(ViewHeadless, SureFractionsAndDetailBuffers) {
     const std::string f = (std::filesystem::path(d2) / "detail_level0.exr").string();
     ASSERT_TRUE(std::filesystem::exists(f)) << f;
     // d_0 = c_0 - c_1 carries the finest noise: clearly non-zero at 2 spp.
-    const Image d = atrous::io::readImage(f);
+    const Image d = atrous::readImage(f);
     double e = 0;
     for (size_t i = 0; i < d.size(); ++i) e += std::fabs(d.data()[i]);
     EXPECT_GT(e / double(d.size()), 1e-3);
@@ -292,7 +292,7 @@ TEST(ViewHeadless, TurntableMovesTheCameraAndFeedsSvgfMotionVectors) {
         turn);
     ASSERT_EQ(r.exitCode, 0) << r.output;
     auto load = [](const std::string& d, const char* f) {
-        return atrous::io::readImage((std::filesystem::path(d) / f).string());
+        return atrous::readImage((std::filesystem::path(d) / f).string());
     };
     // A static camera has zero motion everywhere.
     const Image m0 = load(still, "motion.exr");

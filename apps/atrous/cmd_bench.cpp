@@ -284,7 +284,7 @@ void run(const BenchArgs& a) {
         for (const DenoiseMethodInfo& info : denoiseMethods()) {
             const char* m = info.name;
             if (info.method == DenoiseMethod::Auto || !wants(m)) continue;
-            DenoiseInputs in = denoiseInputsOf(inputs);
+            DenoiseInputs in = inputs.frame();
             DenoiseOptions o;
             o.method = parseDenoiseMethod(m);
             o.weights = weights;

@@ -74,8 +74,8 @@ public:
     std::pair<std::string, std::string> frame(int index, const Image& ref, const Image& test) const {
         const std::string r = (mDir / ("ref_" + std::to_string(index) + ".exr")).string();
         const std::string t = (mDir / ("test_" + std::to_string(index) + ".exr")).string();
-        if (!fs::exists(r)) io::writeImage(r, ref);
-        io::writeImage(t, test);
+        if (!fs::exists(r)) atrous::writeImage(r, ref);
+        atrous::writeImage(t, test);
         return {r, t};
     }
 
@@ -228,7 +228,7 @@ void writeVideo(const std::string& path, const std::vector<std::string>& names,
         }
         char name[32];
         std::snprintf(name, sizeof name, "f%06zu.png", i);
-        io::writeImage((tmpDir / name).string(), strip);
+        atrous::writeImage((tmpDir / name).string(), strip);
     }
     const std::string tmpVideo = (tmpDir / "video.mp4").string();
     const std::string cmd = io::shellQuote(ffmpeg) + " -nostdin -y -loglevel error -framerate 24 -i " + io::shellQuote((tmpDir / "f%06d.png").string()) +
@@ -355,12 +355,12 @@ void run(const CompareArgs& a) {
         if (ext == ".png") notes.push_back("note: " + p + " is an 8-bit PNG preview, compared as its [0,1] values, not HDR radiance");
     };
     notePng(a.ref);
-    Image ref = io::readImage(a.ref);
+    Image ref = atrous::readImage(a.ref);
     std::vector<ImageMetrics> ms;
     std::vector<Image> imgs;
     for (const auto& p : a.images) {
         notePng(p);
-        imgs.push_back(io::readImage(p));
+        imgs.push_back(atrous::readImage(p));
         try {
             ms.push_back(computeMetrics(imgs.back(), ref));
         } catch (const InputError& e) {
@@ -377,8 +377,8 @@ void run(const CompareArgs& a) {
     if (!a.errorMaps.empty()) {
         for (size_t i = 0; i < imgs.size(); ++i) {
             const std::string stem = std::filesystem::path(a.images[i]).stem().string();
-            io::writeImage((std::filesystem::path(a.errorMaps) / (stem + "_se.exr")).string(), squaredErrorMap(imgs[i], ref));
-            io::writeImage((std::filesystem::path(a.errorMaps) / (stem + "_relse.exr")).string(),
+            atrous::writeImage((std::filesystem::path(a.errorMaps) / (stem + "_se.exr")).string(), squaredErrorMap(imgs[i], ref));
+            atrous::writeImage((std::filesystem::path(a.errorMaps) / (stem + "_relse.exr")).string(),
                            relativeErrorMap(imgs[i], ref));
         }
     }

@@ -290,7 +290,7 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     if (!a.addPass.empty())
         io::writeExrWithLayers(a.out, *set.layered, {io::ExrOutLayer{a.addPass, &out}});
     else
-        io::writeImage(a.out, out);
+        atrous::writeImage(a.out, out);
     const double writeMs = writeTimer.ms();
     const std::string method = o.method == DenoiseMethod::Auto
                                    ? std::string("auto -> ") + denoiseMethodName(rep.methodUsed) +

@@ -51,7 +51,7 @@ void writeBuffers(const std::string& dir, const RenderBuffers& b, bool withVaria
     for (const RenderBufferField& f : kRenderBufferFields) {  // NAME.exr for every buffer it has
         const Image& img = b.*f.image;
         if (!img.empty() && (withVariance || f.image != &RenderBuffers::variance))
-            io::writeImage(path(std::string(f.name) + ".exr"), img);
+            atrous::writeImage(path(std::string(f.name) + ".exr"), img);
     }
 }
 
@@ -109,7 +109,7 @@ void runFrames(const RenderArgs& a) {
         io::ensureWritableDirectory(stage);
         try {
             writeBuffers(stage, b, /*withVariance=*/s.spp > 1);  // motion.exr too
-            if (!reference.empty()) io::writeImage((fs::path(stage) / "reference.exr").string(), reference);
+            if (!reference.empty()) atrous::writeImage((fs::path(stage) / "reference.exr").string(), reference);
             io::writePng((fs::path(stage) / "color.png").string(), b.color);
         } catch (...) {
             fs::remove_all(stage, ec);  // e.g. disk full: no half-written hidden frame left behind
@@ -171,7 +171,7 @@ void run(const RenderArgs& a) {
     if (!methods.empty()) {
         // Every buffer, emission included: filtering color - emission keeps a visible light's
         // anti-aliased edge out of its surroundings.
-        DenoiseInputs in = denoiseInputsOf(b);
+        DenoiseInputs in = b.frame();
         Timer dt;
         for (DenoiseMethod m : methods) {
             DenoiseOptions opt;
@@ -188,7 +188,7 @@ void run(const RenderArgs& a) {
     writeBuffers(a.out, b);
     io::writePng(path("color.png"), b.color);
     for (const auto& [name, img] : denoised) {
-        io::writeImage(path("denoised_" + name + ".exr"), img);
+        atrous::writeImage(path("denoised_" + name + ".exr"), img);
         io::writePng(path("denoised_" + name + ".png"), img);
     }
 

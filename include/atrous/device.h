@@ -13,7 +13,7 @@ bool cudaCompiled();
 // "cpu" / "cuda".
 const char* deviceToString(Device d);
 // Parses "cpu", "cuda" or "auto" (auto: cuda when available, else cpu). Throws ParamError
-// (atrous/params.h, field "device") on any other word, or when "cuda" is asked for and
+// (atrous/error.h, field "device") on any other word, or when "cuda" is asked for and
 // cudaAvailable() is false.
 Device parseDevice(const std::string& name);
 // Throws parseDevice("cuda")'s ParamError (field "device") unless cudaAvailable(): what every

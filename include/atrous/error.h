@@ -21,4 +21,22 @@ public:
     explicit RuntimeError(const std::string& what) : std::runtime_error(what) {}
 };
 
+// A parameter out of range (or a value that does not parse): an InputError whose what() names the
+// field (`parameter sigma_normal must be 0 (off) or >= 1e-6 (got 1e-20)`); field() and rule() let
+// the CLI name its flag instead (the parameter tables, atrous/params.h), without reading the message.
+class ParamError : public InputError {
+public:
+    ParamError(const std::string& set, const std::string& field, const std::string& rule, const std::string& got = "")
+        : InputError(std::string(set == "svgf" ? "SVGF parameter " : "parameter ") + field + " " + rule +
+                     (got.empty() ? "" : " (got " + got + ")")),
+          mSet(set), mField(field), mRule(rule), mGot(got) {}
+    const std::string& set() const { return mSet; }      // "denoise", "svgf", "render" (a table), "device", "camera_path" or "scene"
+    const std::string& field() const { return mField; }  // the row's name, e.g. "sigma_normal"
+    const std::string& rule() const { return mRule; }    // e.g. "must be in 1..10"
+    const std::string& got() const { return mGot; }      // the value as given ("" when not shown)
+
+private:
+    std::string mSet, mField, mRule, mGot;
+};
+
 }  // namespace atrous

@@ -59,7 +59,7 @@
 #define ATROUS_RESTRICT
 #endif
 
-// The CPU loops compiled for several instruction sets (src/cpu/cpu_simd.h, parallelForIsa): with
+// The CPU loops compiled for several instruction sets (src/core/isa_dispatch.h, parallelForIsa): with
 // GCC on x86-64 (also the host side of a .cu file: nvcc passes the attributes to GCC).
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 #define ATROUS_CPU_MULTI_ISA 1

@@ -8,8 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "atrous/denoise.h"
+#include "atrous/buffers.h"
 #include "atrous/image.h"
+#include "atrous/param_table.h"
 
 namespace atrous {
 
@@ -17,7 +18,7 @@ namespace pt {
 struct SceneData;  // flat, GPU-friendly scene arrays (src/render/scene_data.h)
 }
 
-// Each field has a row in renderParams() (atrous/params.h): its name, range and doc line.
+// Each field has a row in renderParams() (below): its name, range and doc line.
 struct RenderSettings {
     int width = 512;
     int height = 512;
@@ -40,10 +41,13 @@ struct RenderSettings {
 // The renderer's buffers: 3-channel planar host images of width x height, each with the meaning
 // and conventions of atrous/buffers.h (depth repeated in R, G, B; ids R = mesh id, G = material
 // id, B = 0). motion: animation frames only (renderFrame), the mean over the pixel's samples,
-// background from the camera rotation alone; empty for render(). io::refsOf gives their Frame.
+// background from the camera rotation alone; empty for render(). frame() gives them as the one
+// Frame every denoiser takes.
 struct RenderBuffers {
     Image color, variance, albedo, normal, position, depth, ids;
     Image motion, emission;
+    // Every buffer the render has (motion too, when it made one; empty images are absent), not owned.
+    Frame frame() const;
 };
 
 // RenderBuffers' images by name, in declaration order: the file NAME.exr the CLI writes, the key
@@ -68,10 +72,6 @@ enum class CameraPath { Auto, Static, Orbit, Dolly, Keyframes };
 
 // "auto", "static", "orbit", "dolly", "keyframes"; InputError naming --camera-path otherwise.
 CameraPath parseCameraPath(const std::string& name);
-
-// The denoiser's view of a render: every buffer it uses (variance, features, ids, emission); the
-// library's one input assembly (src/io/buffer_set.h), which the CLI, viewer and Python share.
-DenoiseInputs denoiseInputsOf(const RenderBuffers& b);
 
 // Depth written for pixels that see no surface (a finite stand-in for +inf).
 constexpr float kBackgroundDepth = 1e30f;
@@ -116,7 +116,11 @@ private:
 
 const std::vector<std::string>& builtinSceneNames();
 
-// Throws ParamError (atrous/params.h: an InputError naming the field, `max_depth`) for settings
+// RenderSettings' parameter table (atrous/param_table.h; all but the progress counter): CLI flag
+// --<name> of `atrous render` and `atrous view`, Python's keywords.
+const ParamTable<RenderSettings>& renderParams();
+
+// Throws ParamError (atrous/error.h: an InputError naming the field, `max_depth`) for settings
 // outside their ranges in renderParams(): spp <= 0, width or height <= 0 or > kMaxImageDim,
 // maxDepth outside 0..1024, threads outside 0..4096.
 void validateRenderSettings(const RenderSettings& settings);

@@ -17,9 +17,8 @@ namespace atrous {
 // changes the output (tests/svgf_test.cpp checks that).
 struct SvgfParams {
     // À-trous edge stops (paper's σ_l, σ_n, σ_z).
-    // luminance: exp(-|l_p - l_q| / (σ_l sqrt(g3x3(var_p)) + ε)). 2 with historyClip 0.5, chosen
-    // together on other renderers' orbits, where the paper's 4 lost to per-frame EAW
-    // (docs/decisions.md).
+    // luminance: exp(-|l_p - l_q| / (σ_l sqrt(g3x3(var_p)) + ε)). 2, with historyClip 0.5
+    // (docs/decisions.md, "Sequences").
     float sigmaL = 2.0f;
     float sigmaN = 128.0f;  // normal: max(0, n_p·n_q)^σ_n
     float sigmaZ = 1.0f;    // depth: exp(-|z_p - z_q| / (σ_z |∇z_p·(p - q)| + ε))
@@ -41,10 +40,11 @@ struct SvgfParams {
     // instead of the temporal moments (the paper: 4). >= 1.
     int spatialVarianceFrames = 4;
     // Reprojection consistency: a previous-frame tap is kept when its depth differs by at most
-    // reprojectDepthTolerance * (|dz/dx| + |dz/dy| + 0.01 z) (relative to the local depth gradient),
-    // its normal's cosine to the current one is at least reprojectNormalCos, and the mesh ids agree.
-    float reprojectDepthTolerance = 2.0f;
-    float reprojectNormalCos = 0.9f;
+    // depthTolerance * (|dz/dx| + |dz/dy| + 0.01 z) (relative to the local depth gradient), its
+    // normal's cosine to the current one is at least normalCos, and the mesh ids agree (the same
+    // test and names as TemporalParams', atrous/temporal.h).
+    float depthTolerance = 2.0f;
+    float normalCos = 0.9f;
     // Optional temporal anti-aliasing on the remodulated output: reprojected previous output,
     // clamped to the current 3x3 neighbourhood's colour box, blended with weight taaAlpha.
     bool taa = false;
@@ -55,7 +55,7 @@ struct SvgfParams {
     // emissionMotionAlpha·|motion across the edge in pixels|). It smooths the 1-spp coverage
     // flicker on a visible light's edge; the motion term bounds the lag of a moving edge.
     // emissionAlpha in (0, 1] (1 = the raw emission, no accumulation); emissionMotionAlpha >= 0
-    // (0 = off). Defaults measured on cornell orbit / cornell-moving (docs/quality.md, SVGF).
+    // (0 = off). The defaults: docs/decisions.md, "Sequences".
     float emissionAlpha = 0.1f;
     float emissionMotionAlpha = 4.0f;
     // The spatial filter: false = SVGF's à-trous (the edge stops above), true = the learned
@@ -76,7 +76,7 @@ struct SvgfParams {
 // The row of SVGF in the registry of sequence methods (atrous/sequence_methods.h).
 constexpr const char* kSvgfMethod = "svgf";
 
-// Throws ParamError (atrous/params.h: an InputError naming the field, `sigma_l`) when a
+// Throws ParamError (atrous/error.h: an InputError naming the field, `sigma_l`) when a
 // parameter is out of range.
 void validateSvgfParams(const SvgfParams& p);
 

@@ -20,8 +20,8 @@ namespace atrous {
 
 // Every knob; its table is temporalParams() in atrous/params.h (CLI --temporal-<name>, Python).
 struct TemporalParams {
-    // Frames on each side of t (0 = frame t alone: the still method per frame). Measured on the
-    // corpus's orbits (docs/quality.md, "Sequences"): 1 spp, 20 frames.
+    // Frames on each side of t (0 = frame t alone: the still method per frame). The default:
+    // docs/decisions.md, "Sequences".
     int radius = 3;
     // The hop test (svgf_reproject.h's): |z_q - z_p| <= τ_z (|dz/dx| + |dz/dy| + 0.01 z), n_p·n_q >=
     // normalCos, equal ids.
@@ -38,10 +38,9 @@ struct TemporalParams {
     // Every frame of the window goes through the still filters' firefly pass (prepass.h, bound k
     // local standard deviations, without a variance) before it is averaged: the bilinear taps
     // would spread a neighbour's firefly into a 2x2 blob that the still method's own pass keeps.
-    // 0 = off (with radius 0 nothing is done: the still method has its own pass). The still
-    // filters' 4 clamps the 1-spp frames' caustics and highlights (Cycles' orbit 0.0068 -> 0.0108);
-    // 16 keeps most of them and still takes the ceiling's fireflies out of a Cornell orbit
-    // (docs/temporal.md).
+    // 0 = off (with radius 0 nothing is done: the still method has its own pass). 16, above the
+    // still filters' 4, keeps the 1-spp frames' caustics and highlights (docs/decisions.md,
+    // "Sequences").
     float fireflyK = 16.0f;
     // Causal: frame t from t - radius .. t only (the frames after it are not used even when the
     // window has them), so a frame can be denoised as soon as it is rendered (a viewer, a stream).
@@ -61,8 +60,7 @@ struct TemporalParams {
     // radius 0 the frame is denoised alone. It needs the renderer's motion vectors in every frame:
     // without them (taken as still), and in `denoise --sequence` and the Python module where the
     // motion is fitted to positions or estimated from colours, a moving object looks still, and
-    // it is off. 0 = off. Chosen on atrous's static-camera Cornell sequence; on the held-out
-    // Cycles turntable it takes 7-13% off the error (docs/temporal.md).
+    // it is off. 0 = off. The default: docs/decisions.md, "Sequences".
     int staticRadius = 6;
 };
 

@@ -60,8 +60,7 @@ struct PipelineSettings {
     bool accumulate = true;  // EAW/SURE/none filter the running mean over frames
     // False when nothing will read the accumulated buffers this frame (only sequence-method slots,
     // which take each frame's own samples, and the result or motion view): the accumulation is
-    // skipped (about 10% of an SVGF frame's CPU time at 256x256) and the running mean restarts
-    // when needed again.
+    // skipped (its cost: docs/decisions.md, "Speed") and the running mean restarts when needed again.
     bool needAccumulated = true;
     int maxDepth = 8;
     Method methodA = Method::of(DenoiseMethod::Blend);  // what auto picks with the renderer's albedo and normal

@@ -215,7 +215,7 @@ nb::object pyReadImage(const std::string& path) {
     Image img;
     {
         nb::gil_scoped_release release;
-        img = io::readImage(path);
+        img = atrous::readImage(path);
     }
     return fromImage(std::move(img));
 }
@@ -230,7 +230,7 @@ void pyWriteImage(const std::string& path, const Array& image) {
     Image img = toImage(image, path.c_str(), channels);
     if (img.device() != Device::Cpu) img = img.to(Device::Cpu);  // the writers read host memory
     nb::gil_scoped_release release;
-    io::writeImage(path, img);
+    atrous::writeImage(path, img);
 }
 
 // Library errors name the field (`max_depth`, `device`, `camera_path`: ParamError) or the file,

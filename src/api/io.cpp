@@ -1,5 +1,5 @@
-// The public image I/O (include/atrous/io.h): the internal readers and writers, which stay in
-// src/io so that the CLI, tests and Python keep using them unchanged.
+// The public reading of a render's files (include/atrous/io.h) over the buffer assembly; readImage
+// and writeImage themselves are src/io/image_io.cpp's.
 #include "atrous/io.h"
 
 #include "atrous/io/buffer_set.h"
@@ -7,19 +7,6 @@
 #include "atrous/io/pass_map.h"
 
 namespace atrous {
-
-Image readImage(const std::string& path) {
-    return io::readImage(path);
-}
-
-void writeImage(const std::string& path, const Image& img) {
-    // The writers read host memory; a library user's denoise() result may live on the GPU.
-    if (img.device() != Device::Cpu) {
-        io::writeImage(path, img.to(Device::Cpu));
-        return;
-    }
-    io::writeImage(path, img);
-}
 
 const Image* RenderFiles::get(const std::string& name) const {
     for (const auto& [n, img] : buffers)

@@ -273,7 +273,7 @@ void Session::writeFrame(const std::string& name, std::shared_ptr<io::ExrInfo> l
         if (!mArgs.addPass.empty())
             io::writeExrWithLayers(exrOut, *layered, {io::ExrOutLayer{mArgs.addPass, img.get()}});
         else
-            io::writeImage(exrOut, *img);
+            writeImage(exrOut, *img);
         if (mArgs.pngs) io::writePng((fs::path(stage) / (name + ".png")).string(), *img, mArgs.exposure);
     });
 }

@@ -446,10 +446,10 @@ void ViewPipeline::runSequence(int i, const SequenceMethodInfo& m, const Pipelin
             }
             own->motion = mMotion.clone();
             own->emission = mEmission.clone();
-            in.buffers = io::refsOf(*own);
+            in.buffers = own->frame();
             in.owner = own;
         } else {
-            io::BufferRefs refs = io::refsOf(frame());
+            Frame refs = frame().frame();
             refs.set(io::Buffer::Motion, &mMotion).set(io::Buffer::Emission, &mEmission);
             in.buffers = refs;
         }
@@ -559,7 +559,7 @@ std::vector<std::string> ViewPipeline::saveBuffers(const std::string& dir) const
     std::vector<std::string> names;
     auto put = [&](const std::string& name, const Image& img) {
         if (img.empty()) return;
-        io::writeImage((fs::path(dir) / name).string(), img);
+        atrous::writeImage((fs::path(dir) / name).string(), img);
         names.push_back(name);
     };
     // The host accessors: on CUDA each buffer is downloaded here (once per step).

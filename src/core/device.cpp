@@ -7,9 +7,8 @@
 #include <tbb/info.h>
 
 #include "atrous/error.h"
-#include "atrous/params.h"
 #include "core/memory.h"
-#include "cpu/cpu_isa.h"
+#include "core/cpu_isa.h"
 
 namespace atrous {
 

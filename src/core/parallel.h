@@ -7,7 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include "atrous/device.h"
-#include "cpu/isa_dispatch.h"
+#include "core/isa_dispatch.h"
 
 namespace atrous {
 

@@ -3,7 +3,7 @@
 // organised for SIMD. TBB over row blocks; for each of the 5 tap rows a contiguous, branch-free x
 // loop over the interior columns with the 5 taps of that row unrolled; the columns within 2·step
 // of the left/right border run one loop per tap over the columns where that tap is inside the
-// image (through the scalar functor they took 19% of EAW's time for 5% of the work), so the loads
+// image (not the scalar functor: docs/decisions.md, "Speed"), so the loads
 // stay contiguous and every pixel still sums its taps in the functor's order. The policy's taps
 // read through the centre row's plane pointers plus one row offset (one index per tap rather than
 // a second set of row pointers, which the x loop had to reload from the stack).
@@ -19,7 +19,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "cpu/isa_dispatch.h"
+#include "core/isa_dispatch.h"
 #include "filters/atrous_level.h"
 
 namespace atrous::cpu {

@@ -3,7 +3,7 @@
 #include <vector>
 
 #include "core/parallel.h"
-#include "cpu/isa_dispatch.h"
+#include "core/isa_dispatch.h"
 #include "cpu/row_sums.h"
 #include "filters/still_state.h"
 

@@ -15,7 +15,7 @@ ATROUS_NO_TRAPPING_MATH
 #include <vector>
 
 #include "core/parallel.h"
-#include "cpu/isa_dispatch.h"
+#include "core/isa_dispatch.h"
 #include "filters/emission_filter.h"
 
 namespace atrous::filters {

@@ -23,7 +23,7 @@
 
 #include "atrous/error.h"
 #include "core/parallel.h"
-#include "cpu/isa_dispatch.h"
+#include "core/isa_dispatch.h"
 #include "filters/learned.h"
 
 namespace atrous::filters {

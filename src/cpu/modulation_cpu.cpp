@@ -12,7 +12,7 @@ ATROUS_NO_TRAPPING_MATH
 #include <vector>
 
 #include "core/parallel.h"
-#include "cpu/isa_dispatch.h"
+#include "core/isa_dispatch.h"
 #include "cpu/modulation_rows.h"
 #include "filters/modulation.h"
 #include "filters/noise_estimate.h"

@@ -28,7 +28,7 @@ ATROUS_NO_TRAPPING_MATH
 #include <vector>
 
 #include "core/parallel.h"
-#include "cpu/isa_dispatch.h"
+#include "core/isa_dispatch.h"
 #include "cpu/modulation_rows.h"
 #include "cpu/row_sums.h"
 #include "filters/noise_estimate.h"

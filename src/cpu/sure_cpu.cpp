@@ -14,7 +14,7 @@ ATROUS_NO_TRAPPING_MATH
 #include <vector>
 
 #include "core/parallel.h"
-#include "cpu/isa_dispatch.h"
+#include "core/isa_dispatch.h"
 #include "cpu/row_sums.h"
 #include "filters/safety_net.h"
 #include "filters/sure.h"

@@ -106,8 +106,9 @@ ImageView levelPlane(const Exec& exec, const ImageView& given, int w, int h, Ima
 
 // The CPU row engine is on by default; tests switch it off to compare with the functor
 // (src/cpu/atrous_rows.cpp). Its AVX-512 row loops: on where the CPU has AVX-512 (F/VL/BW/DQ);
-// tests switch it off to run the AVX2 loops too. Setting it on a CPU without AVX-512 is not
-// allowed. One pair of switches for every policy.
+// tests switch it off to run the AVX2 loops too (the dispatch's cpu::avx512Switch(),
+// src/core/cpu_isa.h). Setting it on a CPU without AVX-512 is not allowed. One pair of switches for
+// every policy.
 bool& atrousCpuFastPath();
 bool& atrousCpuAvx512();
 

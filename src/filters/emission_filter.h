@@ -3,8 +3,8 @@
 // The denoisers filter color − emission and add the emission back. Emission itself is noisy only
 // where a pixel is partly covered by an emitter (the edge of a visible area light, the rim of a
 // sun): its value there is the coverage fraction times the emitted radiance, estimated from n
-// random sub-pixel positions (std ~ sqrt(f(1 − f)/n) of the radiance). At 16 spp those edge
-// pixels carried ~90% of the squared error of `cornell` after denoising (docs/quality.md).
+// random sub-pixel positions (std ~ sqrt(f(1 − f)/n) of the radiance). Those edge pixels carry
+// most of the error left after denoising where a light is seen (docs/decisions.md, "Still filters").
 // Neighbouring edge pixels along the same edge have nearly the same coverage, so an à-trous
 // cascade whose colour stop uses 2·min(var_p, var_q) (as EAW's automatic σ_c) averages edge pixels
 // with each other while fully covered or uncovered pixels (variance ~0 in one of the pair) take
@@ -30,9 +30,9 @@ struct EmissionLevel {
     float sigmaMul = 1.0f;  // k · 2 · 4^−i
     ImageView eIn, eOut, variance;
     // Forced inline on the host: with the one fastExp (itself forced inline) the functor grew past
-    // GCC's inlining limit, became a call per pixel from the CPU row loop, and the ~99% of pixels
-    // that take the early exit below paid the call and reloaded the views each time (1080p
-    // cornell, 4 levels: 26.5 -> 33.0 ms; inlined again ~23 ms, outputs bit-equal).
+    // GCC's inlining limit, became a call per pixel from the CPU row loop, and the pixels that
+    // take the early exit below (nearly all) paid the call and reloaded the views each time
+    // (docs/decisions.md, "Speed").
     ATROUS_FORCE_INLINE ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         const float er = eIn(x, y, 0), eg = eIn(x, y, 1), eb = eIn(x, y, 2);
         const float vp = variance(x, y, 0) + variance(x, y, 1) + variance(x, y, 2);
@@ -40,7 +40,7 @@ struct EmissionLevel {
         // (relative variance < 1e-4: fully covered lights, the smooth sky): every neighbour that
         // differs by more than ~3.5% (σ² = 12·min(V_p, V_q) at most) gets no weight, and the
         // B3 average of those within it is that of a locally linear signal, i.e. e_p. Copying
-        // skips 25 taps per sky pixel (sphere-env 512²: 4 levels of the sky cost 70 ms).
+        // skips 25 taps per sky pixel (docs/decisions.md, "Speed").
         const float e2 = er * er + eg * eg + eb * eb;
         if (e2 == 0.0f || !(vp > 1e-4f * e2)) {
             eOut(x, y, 0) = er;
@@ -80,7 +80,7 @@ struct EmissionLevel {
 // One level on `exec`. The CpuExec overload (src/cpu/emission_cpu.cpp) copies rows with a
 // vectorised loop and runs the functor only on the pixels that may need the taps: the generic
 // path's `omp simd` x loop would evaluate all 25 taps of every pixel under a mask, so the early
-// exit (the sky, non-emitters: all but ~1% of sphere-env's emissive pixels) saved nothing.
+// exit (the sky, non-emitters: nearly every emissive pixel; docs/decisions.md, "Speed") saved nothing.
 template <class Exec>
 void runEmissionLevel(const Exec& exec, const EmissionLevel& f) {
     exec.forEachPixel(f.eIn.width, f.eIn.height, f);

@@ -42,8 +42,8 @@ ATROUS_INLINE float maxChannel(float a, float b, float c) { return maxSel(maxSel
 // a'_c of pixel (x, y), c = 0..2, from an albedo view (non-finite channels read as `nonFinite`);
 // an invalid view gives 1 (no demodulation). The one place the filters (EAW, SURE and SVGF) turn
 // an albedo pixel into divisors. rim: the rim rule below (EAW/SURE); SVGF calls it (through
-// AlbedoRule, modulation.h) with rim = false and nonFinite = 1: its floor 0.1 without the rule,
-// as measured for it so far (docs/svgf.md).
+// AlbedoRule, modulation.h) with rim = false and nonFinite = 1: its floor 0.1 without the rule
+// (docs/decisions.md, "Still filters", albedoFloor).
 ATROUS_INLINE void pixelModulationAlbedo(const ImageView& albedo, int x, int y, float eps, float floor, float (&a)[3],
                                          float nonFinite = 0.0f, bool rim = true) {
     if (!albedo.valid()) {

@@ -144,8 +144,8 @@ ATROUS_FORCE_INLINE ATROUS_INLINE float learnedLocalStd(float meanL, float meanL
 // loop unrolled by nvcc) are defined in atrous/platform.h, the one place that asks which compiler.
 
 // One dense layer on N pixels: y[j][l] = act(b[j] + sum_i x[i][l] w[i * NO + j]), the sum from the
-// bias in the order of i. (Four units per pass over x measured no faster: the multiply-adds, not
-// the loads, bound it.)
+// bias in the order of i, one unit per pass over x (the multiply-adds, not the loads, bound it:
+// docs/decisions.md, "Speed").
 // shift (kShift): a per-lane addition to the bias, shift[j][l] (the context's, layer 1).
 template <int NI, int NO, bool kRelu, int N, bool kShift = false>
 ATROUS_FORCE_INLINE ATROUS_INLINE void learnedLayer(const float* w, const float* b, const float (&x)[NI][N],

@@ -82,8 +82,8 @@ ImageView sanitizedFeature(const Exec& exec, ImageView in, int width, int height
 }
 ImageView sanitizedFeature(const CpuExec& exec, ImageView in, int width, int height, int channels, Image& storage);
 
-// The rim albedo (docs/algorithms.md, "Albedo demodulation near black albedo"; measured in
-// docs/quality.md, "Rims beside black albedo"). Other renderers write albedo 0
+// The rim albedo (docs/algorithms.md, "Albedo demodulation near black albedo"; the figures:
+// docs/decisions.md, "Still filters"). Other renderers write albedo 0
 // for the sky, mirrors and lights. A pixel beside such a black pixel (a 3x3 neighbour's largest
 // channel below `black`, kBlackAlbedoFraction times the albedo floor) whose own largest channel
 // m_p is below the neighbourhood's largest m_x is partly covered by the black surface: a thin
@@ -93,8 +93,8 @@ ImageView sanitizedFeature(const CpuExec& exec, ImageView in, int width, int hei
 // uncovered part counts as albedo k (the black surface is divided by nothing), each channel
 // getting k (1 - m_p / m_x) added, where k = min(L_b / L_p, 1) weighs how much of the pixel's
 // colour the black surface can explain: L_p its own reflected colour (colour - emission, mean of
-// the channels), L_b the brightest black neighbour's (the darkest's cost a rough metal, whose
-// albedo is 0 and whose noisy reflection then read as dark, 39% at 4 spp: docs/decisions.md). A
+// the channels), L_b the brightest black neighbour's (not the darkest's: docs/decisions.md, "Still
+// filters", the rim albedo). A
 // sky or a light without an emission buffer gives k = 1; a black void (colour 0), or a light whose
 // radiance the emission buffer holds, k = 0: its colour is the covered part's alone and the albedo
 // explains it as it is. `out` must not be `in`.
@@ -273,9 +273,8 @@ void runFireflyClamp(const CpuExec& exec, const FireflyClamp& f, int* clamped = 
 // away. After the pass, each pixel whose (2R+1)² window (R = kFireflyDenseRadius) holds a fraction
 // ρ of clamped pixels above kFireflyDenseLo is decided again from the unclamped colour with the
 // bound's k raised to k (1 + t), t = min((ρ - lo) / (hi - lo), 1): twice the deviations where ρ
-// reaches kFireflyDenseHi. An isolated firefly (ρ about 1/225) is untouched. Thresholds set on
-// atrous's own 56 training rooms (the default without a variance: −4.1% / −2.7% / −0.2% relMSE at
-// 1 / 4 / 16 spp; docs/decisions.md, docs/algorithms-eaw-sure.md).
+// reaches kFireflyDenseHi. An isolated firefly (ρ about 1/225) is untouched. The thresholds:
+// docs/decisions.md, "Still filters" (dense fireflies).
 constexpr int kFireflyDenseRadius = 7;
 constexpr float kFireflyDenseLo = 0.06f, kFireflyDenseHi = 0.12f;
 struct FireflyDense {

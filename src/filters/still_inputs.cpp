@@ -15,7 +15,7 @@
 #include "atrous/error.h"
 #include "atrous/params.h"
 #include "core/parallel.h"
-#include "cpu/isa_dispatch.h"
+#include "core/isa_dispatch.h"
 #include "cpu/row_sums.h"
 #include "filters/denoise_internal.h"
 #include "filters/noise_estimate.h"

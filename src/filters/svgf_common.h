@@ -51,7 +51,7 @@ ATROUS_INLINE Vec3 sanitizedEmission(const ImageView& emission, int x, int y) {
 
 // a·b with every multiply-add written as fmaf. The edge-stop math below spells out its FMAs so
 // that no compiler is free to contract a·b + c differently: the CPU row loops, the scalar functor
-// and the GPU then round identically (bit-equal CPU paths; measured with GCC 12), which matters
+// and the GPU then round identically (bit-equal CPU paths; docs/decisions.md, "Sequences"), which matters
 // because σ_n = 128 multiplies the rounding of n_p·n_q and the exponentials that of their argument.
 ATROUS_INLINE float dotFma(Vec3 a, Vec3 b) { return fmaf(a.z, b.z, fmaf(a.y, b.y, a.x * b.x)); }
 
@@ -68,7 +68,7 @@ constexpr float kMinNormalFloat = 1.17549435e-38f;
 // ln(d) for finite d >= kMinNormalFloat, to ~1.5e-7 relative on (0, 1] (the float rounding of
 // s below; the series' truncation is 2e-9). Plain arithmetic, identical on host and device (so
 // the two backends agree to float rounding, like fastExp), and branch-free so the CPU row loops
-// vectorise (libm's logf is a call that does not; it was ~25% of the à-trous taps' time).
+// vectorise (libm's logf is a call that does not; its cost: docs/decisions.md, "Speed").
 // d = m·2^e with m in [√½, √2) read from the bits, then ln m = 2 atanh(s), s = (m − 1)/(m + 1),
 // |s| <= 0.1716: the odd series 2s(1 + s²/3 + s⁴/5 + s⁶/7 + s⁸/9).
 ATROUS_FORCE_INLINE ATROUS_INLINE float fastLog(float d) {

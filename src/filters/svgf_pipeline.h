@@ -154,8 +154,8 @@ public:
         filters::markStage(clock, "demodulate");
 
         Reproject rp;
-        rp.depthTolerance = mParams.reprojectDepthTolerance;
-        rp.normalCos = mParams.reprojectNormalCos;
+        rp.depthTolerance = mParams.depthTolerance;
+        rp.normalCos = mParams.normalCos;
         rp.havePrevious = s.havePrevious;
         rp.motion = s.motion.view(), rp.depth = s.depth.view(), rp.normal = s.normal.view(), rp.ids = s.ids.view();
         rp.depthGrad = s.depthGrad.view();

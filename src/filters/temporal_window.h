@@ -41,8 +41,8 @@ struct DemodulatedLum {
 };
 
 // Channels 0 and 1 of `stats`: the 3x3 mean of channel 2 and the variance of that mean (the 3x3
-// sample variance over the number of samples), non-finite samples left out. (5x5 and 7x7 means,
-// and the quietest of four corner windows for the variance, were measured too: docs/temporal.md.)
+// sample variance over the number of samples), non-finite samples left out (what else was tried:
+// docs/decisions.md, "Sequences").
 struct LocalStats {
     FrameViews f;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {

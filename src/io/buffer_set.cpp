@@ -39,20 +39,13 @@ BufferRefs refsOf(const BufferSet& set) {
     return r;
 }
 
-namespace {
-// RenderBuffers and SequenceFrame name their images alike.
-template <class B>
-BufferRefs refsOfNamed(const B& b) {
+BufferRefs refsOf(const SequenceFrame& f) {
     BufferRefs r;
-    r.set(Buffer::Color, &b.color).set(Buffer::Variance, &b.variance).set(Buffer::Albedo, &b.albedo);
-    r.set(Buffer::Normal, &b.normal).set(Buffer::Position, &b.position).set(Buffer::Depth, &b.depth);
-    r.set(Buffer::ObjectId, &b.ids).set(Buffer::Emission, &b.emission).set(Buffer::Motion, &b.motion);
+    r.set(Buffer::Color, &f.color).set(Buffer::Variance, &f.variance).set(Buffer::Albedo, &f.albedo);
+    r.set(Buffer::Normal, &f.normal).set(Buffer::Position, &f.position).set(Buffer::Depth, &f.depth);
+    r.set(Buffer::ObjectId, &f.ids).set(Buffer::Emission, &f.emission).set(Buffer::Motion, &f.motion);
     return r;
 }
-}  // namespace
-
-BufferRefs refsOf(const RenderBuffers& b) { return refsOfNamed(b); }
-BufferRefs refsOf(const SequenceFrame& f) { return refsOfNamed(f); }
 
 
 DenoiseBuffers handOver(const BufferRefs& r, Image& color, Image* variance, Image* emission) {
@@ -268,7 +261,3 @@ BufferSet loadBuffers(const BufferFiles& f) {
 }
 
 }  // namespace atrous::io
-
-namespace atrous {
-DenoiseInputs denoiseInputsOf(const RenderBuffers& b) { return io::refsOf(b); }
-}  // namespace atrous

@@ -2,8 +2,8 @@
 // (openexr.h). Reading:
 // the chunks of a scanline part are located and checked against the file first (rule 3 of
 // exr_limits.h, without decoding anything), then decoded in parallel on TBB's threads, each into
-// its rows of the caller's planes. ZIP and ZIPS chunks are inflated by libdeflate (3-4x zlib's
-// speed here; docs/benchmarks.md, "From file to file"); every other compression by OpenEXR's own
+// its rows of the caller's planes. ZIP and ZIPS chunks are inflated by libdeflate (faster than
+// zlib: docs/decisions.md, "Speed"); every other compression by OpenEXR's own
 // routines. Tiled parts are left to OpenEXR's classic API (the caller's fallback). Writing
 // (writeExrCore): the chunks of a ZIP scanline file packed and deflated by libdeflate in parallel,
 // then written in order by OpenEXR Core.

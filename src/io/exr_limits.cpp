@@ -80,97 +80,128 @@ double maxExpansionOf(int compression) {
 
 }  // namespace
 
-void requireExrHeadersFit(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    unsigned char head[8];
-    if (!in.read(reinterpret_cast<char*>(head), 8) || le32(head) != 20000630u) return;  // not an EXR: the caller says so
-    const uint64_t bytes = exrFileBytes(path);
-    const bool multipart = head[5] & 0x10;
-    auto corrupt = [&](const std::string& what) { return InputError(path + ": truncated or corrupt EXR header (" + what + ")"); };
-    auto readName = [&](std::string& name) {
+namespace {
+
+// Reads an EXR's headers attribute by attribute (name, type, size, value), each value its declared
+// size bounded by the file, and checks them as OpenEXR's classic API and its Core would read them:
+// both must see the same attributes.
+class ExrHeaderScan {
+public:
+    ExrHeaderScan(const std::string& path, std::ifstream& in, uint64_t bytes) : mPath(path), mIn(in), mBytes(bytes) {}
+
+    InputError corrupt(const std::string& what) const {
+        return InputError(mPath + ": truncated or corrupt EXR header (" + what + ")");
+    }
+
+    void readName(std::string& name) {
         name.clear();
-        for (int ch; (ch = in.get()) != 0;) {
+        for (int ch; (ch = mIn.get()) != 0;) {
             if (ch == EOF) throw corrupt("it ends inside a name");
             if (name.size() >= 255) throw corrupt("a name longer than 255 bytes");
             name += char(ch);
         }
-    };
-    std::vector<PartHeader> parts;
-    std::vector<unsigned char> value;
-    // Headers (one, or a part's each up to an empty one), each a list of attributes up to an empty
-    // name. Every value is read (its declared size, bounded by the file) and checked as OpenEXR's
-    // classic API and its Core would read it: both must see the same attributes.
-    for (;;) {
-        std::string name, type;
-        readName(name);
-        if (name.empty()) break;  // no (more) headers
+    }
+
+    // One header, a list of attributes up to an empty name; `name` (read already) is its first.
+    PartHeader readHeader(std::string name) {
         PartHeader part;
         std::vector<std::string> seen;  // an attribute twice: OpenEXR's classic API keeps the last, its Core the first
         for (; !name.empty(); readName(name)) {
             if (std::find(seen.begin(), seen.end(), name) != seen.end()) throw corrupt("attribute '" + name + "' appears twice");
             seen.push_back(name);
-            readName(type);
-            unsigned char sz[4];
-            if (!in.read(reinterpret_cast<char*>(sz), 4)) throw corrupt("it ends inside attribute '" + name + "'");
-            const int64_t size = int32_t(le32(sz));
-            const std::streamoff at = in.tellg();
-            const std::string which = "attribute '" + name + "' of type '" + type + "'";
-            if (size < 0 || at < 0 || uint64_t(at) + uint64_t(size) > bytes)
-                throw corrupt(which + " claims " + std::to_string(size) + " bytes at offset " + std::to_string(at) + " of a " +
-                              std::to_string(bytes) + "-byte file");
-            value.resize(size_t(size));
-            if (size > 0 && !in.read(reinterpret_cast<char*>(value.data()), std::streamsize(size)))
-                throw corrupt("it ends inside attribute '" + name + "'");
-            const int fixed = fixedSize(type);
-            if (fixed >= 0 && size != fixed)
-                throw corrupt(which + " has " + std::to_string(size) + " bytes; a " + type + " has " + std::to_string(fixed));
-            if (type == "chlist") {
-                // Entries (a name, then type, pLinear, 3 reserved bytes, x and y sampling) up to an
-                // empty name, which must end the attribute.
-                size_t p = 0;
-                for (;;) {
-                    const size_t end = std::find(value.begin() + long(p), value.end(), 0) - value.begin();
-                    if (end >= value.size()) throw corrupt("the channel list of " + which + " is not terminated");
-                    if (end == p) {
-                        if (end + 1 != value.size()) throw corrupt("the channel list of " + which + " does not fill its size");
-                        break;
-                    }
-                    if (end - p > 255 || end + 17 > value.size()) throw corrupt("a channel of " + which + " is cut short");
-                    const uint32_t pixelType = le32(&value[end + 1]);
-                    const int32_t xs = int32_t(le32(&value[end + 9])), ys = int32_t(le32(&value[end + 13]));
-                    if (pixelType > 2 || xs < 1 || ys < 1) throw corrupt("a channel of " + which + " has a bad type or sampling");
-                    part.bytesPerPixel += (pixelType == 1 ? 2.0 : 4.0) / (double(xs) * double(ys));
-                    p = end + 17;
-                }
-            } else if (type == "preview") {
-                if (size < 8 || uint64_t(le32(&value[0])) * le32(&value[4]) * 4 + 8 != uint64_t(size))
-                    throw corrupt(which + "'s pixels do not fill its " + std::to_string(size) + " bytes");
-            } else if (type == "stringvector") {
-                for (size_t p = 0; p < value.size();) {
-                    if (p + 4 > value.size()) throw corrupt("a string of " + which + " is cut short");
-                    const uint64_t len = le32(&value[p]);
-                    if (len > value.size() - p - 4) throw corrupt("a string of " + which + " claims " + std::to_string(len) + " bytes");
-                    p += 4 + size_t(len);
-                }
-            } else if (type == "box2i" && name == "dataWindow") {
-                part.hasWindow = true;
-                for (int i = 0; i < 4; ++i) part.window[i] = int32_t(le32(&value[size_t(4 * i)]));
-            } else if (type == "compression" && name == "compression") {
-                part.compression = value[0];
-            } else if (type == "string" && name == "type") {
-                part.deep = std::string(value.begin(), value.end()).rfind("deep", 0) == 0;
-            } else if (type == "string" && name == "name") {
-                part.name.assign(value.begin(), value.end());
-            } else if (type == "tiledesc") {
-                part.tileW = le32(&value[0]);
-                part.tileH = le32(&value[4]);
-            }
+            readAttribute(name, part);
         }
-        parts.push_back(part);
-        if (!multipart) break;
+        return part;
     }
-    // Rules 1 and 2 before OpenEXR sees the file (its classic API allocates line buffers for a
-    // data window's width when a file is opened).
+
+private:
+    // The type, size and value of attribute `name`.
+    void readAttribute(const std::string& name, PartHeader& part) {
+        std::string type;
+        readName(type);
+        unsigned char sz[4];
+        if (!mIn.read(reinterpret_cast<char*>(sz), 4)) throw corrupt("it ends inside attribute '" + name + "'");
+        const int64_t size = int32_t(le32(sz));
+        const std::streamoff at = mIn.tellg();
+        const std::string which = "attribute '" + name + "' of type '" + type + "'";
+        if (size < 0 || at < 0 || uint64_t(at) + uint64_t(size) > mBytes)
+            throw corrupt(which + " claims " + std::to_string(size) + " bytes at offset " + std::to_string(at) + " of a " +
+                          std::to_string(mBytes) + "-byte file");
+        mValue.resize(size_t(size));
+        if (size > 0 && !mIn.read(reinterpret_cast<char*>(mValue.data()), std::streamsize(size)))
+            throw corrupt("it ends inside attribute '" + name + "'");
+        const int fixed = fixedSize(type);
+        if (fixed >= 0 && size != fixed)
+            throw corrupt(which + " has " + std::to_string(size) + " bytes; a " + type + " has " + std::to_string(fixed));
+        checkValue(name, type, which, part);
+    }
+
+    // The value of a type whose parts OpenEXR sizes itself, or of an attribute rules 1 and 2 need.
+    void checkValue(const std::string& name, const std::string& type, const std::string& which, PartHeader& part) {
+        const std::vector<unsigned char>& value = mValue;
+        if (type == "chlist") {
+            readChannelList(which, part);
+        } else if (type == "preview") {
+            if (value.size() < 8 || uint64_t(le32(&value[0])) * le32(&value[4]) * 4 + 8 != uint64_t(value.size()))
+                throw corrupt(which + "'s pixels do not fill its " + std::to_string(value.size()) + " bytes");
+        } else if (type == "stringvector") {
+            requireStrings(which);
+        } else if (type == "box2i" && name == "dataWindow") {
+            part.hasWindow = true;
+            for (int i = 0; i < 4; ++i) part.window[i] = int32_t(le32(&value[size_t(4 * i)]));
+        } else if (type == "compression" && name == "compression") {
+            part.compression = value[0];
+        } else if (type == "string" && name == "type") {
+            part.deep = std::string(value.begin(), value.end()).rfind("deep", 0) == 0;
+        } else if (type == "string" && name == "name") {
+            part.name.assign(value.begin(), value.end());
+        } else if (type == "tiledesc") {
+            part.tileW = le32(&value[0]);
+            part.tileH = le32(&value[4]);
+        }
+    }
+
+    // Entries (a name, then type, pLinear, 3 reserved bytes, x and y sampling) up to an empty name,
+    // which must end the attribute; their bytes per pixel add up in part.bytesPerPixel.
+    void readChannelList(const std::string& which, PartHeader& part) const {
+        const std::vector<unsigned char>& value = mValue;
+        size_t p = 0;
+        for (;;) {
+            const size_t end = std::find(value.begin() + long(p), value.end(), 0) - value.begin();
+            if (end >= value.size()) throw corrupt("the channel list of " + which + " is not terminated");
+            if (end == p) {
+                if (end + 1 != value.size()) throw corrupt("the channel list of " + which + " does not fill its size");
+                break;
+            }
+            if (end - p > 255 || end + 17 > value.size()) throw corrupt("a channel of " + which + " is cut short");
+            const uint32_t pixelType = le32(&value[end + 1]);
+            const int32_t xs = int32_t(le32(&value[end + 9])), ys = int32_t(le32(&value[end + 13]));
+            if (pixelType > 2 || xs < 1 || ys < 1) throw corrupt("a channel of " + which + " has a bad type or sampling");
+            part.bytesPerPixel += (pixelType == 1 ? 2.0 : 4.0) / (double(xs) * double(ys));
+            p = end + 17;
+        }
+    }
+
+    // A stringvector's strings (a 4-byte length, then the bytes) fill the value exactly.
+    void requireStrings(const std::string& which) const {
+        const std::vector<unsigned char>& value = mValue;
+        for (size_t p = 0; p < value.size();) {
+            if (p + 4 > value.size()) throw corrupt("a string of " + which + " is cut short");
+            const uint64_t len = le32(&value[p]);
+            if (len > value.size() - p - 4) throw corrupt("a string of " + which + " claims " + std::to_string(len) + " bytes");
+            p += 4 + size_t(len);
+        }
+    }
+
+    const std::string& mPath;
+    std::ifstream& mIn;
+    uint64_t mBytes;
+    std::vector<unsigned char> mValue;  // the attribute being read
+};
+
+// Rules 1 and 2 on the headers read, before OpenEXR sees the file (its classic API allocates line
+// buffers for a data window's width when a file is opened).
+void requirePartsFit(const std::string& path, const std::vector<PartHeader>& parts, uint64_t bytes) {
     double need = 0.0;
     for (size_t i = 0; i < parts.size(); ++i) {
         const PartHeader& h = parts[i];
@@ -198,6 +229,27 @@ void requireExrHeadersFit(const std::string& path) {
                              sizeText(long(w), long(hh)) + " data window needs more pixel data than the file's " +
                              std::to_string(bytes) + " bytes can hold)");
     }
+}
+
+}  // namespace
+
+void requireExrHeadersFit(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    unsigned char head[8];
+    if (!in.read(reinterpret_cast<char*>(head), 8) || le32(head) != 20000630u) return;  // not an EXR: the caller says so
+    const uint64_t bytes = exrFileBytes(path);
+    const bool multipart = head[5] & 0x10;
+    ExrHeaderScan scan(path, in, bytes);
+    // Headers: one, or a part's each up to an empty one.
+    std::vector<PartHeader> parts;
+    for (;;) {
+        std::string name;
+        scan.readName(name);
+        if (name.empty()) break;  // no (more) headers
+        parts.push_back(scan.readHeader(name));
+        if (!multipart) break;
+    }
+    requirePartsFit(path, parts, bytes);
 }
 
 ExrWindow exrImageWindow(const std::string& path, const Imf::Header& first) {

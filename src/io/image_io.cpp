@@ -364,26 +364,6 @@ static Image readStb(const std::string& path, int* sourceChannels) {
     return img;
 }
 
-Image readImage(const std::string& path, int* sourceChannels, int channels) {
-    requireFile(path);
-    if (channels < 1 || channels > 3) throw InputError(path + ": readImage takes 1 to 3 channels");
-    const std::string ext = extensionOf(path);
-    if (ext == ".exr") return namingFile(path, [&] { return readExr(path, sourceChannels, channels); });
-    if (ext == ".pfm") return namingFile(path, [&] { return firstChannels(readPfm(path, sourceChannels), channels); });
-    if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".hdr" || ext == ".bmp" || ext == ".tga")
-        return namingFile(path, [&] { return firstChannels(readStb(path, sourceChannels), channels); });
-    throw InputError(path + ": unsupported image format '" + ext + "' (expected .exr, .pfm, .png, .jpg or .hdr)");
-}
-
-void writeImage(const std::string& path, const Image& img) {
-    requireNoNul(path);
-    const std::string ext = extensionOf(path);
-    if (ext == ".exr") return writeExr(path, img);
-    if (ext == ".pfm") return writePfm(path, img);
-    if (ext == ".png") return writePng(path, img);
-    throw InputError(path + ": unsupported output format '" + ext + "' (expected .exr, .pfm or .png)");
-}
-
 // ------------------------------------------------------------------------------------ helpers
 
 void ensureWritableDirectory(const std::string& dir) {
@@ -422,3 +402,33 @@ void writeFileAtomically(const std::string& path, const std::function<void(const
 }
 
 }  // namespace atrous::io
+
+namespace atrous {
+
+// The one image reader and writer (atrous/io.h), by the file's extension.
+Image readImage(const std::string& path, int* sourceChannels, int channels) {
+    using namespace io;
+    requireFile(path);
+    if (channels < 1 || channels > 3) throw InputError(path + ": readImage takes 1 to 3 channels");
+    const std::string ext = extensionOf(path);
+    if (ext == ".exr") return namingFile(path, [&] { return readExr(path, sourceChannels, channels); });
+    if (ext == ".pfm") return namingFile(path, [&] { return firstChannels(readPfm(path, sourceChannels), channels); });
+    if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".hdr" || ext == ".bmp" || ext == ".tga")
+        return namingFile(path, [&] { return firstChannels(readStb(path, sourceChannels), channels); });
+    throw InputError(path + ": unsupported image format '" + ext + "' (expected .exr, .pfm, .png, .jpg or .hdr)");
+}
+
+// The one image writer (atrous/io.h), by the file's extension.
+void writeImage(const std::string& path, const Image& img) {
+    using namespace io;
+    // The writers read host memory; a denoise() result may live on the GPU.
+    if (img.device() != Device::Cpu) return writeImage(path, img.to(Device::Cpu));
+    requireNoNul(path);
+    const std::string ext = extensionOf(path);
+    if (ext == ".exr") return writeExr(path, img);
+    if (ext == ".pfm") return writePfm(path, img);
+    if (ext == ".png") return writePng(path, img);
+    throw InputError(path + ": unsupported output format '" + ext + "' (expected .exr, .pfm or .png)");
+}
+
+}  // namespace atrous

@@ -261,126 +261,173 @@ std::string sequenceFolder(const std::string& dirOrPattern) {
     return isSequencePattern(dirOrPattern) && parseFramePattern(dirOrPattern, &p) ? p.dir : dirOrPattern;
 }
 
-std::vector<std::string> listSequenceFrames(const std::string& dir, const FrameRange& range) {
-    if (range.step < 1) throw InputError("--step: must be at least 1 (got " + std::to_string(range.step) + ")");
-    if (range.start >= 0 && range.end >= 0 && range.end < range.start)
-        throw InputError("--end " + std::to_string(range.end) + " is before --start " + std::to_string(range.start));
-    std::error_code ec;
-    std::vector<std::pair<int, std::string>> frames;
+namespace {
+
+using NumberedPaths = std::vector<std::pair<int, std::string>>;
+
+// A sequence's frames by number, and how a frame is named in messages (a missing one).
+struct FrameListing {
+    NumberedPaths frames;
     std::function<std::string(int)> label;
-    FramePattern pat;
-    if (isSequencePattern(dir) && parseFramePattern(dir, &pat)) {
-        // A pattern as compositors write it: render####.exr, render%04d.exr.
-        if (!fs::is_directory(pat.dir, ec)) throw InputError("sequence " + dir + ": " + pat.dir + " is not a directory");
-        for (auto it = fs::directory_iterator(pat.dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
-            std::error_code ec2;
-            const int n = it->is_regular_file(ec2) ? matchFramePattern(pat, it->path().filename().string()) : -1;
-            if (n >= 0) frames.emplace_back(n, it->path().string());
+};
+
+// A pattern as compositors write it: render####.exr, render%04d.exr.
+FrameListing listPatternFrames(const std::string& dir, const FramePattern& pat) {
+    std::error_code ec;
+    if (!fs::is_directory(pat.dir, ec)) throw InputError("sequence " + dir + ": " + pat.dir + " is not a directory");
+    FrameListing l;
+    for (auto it = fs::directory_iterator(pat.dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
+        std::error_code ec2;
+        const int n = it->is_regular_file(ec2) ? matchFramePattern(pat, it->path().filename().string()) : -1;
+        if (n >= 0) l.frames.emplace_back(n, it->path().string());
+    }
+    if (ec) throw InputError("sequence " + dir + ": cannot list " + pat.dir + " (" + ec.message() + ")");
+    if (l.frames.empty()) throw InputError("sequence " + dir + ": no file in " + pat.dir + " matches the pattern");
+    l.label = [pat](int index) { return framePatternName(pat, index) + " (the pattern's file)"; };
+    return l;
+}
+
+// What a sequence directory holds, by layout: frame_NNNN directories, another renderer's numbered
+// frame folders, numbered files per buffer, numbered (layered) EXR files; with the first name of
+// each (for messages) and the prefix the numbered ones share.
+struct DirectoryLayouts {
+    NumberedPaths frameDirs, folders, perBuffer, files;
+    std::string prefix, firstFile, folderPrefix, firstFolder, firstPerBuffer;
+
+    void addDirectory(const std::string& dir, const fs::path& path) {
+        const std::string name = path.filename().string();
+        const int index = parseSequenceFrameName(name);
+        if (index >= 0) {
+            frameDirs.emplace_back(index, path.string());
+            return;
         }
-        if (ec) throw InputError("sequence " + dir + ": cannot list " + pat.dir + " (" + ec.message() + ")");
-        if (frames.empty()) throw InputError("sequence " + dir + ": no file in " + pat.dir + " matches the pattern");
-        label = [pat](int index) { return framePatternName(pat, index) + " (the pattern's file)"; };
-    } else {
-        if (!fs::is_directory(dir, ec)) throw InputError("sequence " + dir + ": not a directory");
-        std::vector<std::pair<int, std::string>> files, folders, perBuffer;
-        std::string prefix, firstFile, folderPrefix, firstFolder, firstPerBuffer;
-        for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
-            std::error_code ec2;
-            const std::string name = it->path().filename().string();
-            if (it->is_directory(ec2)) {
-                const int index = parseSequenceFrameName(name);
-                if (index >= 0) {
-                    frames.emplace_back(index, it->path().string());
-                    continue;
-                }
-                // Another renderer's numbered frame folders (LuxCore's 0001/, frame0001/ ...): one
-                // prefix, the number last, a colour file inside (dirBufferFile's names).
-                std::string pre;
-                const int n = parseFolderFrameName(name, &pre);
-                if (n < 0 || dirBufferFile(it->path().string(), "color").empty()) continue;
-                if (!folders.empty() && pre != folderPrefix)
-                    throw InputError("sequence " + dir + ": numbered frame folders with two prefixes ('" + firstFolder + "' and '" +
-                                     name + "'): keep one sequence per directory");
-                folderPrefix = pre;
-                if (firstFolder.empty()) firstFolder = name;
-                folders.emplace_back(n, it->path().string());
-            } else if (it->is_regular_file(ec2)) {
-                // Per-buffer numbered files (color_0001.exr, albedo_0001.exr, ...): a frame per colour
-                // file; the other buffers' files are found beside it.
-                std::string tail;
-                const std::string buffer = perBufferName(name, &tail);
-                if (buffer == "color") {
-                    perBuffer.emplace_back(perBufferIndex(tail), it->path().string());
-                    if (firstPerBuffer.empty()) firstPerBuffer = name;
-                    continue;
-                }
-                if (!buffer.empty()) continue;
-                std::string pre;
-                const int index = parseLayeredFrameName(name, &pre);
-                if (index < 0) continue;
-                if (!files.empty() && pre != prefix)
-                    throw InputError("sequence " + dir + ": numbered EXR files with two prefixes ('" + firstFile + "' and '" + name +
-                                     "'): keep one sequence per directory");
-                prefix = pre;
-                if (firstFile.empty()) firstFile = name;
-                files.emplace_back(index, it->path().string());
-            }
+        // Another renderer's numbered frame folders (LuxCore's 0001/, frame0001/ ...): one prefix,
+        // the number last, a colour file inside (dirBufferFile's names).
+        std::string pre;
+        const int n = parseFolderFrameName(name, &pre);
+        if (n < 0 || dirBufferFile(path.string(), "color").empty()) return;
+        if (!folders.empty() && pre != folderPrefix)
+            throw InputError("sequence " + dir + ": numbered frame folders with two prefixes ('" + firstFolder + "' and '" +
+                             name + "'): keep one sequence per directory");
+        folderPrefix = pre;
+        if (firstFolder.empty()) firstFolder = name;
+        folders.emplace_back(n, path.string());
+    }
+
+    void addFile(const std::string& dir, const fs::path& path) {
+        const std::string name = path.filename().string();
+        // Per-buffer numbered files (color_0001.exr, albedo_0001.exr, ...): a frame per colour file;
+        // the other buffers' files are found beside it.
+        std::string tail;
+        const std::string buffer = perBufferName(name, &tail);
+        if (buffer == "color") {
+            perBuffer.emplace_back(perBufferIndex(tail), path.string());
+            if (firstPerBuffer.empty()) firstPerBuffer = name;
+            return;
         }
-        if (ec) throw InputError("sequence " + dir + ": cannot list the directory (" + ec.message() + ")");
-        if (!frames.empty() && !files.empty())
+        if (!buffer.empty()) return;
+        std::string pre;
+        const int index = parseLayeredFrameName(name, &pre);
+        if (index < 0) return;
+        if (!files.empty() && pre != prefix)
+            throw InputError("sequence " + dir + ": numbered EXR files with two prefixes ('" + firstFile + "' and '" + name +
+                             "'): keep one sequence per directory");
+        prefix = pre;
+        if (firstFile.empty()) firstFile = name;
+        files.emplace_back(index, path.string());
+    }
+
+    // The one layout the directory holds (two are an error), its frames and their names.
+    FrameListing choose(const std::string& dir) const {
+        FrameListing l;
+        l.frames = frameDirs;
+        if (!frameDirs.empty() && !files.empty())
             throw InputError("sequence " + dir + ": holds both frame_NNNN directories and numbered EXR files (" + firstFile +
                              "): keep one layout per directory");
-        if (!perBuffer.empty() && (!frames.empty() || !files.empty()))
+        if (!perBuffer.empty() && (!frameDirs.empty() || !files.empty()))
             throw InputError("sequence " + dir + ": holds numbered files per buffer (" + firstPerBuffer + ") and " +
-                             (frames.empty() ? "numbered EXR files (" + firstFile + ")" : std::string("frame_NNNN directories")) +
+                             (frameDirs.empty() ? "numbered EXR files (" + firstFile + ")" : std::string("frame_NNNN directories")) +
                              ": keep one layout per directory");
         const bool byBuffer = !perBuffer.empty();
-        if (byBuffer) frames = perBuffer;
-        const bool byFolder = frames.empty() && !folders.empty();
+        if (byBuffer) l.frames = perBuffer;
+        const bool byFolder = l.frames.empty() && !folders.empty();
         if (byFolder && !files.empty())
             throw InputError("sequence " + dir + ": holds both numbered frame folders (" + firstFolder +
                              ") and numbered EXR files (" + firstFile + "): keep one layout per directory");
-        if (byFolder) frames = folders;
-        const bool layered = frames.empty();
-        if (layered) frames = files;
-        if (frames.empty())
+        if (byFolder) l.frames = folders;
+        const bool layered = l.frames.empty();
+        if (layered) l.frames = files;
+        if (l.frames.empty())
             throw InputError("sequence " + dir + ": no frame_NNNN directories, numbered frame folders with a colour file "
                              "(color.exr or RGB.exr), numbered files per buffer (color_0001.exr ...) or numbered EXR files");
-        label = [=](int index) {
+        l.label = [layered, byFolder, byBuffer, prefix = prefix, folderPrefix = folderPrefix,
+                   firstPerBuffer = firstPerBuffer](int index) {
             if (layered) return prefix + std::to_string(index) + " (a numbered EXR file)";
             if (byFolder) return folderPrefix + std::to_string(index) + " (a numbered frame folder)";
             if (byBuffer) return "frame " + std::to_string(index) + " (" + firstPerBuffer + "'s number)";
             return sequenceFrameName(index);
         };
+        return l;
     }
+};
+
+FrameListing listDirectoryFrames(const std::string& dir) {
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec)) throw InputError("sequence " + dir + ": not a directory");
+    DirectoryLayouts layouts;
+    for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
+        std::error_code ec2;
+        if (it->is_directory(ec2))
+            layouts.addDirectory(dir, it->path());
+        else if (it->is_regular_file(ec2))
+            layouts.addFile(dir, it->path());
+    }
+    if (ec) throw InputError("sequence " + dir + ": cannot list the directory (" + ec.message() + ")");
+    return layouts.choose(dir);
+}
+
+// The frames in order, each number once; then --start, --end, --step: the frames from start to
+// end, every step-th, none missing.
+std::vector<std::string> keepFrameRange(const std::string& dir, FrameListing l, const FrameRange& range) {
+    NumberedPaths& frames = l.frames;
     std::sort(frames.begin(), frames.end());
     for (size_t i = 1; i < frames.size(); ++i)
         if (frames[i].first == frames[i - 1].first)
             throw InputError("sequence " + dir + ": frame " + std::to_string(frames[i].first) + " appears twice (" +
                              frames[i - 1].second + ", " + frames[i].second + ")");
-    // --start, --end, --step: the frames from start to end, every step-th; none may be missing.
     const int first = range.start >= 0 ? range.start : frames.front().first;
     const int last = range.end >= 0 ? range.end : frames.back().first;
-    std::vector<std::pair<int, std::string>> kept;
+    NumberedPaths kept;
     for (const auto& f : frames)
         if (f.first >= first && f.first <= last && (f.first - first) % range.step == 0) kept.push_back(f);
     if (kept.empty())
         throw InputError("sequence " + dir + ": no frame from " + std::to_string(first) + " to " + std::to_string(last) +
                          " (its frames: " + std::to_string(frames.front().first) + " to " + std::to_string(frames.back().first) + ")");
     if (range.start >= 0 && kept.front().first != first)
-        throw InputError("sequence " + dir + ": " + label(first) + " is missing (--start " + std::to_string(first) + ")");
+        throw InputError("sequence " + dir + ": " + l.label(first) + " is missing (--start " + std::to_string(first) + ")");
     std::vector<std::string> out;
     for (size_t i = 0; i < kept.size(); ++i) {
         if (i > 0 && kept[i].first != kept[i - 1].first + range.step)
-            throw InputError("sequence " + dir + ": " + label(kept[i - 1].first + range.step) + " is missing (gap between " +
+            throw InputError("sequence " + dir + ": " + l.label(kept[i - 1].first + range.step) + " is missing (gap between " +
                              fs::path(kept[i - 1].second).filename().string() + " and " +
                              fs::path(kept[i].second).filename().string() + ")");
         out.push_back(kept[i].second);
     }
     if (range.end >= 0 && kept.back().first + range.step <= last)
-        throw InputError("sequence " + dir + ": " + label(kept.back().first + range.step) + " is missing (--end " +
+        throw InputError("sequence " + dir + ": " + l.label(kept.back().first + range.step) + " is missing (--end " +
                          std::to_string(last) + ")");
     return out;
+}
+
+}  // namespace
+
+std::vector<std::string> listSequenceFrames(const std::string& dir, const FrameRange& range) {
+    if (range.step < 1) throw InputError("--step: must be at least 1 (got " + std::to_string(range.step) + ")");
+    if (range.start >= 0 && range.end >= 0 && range.end < range.start)
+        throw InputError("--end " + std::to_string(range.end) + " is before --start " + std::to_string(range.start));
+    FramePattern pat;
+    const bool pattern = isSequencePattern(dir) && parseFramePattern(dir, &pat);
+    return keepFrameRange(dir, pattern ? listPatternFrames(dir, pat) : listDirectoryFrames(dir), range);
 }
 
 std::vector<std::string> validateSequence(const std::vector<std::string>& frames, int& width, int& height,

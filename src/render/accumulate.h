@@ -10,7 +10,7 @@
 //   x̄_N = x̄_{N−1} + (x_N − x̄_{N−1}) / N,   M2_N = M2_{N−1} + (x_N − x̄_{N−1}) (x_N − x̄_N),
 // which only adds products of deviations. Plain float Welford still loses digits when σ ≪ x̄: the
 // rounding of x̄ (2^-24 x̄) enters every deviation, so var is off by ~0.1 · 2^-24 · 256 · x̄/σ
-// (measured: 1e-4 relative at σ/x̄ = 1e-3, 1e-3 at 1e-4). So the mean is kept compensated, as two
+// (docs/decisions.md, "Renderer"). So the mean is kept compensated, as two
 // float planes x̄ = hi + lo (hi is the output colour, lo its rounding residual, updated with
 // Knuth's 2Sum): deviations are then exact to 2^-24 σ and both the mean and the pooled variance agree
 // with a double reference to ~1e-6 relative after 256 frames whatever σ/x̄ (tests/accumulate_test.cpp

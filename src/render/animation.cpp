@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "atrous/error.h"
-#include "atrous/params.h"
 #include "render/camera.h"
 
 namespace atrous {

@@ -5,7 +5,6 @@
 #include <vector>
 
 #include "atrous/error.h"
-#include "atrous/params.h"
 #include "atrous/render.h"
 #include "render/scene_builder.h"
 #include "render/scene_data.h"

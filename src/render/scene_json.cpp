@@ -141,7 +141,7 @@ Material parseMaterial(const JsonContext& c, SceneBuilder& b, const json& j, con
     checkReflectance(m.albedo, where + ": \"albedo\"");
     if (j.contains("texture")) {
         std::string path = resolvePath(c, getString(c, j, "texture", where));
-        m.texture = b.addTexture(io::readImage(path), /*reflectance=*/true);  // InputError names the texture file
+        m.texture = b.addTexture(atrous::readImage(path), /*reflectance=*/true);  // InputError names the texture file
     }
     if (j.contains("checker")) {
         const json& ch = j.at("checker");
@@ -339,7 +339,7 @@ std::shared_ptr<SceneData> parseJsonScene(const std::string& text, const JsonCon
                     float scale = getFloat(c, l, "scale", where, 1.0f, kScaleRule);
                     if (l.contains("file")) {
                         const std::string file = resolvePath(c, getString(c, l, "file", where));
-                        Image map = io::readImage(file);
+                        Image map = atrous::readImage(file);
                         checkEnvMap(c, map, file, scale);
                         b.setEnvMap(map, scale);
                     } else {

@@ -71,68 +71,56 @@ void requireExponentsInRange(const std::string& line, const std::string& file, s
     }
 }
 
-// What tinyobjloader does not check, read from the OBJ text before it parses it: a face index
-// beyond int's range (atoi wraps 99999999999999999999 to -1, the last vertex), a face with more
-// than kMaxFaceVertices vertices (its ear clipping is quadratic: a 200k-vertex face ran for
-// minutes), and the mtllib names (tinyobjloader only warns when one is missing).
-std::vector<std::string> prescanObj(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::vector<std::string> mtllibs;
-    std::string line;
-    size_t lineNo = 0;
-    long long counts[3] = {0, 0, 0};  // v, vt, vn so far: a relative (negative) index must stay within them
-    long long maxIndex[3] = {0, 0, 0};  // the largest absolute index, checked against the totals at the end
-    size_t maxLine[3] = {0, 0, 0};
-    std::string maxToken[3];
-    while (objLine(in, line)) {
-        ++lineNo;
-        size_t i = line.find_first_not_of(" \t");
-        if (i == std::string::npos) continue;
-        requireExponentsInRange(line, path, lineNo);
-        const bool face = line.compare(i, 2, "f ") == 0 || line.compare(i, 2, "f\t") == 0;
-        const bool lib = line.compare(i, 7, "mtllib ") == 0 || line.compare(i, 7, "mtllib\t") == 0;
-        // v, vt, vn: every value a finite number (tinyobjloader reads "nan" or "x" as 0 and 1e39 as Inf).
-        const size_t vlen = line.compare(i, 2, "v ") == 0 ? 2 : (line.compare(i, 3, "vt ") == 0 || line.compare(i, 3, "vn ") == 0) ? 3 : 0;
-        if (vlen) {
-            ++counts[vlen == 2 ? 0 : (line[i + 1] == 't' ? 1 : 2)];
-            std::istringstream vals(line.substr(i + vlen));
-            std::string tok;
-            while (vals >> tok) {
-                char* end = nullptr;
-                const double x = std::strtod(tok.c_str(), &end);
-                if (end == tok.c_str() || *end != '\0' || !std::isfinite(x) || std::fabs(x) > 3.0e38)
-                    throw InputError(path + ": line " + std::to_string(lineNo) + ": \"" + tok + "\" is not a finite number");
-            }
-            continue;
-        }
-        // vw: skin weights, a tinyobjloader extension atrous ignores ("vw vid joint weight joint
-        // weight ..."); tinyobjloader casts each joint id from a float to int, undefined beyond int's
-        // range and for NaN, which its own number parser makes of "7...7e-2000" (inf * 0) where
-        // strtod reads 0 (found by the libFuzzer target obj_mtl: "vw 1 777...7"). Each joint id is
-        // an integer of at most 9 digits (a fraction allowed): what a joint index looks like.
-        if (line.compare(i, 3, "vw ") == 0 || line.compare(i, 3, "vw\t") == 0) {
-            std::istringstream vals(line.substr(i + 3));
-            std::string tok;
-            for (int k = 0; vals >> tok; ++k) {
-                if (k % 2 == 0) continue;  // the vertex id (read with atoi) and the weights
-                size_t p = tok[0] == '+' || tok[0] == '-' ? 1 : 0;
-                const size_t digits = tok.find_first_not_of("0123456789", p);
-                const size_t intDigits = (digits == std::string::npos ? tok.size() : digits) - p;
-                const bool fraction = digits != std::string::npos && tok[digits] == '.' &&
-                                      tok.find_first_not_of("0123456789", digits + 1) == std::string::npos;
-                if (intDigits == 0 || intDigits > 9 || (digits != std::string::npos && !fraction))
-                    throw InputError(path + ": line " + std::to_string(lineNo) + ": skin weight joint id \"" + tok +
-                                     "\" is not an integer of at most 9 digits");
-            }
-            continue;
-        }
-        if (lib) {
-            std::istringstream names(line.substr(i + 7));
-            std::string n;
-            while (names >> n) mtllibs.push_back(n);
-            continue;
-        }
-        if (!face) continue;
+// "FILE: line N: ", what every prescan message starts with.
+std::string atLine(const std::string& file, size_t lineNo) { return file + ": line " + std::to_string(lineNo) + ": "; }
+
+// v, vt, vn: every value a finite number (tinyobjloader reads "nan" or "x" as 0 and 1e39 as Inf).
+void requireFiniteValues(const std::string& values, const std::string& path, size_t lineNo) {
+    std::istringstream vals(values);
+    std::string tok;
+    while (vals >> tok) {
+        char* end = nullptr;
+        const double x = std::strtod(tok.c_str(), &end);
+        if (end == tok.c_str() || *end != '\0' || !std::isfinite(x) || std::fabs(x) > 3.0e38)
+            throw InputError(atLine(path, lineNo) + "\"" + tok + "\" is not a finite number");
+    }
+}
+
+// vw: skin weights, a tinyobjloader extension atrous ignores ("vw vid joint weight joint weight
+// ..."); tinyobjloader casts each joint id from a float to int, undefined beyond int's range and for
+// NaN, which its own number parser makes of "7...7e-2000" (inf * 0) where strtod reads 0 (found by
+// the libFuzzer target obj_mtl: "vw 1 777...7"). Each joint id is an integer of at most 9 digits (a
+// fraction allowed): what a joint index looks like.
+void requireJointIds(const std::string& values, const std::string& path, size_t lineNo) {
+    std::istringstream vals(values);
+    std::string tok;
+    for (int k = 0; vals >> tok; ++k) {
+        if (k % 2 == 0) continue;  // the vertex id (read with atoi) and the weights
+        size_t p = tok[0] == '+' || tok[0] == '-' ? 1 : 0;
+        const size_t digits = tok.find_first_not_of("0123456789", p);
+        const size_t intDigits = (digits == std::string::npos ? tok.size() : digits) - p;
+        const bool fraction = digits != std::string::npos && tok[digits] == '.' &&
+                              tok.find_first_not_of("0123456789", digits + 1) == std::string::npos;
+        if (intDigits == 0 || intDigits > 9 || (digits != std::string::npos && !fraction))
+            throw InputError(atLine(path, lineNo) + "skin weight joint id \"" + tok +
+                             "\" is not an integer of at most 9 digits");
+    }
+}
+
+const char* objElementName(int part) { return part == 0 ? "vertex" : part == 1 ? "texture coordinate" : "normal"; }
+
+// The face indices of an OBJ file against its v, vt and vn statements (0: v, 1: vt, 2: vn): a
+// relative (negative) index must stay within the elements read so far, an absolute one within the
+// file's totals (checked at the end, against the largest seen).
+class ObjIndexCheck {
+public:
+    explicit ObjIndexCheck(const std::string& path) : mPath(path) {}
+
+    void countElement(int part) { ++mCounts[part]; }
+
+    // A face statement ("f" at column i): each corner's indices in int's range and referring to an
+    // element, at most kMaxFaceVertices corners.
+    void checkFace(const std::string& line, size_t i, size_t lineNo) {
         size_t count = 0;
         for (size_t k = i + 1; k < line.size();) {
             while (k < line.size() && (line[k] == ' ' || line[k] == '\t' || line[k] == '\r')) ++k;
@@ -140,46 +128,96 @@ std::vector<std::string> prescanObj(const std::string& path) {
             const size_t tokenStart = k;
             while (k < line.size() && line[k] != ' ' && line[k] != '\t' && line[k] != '\r') ++k;
             ++count;
-            // Each of v/vt/vn: an optional sign and digits; more than 10 digits or above INT_MAX is out of range.
-            const std::string token = line.substr(tokenStart, k - tokenStart);
-            size_t p = 0;
-            int part = 0;
-            while (p <= token.size()) {
-                size_t q = token.find('/', p);
-                if (q == std::string::npos) q = token.size();
-                std::string num = token.substr(p, q - p);
-                if (!num.empty() && (num[0] == '-' || num[0] == '+')) num.erase(0, 1);
-                size_t digits = num.find_first_not_of("0123456789");
-                if (digits == std::string::npos) digits = num.size();
-                const std::string d = num.substr(0, digits);
-                const size_t nz = d.find_first_not_of('0');
-                const std::string sig = nz == std::string::npos ? "" : d.substr(nz);
-                if (sig.size() > 10 || (sig.size() == 10 && sig > "2147483647"))
-                    throw InputError(path + ": line " + std::to_string(lineNo) + ": face index \"" + token +
-                                     "\" is out of range");
-                const long long value = sig.empty() ? 0 : std::stoll(sig);
-                const bool negative = q > p && token[p] == '-';
-                if (part < 3 && !d.empty() && (value == 0 || (negative && value > counts[part])))
-                    throw InputError(path + ": line " + std::to_string(lineNo) + ": face index \"" + token +
-                                     "\" refers to a missing " + (part == 0 ? "vertex" : part == 1 ? "texture coordinate" : "normal"));
-                if (part < 3 && !negative && value > maxIndex[part]) {
-                    maxIndex[part] = value;
-                    maxLine[part] = lineNo;
-                    maxToken[part] = token;
-                }
-                ++part;
-                p = q + 1;
-            }
+            checkCorner(line.substr(tokenStart, k - tokenStart), lineNo);
             if (count > size_t(kMaxFaceVertices))
-                throw InputError(path + ": line " + std::to_string(lineNo) + ": face with more than " +
-                                 std::to_string(kMaxFaceVertices) + " vertices");
+                throw InputError(atLine(mPath, lineNo) + "face with more than " + std::to_string(kMaxFaceVertices) +
+                                 " vertices");
         }
     }
-    for (int k = 0; k < 3; ++k)
-        if (maxIndex[k] > counts[k])
-            throw InputError(path + ": line " + std::to_string(maxLine[k]) + ": face index \"" + maxToken[k] +
-                             "\" refers to a missing " + (k == 0 ? "vertex" : k == 1 ? "texture coordinate" : "normal") +
-                             " (the file has " + std::to_string(counts[k]) + ")");
+
+    // After the last line: every absolute index within the file's totals.
+    void requireTotals() const {
+        for (int k = 0; k < 3; ++k)
+            if (mMaxIndex[k] > mCounts[k])
+                throw InputError(atLine(mPath, mMaxLine[k]) + "face index \"" + mMaxToken[k] + "\" refers to a missing " +
+                                 objElementName(k) + " (the file has " + std::to_string(mCounts[k]) + ")");
+    }
+
+private:
+    // One corner, "v/vt/vn": each an optional sign and digits; more than 10 digits or above INT_MAX
+    // is out of range.
+    void checkCorner(const std::string& token, size_t lineNo) {
+        size_t p = 0;
+        int part = 0;
+        while (p <= token.size()) {
+            size_t q = token.find('/', p);
+            if (q == std::string::npos) q = token.size();
+            std::string num = token.substr(p, q - p);
+            if (!num.empty() && (num[0] == '-' || num[0] == '+')) num.erase(0, 1);
+            size_t digits = num.find_first_not_of("0123456789");
+            if (digits == std::string::npos) digits = num.size();
+            const std::string d = num.substr(0, digits);
+            const size_t nz = d.find_first_not_of('0');
+            const std::string sig = nz == std::string::npos ? "" : d.substr(nz);
+            if (sig.size() > 10 || (sig.size() == 10 && sig > "2147483647"))
+                throw InputError(atLine(mPath, lineNo) + "face index \"" + token + "\" is out of range");
+            const long long value = sig.empty() ? 0 : std::stoll(sig);
+            const bool negative = q > p && token[p] == '-';
+            if (part < 3 && !d.empty() && (value == 0 || (negative && value > mCounts[part])))
+                throw InputError(atLine(mPath, lineNo) + "face index \"" + token + "\" refers to a missing " +
+                                 objElementName(part));
+            if (part < 3 && !negative && value > mMaxIndex[part]) {
+                mMaxIndex[part] = value;
+                mMaxLine[part] = lineNo;
+                mMaxToken[part] = token;
+            }
+            ++part;
+            p = q + 1;
+        }
+    }
+
+    const std::string& mPath;
+    long long mCounts[3] = {0, 0, 0};    // v, vt, vn so far
+    long long mMaxIndex[3] = {0, 0, 0};  // the largest absolute index
+    size_t mMaxLine[3] = {0, 0, 0};
+    std::string mMaxToken[3];
+};
+
+// Whether `line` has the statement `key` at column i, followed by a space or (when `tab`) a tab.
+bool isStatement(const std::string& line, size_t i, const std::string& key, bool tab = true) {
+    return line.compare(i, key.size() + 1, key + " ") == 0 || (tab && line.compare(i, key.size() + 1, key + "\t") == 0);
+}
+
+// What tinyobjloader does not check, read from the OBJ text before it parses it: a face index
+// beyond int's range (atoi wraps 99999999999999999999 to -1, the last vertex), a face with more
+// than kMaxFaceVertices vertices (its ear clipping is quadratic: a 200k-vertex face ran for
+// minutes), and the mtllib names (tinyobjloader only warns when one is missing).
+std::vector<std::string> prescanObj(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::vector<std::string> mtllibs;
+    ObjIndexCheck indices(path);
+    std::string line;
+    for (size_t lineNo = 1; objLine(in, line); ++lineNo) {
+        const size_t i = line.find_first_not_of(" \t");
+        if (i == std::string::npos) continue;
+        requireExponentsInRange(line, path, lineNo);
+        // v, vt, vn: a space after the keyword, as tinyobjloader reads them.
+        const int part = isStatement(line, i, "v", false) ? 0 : isStatement(line, i, "vt", false) ? 1
+                         : isStatement(line, i, "vn", false) ? 2 : -1;
+        if (part >= 0) {
+            indices.countElement(part);
+            requireFiniteValues(line.substr(i + (part == 0 ? 2 : 3)), path, lineNo);
+        } else if (isStatement(line, i, "vw")) {
+            requireJointIds(line.substr(i + 3), path, lineNo);
+        } else if (isStatement(line, i, "mtllib")) {
+            std::istringstream names(line.substr(i + 7));
+            std::string n;
+            while (names >> n) mtllibs.push_back(n);
+        } else if (isStatement(line, i, "f")) {
+            indices.checkFace(line, i, lineNo);
+        }
+    }
+    indices.requireTotals();
     return mtllibs;
 }
 
@@ -286,7 +324,7 @@ void loadObj(const std::string& referencedBy, SceneBuilder& b, const std::string
         if (!t.diffuse_texname.empty()) {
             std::string tex = (fs::path(path).parent_path() / t.diffuse_texname).lexically_normal().string();
             try {
-                m.texture = b.addTexture(io::readImage(tex), /*reflectance=*/true);
+                m.texture = b.addTexture(atrous::readImage(tex), /*reflectance=*/true);
             } catch (const InputError& e) {
                 throw InputError(std::string(e.what()) + " (map_Kd of material \"" + t.name + "\" in " + mtlNames +
                                  ", used by " + path + ")");

@@ -1,11 +1,20 @@
 // The public device-choosing renderers (include/atrous/render.h): render(scene, settings, device)
-// and SceneRenderer, over the Embree renderer and the CUDA BVH renderer (render/bvh_render.h).
+// and SceneRenderer, over the Embree renderer and the CUDA BVH renderer (render/bvh_render.h); and
+// the Frame of what they return.
 #include <memory>
 
 #include "atrous/render.h"
 #include "render/bvh_render.h"
 
 namespace atrous {
+
+Frame RenderBuffers::frame() const {
+    Frame f;
+    f.set(Buffer::Color, &color).set(Buffer::Variance, &variance).set(Buffer::Albedo, &albedo);
+    f.set(Buffer::Normal, &normal).set(Buffer::Position, &position).set(Buffer::Depth, &depth);
+    f.set(Buffer::ObjectId, &ids).set(Buffer::Emission, &emission).set(Buffer::Motion, &motion);
+    return f;
+}
 
 RenderBuffers render(const Scene& scene, const RenderSettings& settings, Device device) {
     return device == Device::Cuda ? renderBvhCuda(scene, settings) : render(scene, settings);

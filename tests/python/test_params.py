@@ -71,7 +71,7 @@ def test_the_table_keeps_the_known_keywords_and_flags():
     assert rows["sure_mode"]["choices"] == ["discrete", "james-stein"]
     assert _core.resolve_denoise_params({"sure_mode": "james_stein"})["sure_mode"] == "james-stein"
     svgf = {r["name"]: r for r in atrous.svgf_params()}
-    assert svgf["reproject_depth_tolerance"]["flag"] == "--svgf-depth-tolerance"
+    assert svgf["depth_tolerance"]["flag"] == "--svgf-depth-tolerance"
     assert svgf["taa"]["flag"] == "--taa" and svgf["sigma_l"]["flag"] == "--svgf-sigma-l"
 
 

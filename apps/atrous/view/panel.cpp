@@ -16,6 +16,7 @@
 #include "atrous/param_set.h"
 #include "atrous/params.h"
 #include "atrous/sequence_methods.h"
+#include "atrous/render.h"
 
 namespace atrous::view {
 namespace {

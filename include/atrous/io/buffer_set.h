@@ -9,8 +9,6 @@
 
 #include "atrous/denoise.h"
 #include "atrous/image.h"
-#include "atrous/render.h"
-#include "atrous/svgf.h"
 #include "atrous/io/exr_layers.h"
 #include "atrous/io/pass_map.h"
 #include "atrous/io/sequence.h"
@@ -44,10 +42,9 @@ struct BufferSet {
 // One set of buffers, not owned: a Frame (atrous/buffers.h; ids in the object_id slot, as in
 // BufferSet). Every entry point (render --denoise, denoise, denoise --sequence, the viewer,
 // Python) puts what it holds here and hands it to the denoisers as it is, so a new buffer reaches
-// all of them at once.
+// all of them at once (a render's: RenderBuffers::frame(), atrous/render.h).
 using BufferRefs = Frame;
 BufferRefs refsOf(const BufferSet& set);
-BufferRefs refsOf(const RenderBuffers& b);  // motion too, when the render made one
 BufferRefs refsOf(const SequenceFrame& f);  // all but the reference
 
 // The buffers of denoise(DenoiseBuffers&): the colour, variance and emission are the caller's own

@@ -6,21 +6,13 @@
 #include <string>
 
 #include "atrous/image.h"
+#include "atrous/io.h"
 
 namespace atrous::io {
 
-// Reads an image file as a planar host Image (linear RGB; 3 channels unless asked for fewer). EXR needs R,G,B channels
-// (A is ignored), or Y, or exactly one channel (grey, repeated into R,G,B); PFM may be colour or
-// grey; 8-bit formats are converted from sRGB to linear. Throws InputError naming the file and the
-// problem for a missing, unreadable, truncated or oddly-shaped file (exr_limits.h: the size rule
-// every EXR reader shares). `sourceChannels`, when given, receives how many distinct channels the
-// file held: 1 for grey (one EXR channel, Y, a grey PFM or PNG), else 3. `channels` (1..3) keeps
-// the first channels only (a depth file's R, an ids file's R and G): an EXR decodes no others.
-Image readImage(const std::string& path, int* sourceChannels = nullptr, int channels = 3);
-
-// Writes `img` (1 or 3 channels on the host) by the file's extension: .exr (32-bit float R,G,B,
-// ZIP compressed), .pfm, or .png (tonemapped preview: exposure, clamp, sRGB). Atomic.
-void writeImage(const std::string& path, const Image& img);
+// Reading and writing an image file by its extension are atrous::readImage and atrous::writeImage
+// (atrous/io.h), the one reader and writer of the library, the CLI, Python and installed users
+// alike. The writers of one format (host images, 1 or 3 channels; atomic):
 void writeExr(const std::string& path, const Image& img);
 void writePfm(const std::string& path, const Image& img);
 // 8-bit sRGB preview of linear HDR: out = srgb(clamp(exposure * v, 0, 1)).

@@ -1,4 +1,4 @@
-// libFuzzer target: a single EXR file through atrous::io::readImage (the reader of --color FILE.exr,
+// libFuzzer target: a single EXR file through atrous::readImage (the reader of --color FILE.exr,
 // textures and environment maps). The input is the file's bytes.
 //
 // Contract (fuzz_common.h): readImage returns a 3-channel image or throws InputError. Its size is
@@ -12,7 +12,7 @@ using namespace atrous_fuzz;
 
 ATROUS_FUZZ_FILE_TARGET("exr_single", "in.exr") {
     Image img;
-    if (!returnsOrInputError("readImage(.exr)", [&] { img = atrous::io::readImage(path); })) return 0;
+    if (!returnsOrInputError("readImage(.exr)", [&] { img = atrous::readImage(path); })) return 0;
     checkShape("readImage(.exr)", img);
     if (double(img.width()) * img.height() * 2.0 > double(size) * 8192.0 + 65536.0)
         finding("readImage(.exr) returned a " + std::to_string(img.width()) + "x" + std::to_string(img.height()) +

@@ -1,4 +1,4 @@
-// libFuzzer target: a PFM file through atrous::io::readImage (oidnDenoise's format: --hdr, --alb,
+// libFuzzer target: a PFM file through atrous::readImage (oidnDenoise's format: --hdr, --alb,
 // --nrm). The input is the file's bytes.
 //
 // Contract (fuzz_common.h): readImage returns a 3-channel image or throws InputError, and the image
@@ -13,7 +13,7 @@ using namespace atrous_fuzz;
 
 ATROUS_FUZZ_FILE_TARGET("pfm", "in.pfm") {
     Image img;
-    if (!returnsOrInputError("readImage(.pfm)", [&] { img = atrous::io::readImage(path); })) return 0;
+    if (!returnsOrInputError("readImage(.pfm)", [&] { img = atrous::readImage(path); })) return 0;
     checkShape("readImage(.pfm)", img);
     size_t m = 0;  // the magic after any leading whitespace (the reader reads it with >>)
     while (m < size && std::strchr(" \t\n\v\f\r", data[m]) && data[m]) ++m;

@@ -1,4 +1,4 @@
-// libFuzzer target: 8-bit images through atrous::io::readImage (PNG textures; JPEG through
+// libFuzzer target: 8-bit images through atrous::readImage (PNG textures; JPEG through
 // libjpeg-turbo since b765052; BMP and TGA through stb_image). A file is read only as the format its
 // extension names (image_io.cpp), so the input's bytes are written under the extension its first
 // bytes suggest: in.hdr for "#?", in.jpg for FF D8, in.bmp for "BM", in.png for the PNG signature,
@@ -33,7 +33,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const std::string path = writeScratch(std::string("in") + ext, data, size);
     const std::string what = std::string("readImage(") + ext + ")";
     Image img;
-    if (!returnsOrInputError(what, [&] { img = atrous::io::readImage(path); })) return 0;
+    if (!returnsOrInputError(what, [&] { img = atrous::readImage(path); })) return 0;
     checkShape(what, img);
     if (double(img.width()) * img.height() > double(size) * 8448.0 + 65536.0)
         finding(what + " returned a " + std::to_string(img.width()) + "x" + std::to_string(img.height()) +

@@ -1,11 +1,9 @@
-// Run-time choice of the CPU loops' instruction set (src/cpu/cpu_isa.h).
-#include "cpu/cpu_isa.h"
+// Run-time choice of the CPU loops' instruction set (src/core/cpu_isa.h).
+#include "core/cpu_isa.h"
 
 #include <cstdlib>
 
 #include "atrous/error.h"
-#include "cpu/cpu_simd.h"
-#include "filters/atrous_level.h"
 
 namespace atrous::cpu {
 
@@ -98,7 +96,12 @@ void setActiveIsa(Isa isa) {
     IsaState& s = state();
     s.isa = isa;
     s.error.clear();
-    filters::atrousCpuAvx512() = isa == Isa::Avx512;
+    avx512Switch() = isa == Isa::Avx512;
+}
+
+bool& avx512Switch() {
+    static bool enabled = activeIsaOrBaseline() == Isa::Avx512;
+    return enabled;
 }
 
 std::string isaDescription() {

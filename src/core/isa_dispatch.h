@@ -1,12 +1,12 @@
-// The one place the CPU loops pick their instruction set (src/cpu/cpu_isa.h): parallelForIsa
-// runs a body compiled for baseline x86-64, AVX2 (x86-64-v3) or AVX-512 on TBB threads. The row
-// engine (atrous_rows.h) and the row loops of src/cpu come through here, so no stage writes its
-// own dispatch.
+// The one place the CPU loops pick their instruction set (src/core/cpu_isa.h): parallelForIsa
+// runs a body compiled for baseline x86-64, AVX2 (x86-64-v3) or AVX-512 on TBB threads. CpuExec
+// (parallel.h), the row engine (src/cpu/atrous_rows.h) and the row loops of src/cpu come through
+// here, so no stage writes its own dispatch.
 #pragma once
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "cpu/cpu_simd.h"
+#include "core/cpu_isa.h"
 
 namespace atrous::cpu {
 
@@ -47,8 +47,8 @@ void parallelForIsa(Isa isa, Index begin, Index end, Index grain, const Body& bo
                       [&](const tbb::blocked_range<Index>& r) { fn(body, r.begin(), r.end()); });
 }
 
-// The row engine's switch (filters::atrousCpuAvx512()) as an ISA: its AVX-512 loops, or the
-// ISA in use capped at AVX2 (tests turn the switch off to run the AVX2 loops on an AVX-512 CPU).
+// The AVX-512 switch (avx512Switch(), filters::atrousCpuAvx512()) as an ISA: the AVX-512 loops, or
+// the ISA in use capped at AVX2 (tests turn the switch off to run the AVX2 loops on an AVX-512 CPU).
 inline Isa isaFromAvx512Switch(bool avx512) {
     if (avx512) return Isa::Avx512;
     const Isa a = activeIsa();
