@@ -55,11 +55,15 @@ LAYERS = {
     "include/atrous/learned.h": "filters",
     "include/atrous/params.h": "filters",
     "include/atrous/metrics.h": "filters",
+    "include/atrous/param_set.h": "filters",
+    "include/atrous/sequence_methods.h": "filters",
     "src/api/": "sessions",
     "include/atrous/sequence.h": "sessions",
     "include/atrous/view_pipeline.h": "sessions",
     "include/atrous/plugins.h": "sessions",
     "apps/": "front-end",
+    "src/capi/": "front-end",
+    "include/atrous/atrous.h": "front-end",
     "python/src/": "front-end",
 }
 

@@ -304,16 +304,16 @@ TEST(ToyMethod, AsAPluginTheCliListsAndRunsIt) {
     const std::string seq = test::renderSequence(dir, 3);
     test::expectCli(plugin + "denoise --sequence " + seq + " --method toyseq --toyseq-alpha 0.5 --out " + (dir / "toyseq"), 0,
                     {"frame_0002: toyseq"});
-    Image avg = io::readImage(seq + "/frame_0000/color.exr");
+    Image avg = atrous::readImage(seq + "/frame_0000/color.exr");
     for (int f = 0; f < 3; ++f) {
         const std::string frame = seq + "/frame_000" + std::to_string(f);
-        const Image c = io::readImage(frame + "/color.exr"), motion = io::readImage(frame + "/motion.exr");
+        const Image c = atrous::readImage(frame + "/color.exr"), motion = atrous::readImage(frame + "/motion.exr");
         for (int y = 0; y < c.height(); ++y)
             for (int x = 0; x < c.width(); ++x) {
                 const bool still = f > 0 && std::fabs(motion(x, y, 0)) < 0.05f && std::fabs(motion(x, y, 1)) < 0.05f;
                 for (int ch = 0; ch < 3; ++ch) avg(x, y, ch) = still ? 0.5f * c(x, y, ch) + 0.5f * avg(x, y, ch) : c(x, y, ch);
             }
-        EXPECT_TRUE(test::sameImages(io::readImage(dir / ("toyseq/frame_000" + std::to_string(f) + ".exr")), avg)) << f;
+        EXPECT_TRUE(test::sameImages(atrous::readImage(dir / ("toyseq/frame_000" + std::to_string(f) + ".exr")), avg)) << f;
     }
     test::expectCli(plugin + "denoise --sequence " + seq + " --method toyseq --toyseq-alpha 2 --out " + (dir / "bad"), 2,
                     {"--toyseq-alpha: must be in (0, 1] (got 2)"});
