@@ -8,7 +8,6 @@
 #include <nanobind/stl/vector.h>
 #include <nanobind/stl/unordered_map.h>
 
-#include <cctype>
 #include <cmath>
 #include <initializer_list>
 #include <memory>
@@ -27,7 +26,6 @@
 #include "atrous/sequence.h"
 #include "atrous/svgf.h"
 #include "atrous/temporal.h"
-#include "atrous/io/alpha.h"
 #include "atrous/io/buffer_set.h"
 #include "atrous/io/image_io.h"
 #include "arrays.h"
@@ -38,6 +36,7 @@ using namespace atrous;
 namespace atrous::python {
 void bindMethods(nb::module_& m);  // methods.cpp: register_method
 void bindMetrics(nb::module_& m);  // metrics.cpp: metrics, temporal_metrics
+void bindFiles(nb::module_& m);    // files.cpp: read_image, read_buffers, write_image
 void bindVocabulary(nb::module_& m);  // vocabulary.cpp: buffers, Weights, load_weights
 LearnedWeights weightsFrom(nb::handle h);  // vocabulary.cpp: None, "", a path or a Weights
 }
@@ -424,40 +423,6 @@ nb::dict pyDenoiseSequence(const std::string& input, const std::string& out, con
 }
 
 // One render's files (readRenderFiles, include/atrous/io.h) as a dict of host arrays by buffer name.
-// The library's messages about a render's files name the CLI's flags (`--in DIR`, `--pass
-// BUFFER=NAME`, `--layer NAME`: io::loadBuffers, pass_map); Python's errors name Python's keywords
-// instead (path, passes, layer). A flag is a whole word: "--in" followed by a letter, digit or '-'
-// is another flag and stays.
-std::string pythonWords(std::string msg, std::initializer_list<std::pair<const char*, const char*>> words) {
-    for (const auto& [flag, keyword] : words) {
-        const std::string f = flag;
-        for (size_t at = msg.find(f); at != std::string::npos; at = msg.find(f, at)) {
-            const size_t end = at + f.size();
-            const bool whole = end == msg.size() || !(std::isalnum(static_cast<unsigned char>(msg[end])) || msg[end] == '-');
-            if (!whole) {
-                at = end;
-                continue;
-            }
-            msg.replace(at, f.size(), keyword);
-            at += std::string(keyword).size();
-        }
-    }
-    return msg;
-}
-
-nb::dict pyReadBuffers(const std::string& path, const std::vector<std::string>& passes, const std::string& layer) {
-    RenderFiles r;
-    try {
-        nb::gil_scoped_release release;
-        r = readRenderFiles(path, passes, layer);
-    } catch (const InputError& e) {
-        throw InputError(pythonWords(e.what(), {{"--in", "path"}, {"--pass", "passes"}, {"--layer", "layer"}}));
-    }
-    nb::dict d;
-    for (auto& [name, img] : r.buffers) d[name.c_str()] = fromImage(std::move(img));
-    return d;
-}
-
 // Python's keywords are the render table's rows (params.h); the library validates the ranges.
 RenderSettings renderSettings(nb::dict params) {
     RenderSettings rs;
@@ -508,36 +473,6 @@ nb::dict pyRenderFrame(const std::string& scene, int frame, int frames, const st
     return d;
 }
 
-// Image files go through the library's readers and writers (OpenEXR, PFM, stb), so Python reads
-// exactly what the CLI writes and the other way round; errors name the file (InputError).
-// alpha: the file's alpha channel as a 4th (io::readAlpha), when it has one.
-nb::object pyReadImage(const std::string& path, bool alpha) {
-    Image img;
-    {
-        nb::gil_scoped_release release;
-        img = io::readImage(path);
-        if (alpha) {
-            const Image a = io::readAlpha(path, {}, "", img.width(), img.height());
-            img = io::withAlpha(std::move(img), a);
-        }
-    }
-    return fromImage(std::move(img));
-}
-
-// `image` is H x W x 3, H x W x 4 (alpha), H x W x 1 or H x W float32 (python/atrous/__init__.py
-// converts other float dtypes); one channel stays one channel so that PFM writes grey ("Pf") and EXR
-// repeats it.
-void pyWriteImage(const std::string& path, const Array& image) {
-    const int channels = image.ndim() == 3 ? int(image.shape(2)) : 1;
-    if (image.ndim() == 3 && channels != 1 && channels != 3 && channels != 4)
-        throw InputError(path + ": expected an array of shape (H, W, 3), (H, W, 4), (H, W, 1) or (H, W), got " +
-                         std::to_string(channels) + " channels");
-    Image img = toImage(image, path.c_str(), channels);
-    if (img.device() != Device::Cpu) img = img.to(Device::Cpu);  // the writers read host memory
-    nb::gil_scoped_release release;
-    io::writeImage(path, img);
-}
-
 // Library errors name the field (`max_depth`, `device`, `camera_path`: ParamError) or the file,
 // never a CLI flag, so Python shows them as they are: the field is the keyword.
 }  // namespace
@@ -564,9 +499,7 @@ NB_MODULE(_core, m) {
     m.def("render", &pyRender, nb::arg("scene"), nb::arg("params"));
     m.def("render_frame", &pyRenderFrame, nb::arg("scene"), nb::arg("frame"), nb::arg("frames"), nb::arg("camera_path"),
           nb::arg("params"));
-    m.def("read_image", &pyReadImage, nb::arg("path"), nb::arg("alpha") = false);
-    m.def("read_buffers", &pyReadBuffers, nb::arg("path"), nb::arg("passes"), nb::arg("layer"));
-    m.def("write_image", &pyWriteImage, nb::arg("path"), nb::arg("image"));
+    atrous::python::bindFiles(m);  // files.cpp: read_image, read_buffers, write_image
     m.def("denoise_params", [] { return paramRows(denoiseParams()); });
     // The still methods (denoiseMethods()): atrous.METHODS and the rows of atrous.denoise_methods().
     m.def("denoise_methods",
