@@ -445,15 +445,7 @@ void addCompareCommand(CLI::App& app) {
                     "(docs/eval.md), and the flicker measure when --input (or the reference) has motion. Alone, or "
                     "with --no-reference: a sequence to judge without a reference (the flicker measure)");
     cmd->add_option("images", a->images, "Images (or, with --sequence, sequence directories) to compare");
-    cmd->add_flag("--no-reference", a->noReference,
-                  "With --sequence: there is no reference sequence; the --sequence folder and the positional ones are all "
-                  "judged by the reference-free flicker measure (each frame against the one before it, warped by the "
-                  "motion vectors where they reproject; docs/temporal.md) and ranked by it. Implied by --sequence "
-                  "DIR with no other sequence");
-    cmd->add_option("--input", a->input,
-                    "With --sequence: the sequence that was denoised (its motion vectors, depth, normals and ids place "
-                    "each frame's predecessor for the flicker measure; default: the judged or reference sequence's own, "
-                    "its Position pass, or motion estimated from its colours)");
+    addFlickerOptions(*cmd, a->noReference, a->input);  // --no-reference, --input
     cmd->add_option("--video", a->video,
                     "With --sequence: write an .mp4 of the sequences and the reference side by side, each labelled "
                     "with its folder's name (needs ffmpeg)");

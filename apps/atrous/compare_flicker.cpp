@@ -77,6 +77,14 @@ FlickerMetrics FlickerGuide::measure(const SequenceImages& seq, const std::strin
     return m;
 }
 
+void addFlickerOptions(CLI::App& cmd, bool& noReference, std::string& input) {
+    cmd.add_flag("--no-reference", noReference,
+                 "With --sequence: no reference; --sequence's folder and the others are ranked by the flicker measure "
+                 "(each frame against the one before, warped by the motion vectors; docs/temporal.md)");
+    cmd.add_option("--input", input, "With --sequence: the sequence that was denoised, whose motion, depth, normals and ids "
+                                     "place the frames for the flicker measure (default: the sequence's own)");
+}
+
 void runFlickerCompare(const FlickerCompareArgs& a) {
     std::vector<std::string> notes;
     std::vector<SequenceImages> seqs;

@@ -2,6 +2,8 @@
 // (metrics.h, computeFlicker) of each sequence, the frames placed by the motion vectors, depth,
 // normals and ids of the sequence that was denoised (--input), and a ranking by it.
 #pragma once
+#include <CLI/CLI.hpp>
+
 #include <map>
 #include <string>
 #include <utility>
@@ -46,6 +48,9 @@ struct FlickerCompareArgs {
     std::string input;                   // --input: the guide ("" = the first judged sequence)
     bool json = false;
 };
+
+// compare's --no-reference and --input.
+void addFlickerOptions(CLI::App& cmd, bool& noReference, std::string& input);
 
 // compare --sequence A [B ...] --no-reference: each sequence's flicker and share reprojected, then the
 // ranking (least flicker first). Prints a table, or JSON with --json.
