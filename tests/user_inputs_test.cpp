@@ -248,6 +248,8 @@ TEST(DidYouMean, UnknownNamesGetTheNearestOne) {
     // The CLI: an unknown flag gets the command's nearest flag, on the one error line.
     expectCli("denoise --color x.exr --out y.exr --sigma-norml 2", 2, {"did you mean --sigma-normal?"});
     expectCli("compare --sequence a --no-refrence", 2, {"did you mean --no-reference?"});
+    // A choice's value likewise (setParamFromText).
+    expectCli("denoise --color x.exr --out y.exr --sure-mode jamesstein", 2, {"did you mean 'james-stein'?"});
     const CliResult far = expectCli("denoise --color x.exr --out y.exr --frobnicate", 2);
     EXPECT_EQ(far.output.find("did you mean"), std::string::npos) << far.output;
 }

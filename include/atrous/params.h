@@ -395,14 +395,16 @@ void setParamFromText(S& s, const ParamTable<S>& t, const ParamField<S>& f, cons
         std::string want, norm = text;
         for (char& c : norm)
             if (c == '_') c = '-';
+        std::vector<std::string> names;
         for (int i = 0; f.choices[i]; ++i) {
             if (norm == f.choices[i]) {
                 **m = SureMode(i);
                 return;
             }
             want += std::string(i ? (f.choices[i + 1] ? ", " : " or ") : "") + f.choices[i];
+            names.push_back(f.choices[i]);
         }
-        throw ParamError(t.set, f.name, "must be " + want, "'" + text + "'");
+        throw ParamError(t.set, f.name, "must be " + want, "'" + text + "'" + didYouMean(text, names));
     }
     if (std::vector<float>* const* list = std::get_if<std::vector<float>*>(&r)) {
         std::vector<float> v;
