@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include <string>
+#include <vector>
 
 #include "atrous/device.h"
 #include "atrous/error.h"
@@ -119,7 +120,9 @@ void addParamOptions(CLI::App& cmd, S& s, const ParamTable<S>& t, GroupOf&& grou
                            try {
                                setParamFromText(*target, *table, *field, v);
                            } catch (const ParamError& e) {
-                               throw InputError(flag + ": " + e.rule() + " (got " + v + ")");
+                               std::vector<std::string> choices;  // a choice's names, for "did you mean"
+                               for (int k = 0; field->choices && field->choices[k]; ++k) choices.push_back(field->choices[k]);
+                               throw InputError(flag + ": " + e.rule() + " (got " + v + ")" + didYouMean(v, choices));
                            }
                        },
                        f.doc)
