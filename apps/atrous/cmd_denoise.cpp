@@ -197,11 +197,11 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     };
     Timer readTimer;
     io::BufferSet set = io::loadBuffers(files);
+    // LDR colour, alpha, no finite pixel (still_output.h): checked before anything is denoised.
+    const StillExtras extras = readStillExtras(files, set, a.ldr);
     const double readMs = readTimer.ms();
     if (!a.addPass.empty() && (!set.layered || ext != ".exr"))
         throw InputError("--add-pass '" + a.addPass + "' writes a copy of a layered EXR: give --in FILE.exr and --out COPY.exr");
-    // LDR colour, alpha, no finite pixel (still_output.h): checked before anything is denoised.
-    const StillExtras extras = readStillExtras(files, set, a.ldr);
     Image& color = set.image[int(io::Buffer::Color)];
     if (a.srgb && !extras.ldrFile) srgbToLinear(color);  // an 8-bit file is decoded by its reader
     const int width = color.width(), height = color.height();

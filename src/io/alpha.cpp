@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <utility>
 
 #include "atrous/error.h"
 #include "atrous/io/buffer_set.h"
@@ -48,10 +49,7 @@ Image exrAlpha(const std::string& path, const std::vector<PassRequest>& passes, 
                          sizeText(width >= 0 ? width : info.width, height >= 0 ? height : info.height) +
                          ": atrous passes an alpha of the colour's size through, one value per pixel");
     }
-    Image rgb = readExrChannels(info, {channel}, "alpha channel '" + ch.fullName + "'");
-    Image a = Image::uninitialized(rgb.width(), rgb.height(), 1);
-    std::copy(rgb.data(), rgb.data() + a.size(), a.data());  // the one channel, repeated: its first plane
-    return a;
+    return std::move(readExrChannelSets(info, {{channel}}, {"alpha channel '" + ch.fullName + "'"}, {1})[0]);
 }
 
 }  // namespace
