@@ -112,10 +112,10 @@ TEST(SequenceCompare, FramesThatDoNotMatchAreOneLineAndExit2) {
     r = runCli("compare --sequence " + dir / "ref" + " " + dir / "odd");
     EXPECT_EQ(r.exitCode, 2) << r.output;
     EXPECT_NE(r.output.find("frame 2"), std::string::npos) << r.output;
-    // --ref is for images; no sequence to compare is an error too.
+    // --ref is for images. (A sequence alone is judged without a reference: tests/flicker_test.cpp.)
     r = runCli("compare --sequence " + dir / "ref" + " --ref " + dir / "ref/frame_0001.exr " + dir / "odd");
     EXPECT_EQ(r.exitCode, 2) << r.output;
-    r = runCli("compare --sequence " + dir / "ref");
+    r = runCli("compare --sequence " + dir / "ref" + " --no-reference --video " + dir / "v.mp4");
     EXPECT_EQ(r.exitCode, 2) << r.output;
     r = runCli("compare " + dir / "odd/frame_0001.exr");
     EXPECT_EQ(r.exitCode, 2) << r.output;

@@ -8,6 +8,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "atrous/device.h"
 #include "atrous/error.h"
@@ -127,7 +128,10 @@ inline void addParamOptions(CLI::App& cmd, ParamSet values, const std::function<
                            try {
                                set->setText(i, v);
                            } catch (const ParamError& e) {
-                               throw InputError(flag + ": " + e.rule() + " (got " + v + ")");
+                               std::vector<std::string> choices;  // a choice's names, for "did you mean"
+                               const char* const* names = set->rows()[i].choices;
+                               for (int k = 0; names && names[k]; ++k) choices.push_back(names[k]);
+                               throw InputError(flag + ": " + e.rule() + " (got " + v + ")" + didYouMean(v, choices));
                            }
                        },
                        f.doc)

@@ -1,6 +1,7 @@
 // `atrous compare`: MSE, relMSE, tonemapped PSNR and SSIM of images against a reference; with
 // --sequence, of denoised sequences against a reference sequence, with the temporal metrics and
-// (where they are installed) HDR-FLIP and ColorVideoVDP.
+// (where they are installed) HDR-FLIP and ColorVideoVDP; without a reference sequence, the
+// reference-free flicker measure (compare_flicker.h).
 #include <unistd.h>
 
 #include <algorithm>
@@ -19,6 +20,7 @@
 #include "atrous/error.h"
 #include "atrous/metrics.h"
 #include "commands.h"
+#include "compare_flicker.h"
 #include "atrous/io/staged_dir.h"
 #include "atrous/io/image_io.h"
 #include "atrous/io/paths.h"
@@ -32,9 +34,11 @@ namespace {
 
 struct CompareArgs {
     std::string ref, errorMaps, sequence, video;
+    std::string input;  // --input: the sequence whose motion places the frames for the flicker measure
     std::vector<std::string> images;
     bool json = false;
     bool noFlip = false, noCvvdp = false;
+    bool noReference = false;
 };
 
 // Runs a shell command, returns what it printed (stdout; the caller adds 2>&1), its status in *rc.
@@ -176,18 +180,6 @@ private:
     std::string mExe, mNote;
 };
 
-// The frames of a sequence by number: a reference frame's reference.exr when it has one (`atrous
-// render --frames --reference-spp`), else its colour (frame_NNNN.exr as `denoise --sequence` writes
-// them, or any layout --sequence reads).
-std::vector<std::pair<int, Image>> sequenceImages(const std::string& dir, bool preferReference) {
-    std::vector<std::pair<int, Image>> out;
-    for (const std::string& frame : io::listSequenceFrames(dir)) {
-        io::SequenceFrame f = io::loadSequenceFrame(frame);
-        out.emplace_back(f.index, preferReference && !f.reference.empty() ? std::move(f.reference) : std::move(f.color));
-    }
-    return out;
-}
-
 // A label ffmpeg's drawtext takes as it is: letters, digits and "_-." (others become '_').
 std::string plainLabel(const std::string& s) {
     std::string out;
@@ -240,10 +232,32 @@ void writeVideo(const std::string& path, const std::vector<std::string>& names,
     if (ec) throw RuntimeError("--video " + path + ": cannot move the video into place (" + ec.message() + ")");
 }
 
+// The flicker measure beside the reference's metrics, when something places the frames: --input, or
+// the reference sequence's own motion vectors or Position pass. Null otherwise.
+std::unique_ptr<FlickerGuide> referenceGuide(const CompareArgs& a, std::vector<std::string>* notes) {
+    std::string dir = a.input;
+    if (dir.empty()) {
+        int w = 0, h = 0;
+        const std::vector<std::string> present = io::validateSequence(io::listSequenceFrames(a.sequence), w, h);
+        for (const char* b : {"motion", "position"})
+            if (std::find(present.begin(), present.end(), b) != present.end()) dir = a.sequence;
+    }
+    return dir.empty() ? nullptr : std::make_unique<FlickerGuide>(FlickerGuide::load(dir, notes));
+}
+
 void runSequence(const CompareArgs& a) {
     if (!a.ref.empty() || !a.errorMaps.empty())
         throw InputError("--sequence REF_DIR: compares sequences; --ref and --error-maps are for images");
-    if (a.images.empty()) throw InputError("compare --sequence REF_DIR: give at least one sequence directory to compare");
+    if (a.noReference || a.images.empty()) {
+        // No reference: the sequence given with --sequence is judged too (the first), by the flicker measure.
+        if (!a.video.empty()) throw InputError("--video: shows the sequences beside a reference; drop --no-reference");
+        FlickerCompareArgs f;
+        f.sequences.push_back(a.sequence);
+        f.sequences.insert(f.sequences.end(), a.images.begin(), a.images.end());
+        f.input = a.input;
+        f.json = a.json;
+        return runFlickerCompare(f);
+    }
     if (!a.video.empty()) {
         std::vector<std::string> inputs = a.images;
         inputs.push_back(a.sequence);
@@ -263,9 +277,20 @@ void runSequence(const CompareArgs& a) {
     if (!cvvdp.note().empty()) std::fprintf(stderr, "note: no CVVDP column: %s\n", cvvdp.note().c_str());
     // Written once for both external metrics, only when one of them runs.
     const std::unique_ptr<FrameFiles> files = flip.enabled() || cvvdp.enabled() ? std::make_unique<FrameFiles>() : nullptr;
+    std::vector<std::string> notes;
+    const std::unique_ptr<FlickerGuide> guide = referenceGuide(a, &notes);
+    for (const std::string& n : notes) std::fprintf(stderr, "%s\n", n.c_str());
+    if (guide) {
+        // The measure's floor on this sequence: what the reference itself changes where it reprojects.
+        const FlickerMetrics rf = guide->measure(ref, a.sequence);
+        j["reference_flicker"] = rf.relMse;
+        if (!a.json)
+            std::printf("flicker (no reference needed): the reference's own is %.6g, %.1f%% of its pixels reproject (motion of %s)\n",
+                        rf.relMse, 100.0 * rf.reprojected, guide->dir().c_str());
+    }
     if (!a.json)
-        std::printf("%-32s %7s %14s %10s %8s %14s %10s%s%s\n", "sequence", "frames", "relMSE", "PSNR(dB)", "SSIM", "temporal relMSE",
-                    "tPSNR(dB)", flip.enabled() ? "     FLIP" : "", cvvdp.enabled() ? " CVVDP(JOD)" : "");
+        std::printf("%-32s %7s %14s %10s %8s %14s %10s%s%s%s\n", "sequence", "frames", "relMSE", "PSNR(dB)", "SSIM", "temporal relMSE",
+                    "tPSNR(dB)", guide ? "        flicker" : "", flip.enabled() ? "     FLIP" : "", cvvdp.enabled() ? " CVVDP(JOD)" : "");
     for (const std::string& dir : a.images) {
         auto seq = sequenceImages(dir, false);
         // The frames are matched by number: the same numbers in both, or one line naming the first that is not.
@@ -304,6 +329,8 @@ void runSequence(const CompareArgs& a) {
         nlohmann::json s = {{"path", dir},           {"frames", seq.size()},       {"relmse", rel / n},
                             {"psnr", psnr / n},      {"ssim", ssim / n},           {"temporal_relmse", trel / steps},
                             {"tpsnr", tpsnr / steps}};
+        const double flicker = guide ? guide->measure(seq, dir).relMse : 0.0;
+        s["flicker"] = guide ? nlohmann::json(flicker) : nlohmann::json(nullptr);
         s["flip"] = flipOk ? nlohmann::json(flipSum / n) : nlohmann::json(nullptr);
         const std::optional<double> jod = cvvdp.enabled() ? cvvdp.sequence(dir, frameFiles, files->dir()) : std::nullopt;
         s["cvvdp"] = jod ? nlohmann::json(*jod) : nlohmann::json(nullptr);
@@ -312,6 +339,7 @@ void runSequence(const CompareArgs& a) {
         } else {
             std::printf("%-32s %7zu %14.6g %10.3f %8.4f %14.6g %10.3f", dir.c_str(), seq.size(), rel / n, psnr / n, ssim / n,
                         trel / steps, tpsnr / steps);
+            if (guide) std::printf(" %14.6g", flicker);
             if (flip.enabled()) flipOk ? std::printf(" %8.4f", flipSum / n) : std::printf(" %8s", "-");
             if (cvvdp.enabled()) jod ? std::printf(" %10.4f", *jod) : std::printf(" %10s", "-");
             std::printf("\n");
@@ -414,8 +442,10 @@ void addCompareCommand(CLI::App& app) {
                     "Reference sequence (any layout --sequence reads; a frame's reference.exr when it has one): the "
                     "positional arguments are then sequences to compare with it (denoise --sequence's output "
                     "folders), frame by frame, with the temporal relMSE and tPSNR of frame-to-frame differences "
-                    "(docs/eval.md)");
+                    "(docs/eval.md), and the flicker measure when --input (or the reference) has motion. Alone, or "
+                    "with --no-reference: a sequence to judge without a reference (the flicker measure)");
     cmd->add_option("images", a->images, "Images (or, with --sequence, sequence directories) to compare");
+    addFlickerOptions(*cmd, a->noReference, a->input);  // --no-reference, --input
     cmd->add_option("--video", a->video,
                     "With --sequence: write an .mp4 of the sequences and the reference side by side, each labelled "
                     "with its folder's name (needs ffmpeg)");

@@ -18,6 +18,7 @@
 #include "commands.h"
 #include "atrous/timer.h"
 #include "denoise_sequence.h"
+#include "still_output.h"
 #include "atrous/srgb.h"
 #include "atrous/io/buffer_set.h"
 #include "atrous/io/image_io.h"
@@ -156,13 +157,6 @@ io::BufferFiles bufferFiles(const DenoiseArgs& a) {
 void srgbToLinear(Image& img) {
     for (size_t i = 0; i < img.plane() * size_t(img.channels()); ++i) img.data()[i] = srgbDecode(img.data()[i]);
 }
-void linearToSrgb(Image& img) {
-    for (size_t i = 0; i < img.plane() * size_t(img.channels()); ++i) img.data()[i] = srgbEncode(img.data()[i]);
-}
-void clampUnit(Image& img) {
-    for (size_t i = 0; i < img.plane() * size_t(img.channels()); ++i)
-        img.data()[i] = std::min(std::max(img.data()[i], 0.0f), 1.0f);
-}
 
 // --spatial, the still method of a sequence method that ends with one (`row`): whether it applies;
 // InputError when it was given to another method or names no still method.
@@ -254,11 +248,13 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     };
     Timer readTimer;
     io::BufferSet set = io::loadBuffers(files);
+    // LDR colour, alpha, no finite pixel (still_output.h): checked before anything is denoised.
+    const StillExtras extras = readStillExtras(files, set, a.ldr);
     const double readMs = readTimer.ms();
     if (!a.addPass.empty() && (!set.layered || ext != ".exr"))
         throw InputError("--add-pass '" + a.addPass + "' writes a copy of a layered EXR: give --in FILE.exr and --out COPY.exr");
     Image& color = set.image[int(io::Buffer::Color)];
-    if (a.srgb) srgbToLinear(color);
+    if (a.srgb && !extras.ldrFile) srgbToLinear(color);  // an 8-bit file is decoded by its reader
     const int width = color.width(), height = color.height();
     const bool albedoGiven = set.get(io::Buffer::Albedo) != nullptr;
     // The colour, variance and emission were read to be denoised: the filter works in their
@@ -282,13 +278,14 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
         }, ""));
     }
     const double ms = t.ms();
-    Image& out = result.image;
     const DenoiseReport& rep = result.report;
-    if (a.ldr) clampUnit(out);
-    if (a.srgb) linearToSrgb(out);
+    bool alphaDropped = false;
+    const Image out = stillOutput(std::move(result.image), extras, a.srgb, a.out, &alphaDropped);
     Timer writeTimer;
     if (!a.addPass.empty())
-        io::writeExrWithLayers(a.out, *set.layered, {io::ExrOutLayer{a.addPass, &out}});
+        io::writeExrWithLayers(a.out, *set.layered,
+                               {io::ExrOutLayer{a.addPass, &out, out.channels() == 4 ? std::vector<std::string>{"R", "G", "B", "A"}
+                                                                                    : std::vector<std::string>{"R", "G", "B"}}});
     else
         atrous::writeImage(a.out, out);
     const double writeMs = writeTimer.ms();
@@ -303,6 +300,7 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
         std::printf("denoise: no variance buffer: noise estimated from the image, per pixel (docs/algorithms.md), at least "
                     "the global MAD sigma = %.4g %.4g %.4g%s\n",
                     rep.noiseSigma[0], rep.noiseSigma[1], rep.noiseSigma[2], albedoGiven && o.demodulate ? " (of the demodulated colour)" : "");
+    std::printf("%s", stillExtrasLines(extras, a.out, alphaDropped).c_str());
     if (rep.nonFinitePixels > 0)
         std::printf("denoise: %d pixels had NaN/Inf colour, treated as missing\n", rep.nonFinitePixels);
     if (o.firefly.enabled)
@@ -351,9 +349,11 @@ void addDenoiseCommand(CLI::App& app) {
     cmd->add_option("--end", a->range.end, "With --sequence: the last frame number to denoise (default: the last)");
     cmd->add_option("--step", a->range.step, "With --sequence: denoise every step-th frame from --start")
         ->capture_default_str();
-    cmd->add_option("--color,--hdr", a->color, "Noisy colour (EXR/PFM; --hdr as in oidnDenoise)");
+    cmd->add_option("--color,--hdr", a->color, "Noisy colour (EXR/PFM, HDR; --hdr as in oidnDenoise). An 8-bit PNG/JPEG is LDR: sRGB-decoded to [0, 1], "
+                    "denoised, clamped to [0, 1] (docs/inputs.md, \"LDR input\"); its alpha, like an EXR's, is passed through");
     cmd->add_option("--ldr", a->ldrColor, "Noisy LDR colour in [0, 1] (oidnDenoise's --ldr): the output is clamped to [0, 1]");
-    cmd->add_flag("--srgb", a->srgb, "With --ldr: the colour is sRGB-encoded (decoded before, encoded after)");
+    cmd->add_flag("--srgb", a->srgb, "With --ldr: the colour is sRGB-encoded (decoded before, encoded after; a PNG/JPEG always is, and a "
+                  ".png output is always encoded)");
     cmd->add_option("--variance", a->variance, "Per-channel variance of the pixel mean")->group(kGroupBuffers);
     cmd->add_option("--albedo,--alb", a->albedo, "Albedo buffer (a layered EXR: its albedo pass)")->group(kGroupBuffers);
     cmd->add_option("--normal,--nrm", a->normal, "Normal buffer, world or camera space")->group(kGroupBuffers);

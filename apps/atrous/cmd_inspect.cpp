@@ -171,6 +171,12 @@ void run(const InspectArgs& a) {
     }
     if (!m.pass[size_t(io::Buffer::Color)].found())
         std::printf("no colour pass: name one with --pass color=LAYER\n");
+    std::string moments;
+    for (const io::ExrLayer& l : info.layers)
+        if (io::isSecondMomentLayer(l)) moments += (moments.empty() ? "" : ", ") + l.name;
+    if (!moments.empty())
+        std::printf("not taken: %s (Mitsuba's moment integrator: second moments of the samples, not buffers)\n",
+                    moments.c_str());
     if (set) {
         for (const std::string& n : set->notes) std::printf("note: %s\n", n.c_str());
         exportBuffers(*set, a.exportDir);

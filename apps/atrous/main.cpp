@@ -1,6 +1,7 @@
 // atrous: render noisy images with denoiser buffers, denoise them, compare against references.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -33,6 +34,32 @@ std::vector<std::string> pluginArgs(int argc, char** argv) {
         else if (!a.empty() && a[0] != '-') break;  // the command: its own flags follow
     }
     return files;
+}
+
+// " (did you mean --levels?)" for the first --flag of the command line that its command does not
+// take, when one of the command's flags is a slip away (param_table.h, closestName); else "".
+std::string flagSuggestion(CLI::App& app, int argc, char** argv) {
+    CLI::App* cmd = nullptr;
+    for (int i = 1; i < argc && !cmd; ++i) {
+        if (argv[i][0] == '-') continue;
+        try {
+            cmd = app.get_subcommand(argv[i]);
+        } catch (const CLI::OptionNotFound&) {
+        }
+    }
+    if (!cmd) return "";
+    std::vector<std::string> names;
+    for (const CLI::Option* o : cmd->get_options())
+        for (const std::string& n : o->get_lnames()) names.push_back("--" + n);
+    for (int i = 1; i < argc; ++i) {
+        std::string a = argv[i];
+        if (a.rfind("--", 0) != 0) continue;
+        a = a.substr(0, a.find('='));
+        if (a == "--plugin" || std::find(names.begin(), names.end(), a) != names.end()) continue;
+        const std::string n = atrous::closestName(a, names);
+        if (!n.empty()) return " (did you mean " + n + "?)";
+    }
+    return "";
 }
 
 }  // namespace
@@ -73,6 +100,11 @@ int main(int argc, char** argv) {
         return app.exit(e);
     } catch (const CLI::CallForVersion& e) {
         return app.exit(e);
+    } catch (const CLI::ExtrasError& e) {
+        // An unknown flag: one line, the nearest flag of the command when it is a slip away.
+        std::fprintf(stderr, "atrous: error: %s%s (see --help)\n", oneLine(e.what()).c_str(),
+                     flagSuggestion(app, argc, argv).c_str());
+        return 2;
     } catch (const CLI::ParseError& e) {
         // Bad flags are bad input: one line, exit code 2.
         std::fprintf(stderr, "atrous: error: %s (see --help)\n", oneLine(e.what()).c_str());

@@ -10,17 +10,19 @@
 namespace atrous {
 
 // Reads an EXR, PFM, PNG, JPEG, HDR, BMP or TGA file as a planar host Image in linear RGB (3
-// channels unless asked for fewer). EXR needs R,G,B channels (A is ignored), or Y, or exactly one
-// channel (grey, repeated into R,G,B); PFM may be colour or grey; 8-bit formats are converted from
-// sRGB to linear. Throws InputError naming the file and the problem for a missing, unreadable,
+// channels unless asked for fewer). EXR needs R,G,B channels (A is not read here: readAlpha,
+// atrous/io/alpha.h), or Y, or exactly one channel (grey, repeated into R,G,B); PFM may be colour or
+// grey; 8- and 16-bit formats (PNG, JPEG, BMP, TGA) are converted from sRGB to linear with the sRGB
+// curve (srgb.h: the inverse of the PNG writer's), so their values are in [0, 1]. Throws InputError naming the file and the problem for a missing, unreadable,
 // truncated or oddly-shaped file (every EXR reader's size rule: src/io/exr_limits.h).
 // `sourceChannels`, when given, receives how many distinct channels the file held: 1 for grey (one
 // EXR channel, Y, a grey PFM or PNG), else 3. `channels` (1..3) keeps the first channels only (a
 // depth file's R, an ids file's R and G): an EXR decodes no others.
 Image readImage(const std::string& path, int* sourceChannels = nullptr, int channels = 3);
 
-// Writes `img` (1 or 3 channels) by the file's extension: .exr (32-bit float R,G,B, ZIP
-// compressed), .pfm, or .png (8-bit sRGB preview of clamp(v, 0, 1)). An image on the GPU is
+// Writes `img` (1, 3 or 4 channels; a 4th is alpha) by the file's extension: .exr (32-bit float
+// R,G,B and A, ZIP compressed), .pfm (no alpha: a 4-channel image is an InputError), or .png (8-bit
+// sRGB preview of clamp(v, 0, 1); alpha as 8-bit linear coverage). An image on the GPU is
 // copied to the host first. The write is atomic: the file is written under a temporary name in
 // the same directory and renamed, so a failure never leaves half a file under `path`.
 // Throws InputError naming the file for an unknown extension, an unwritable directory or an

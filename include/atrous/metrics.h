@@ -1,7 +1,9 @@
-// Image-quality metrics against a reference (docs/eval.md, "What is measured"). All inputs are linear HDR RGB
+// Image-quality metrics against a reference (docs/eval.md, "What is measured"), and one without
+// (computeFlicker: a sequence's frame-to-frame change where the motion vectors reproject). All inputs are linear HDR RGB
 // host images of the same size; non-finite pixels count as errors (they are replaced by 0 before
 // comparing, so a NaN in the image shows up as a large error instead of poisoning the mean).
 #pragma once
+#include "atrous/buffers.h"
 #include "atrous/image.h"
 
 namespace atrous {
@@ -31,6 +33,24 @@ struct TemporalMetrics {
 };
 TemporalMetrics computeTemporalMetrics(const Image& image, const Image& previous, const Image& reference,
                                        const Image& previousReference);
+
+// The reference-free flicker of one step of a sequence (docs/temporal.md, "Flicker without a
+// reference"): frame t's `image` against frame t-1's `previous` warped onto t by the motion vectors
+// of `guide` (frame t's buffers: motion previous - current in pixels, and the depth, normal and ids
+// where it has them; atrous/buffers.h), each bilinear tap kept only where the offline temporal
+// filter's reprojection test holds between `guide` and `previousGuide` (frame t-1's): equal ids,
+// depth within 2x the local depth gradient + 1%, normals within cos 0.9. A pixel without motion, or
+// whose kept taps weigh under half the footprint, is left out. relMse = the mean, over the pixels
+// that reproject and the channels, of (x - w)² / (((x + w) / 2)² + 0.01), with w the warped
+// previous value (temporal relMSE with the reference's difference taken as 0: what does not
+// reproject, and a surface whose true colour changes, are not told apart from flicker);
+// reprojected = the fraction of the pixels that reproject (relMse 0 when none does). Non-finite
+// values count as 0. Throws InputError when sizes differ, an image is empty or guide has no motion.
+struct FlickerMetrics {
+    double relMse = 0;
+    double reprojected = 0;
+};
+FlickerMetrics computeFlicker(const Image& image, const Image& previous, const Frame& guide, const Frame& previousGuide);
 
 // Tonemap used by PSNR/SSIM: clamp(pow(x/(1+x), 1/2.2), 0, 1) (x < 0 → 0).
 float tonemapForMetrics(float x);

@@ -107,6 +107,59 @@ ParamRef at2(typename ClassOf<decltype(Outer)>::type& s) {
 
 // ---- what the consumers share -------------------------------------------------------------------
 
+// The name of `names` closest to `got` (an unknown parameter, flag or keyword) by edit distance
+// (insertions, deletions, substitutions and swaps of neighbours, each 1; case, '-' and '_' ignored),
+// when it is near enough to be a slip: at most 2 edits, and fewer than half of `got`'s length. ""
+// when none is. For "did you mean ...?" after an unknown name (Python's keywords, the CLI's flags).
+inline std::string closestName(const std::string& got, const std::vector<std::string>& names) {
+    auto norm = [](std::string s) {
+        for (char& c : s) c = c == '-' ? '_' : char(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
+        return s;
+    };
+    const std::string a = norm(got);
+    std::string best;
+    size_t bestD = std::min<size_t>(3, (a.size() + 1) / 2);  // a candidate must beat this
+    for (const std::string& name : names) {
+        const std::string b = norm(name);
+        // Optimal string alignment distance, three rows.
+        std::vector<size_t> p2(b.size() + 1), p1(b.size() + 1), cur(b.size() + 1);
+        for (size_t j = 0; j <= b.size(); ++j) p1[j] = j;
+        for (size_t i = 1; i <= a.size(); ++i) {
+            cur[0] = i;
+            for (size_t j = 1; j <= b.size(); ++j) {
+                cur[j] = std::min({p1[j] + 1, cur[j - 1] + 1, p1[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+                if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) cur[j] = std::min(cur[j], p2[j - 2] + 1);
+            }
+            p2.swap(p1);
+            p1.swap(cur);
+        }
+        if (p1[b.size()] < bestD) bestD = p1[b.size()], best = name;
+    }
+    return best;
+}
+
+// " (did you mean 'NAME'?)" for closestName's answer, with `quote` around it; "" when there is none.
+inline std::string didYouMean(const std::string& got, const std::vector<std::string>& names, const char* quote = "'") {
+    const std::string n = closestName(got, names);
+    return n.empty() ? "" : std::string(" (did you mean ") + quote + n + quote + "?)";
+}
+
+// Every name a table's rows take in Python: the row's name, and a negated switch's CLI name as a
+// keyword (--no-firefly: no_firefly).
+template <class S>
+std::vector<std::string> paramKeywords(const ParamTable<S>& t) {
+    std::vector<std::string> names;
+    for (const ParamField<S>& f : t) {
+        names.push_back(f.name);
+        if (!f.negated || t.flag(f).size() < 3) continue;
+        std::string k = t.flag(f).substr(2);
+        for (char& c : k)
+            if (c == '-') c = '_';
+        names.push_back(k);
+    }
+    return names;
+}
+
 // The shortest text that reads back as the same float: 1e-6, 0.9, 1048576.
 inline std::string formatParamNumber(double v) {
     if (!std::isfinite(v)) return std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf");
@@ -175,14 +228,16 @@ void setParamFromText(S& s, const ParamTable<S>& t, const ParamField<S>& f, cons
         std::string want, norm = text;
         for (char& c : norm)
             if (c == '_') c = '-';
+        std::vector<std::string> names;
         for (int i = 0; f.choices[i]; ++i) {
             if (norm == f.choices[i]) {
                 **m = SureMode(i);
                 return;
             }
             want += std::string(i ? (f.choices[i + 1] ? ", " : " or ") : "") + f.choices[i];
+            names.push_back(f.choices[i]);
         }
-        throw ParamError(t.set, f.name, "must be " + want, "'" + text + "'");
+        throw ParamError(t.set, f.name, "must be " + want, "'" + text + "'" + didYouMean(text, names));
     }
     if (std::vector<float>* const* list = std::get_if<std::vector<float>*>(&r)) {
         std::vector<float> v;

@@ -22,7 +22,11 @@ writes.
 
 Errors from the library arrive as ValueError (bad input: shapes, sizes, parameters, files) or
 RuntimeError (everything else). NaN and Inf in the colour are treated as missing samples; the
-output is always finite.
+output is always finite (a colour with no finite pixel at all is a ValueError).
+
+Alpha: an H x W x 4 colour's 4th channel is alpha; :func:`denoise` returns it unchanged beside the
+denoised colour, :func:`read_image` (``alpha=True``) and :func:`write_image` read and write it, as
+``atrous denoise`` passes an RGBA file's alpha through (docs/inputs.md, "Alpha").
 """
 from __future__ import annotations
 
@@ -279,12 +283,14 @@ def denoise(
     method: str = "auto",
     device: str = "auto",
     learned_weights: Union["PathLike", "Weights", None] = None,
+    ldr: bool = False,
     **params: Any,
 ) -> Any:
     """Denoises a Monte Carlo rendering with EAW, SURE-based À-Trous or the learned à-trous filter.
 
     The buffers and their conventions are :func:`buffers`' (one table for the renderer, the
-    readers and every denoiser). color: H x W x 3 mean radiance (linear HDR). variance: the
+    readers and every denoiser). color: H x W x 3 mean radiance (linear HDR), or H x W x 4 with
+    alpha: the alpha is not denoised and comes back as it was (the same float32 values). variance: the
     variance of that mean per channel (not the sample variance); without it the noise is estimated
     from the image. albedo, normal (world-space, unit), position (world-space), depth (view depth,
     channel 0), ids (object id, and the material id in a second channel when given; -1
@@ -302,12 +308,17 @@ def denoise(
     it. device: "auto" (the arrays' device: CUDA arrays on the GPU, numpy on
     the CPU), "cpu" or "cuda" (numpy inputs are then copied to the GPU and back).
 
+    ldr: the colour is LDR, display-referred values in [0, 1] (what :func:`read_image` returns for
+    an 8-bit PNG or JPEG: its codes through the sRGB curve), as OIDN's hdr=False: the output is
+    clamped to [0, 1], and a variance is refused (ValueError); `atrous denoise --color FILE.png` does
+    this for an 8-bit file by itself (docs/inputs.md, "LDR input").
+
     params: the filter parameters, the rows of :func:`denoise_params` (the CLI's flags with '_'
     for '-'; docs/denoising.md gives their meaning and defaults):
 
 {params}
 
-    Returns the denoised H x W x 3 float32 image as the same kind of array as `color`.
+    Returns the denoised H x W x 3 (x 4 with alpha) float32 image as the same kind of array as `color`.
     """
     known = __getattr__("METHODS")
     if method not in known:
@@ -315,7 +326,13 @@ def denoise(
     if device not in ("auto", "cpu", "cuda"):
         raise ValueError(f"unknown device '{device}' (expected auto, cpu or cuda)")
     weights = _weights_arg(learned_weights)
-    c = _prepare(color, "color", allow_gray=False)
+    c = _prepare(color, "color", allow_gray=False, channels=(3, 4))
+    alpha = None
+    if c.shape[2] == 4:
+        c, alpha = c[:, :, :3], c[:, :, 3:]
+    if ldr and variance is not None:
+        raise ValueError("variance: ldr=True takes no variance (the variance of display-encoded values is not the "
+                         "variance of the pixel mean atrous filters with); give the HDR colour with it, or drop it")
     bufs = {
         name: _prepare(val, name, channels=(2, 3) if name == "ids" else (3,))
         for name, val in (("albedo", albedo), ("normal", normal), ("position", position),
@@ -326,7 +343,7 @@ def denoise(
     if device == "cuda" and not on_gpu:
         if not cuda_available():
             raise ValueError("device='cuda': no usable CUDA backend or GPU in this build")
-        return _denoise_numpy_on_gpu(c, bufs, method, weights, params)
+        return _finish(_denoise_numpy_on_gpu(c, bufs, method, weights, params), ldr, alpha)
     if device == "cpu" and on_gpu:
         raise ValueError("device='cpu' with CUDA arrays: move them to the host first")
     for name, b in bufs.items():
@@ -334,7 +351,33 @@ def denoise(
             raise ValueError(f"{name}: lives on a different device than color")
     out = _core.denoise(c, bufs["albedo"], bufs["normal"], bufs["position"], bufs["depth"],
                         bufs["variance"], bufs["ids"], bufs["emission"], method, weights, dict(params))
-    return _wrap_like(out, color)
+    return _finish(_wrap_like(out, color), ldr, alpha)
+
+
+def _finish(out: Any, ldr: bool, alpha: Any) -> Any:
+    """denoise's output: clamped to [0, 1] for LDR input, the colour's alpha added back unchanged."""
+    fw = _framework(out)
+    if ldr:
+        if fw == "torch":
+            out = out.clamp_(0.0, 1.0)
+        elif fw == "cupy":  # pragma: no cover - needs a GPU
+            import cupy
+
+            cupy.clip(out, 0.0, 1.0, out=out)
+        else:
+            np.clip(out, 0.0, 1.0, out=out)
+    if alpha is None:
+        return out
+    if fw == "torch":
+        import torch
+
+        a = alpha if _framework(alpha) == "torch" else torch.from_numpy(np.ascontiguousarray(alpha))
+        return torch.cat([out, a.to(out.device)], dim=2)
+    if fw == "cupy":  # pragma: no cover - needs a GPU
+        import cupy
+
+        return cupy.concatenate([out, cupy.asarray(alpha)], axis=2)
+    return np.concatenate([out, np.asarray(alpha)], axis=2)
 
 
 def learned_planes(color: Any, variance: Any = None, albedo: Any = None, normal: Any = None,
@@ -417,16 +460,19 @@ def render_sequence(scene: str, frames: int, *, camera_path: str = "auto", spp: 
 PathLike = Union[str, "os.PathLike[str]"]
 
 
-def read_image(path: PathLike) -> np.ndarray:
+def read_image(path: PathLike, *, alpha: bool = False) -> np.ndarray:
     """Reads an image file as an H x W x 3 float32 numpy array (linear RGB).
 
-    The format follows the extension, read by the C++ library: .exr (OpenEXR: R, G, B channels,
-    A ignored; or Y, or a single channel, repeated into R, G, B; any compression and pixel type
-    OpenEXR reads), .pfm (colour or grey), .png/.jpg/.hdr (8-bit files converted from sRGB to
-    linear). Raises ValueError naming the file when it is missing, unreadable, truncated, not an
-    image or has channels that do not make RGB.
+    The format follows the extension, read by the C++ library: .exr (OpenEXR: R, G, B channels;
+    or Y, or a single channel, repeated into R, G, B; any compression and pixel type OpenEXR
+    reads), .pfm (colour or grey), .png/.jpg (8- and 16-bit files through the sRGB curve into
+    linear [0, 1]: LDR, see :func:`denoise`'s ldr; the exact inverse of :func:`write_image`'s PNG),
+    .hdr. alpha=True: H x W x 4 when the file has an alpha channel (an EXR's A beside the colour, a
+    PNG's alpha), the alpha as stored; H x W x 3 when it has none. Raises ValueError naming the file
+    when it is missing, unreadable, truncated, not an image, has channels that do not make RGB, or
+    an alpha channel of another size than the colour.
     """
-    return _core.read_image(os.fsdecode(os.fspath(path)))
+    return _core.read_image(os.fsdecode(os.fspath(path)), bool(alpha))
 
 
 def read_buffers(path: PathLike, *, passes: Optional[Dict[str, str]] = None, layer: str = "",
@@ -451,18 +497,20 @@ def read_buffers(path: PathLike, *, passes: Optional[Dict[str, str]] = None, lay
 
 
 def write_image(path: PathLike, image: Any) -> None:
-    """Writes an H x W x 3 (or H x W / H x W x 1 grey) image by the file's extension.
+    """Writes an H x W x 3 (or H x W / H x W x 1 grey, or H x W x 4 with alpha) image by the file's
+    extension.
 
-    .exr: 32-bit float R, G, B, ZIP compressed (lossless: :func:`read_image` returns the same
-    float32 values; grey is written into all three channels); .pfm: colour or grey; .png: an 8-bit
-    sRGB preview (clamped to [0, 1]). The array rule of the module docstring applies (other float
+    .exr: 32-bit float R, G, B (and A), ZIP compressed (lossless: :func:`read_image` returns the same
+    float32 values; grey is written into all three channels); .pfm: colour or grey (no alpha: an
+    H x W x 4 image is a ValueError); .png: an 8-bit sRGB preview (clamped to [0, 1]; alpha as 8-bit
+    linear coverage). The array rule of the module docstring applies (other float
     dtypes are converted to float32, integers are rejected). The file is written under a temporary
     name and renamed, so a failure never leaves half a file. Raises ValueError naming the file for
     a bad shape or dtype, an unknown extension or a directory that does not exist or cannot be
     written; RuntimeError when the encoder itself fails.
     """
     p = os.fsdecode(os.fspath(path))
-    _core.write_image(p, _prepare(image, p))
+    _core.write_image(p, _prepare(image, p, channels=(3, 4)))
 
 
 def _list_params(rows) -> str:

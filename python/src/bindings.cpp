@@ -36,6 +36,7 @@ using namespace atrous;
 namespace atrous::python {
 void bindMethods(nb::module_& m);  // methods.cpp: register_method
 void bindMetrics(nb::module_& m);  // metrics.cpp: metrics, temporal_metrics
+void bindFiles(nb::module_& m);    // files.cpp: read_image, read_buffers, write_image
 void bindVocabulary(nb::module_& m);  // vocabulary.cpp: buffers, Weights, load_weights
 void bindSequence(nb::module_& m);    // sequence.cpp: the sequence methods, their streams, denoise_sequence
 LearnedWeights weightsFrom(nb::handle h);  // vocabulary.cpp: None, "", a path or a Weights
@@ -98,6 +99,7 @@ nb::object pyDenoise(const Array& color, nb::handle albedo, nb::handle normal, n
                      nb::handle learnedWeights, nb::dict params) {
     using B = io::Buffer;
     Image c = toImage(color, "color");
+    io::requireFinitePixel(c, "");  // host arrays; CUDA ones are not looked at here
     Buffers b(c);
     b.add({{albedo, B::Albedo, "albedo"}, {normal, B::Normal, "normal"}, {position, B::Position, "position"},
            {depth, B::Depth, "depth"}, {variance, B::Variance, "variance"}, {ids, B::ObjectId, "ids"},
@@ -148,17 +150,6 @@ nb::dict pyLearnedPlanes(const Array& color, nb::handle variance, nb::handle alb
 }
 
 // One render's files (readRenderFiles, include/atrous/io.h) as a dict of host arrays by buffer name.
-nb::dict pyReadBuffers(const std::string& path, const std::vector<std::string>& passes, const std::string& layer) {
-    RenderFiles r;
-    {
-        nb::gil_scoped_release release;
-        r = readRenderFiles(path, passes, layer);
-    }
-    nb::dict d;
-    for (auto& [name, img] : r.buffers) d[name.c_str()] = fromImage(std::move(img));
-    return d;
-}
-
 // Python's keywords are the render table's rows (params.h); the library validates the ranges.
 RenderSettings renderSettings(nb::dict params) {
     RenderSettings rs;
@@ -209,30 +200,6 @@ nb::dict pyRenderFrame(const std::string& scene, int frame, int frames, const st
     return d;
 }
 
-// Image files go through the library's readers and writers (OpenEXR, PFM, stb), so Python reads
-// exactly what the CLI writes and the other way round; errors name the file (InputError).
-nb::object pyReadImage(const std::string& path) {
-    Image img;
-    {
-        nb::gil_scoped_release release;
-        img = atrous::readImage(path);
-    }
-    return fromImage(std::move(img));
-}
-
-// `image` is H x W x 3, H x W x 1 or H x W float32 (python/atrous/__init__.py converts other float
-// dtypes); one channel stays one channel so that PFM writes grey ("Pf") and EXR repeats it.
-void pyWriteImage(const std::string& path, const Array& image) {
-    const int channels = image.ndim() == 3 ? int(image.shape(2)) : 1;
-    if (image.ndim() == 3 && channels != 1 && channels != 3)
-        throw InputError(path + ": expected an array of shape (H, W, 3), (H, W, 1) or (H, W), got " +
-                         std::to_string(channels) + " channels");
-    Image img = toImage(image, path.c_str(), channels);
-    if (img.device() != Device::Cpu) img = img.to(Device::Cpu);  // the writers read host memory
-    nb::gil_scoped_release release;
-    atrous::writeImage(path, img);
-}
-
 // Library errors name the field (`max_depth`, `device`, `camera_path`: ParamError) or the file,
 // never a CLI flag, so Python shows them as they are: the field is the keyword.
 }  // namespace
@@ -260,9 +227,7 @@ NB_MODULE(_core, m) {
     m.def("render", &pyRender, nb::arg("scene"), nb::arg("params"));
     m.def("render_frame", &pyRenderFrame, nb::arg("scene"), nb::arg("frame"), nb::arg("frames"), nb::arg("camera_path"),
           nb::arg("params"));
-    m.def("read_image", &pyReadImage, nb::arg("path"));
-    m.def("read_buffers", &pyReadBuffers, nb::arg("path"), nb::arg("passes"), nb::arg("layer"));
-    m.def("write_image", &pyWriteImage, nb::arg("path"), nb::arg("image"));
+    atrous::python::bindFiles(m);  // files.cpp: read_image, read_buffers, write_image
     m.def("denoise_params", [] { return paramRows(denoiseParams()); });
     // The still methods (denoiseMethods()): atrous.METHODS and the rows of atrous.denoise_methods().
     m.def("denoise_methods", &stillMethodRows);

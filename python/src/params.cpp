@@ -47,7 +47,14 @@ void applyParam(ParamSet& set, const std::string& k, const nb::handle& v, const 
     bool negate = false;
     for (size_t i = 0; row < 0 && i < set.rows().size(); ++i)
         if (set.rows()[i].negated && k == pyAlias(set.rows()[i])) row = int(i), negate = true;
-    if (row < 0) throw InputError("unknown " + std::string(what) + " parameter '" + k + "'");
+    if (row < 0) {
+        std::vector<std::string> names;  // every keyword the set takes, for a did-you-mean
+        for (const ParamRow& f : set.rows()) {
+            names.push_back(f.name);
+            if (f.negated) names.push_back(pyAlias(f));
+        }
+        throw InputError("unknown " + std::string(what) + " parameter '" + k + "'" + didYouMean(k, names));
+    }
     const ParamRow& f = set.rows()[size_t(row)];
     const ParamRef r = set.at(size_t(row));
     if (int* const* n = std::get_if<int*>(&r)) **n = as<int>(v, k);

@@ -21,8 +21,10 @@ renderer wrote it ("" is what a user gets without --method). Corpus sequences ar
 OIDN (pyoidn, HDR, colour + albedo + normal) runs per frame on the buffers the corpus loaders read
 (atrous.eval corpus (python/atrous/eval/corpus.py)) or on the frame's color/albedo/normal.exr. The metrics are `atrous
 compare --sequence`'s, over all pixels and again with the pixels that show a light (reference
-luminance above LIGHT_LUM in any frame, grown by a pixel) left out. Runs in the project venv
-(.venv: numpy, pyoidn, atrous).
+luminance above LIGHT_LUM in any frame, grown by a pixel) left out, and the reference-free flicker
+measure (`compare --input SEQ`: each frame against the one before it, warped by the noisy
+sequence's motion) with how often it orders two variants as the temporal relMSE does. Runs in the
+project venv (.venv: numpy, pyoidn, atrous).
 """
 import argparse
 import json
@@ -162,10 +164,25 @@ def atrous_write(path, img):
     atrous.write_image(str(path), np.ascontiguousarray(img, np.float32))
 
 
-def compare(cli, ref, outs):
-    r = subprocess.run([cli, "compare", "--sequence", str(ref)] + [str(o) for o in outs] + ["--json"],
-                       capture_output=True, text=True, check=True)
+def compare(cli, ref, outs, guide=None):
+    """`atrous compare --sequence REF OUTS --json`; with guide (the noisy sequence) also the
+    reference-free flicker measure, the frames placed by the guide's motion (--input)."""
+    extra = ["--input", str(guide)] if guide else []
+    r = subprocess.run([cli, "compare", "--sequence", str(ref)] + [str(o) for o in outs] + ["--json", "--no-flip",
+                       "--no-cvvdp"] + extra, capture_output=True, text=True, check=True)
     return json.loads(r.stdout)
+
+
+def pair_agreement(r, names, a="temporal_relmse", b="flicker"):
+    """Of the pairs of variants, how many `a` and `b` order alike (ties count half)."""
+    agree = pairs = 0.0
+    for i in range(len(names)):
+        for j in range(i + 1, len(names)):
+            da = r[names[i]][a] - r[names[j]][a]
+            db = r[names[i]][b] - r[names[j]][b]
+            pairs += 1
+            agree += 1.0 if da * db > 0 else 0.5 if da * db == 0 else 0.0
+    return agree, pairs
 
 
 def main():
@@ -202,8 +219,10 @@ def main():
             o = Path(tmp) / name / "oidn_high_per_frame"
             oidn_per_frame(scene, seq, o)
             outs.append(o)
-            rows = compare(a.cli, ref, outs)
-            r = {Path(x["path"]).name: {k: x[k] for k in ("relmse", "temporal_relmse", "psnr")} for x in rows["sequences"]}
+            rows = compare(a.cli, ref, outs, guide=seq)
+            r = {Path(x["path"]).name: {k: x[k] for k in ("relmse", "temporal_relmse", "psnr", "flicker")}
+                 for x in rows["sequences"]}
+            r["reference_flicker"] = rows.get("reference_flicker")
             # The same with the pixels that show a light left out (their error set to 0, the means
             # taken over the other pixels).
             refs = [np.asarray(b["color"], np.float32) for _, b in frame_buffers(scene, seq, ref=True)]
@@ -242,6 +261,19 @@ def main():
             extra = f" ({100 * r['light_pixels']:.1f}% left out)" if key else ""
             print(f"| {s}{extra} | " + " | ".join(
                 f"{r[n]['relmse' + key]:.4f} / {r[n]['temporal_relmse' + key]:.4f}" for n in names) + " |")
+    # The reference-free flicker (compare --no-reference's measure, the frames placed by the noisy
+    # sequence's own motion) beside the temporal error it stands in for, and how often the two rank
+    # a pair of variants alike.
+    print("\ntemporal relMSE / flicker (no reference), and the pairs of variants the two order alike:\n")
+    print("| sequence | " + " | ".join(names) + " | reference's flicker | pairs alike |")
+    print("|---" * (len(names) + 3) + "|")
+    total_agree = total_pairs = 0.0
+    for s, r in results.items():
+        agree, pairs = pair_agreement(r, names)
+        total_agree, total_pairs = total_agree + agree, total_pairs + pairs
+        print(f"| {s} | " + " | ".join(f"{r[n]['temporal_relmse']:.4f} / {r[n]['flicker']:.4f}" for n in names) +
+              f" | {r['reference_flicker']:.4f} | {agree:g} of {pairs:g} |")
+    print(f"\npairs ordered alike: {total_agree:g} of {total_pairs:g}")
     if a.json:
         a.json.write_text(json.dumps(results, indent=1))
 

@@ -1,11 +1,16 @@
 // Metrics of docs/eval.md, "What is measured" (MSE, relMSE, tonemapped PSNR, SSIM of tonemapped luminance).
 #include "atrous/metrics.h"
 
+#include "atrous/temporal.h"
+
 #include <cmath>
 #include <string>
 #include <vector>
 
 #include "atrous/error.h"
+#include "core/parallel.h"
+#include "filters/flicker.h"
+#include "filters/svgf_gbuffer.h"
 
 namespace atrous {
 
@@ -68,6 +73,63 @@ TemporalMetrics computeTemporalMetrics(const Image& a, const Image& a0, const Im
     TemporalMetrics m;
     m.relMse = rel / n;
     m.psnr = tse > 0 ? 10.0 * std::log10(n / tse) : 100.0;  // as computeMetrics: equal differences capped at 100 dB
+    return m;
+}
+
+namespace {
+
+// A frame's G-buffer as the temporal filter's hop reads it (svgf_gbuffer.h: missing buffers take
+// the sanitiser's defaults, which every test passes), owned here.
+struct Guide {
+    Image depth, normal, ids, motion, grad;
+    temporal::FrameViews views(const Image& image) const {
+        temporal::FrameViews v;
+        v.depth = depth.view(), v.normal = normal.view(), v.ids = ids.view(), v.motion = motion.view(), v.grad = grad.view();
+        v.color = image.view();
+        return v;
+    }
+};
+
+ImageView viewOf(const Image* img) { return img && !img->empty() ? img->view() : ImageView{}; }
+
+Guide sanitise(const CpuExec& exec, const Frame& f, int w, int h) {
+    for (const Image* b : {f.depth, f.normal, f.ids, f.motion})
+        if (b && !b->empty() && (b->width() != w || b->height() != h))
+            throw InputError("a buffer of the frames that place the sequence is " + std::to_string(b->width()) + "x" +
+                             std::to_string(b->height()) + " but the images are " + std::to_string(w) + "x" + std::to_string(h));
+    Guide g;
+    g.depth = Image::uninitialized(w, h, 1), g.normal = Image::uninitialized(w, h, 3), g.ids = Image::uninitialized(w, h, 1);
+    g.motion = Image::uninitialized(w, h, 2), g.grad = Image::uninitialized(w, h, 2);
+    exec.forEachPixel(w, h, svgf::SanitizeGbuffer{viewOf(f.depth), viewOf(f.normal), viewOf(f.ids), viewOf(f.motion),
+                                                  g.depth.view(), g.normal.view(), g.ids.view(), g.motion.view()});
+    exec.forEachPixel(w, h, svgf::DepthGradient{g.depth.view(), g.grad.view()});
+    return g;
+}
+
+}  // namespace
+
+FlickerMetrics computeFlicker(const Image& image, const Image& previous, const Frame& guide, const Frame& previousGuide) {
+    checkPair(image, previous);
+    if (!guide.motion || guide.motion->empty() || guide.motion->channels() < 2)
+        throw InputError("the flicker measure needs the frames' motion vectors (2 channels)");
+    const int w = image.width(), h = image.height();
+    const CpuExec exec;
+    const Guide now = sanitise(exec, guide, w, h), before = sanitise(exec, previousGuide, w, h);
+    metrics::FlickerStep step;
+    step.hop.from = now.views(image);
+    step.hop.to = before.views(previous);
+    const TemporalParams defaults;  // the offline filter's tolerances
+    step.hop.depthTolerance = defaults.depthTolerance, step.hop.normalCos = defaults.normalCos;
+    step.image = image.view(), step.previous = previous.view();
+    Image out = Image::uninitialized(w, h, 2);
+    step.out = out.view();
+    exec.forEachPixel(w, h, step);
+    double rel = 0, n = 0;
+    const size_t plane = out.plane();
+    for (size_t i = 0; i < plane; ++i) rel += out.data()[i], n += out.data()[plane + i];
+    FlickerMetrics m;
+    m.reprojected = n / double(plane);
+    m.relMse = n > 0 ? rel / n : 0.0;
     return m;
 }
 

@@ -180,13 +180,15 @@ static Image readExr(const std::string& path, int* sourceChannels, int outChanne
 
 void writeExr(const std::string& path, const Image& img) {
     if (img.device() != Device::Cpu) throw InputError(path + ": writeExr needs a host image");
-    if (img.channels() != 1 && img.channels() != 3)
-        throw InputError(path + ": can only write 1- or 3-channel images, got " + std::to_string(img.channels()));
+    if (img.channels() != 1 && img.channels() != 3 && img.channels() != 4)
+        throw InputError(path + ": can only write 1-, 3- or 4-channel (RGBA) images, got " + std::to_string(img.channels()));
     writeFileAtomically(path, [&](const std::string& tmp) {
-        // 32-bit float R,G,B, ZIP: chunks packed and deflated in parallel (exr_core.h).
+        // 32-bit float R,G,B (and A), ZIP: chunks packed and deflated in parallel (exr_core.h).
         std::vector<const float*> planes;
-        for (int c = 0; c < 3; ++c) planes.push_back(img.view().channel(img.channels() == 3 ? c : 0));
-        writeExrCore(tmp, img.width(), img.height(), {"R", "G", "B"}, planes);
+        for (int c = 0; c < 3; ++c) planes.push_back(img.view().channel(img.channels() >= 3 ? c : 0));
+        std::vector<std::string> names = {"R", "G", "B"};
+        if (img.channels() == 4) names.push_back("A"), planes.push_back(img.view().channel(3));
+        writeExrCore(tmp, img.width(), img.height(), names, planes);
     });
 }
 
@@ -245,6 +247,7 @@ static Image readPfm(const std::string& path, int* sourceChannels) {
 
 void writePfm(const std::string& path, const Image& img) {
     if (img.device() != Device::Cpu) throw InputError(path + ": writePfm needs a host image");
+    if (img.channels() == 4) throw InputError(path + ": PFM has no alpha channel (write .exr or .png to keep it)");
     writeFileAtomically(path, [&](const std::string& tmp) {
         std::ofstream out(tmp, std::ios::binary);
         if (!out) throw RuntimeError(tmp + ": cannot open for writing");
@@ -271,23 +274,43 @@ void writePfm(const std::string& path, const Image& img) {
 void writePng(const std::string& path, const Image& img, float exposure) {
     if (img.device() != Device::Cpu) throw InputError(path + ": writePng needs a host image");
     const int w = img.width(), h = img.height();
-    std::vector<unsigned char> px(size_t(w) * h * 3);
+    // A 4th channel is alpha: written as RGBA, linearly (PNG's rule: code = alpha x 255), no exposure.
+    const int n = img.channels() == 4 ? 4 : 3;
+    std::vector<unsigned char> px(size_t(w) * h * size_t(n));
     for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x)
+        for (int x = 0; x < w; ++x) {
             for (int c = 0; c < 3; ++c) {
-                float v = img(x, y, img.channels() == 3 ? c : 0) * exposure;
+                float v = img(x, y, img.channels() >= 3 ? c : 0) * exposure;
                 if (!std::isfinite(v)) v = 0.0f;
-                px[(size_t(y) * w + x) * 3 + c] = (unsigned char)std::lround(srgbEncode(v) * 255.0f);
+                px[(size_t(y) * w + x) * n + c] = (unsigned char)std::lround(srgbEncode(v) * 255.0f);
             }
+            if (n == 4) {
+                const float a = img(x, y, 3);
+                px[(size_t(y) * w + x) * n + 3] = (unsigned char)std::lround((a > 0.0f ? (a < 1.0f ? a : 1.0f) : 0.0f) * 255.0f);
+            }
+        }
     writeFileAtomically(path, [&](const std::string& tmp) {
-        if (!stbi_write_png(tmp.c_str(), w, h, 3, px.data(), w * 3)) throw RuntimeError(path + ": cannot write PNG");
+        if (!stbi_write_png(tmp.c_str(), w, h, n, px.data(), w * n)) throw RuntimeError(path + ": cannot write PNG");
     });
+}
+
+// The linear value of every 8-bit code: the sRGB curve (srgb.h), the exact inverse of writePng's
+// encode, so a PNG atrous writes reads back as the values it was written from (to a code's
+// rounding). (Until 2026-12-07 the 8-bit formats were read with stb's x^2.2, which put code 13 at
+// 0.0012 instead of 0.0040: docs/decisions.md, "LDR input".)
+static const float* srgbCodes() {
+    static const std::vector<float> lut = [] {
+        std::vector<float> t(256);
+        for (int i = 0; i < 256; ++i) t[size_t(i)] = srgbDecode(float(i) / 255.0f);
+        return t;
+    }();
+    return lut.data();
 }
 
 // A JPEG through libjpeg-turbo (TurboJPEG), not stb: stb_image 2.27's JPEG decoder overruns its
 // Huffman tables, shifts by 32 and asserts on crafted files (found by tests/fuzz/libfuzzer). Warnings
-// (a damaged stream) are errors. 8-bit sRGB to linear as stb's loader does for the other 8-bit
-// formats (x^2.2), so a JPEG and a PNG of the same pixels read alike.
+// (a damaged stream) are errors. 8-bit sRGB to linear as for the other 8-bit formats (srgbCodes),
+// so a JPEG and a PNG of the same pixels read alike.
 static Image readJpeg(const std::string& path, const std::vector<unsigned char>& bytes, int* sourceChannels) {
     struct Handle {
         tjhandle h = tjInitDecompress();
@@ -305,8 +328,7 @@ static Image readJpeg(const std::string& path, const std::vector<unsigned char>&
                       TJFLAG_STOPONWARNING) != 0)
         throw InputError(path + ": corrupt JPEG (" + tjGetErrorStr2(tj.h) + ")");
     if (sourceChannels) *sourceChannels = subsamp == TJSAMP_GRAY ? 1 : 3;
-    float lut[256];
-    for (int i = 0; i < 256; ++i) lut[i] = std::pow(float(i) / 255.0f, 2.2f);
+    const float* lut = srgbCodes();
     Image img = Image::uninitialized(w, h, 3);
     const ImageView v = img.view();
     tbb::parallel_for(0, h, [&](int y) {
@@ -319,52 +341,140 @@ static Image readJpeg(const std::string& path, const std::vector<unsigned char>&
     return img;
 }
 
-static Image readStb(const std::string& path, int* sourceChannels) {
+// An stb-read file (PNG, BMP, TGA, HDR), in memory and checked: its bytes and the header as stb's
+// info call reads it (w, h, n channels in the file).
+struct StbFile {
+    std::vector<unsigned char> bytes;
+    int len = 0, w = 0, h = 0, n = 0;
+};
+
+static StbFile openStb(const std::string& path) {
+    StbFile f;
     // The whole file in memory (its size is what it holds), checked, then decoded from there.
-    std::vector<unsigned char> bytes(static_cast<size_t>(fileSize(path)));
+    f.bytes.resize(static_cast<size_t>(fileSize(path)));
     {
         std::ifstream in(path, std::ios::binary);
-        if (!in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(bytes.size())))
+        if (!in.read(reinterpret_cast<char*>(f.bytes.data()), std::streamsize(f.bytes.size())))
             throw InputError(path + ": cannot read the file");
     }
-    requireFormatOfExtension(path, bytes);
-    const std::string ext = extensionOf(path);
-    if (ext == ".jpg" || ext == ".jpeg") return readJpeg(path, bytes, sourceChannels);
-    checkPngChunks(path, bytes);
-    const int len = bytes.size() > size_t(INT32_MAX) ? INT32_MAX : int(bytes.size());
-    int w = 0, h = 0, n = 0;
+    requireFormatOfExtension(path, f.bytes);
+    return f;
+}
+
+// The header checks of an stb format (not JPEG), then f.w, f.h, f.n as stb reads them.
+static void checkStb(const std::string& path, StbFile& f) {
+    checkPngChunks(path, f.bytes);
+    f.len = f.bytes.size() > size_t(INT32_MAX) ? INT32_MAX : int(f.bytes.size());
     // Every check below needs the header as stb reads it: a file whose header stb's info call
     // cannot read is refused, not handed to its loader (whose header parse differs: a 203-byte .hdr
     // with two FORMAT lines passed to the loader looped for minutes, found by tests/fuzz/libfuzzer).
-    if (!stbi_info_from_memory(bytes.data(), len, &w, &h, &n))
+    if (!stbi_info_from_memory(f.bytes.data(), f.len, &f.w, &f.h, &f.n))
         throw InputError(path + ": cannot read image (" + stbi_failure_reason() + ")");
-    if (sourceChannels) *sourceChannels = n <= 2 ? 1 : 3;  // grey (+ alpha) or colour (+ alpha)
     // stb's BMP info gives a top-down file's height negative; its loader reads it as |h|.
-    if (extensionOf(path) == ".bmp" && h < 0 && h > -65536) h = -h;
-    requireImagePixelsFit(path, bytes, w, h);
-    // stbi_loadf converts 8-bit sRGB to linear (gamma 2.2) and reads Radiance .hdr as is.
-    float* data = stbi_loadf_from_memory(bytes.data(), len, &w, &h, &n, 3);
+    if (extensionOf(path) == ".bmp" && f.h < 0 && f.h > -65536) f.h = -f.h;
+    requireImagePixelsFit(path, f.bytes, f.w, f.h);
+}
+
+// stb's pixels (`channels` interleaved, 8-bit, 16-bit or float) as planes of `img`, each value
+// through conv. The planes are img's first `planes`, from the interleaved channels `from`.
+template <class T, class Conv>
+static void deinterleave(const T* data, int channels, Image& img, int planes, int from, Conv conv) {
+    const ImageView v = img.view();
+    const int w = img.width();
+    tbb::parallel_for(0, img.height(), [&](int y) {
+        for (int c = 0; c < planes; ++c) {
+            float* dst = &v(0, y, c);
+            const T* src = data + size_t(y) * size_t(w) * size_t(channels) + size_t(from + c);
+            for (int x = 0; x < w; ++x) dst[x] = conv(src[size_t(x) * size_t(channels)]);
+        }
+    });
+}
+
+// Decodes f as stb does, `want` channels interleaved (0: as many as the file has), and hands the
+// pixels to use(data, bits) (8, 16 or 32 for float: Radiance .hdr) before freeing them.
+template <class Use>
+static void decodeStb(const std::string& path, const StbFile& f, int want, Use use) {
+    int w = 0, h = 0, n = 0;
+    void* data = nullptr;
+    int bits = 8;
+    if (extensionOf(path) == ".hdr") {
+        data = stbi_loadf_from_memory(f.bytes.data(), f.len, &w, &h, &n, want), bits = 32;
+    } else if (stbi_is_16_bit_from_memory(f.bytes.data(), f.len)) {
+        data = stbi_load_16_from_memory(f.bytes.data(), f.len, &w, &h, &n, want), bits = 16;
+    } else {
+        data = stbi_load_from_memory(f.bytes.data(), f.len, &w, &h, &n, want);
+    }
     if (!data) throw InputError(path + ": cannot read image (" + stbi_failure_reason() + ")");
-    Image img;
     try {
-        img = Image::uninitialized(w, h, 3);
+        use(data, bits);
     } catch (...) {
         stbi_image_free(data);
         throw;
     }
-    const ImageView v = img.view();
-    tbb::parallel_for(0, h, [&](int y) {
-        for (int c = 0; c < 3; ++c) {
-            float* dst = &v(0, y, c);
-            const float* src = data + size_t(y) * size_t(w) * 3 + size_t(c);
-            for (int x = 0; x < w; ++x) dst[x] = src[size_t(x) * 3];
+    stbi_image_free(data);
+}
+
+static Image readStb(const std::string& path, int* sourceChannels) {
+    StbFile f = openStb(path);
+    const std::string ext = extensionOf(path);
+    if (ext == ".jpg" || ext == ".jpeg") return readJpeg(path, f.bytes, sourceChannels);
+    checkStb(path, f);
+    if (sourceChannels) *sourceChannels = f.n <= 2 ? 1 : 3;  // grey (+ alpha) or colour (+ alpha)
+    // Radiance .hdr as is; 8- and 16-bit codes through the sRGB curve (srgbCodes).
+    Image img;
+    decodeStb(path, f, 3, [&](const void* data, int bits) {
+        img = Image::uninitialized(f.w, f.h, 3);
+        if (bits == 32) deinterleave(static_cast<const float*>(data), 3, img, 3, 0, [](float v) { return v; });
+        if (bits == 16)
+            deinterleave(static_cast<const uint16_t*>(data), 3, img, 3, 0,
+                         [](uint16_t v) { return srgbDecode(float(v) / 65535.0f); });
+        if (bits == 8) {
+            const float* lut = srgbCodes();
+            deinterleave(static_cast<const unsigned char*>(data), 3, img, 3, 0, [lut](unsigned char v) { return lut[v]; });
         }
     });
-    stbi_image_free(data);
     return img;
 }
 
+Image readStbAlpha(const std::string& path) {
+    requireFile(path);
+    StbFile f = openStb(path);
+    const std::string ext = extensionOf(path);
+    if (ext == ".jpg" || ext == ".jpeg" || ext == ".hdr") return {};  // no alpha in these formats
+    checkStb(path, f);
+    if (f.n != 2 && f.n != 4) return {};
+    Image a;
+    // Alpha is a coverage, stored linearly (PNG's rule): code / max.
+    decodeStb(path, f, 0, [&](const void* data, int bits) {
+        a = Image::uninitialized(f.w, f.h, 1);
+        if (bits == 16)
+            deinterleave(static_cast<const uint16_t*>(data), f.n, a, 1, f.n - 1, [](uint16_t v) { return float(v) / 65535.0f; });
+        else
+            deinterleave(static_cast<const unsigned char*>(data), f.n, a, 1, f.n - 1,
+                         [](unsigned char v) { return float(v) / 255.0f; });
+    });
+    return a;
+}
+
+bool isLdrFormat(const std::string& path) {
+    const std::string ext = extensionOf(path);
+    return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".tga";
+}
+
 // ------------------------------------------------------------------------------------ helpers
+
+void requireFinitePixel(const Image& color, const std::string& what) {
+    if (color.empty() || color.device() != Device::Cpu) return;
+    const size_t n = color.plane();
+    const int ch = std::min(color.channels(), 3);
+    for (size_t i = 0; i < n; ++i) {
+        bool finite = true;
+        for (int c = 0; c < ch && finite; ++c) finite = std::isfinite(color.data()[size_t(c) * n + i]);
+        if (finite) return;
+    }
+    throw InputError((what.empty() ? std::string() : what + ": ") +
+                     "color buffer has no finite pixel (every pixel has a NaN or an infinite value): nothing to denoise");
+}
 
 void ensureWritableDirectory(const std::string& dir) {
     std::error_code ec;

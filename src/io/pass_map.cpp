@@ -64,6 +64,12 @@ bool inViewLayer(const ExrLayer& l, const std::string& viewLayer) {
     return viewLayer.empty() || l.prefix().empty() || l.prefix() == viewLayer;
 }
 
+}  // namespace
+
+bool isSecondMomentLayer(const ExrLayer& l) { return l.name.rfind("m2_", 0) == 0; }
+
+namespace {
+
 // The channels of `layer` for buffer b, or an InputError naming the file and the layer.
 std::vector<int> channelsFor(const ExrInfo& info, const ExrLayer& layer, Buffer b) {
     // Motion: X, Y of Blender's Vector (to the previous frame; Z, W point to the next one).
@@ -82,7 +88,9 @@ int matchRules(const ExrInfo& info, Buffer b, const std::string& viewLayer, std:
             int found = -1;
             for (size_t i = 0; i < info.layers.size(); ++i) {
                 const ExrLayer& l = info.layers[i];
-                if (!inViewLayer(l, viewLayer)) continue;
+                // Mitsuba's moment integrator writes each output twice, as itself and as "m2_<name>",
+                // its samples' second moment: never a buffer by name (a --pass may still name it).
+                if (!inViewLayer(l, viewLayer) || isSecondMomentLayer(l)) continue;
                 const bool root = l.name.empty();
                 const bool match = name.empty() ? root : !root && norm(l.passName()) == name;
                 if (!match) continue;
@@ -103,7 +111,9 @@ int matchRules(const ExrInfo& info, Buffer b, const std::string& viewLayer, std:
     return -1;
 }
 
-PassChoice requested(const ExrInfo& info, const PassRequest& r) {
+// A --pass by a layer's full name, else by a pass name under `viewLayer` (--layer; all view layers
+// when empty), else by a full channel name.
+PassChoice requested(const ExrInfo& info, const PassRequest& r, const std::string& viewLayer) {
     PassChoice c;
     c.rule = "--pass " + std::string(bufferName(r.buffer)) + "=" + r.name;
     for (size_t i = 0; i < info.layers.size(); ++i)
@@ -114,10 +124,10 @@ PassChoice requested(const ExrInfo& info, const PassRequest& r) {
         }
     int byPass = -1;
     for (size_t i = 0; i < info.layers.size(); ++i)
-        if (!info.layers[i].name.empty() && info.layers[i].passName() == r.name) {
+        if (!info.layers[i].name.empty() && info.layers[i].passName() == r.name && inViewLayer(info.layers[i], viewLayer)) {
             if (byPass >= 0)
                 throw InputError(info.path + ": " + c.rule + " is ambiguous: layers '" + info.layers[size_t(byPass)].name +
-                                 "' and '" + info.layers[i].name + "' (give the full layer name)");
+                                 "' and '" + info.layers[i].name + "' (give the full layer name, or a view layer with --layer)");
             byPass = int(i);
         }
     if (byPass >= 0) {
@@ -191,7 +201,7 @@ PassMap mapPasses(const ExrInfo& info, const std::vector<PassRequest>& requests,
                                    layerList(info) + ")");
     }
     PassMap m;
-    for (const PassRequest& r : requests) m.pass[size_t(r.buffer)] = requested(info, r);
+    for (const PassRequest& r : requests) m.pass[size_t(r.buffer)] = requested(info, r, viewLayer);
     for (int b = 0; b < kBufferCount; ++b) {
         PassChoice& c = m.pass[size_t(b)];
         if (c.found()) continue;
@@ -204,10 +214,11 @@ PassMap mapPasses(const ExrInfo& info, const std::vector<PassRequest>& requests,
 PassChoice passForFile(const ExrInfo& info, Buffer b, const std::vector<PassRequest>& requests,
                        const std::string& viewLayer) {
     for (const PassRequest& r : requests)
-        if (r.buffer == b) return requested(info, r);
+        if (r.buffer == b) return requested(info, r, viewLayer);
     std::vector<int> usable;
     for (size_t i = 0; i < info.layers.size(); ++i)
-        if (!pickComponents(info, info.layers[i], bufferChannels(b)).empty()) usable.push_back(int(i));
+        if (!isSecondMomentLayer(info.layers[i]) && !pickComponents(info, info.layers[i], bufferChannels(b)).empty())
+            usable.push_back(int(i));
     PassChoice c;
     if (usable.size() == 1) {
         c.layer = usable[0];

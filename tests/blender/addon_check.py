@@ -163,7 +163,7 @@ def main():
         except RuntimeError as e:  # bpy raises the operator's ERROR report as RuntimeError
             rc = {"CANCELLED"}
             print("     (reported:", str(e).strip().splitlines()[-1], ")")
-        check(rc == {"CANCELLED"} and not os.path.exists(s.output) and "MultiLayer" in s.last_result,
+        check(rc == {"CANCELLED"} and not os.path.exists(s.output) and "Multi-Layer EXR" in s.last_result,
               "a non-MultiLayer output format is refused, nothing written")
         set_format(sc, multilayer=True)
         os.remove(os.path.join(root, "render", "render0004.exr"))

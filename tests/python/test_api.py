@@ -92,7 +92,7 @@ def test_every_keyword_reaches_the_filter(bufs):
 
 @pytest.mark.parametrize("bad, match", [
     (np.zeros((8, 8), np.float32), "shape"),
-    (np.zeros((8, 8, 4), np.float32), "shape"),
+    (np.zeros((8, 8, 5), np.float32), "shape"),  # (8, 8, 4) is RGBA: test_user_inputs.py
     (np.zeros((8, 8, 3), np.int32), "floating-point"),
     (np.zeros((0, 8, 3), np.float32), "empty"),
 ])

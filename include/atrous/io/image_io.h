@@ -12,7 +12,7 @@ namespace atrous::io {
 
 // Reading and writing an image file by its extension are atrous::readImage and atrous::writeImage
 // (atrous/io.h), the one reader and writer of the library, the CLI, Python and installed users
-// alike. The writers of one format (host images, 1 or 3 channels; atomic):
+// alike. The writers of one format (host images, 1 or 3 channels, EXR 4 too; atomic):
 void writeExr(const std::string& path, const Image& img);
 void writePfm(const std::string& path, const Image& img);
 // 8-bit sRGB preview of linear HDR: out = srgb(clamp(exposure * v, 0, 1)).
@@ -25,6 +25,32 @@ void writeFileAtomically(const std::string& path, const std::function<void(const
 
 // Throws InputError unless `dir` exists (or can be created) and a file can be created in it.
 void ensureWritableDirectory(const std::string& dir);
+
+// Whether `path` names an 8- or 16-bit display-referred format (PNG, JPEG, BMP, TGA: LDR, values
+// in [0, 1] once read), by its extension; not EXR, PFM or Radiance .hdr.
+bool isLdrFormat(const std::string& path);
+
+// The alpha channel of a PNG, BMP or TGA with one (grey + alpha, RGBA), as a 1-channel host
+// image of code / 255 (or / 65535); empty when the file has none (and for JPEG and .hdr, which
+// have none). Throws InputError as readImage does. (alpha.h's readAlpha reads any format's.)
+Image readStbAlpha(const std::string& path);
+
+// Throws InputError "<what>: color buffer has no finite pixel ..." when no pixel of the host image
+// `color` has three finite channels (an all-NaN render would otherwise come out black).
+void requireFinitePixel(const Image& color, const std::string& what);
+
+// Whether `path` names an 8- or 16-bit display-referred format (PNG, JPEG, BMP, TGA: LDR, values
+// in [0, 1] once read), by its extension; not EXR, PFM or Radiance .hdr.
+bool isLdrFormat(const std::string& path);
+
+// The alpha channel of a PNG, BMP or TGA with one (grey + alpha, RGBA), as a 1-channel host
+// image of code / 255 (or / 65535); empty when the file has none (and for JPEG and .hdr, which
+// have none). Throws InputError as readImage does. (alpha.h's readAlpha reads any format's.)
+Image readStbAlpha(const std::string& path);
+
+// Throws InputError "<what>: color buffer has no finite pixel ..." when no pixel of the host image
+// `color` has three finite channels (an all-NaN render would otherwise come out black).
+void requireFinitePixel(const Image& color, const std::string& what);
 
 // Lower-case extension with the dot (".exr"), or "" when there is none.
 std::string extensionOf(const std::string& path);

@@ -82,6 +82,11 @@ std::vector<Image> readPasses(const ExrInfo& info, const std::vector<std::pair<B
 // non-finite colour).
 void conformBuffer(Buffer b, Image& img);
 
+// A layer of Mitsuba 3's moment integrator's second moments ("m2_<output>": the mean of the squared
+// samples of each output it writes beside): never taken as a buffer by the rules above (the file's
+// variance would need its sample count, which Mitsuba does not write); a --pass may name one.
+bool isSecondMomentLayer(const ExrLayer& layer);
+
 // The file's layer names, comma-separated ("(root)" for the root layer), for messages.
 std::string layerList(const ExrInfo& info);
 

@@ -1,7 +1,7 @@
 """Blender add-on: denoise a rendered Cycles animation with atrous's sequence denoiser
 (docs/blender.md).
 
-Blender writes an animation as numbered OpenEXR MultiLayer files (render0001.exr, ...) with the
+Blender writes an animation as numbered Multi-Layer EXR files (render0001.exr, ...) with the
 passes a denoiser needs (Denoising Data: albedo and normal; Vector: motion). The add-on's operator
 (Properties > Output > "Denoise Animation (atrous)", or Render > "Denoise Animation (atrous)")
 hands those files, as Blender wrote them, to :func:`atrous.denoise_sequence` and writes
@@ -23,7 +23,7 @@ bl_info = {
     "version": (0, 1, 0),
     "blender": (4, 2, 0),
     "location": "Properties > Output > Denoise Animation (atrous); Render menu",
-    "description": "Denoises a rendered Cycles animation (OpenEXR MultiLayer frames) with atrous's sequence denoiser",
+    "description": "Denoises a rendered Cycles animation (Multi-Layer EXR frames) with atrous's sequence denoiser",
     "category": "Render",
 }
 

@@ -85,8 +85,9 @@ def denoise_animation(context, on_frame=None) -> dict:
     returns atrous.denoise_sequence's report. Raises ValueError for what the user must change."""
     scene = context.scene
     if not is_multilayer(scene):
-        raise ValueError("set Output > File Format to OpenEXR MultiLayer (with the Denoising Data and Vector "
-                         "passes of the view layer on), render the animation, then denoise it")
+        raise ValueError("set Output > Media Type to Multi-Layer EXR (Blender 5; File Format OpenEXR MultiLayer "
+                         "before 5) with the Denoising Data and Vector passes of the view layer on, render the "
+                         "animation, then denoise it")
     s = scene.atrous
     if scene.frame_step > 1 and s.method in atrous.SEQUENCE_METHODS:
         raise ValueError(f"Frame Step is {scene.frame_step}: the {s.method} method joins neighbouring frames, "
@@ -99,7 +100,7 @@ def denoise_animation(context, on_frame=None) -> dict:
 
 
 class ATROUS_OT_denoise_animation(bpy.types.Operator):
-    """Denoise the rendered animation (OpenEXR MultiLayer frames) with atrous"""
+    """Denoise the rendered animation (Multi-Layer EXR frames) with atrous"""
 
     bl_idname = "atrous.denoise_animation"
     bl_label = "Denoise Animation (atrous)"
@@ -243,7 +244,7 @@ class ATROUS_PT_denoise(bpy.types.Panel):
         layout.prop(s, "output")
         layout.prop(s, "preview")
         if not is_multilayer(context.scene):
-            layout.label(text="Needs OpenEXR MultiLayer output", icon="ERROR")
+            layout.label(text="Needs Media Type: Multi-Layer EXR", icon="ERROR")
         layout.operator(ATROUS_OT_denoise_animation.bl_idname)
         layout.operator(ATROUS_OT_denoise_still.bl_idname)
         if s.last_result:
