@@ -277,7 +277,7 @@ void writePng(const std::string& path, const Image& img, float exposure) {
             for (int c = 0; c < 3; ++c) {
                 float v = img(x, y, img.channels() == 3 ? c : 0) * exposure;
                 if (!std::isfinite(v)) v = 0.0f;
-                px[(size_t(y) * w + x) * 3 + c] = (unsigned char)std::lround(srgbEncode(v) * 255.0f);
+                px[(size_t(y) * w + x) * 3 + c] = displayByte(srgbEncode(v));
             }
     writeFileAtomically(path, [&](const std::string& tmp) {
         if (!stbi_write_png(tmp.c_str(), w, h, 3, px.data(), w * 3)) throw RuntimeError(path + ": cannot write PNG");
