@@ -65,8 +65,10 @@ StridedImage Arrays::strided(nb::handle obj, const char* what) {
     const Device device = deviceOf(a, what);
     const bool f32 = isFloat(a, 32), f16 = isFloat(a, 16), f64 = isFloat(a, 64) && device == Device::Cpu;
     if (!f32 && !f16 && !f64)
-        throw InputError(std::string(what) + ": expected float32 or float16 data (float64 on the host is converted), got " +
+        throw InputError(std::string(what) + ": expected float32 or float16 data (float64 on the host is converted), got dtype " +
                          dtypeName(a));
+    if (a.ndim() == 3 && (a.shape(2) < 1 || a.shape(2) > 4))
+        throw InputError(std::string(what) + ": expected 1 to 4 channels, got " + std::to_string(a.shape(2)));
     StridedImage s;
     s.type = f16 ? DataType::Float16 : DataType::Float32;
     s.height = int(a.shape(0));

@@ -8,6 +8,7 @@
 #include <nanobind/stl/vector.h>
 #include <nanobind/stl/unordered_map.h>
 
+#include <algorithm>
 #include <cmath>
 #include <initializer_list>
 #include <memory>
@@ -80,12 +81,14 @@ nb::list stillMethodRows() {
         d["uses_weights"] = readsWeights(i);
         d["registered"] = i.registered(), d["params"] = "denoise";
         // What the row reads (its cascade's buffers with the default options, and its parameter groups).
-        nb::list reads, groups;
+        nb::list reads;
         const BufferMask use = methodReads(i, DenoiseOptions{});
         for (int b = 0; b < kBufferCount; ++b)
             if (use.has(Buffer(b))) reads.append(bufferName(Buffer(b)));
+        std::vector<std::string> groups;
         for (const ParamField<DenoiseOptions>& f : denoiseParams())
-            if (readsParamGroup(i, f.group) && !groups.contains(f.group)) groups.append(f.group);
+            if (readsParamGroup(i, f.group) && std::find(groups.begin(), groups.end(), f.group) == groups.end())
+                groups.push_back(f.group);
         d["reads"] = reads;
         d["param_groups"] = groups;
         // A row that denoise() resolves into another per call (auto), with no cascade of its own.

@@ -62,7 +62,7 @@ nb::list sequenceMethodRows() {
         nb::dict d;
         d["name"] = m.name, d["label"] = m.label, d["summary"] = m.summary, d["params"] = m.params.set();
         d["causal"] = m.causal, d["causal_mode"] = m.causalMode, d["history"] = m.history;
-        d["stillNamemethod"] = m.stillMethod, d["registered"] = m.registered, d["reads"] = reads;
+        d["still_method"] = m.stillMethod, d["registered"] = m.registered, d["reads"] = reads;
         d["weights_param"] = m.weightsParam ? nb::cast(std::string(m.weightsParam)) : nb::none();
         rows.append(d);
     }

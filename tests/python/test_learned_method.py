@@ -173,7 +173,7 @@ def test_bad_weights_raise_value_error_naming_the_file(tmp_path):
         atrous.denoise(b["color"], albedo=b["albedo"], normal=b["normal"], method="auto", learned_weights=junk)
     with pytest.raises(ValueError, match="junk.atrl"):
         atrous.load_weights(junk)
-    with pytest.raises(ValueError, match="unknown method"):
+    with pytest.raises(ValueError, match="unknown denoise method"):
         atrous.denoise(b["color"], method="learnt")
 
 

@@ -61,7 +61,7 @@ _ALLOWED_FILES: set = set()
 # address; "temporal" is also the temporal error metric of bench/svgf_sequence_tool, which the SVGF
 # study (eval/sequences.py) reads and writes under that key.
 _SHARED_WORDS = (
-    ("auto", None, re.compile(r"device|camera|address|ray start")),
+    ("auto", None, re.compile(r"device|camera|address|ray start", re.IGNORECASE)),
     ("temporal", "python/atrous/eval/sequences.py", re.compile(r".")),
 )
 _ROOT = Path(__file__).resolve().parents[2]
