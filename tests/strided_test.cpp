@@ -167,6 +167,33 @@ TEST(Strided, AGreyImageRepeatsIntoEveryChannelAndExportTakesTheFirstChannels) {
     }
 }
 
+// The first channels of wider interleaved float32 pixels (a depth's first of three, the ids' two of
+// three, RGB of RGBA, a grey array's one repeated), each pixel width, a padded row and a flipped
+// one: importImage's row gather gives the values the element-wise definition gives.
+TEST(Strided, TheFirstChannelsOfWiderInterleavedPixels) {
+    const int w = 13, h = 5;
+    for (int k = 1; k <= 4; ++k)
+        for (int c = 1; c <= k; ++c)
+            for (int64_t pad : {int64_t(0), int64_t(8)})
+                for (bool flip : {false, true}) {
+                    SCOPED_TRACE("pixel of " + std::to_string(k) + ", " + std::to_string(c) + " read, pad " +
+                                 std::to_string(pad) + (flip ? ", flipped" : ""));
+                    const int64_t row = int64_t(w) * k + pad / 4;
+                    std::vector<float> data(size_t(row) * h);
+                    for (size_t i = 0; i < data.size(); ++i) data[i] = float(int(i * 37 % 101) - 50) / 4.0f;
+                    StridedImage s = interleavedImage(data.data(), DataType::Float32, w, h, c, Device::Cpu, row * 4);
+                    s.pixelStride = 4 * k;
+                    if (flip) s.data = data.data() + (h - 1) * row, s.rowStride = -row * 4;
+                    for (int out : {c, c == 1 ? 3 : c}) {
+                        const Image img = importImage(s, out, "in");
+                        for (int ch = 0; ch < out; ++ch)
+                            for (int y = 0; y < h; ++y)
+                                for (int x = 0; x < w; ++x)
+                                    ASSERT_EQ(img(x, y, ch), loadStrided(s, x, y, c == 1 ? 0 : ch));
+                    }
+                }
+}
+
 TEST(Strided, HalvesAreExactWhereRepresentableAndRoundToNearestEvenElsewhere) {
     const float exact[] = {0.0f,
                            -0.0f,

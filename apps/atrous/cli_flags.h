@@ -145,9 +145,12 @@ inline void addParamOptions(CLI::App& cmd, ParamSet values, const std::function<
 template <class S, class GroupOf>
 void addParamOptions(CLI::App& cmd, S& s, const ParamTable<S>& t, GroupOf&& group,
                      bool (*keep)(const ParamField<S>&) = nullptr) {
+    std::string title;  // group(f) may return a std::string: held until the row's option is made
     addParamOptions(cmd, ParamSet::bind(t, s), [&](const ParamRow& row) -> const char* {
         const ParamField<S>& f = *t.find(row.name);
-        return keep && !keep(f) ? nullptr : group(f);
+        if (keep && !keep(f)) return nullptr;
+        title = group(f);
+        return title.c_str();
     });
 }
 

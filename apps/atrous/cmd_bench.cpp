@@ -196,7 +196,7 @@ void run(const BenchArgs& a) {
     if (a.warmup < 0) throw InputError("--warmup must be >= 0");
     std::vector<std::string> what = split(a.what);
     for (auto& w : what)
-        if ((!findDenoiseMethod(w) || w == "auto") && !findSequenceMethod(w) && w != "render")
+        if ((!findDenoiseMethod(w) || findDenoiseMethod(w)->kind == CascadeKind::Auto) && !findSequenceMethod(w) && w != "render")
             throw InputError("--what: unknown item '" + w + "' (expected a denoise method but auto (" + denoiseMethodNames() +
                              "), a sequence method (" + sequenceMethodNames() + ") or render)");
     auto wants = [&](const char* k) { return std::find(what.begin(), what.end(), k) != what.end(); };

@@ -36,8 +36,9 @@ struct DenoiseArgs {
     bool ldr = false, srgb = false;    // LDR input: output clamped to [0, 1]; --srgb: sRGB-encoded
     std::string oidnFilter = "RT", oidnQuality;  // oidnDenoise's -f, -q (accepted; see addOidnFlags)
     bool oidnCleanAux = false;
-    std::string method = "auto", device = "auto";
-    std::string spatial = "auto";  // --spatial: the still method of a sequence method that ends with one
+    std::string method = denoiseMethodName(DenoiseOptions{}.method);  // the library's default still method
+    std::string device = "auto";
+    std::string spatial = method;  // --spatial: the still method of a sequence method that ends with one
     io::FrameRange range;  // --start, --end, --step (with --sequence)
     DenoiseOptions opt;  // the filter parameters' flags write here (params.h's table)
     std::string learnedWeights;  // --learned-weights: loaded once into opt.weights
@@ -385,7 +386,7 @@ void addDenoiseCommand(CLI::App& app) {
         ->group(learnedGroup());
     cmd->add_option("--device,-d", a->device, "cpu | cuda | auto (cuda when a GPU is present; oidnDenoise's 'default' = auto)")
         ->capture_default_str()
-        ->transform([](std::string v) { return v == "default" ? std::string("auto") : v; });
+        ->transform([](std::string v) { return v == "default" ? std::string("auto") : v; });  // the device auto
     // oidnDenoise's other flags, so that a script written for it runs unchanged (docs/inputs.md).
     const char* kGroupOidn = "oidnDenoise compatibility";
     cmd->add_option("-f,--filter", a->oidnFilter, "oidnDenoise's filter type: RT only")->group(kGroupOidn);

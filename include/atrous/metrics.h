@@ -54,6 +54,10 @@ FlickerMetrics computeFlicker(const Image& image, const Image& previous, const F
 
 // Tonemap used by PSNR/SSIM: clamp(pow(x/(1+x), 1/2.2), 0, 1) (x < 0 → 0).
 float tonemapForMetrics(float x);
+// The same as an 8-bit display value (displayByte, atrous/srgb.h: rounded to nearest): the one
+// tonemapped preview of an HDR image (the evaluation's crops and reports, the corpus previews;
+// Python's atrous.tonemap(image, dtype=numpy.uint8)). Non-finite values are 0, as in the PNG writer.
+unsigned char tonemap8(float x);
 
 // Per-pixel error maps (3-channel host images, the value repeated in R,G,B): squared error
 // averaged over channels, and relative squared error.

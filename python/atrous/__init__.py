@@ -5,16 +5,21 @@
     clean = atrous.denoise(bufs["color"], albedo=bufs["albedo"], normal=bufs["normal"],
                            position=bufs["position"], variance=bufs["variance"], method="sure")
 
-Arrays are H x W x 3 (features may also be H x W or H x W x 1, repeated into 3 channels), linear
-HDR. The array rule:
+Arrays are H x W x 3 (or x 4: the first three channels are read; features may also be H x W or
+H x W x 1, repeated into 3 channels), linear HDR. The array rule, checked by the library (the
+package passes arrays through):
 
-* numpy arrays of float32 are used as they are, with any strides (non-contiguous views, negative
-  strides): atrous copies them into its own planar layout anyway;
-* other floating-point dtypes (float16, float64) are converted to float32;
-* anything else (integers, booleans, complex, objects) is rejected with ValueError;
-* CUDA arrays (PyTorch tensors, CuPy arrays, anything with ``__dlpack__`` on a CUDA device) must be
-  float32; on a CUDA build they are denoised on their GPU without a host round trip, and the result
-  comes back as the same kind of array on the same device.
+* numpy arrays of float32 or float16 are taken where they are, with any strides (C-contiguous,
+  interleaved or planar views, negative strides): no copy of the colour, the variance or the
+  emission (the filter's first pass reads them into its own planes); a feature the filter reads
+  is copied into planar storage, which ``denoise(..., report=True)`` names (``copies``);
+* float64 host arrays are converted to float32; anything that is not an array (a list) goes
+  through numpy.asarray;
+* anything else (integers, booleans, complex, another number of dimensions or channels, an empty
+  array) is a ValueError naming the keyword;
+* CUDA arrays (PyTorch tensors, CuPy arrays, anything with ``__dlpack__`` on a CUDA device),
+  float32 or float16: on a CUDA build they are denoised on their GPU without a host round trip,
+  and the result comes back as the same kind of array on the same device.
 
 Image files: :func:`read_image` and :func:`write_image` use the library's own readers and writers
 (OpenEXR, PFM, PNG), so Python reads what ``atrous render`` writes and the CLI reads what Python
@@ -31,17 +36,20 @@ denoised colour, :func:`read_image` (``alpha=True``) and :func:`write_image` rea
 from __future__ import annotations
 
 import os
-import textwrap
 from typing import Any, Dict, Iterator, Optional, Sequence, Union
 
 import numpy as np
 
-from . import _core
+from . import _core, names
+from ._shared import _framework, list_methods as _list_methods, list_params as _list_params, wrap_like as _wrap_like
+from .measure import metrics, relmse, temporal_metrics, tonemap
+from .sequence import (SequenceDenoiser, Svgf, denoise_sequence, denoise_temporal, denoise_window, sequence_methods,
+                       sequence_params)
 from .vocabulary import Weights, _weights_arg, buffers, load_weights
 
 __all__ = [
     "denoise",
-    "learned_planes",
+    "prepared_planes",
     "render",
     "render_sequence",
     "metrics",
@@ -139,7 +147,12 @@ def load_plugin(path: "PathLike") -> None:
 
 
 def denoise_methods() -> list:
-    """The still methods, one dict per method: name, summary, uses_weights, registered (the library's list)."""
+    """The still methods, one dict per method, the library's registry in its order: name, summary,
+    uses_weights (reads the learned filter's weights), registered (added by register_method or a
+    plugin), params ("denoise": the table of :func:`denoise_params`), reads (the buffers a call
+    with the default options reads, :func:`buffers`' names), param_groups (the groups of
+    :func:`denoise_params` it reads), resolves (True for a choice that denoise() resolves into
+    another row per call: auto) and combines (the rows whose reads it adds: blend's, auto's)."""
     return [dict(r) for r in _core.denoise_methods()]
 
 
@@ -197,79 +210,6 @@ def cuda_available() -> bool:
     return bool(_core.cuda_available())
 
 
-def _framework(x: Any) -> str:
-    mod = type(x).__module__.split(".")[0]
-    if mod == "torch":
-        return "torch"
-    if mod == "cupy":
-        return "cupy"
-    return "numpy"
-
-
-def _is_cuda(x: Any) -> bool:
-    dev = getattr(x, "__dlpack_device__", None)
-    if dev is None or isinstance(x, np.ndarray):
-        return False
-    try:
-        return int(dev()[0]) == 2  # kDLCUDA
-    except Exception:
-        return False
-
-
-def _prepare(x: Any, name: str, allow_gray: bool = True, channels: tuple = (3,)) -> Any:
-    """Applies the array rule of the module docstring; returns something _core accepts."""
-    if x is None:
-        return None
-    if _is_cuda(x):
-        dtype = str(getattr(x, "dtype", ""))
-        if not dtype.endswith("float32"):
-            raise ValueError(f"{name}: CUDA arrays must be float32, got {dtype}")
-        arr = x
-        shape = tuple(arr.shape)
-    else:
-        if _framework(x) == "torch":
-            x = x.detach().cpu().numpy()
-        elif _framework(x) == "cupy":  # pragma: no cover - cupy on host is not a thing
-            x = x.get()
-        arr = np.asarray(x)
-        if arr.dtype.kind != "f":
-            raise ValueError(f"{name}: expected a floating-point array, got dtype {arr.dtype}")
-        if arr.dtype != np.float32:
-            arr = arr.astype(np.float32)
-        shape = arr.shape
-    if len(shape) == 2 and allow_gray:
-        pass
-    elif len(shape) == 3 and (shape[2] in channels or (allow_gray and shape[2] == 1)):
-        pass
-    else:
-        ch = " or ".join(f"(H, W, {k})" for k in channels)
-        want = f"{ch}, (H, W, 1) or (H, W)" if allow_gray else ch
-        raise ValueError(f"{name}: expected shape {want}, got {tuple(shape)}")
-    if shape[0] == 0 or shape[1] == 0:
-        raise ValueError(f"{name}: empty image {tuple(shape)}")
-    return arr
-
-
-def _wrap_like(result: Any, like: Any) -> Any:
-    """Returns a _core result as the same kind of array as the input `like`."""
-    if isinstance(result, np.ndarray):
-        if _framework(like) == "torch":
-            import torch
-
-            return torch.from_numpy(result)
-        return result
-    fw = _framework(like)
-    if fw == "torch":
-        import torch
-
-        return torch.from_dlpack(result)
-    if fw == "cupy":
-        import cupy
-
-        return cupy.from_dlpack(result)
-    return result
-
-
 def denoise(
     color: Any,
     *,
@@ -280,33 +220,36 @@ def denoise(
     variance: Any = None,
     ids: Any = None,
     emission: Any = None,
-    method: str = "auto",
+    method: Optional[str] = None,
     device: str = "auto",
     learned_weights: Union["PathLike", "Weights", None] = None,
     ldr: bool = False,
+    report: bool = False,
     **params: Any,
 ) -> Any:
-    """Denoises a Monte Carlo rendering with EAW, SURE-based À-Trous or the learned à-trous filter.
+    """Denoises a Monte Carlo rendering with one of the library's still methods.
 
     The buffers and their conventions are :func:`buffers`' (one table for the renderer, the
     readers and every denoiser). color: H x W x 3 mean radiance (linear HDR), or H x W x 4 with
-    alpha: the alpha is not denoised and comes back as it was (the same float32 values). variance: the
-    variance of that mean per channel (not the sample variance); without it the noise is estimated
-    from the image. albedo, normal (world-space, unit), position (world-space), depth (view depth,
-    channel 0), ids (object id, and the material id in a second channel when given; -1
-    background): optional features; a missing one simply has no edge stop. emission: the emitted
+    alpha: the alpha is not denoised and comes back as it was (the same values, as float32).
+    variance: the variance of that mean per channel (not the sample variance); without it the noise
+    is estimated from the image. albedo, normal (world-space, unit), position (world-space), depth
+    (view depth, channel 0), ids (object id, and the material id in a second channel when given;
+    -1 background): optional features; a missing one simply has no edge stop. emission: the emitted
     radiance seen at the primary hit; the filter works on color - emission and adds it back, so a
-    visible light's edge is not smeared.
+    visible light's edge is not smeared. Every array follows the module's array rule (float32 or
+    float16, any strides, taken without a copy).
 
-    method: "eaw", "sure", "learned" (the learned à-trous filter, docs/learned.md: it uses the
-    firefly, emission, albedo and safety-net parameters, not levels, the sigma's or SURE's) or
-    "blend" (the mean of the learned and the SURE outputs, from one preparation) or "auto" (the
-    default: blend when an albedo and a normal are given, else sure: the method measured best for
-    those buffers, docs/quality.md). learned_weights: the network of "learned"/"blend"/"auto":
-    a Weights from :func:`load_weights` (read once, shared by calls), a weight file's path (version
-    4, or 3; read by this call) or None (the built-in weights); a bad file raises ValueError naming
-    it. device: "auto" (the arrays' device: CUDA arrays on the GPU, numpy on
-    the CPU), "cpu" or "cuda" (numpy inputs are then copied to the GPU and back).
+    method: a name of :data:`METHODS` (the library's registry, :func:`denoise_methods`), None for
+    the library's default:
+
+{methods}
+
+    learned_weights: the network of the methods that read it (:data:`WEIGHTED_METHODS`): a Weights
+    from :func:`load_weights` (read once, shared by calls), a weight file's path (version 4, or 3;
+    read by this call) or None (the built-in weights); a bad file raises ValueError naming it.
+    device: "auto" (the arrays' device: CUDA arrays on the GPU, numpy on the CPU), "cpu" or
+    "cuda" (numpy inputs are then filtered on the GPU and the result comes back to the host).
 
     ldr: the colour is LDR, display-referred values in [0, 1] (what :func:`read_image` returns for
     an 8-bit PNG or JPEG: its codes through the sRGB curve), as OIDN's hdr=False: the output is
@@ -318,40 +261,30 @@ def denoise(
 
 {params}
 
-    Returns the denoised H x W x 3 (x 4 with alpha) float32 image as the same kind of array as `color`.
+    Returns the denoised H x W x 3 (x 4 with alpha) float32 image as the same kind of array as
+    `color`; with report=True, a pair (image, report): the report is a dict of what the call did
+    (the C++ DenoiseReport): method_used (auto resolved), noise_estimated, variance_ignored,
+    noise_sigma, non_finite_pixels, fireflies_clamped, buffers_used (the CLI's line), milliseconds
+    (the filter), stages (a list of (name, ms)) and copies (the buffers copied into planar storage
+    before filtering, e.g. "albedo (float16, 3 channels)"; never the colour, the variance or the
+    emission).
     """
-    known = __getattr__("METHODS")
-    if method not in known:
-        raise ValueError(f"unknown method '{method}' (expected one of {', '.join(known)})")
-    if device not in ("auto", "cpu", "cuda"):
-        raise ValueError(f"unknown device '{device}' (expected auto, cpu or cuda)")
-    weights = _weights_arg(learned_weights)
-    c = _prepare(color, "color", allow_gray=False, channels=(3, 4))
-    alpha = None
-    if c.shape[2] == 4:
-        c, alpha = c[:, :, :3], c[:, :, 3:]
     if ldr and variance is not None:
         raise ValueError("variance: ldr=True takes no variance (the variance of display-encoded values is not the "
                          "variance of the pixel mean atrous filters with); give the HDR colour with it, or drop it")
-    bufs = {
-        name: _prepare(val, name, channels=(2, 3) if name == "ids" else (3,))
-        for name, val in (("albedo", albedo), ("normal", normal), ("position", position),
-                          ("depth", depth), ("variance", variance), ("ids", ids),
-                          ("emission", emission))
-    }
-    on_gpu = _is_cuda(c)
-    if device == "cuda" and not on_gpu:
-        if not cuda_available():
-            raise ValueError("device='cuda': no usable CUDA backend or GPU in this build")
-        return _finish(_denoise_numpy_on_gpu(c, bufs, method, weights, params), ldr, alpha)
-    if device == "cpu" and on_gpu:
-        raise ValueError("device='cpu' with CUDA arrays: move them to the host first")
-    for name, b in bufs.items():
-        if b is not None and _is_cuda(b) != on_gpu:
-            raise ValueError(f"{name}: lives on a different device than color")
-    out = _core.denoise(c, bufs["albedo"], bufs["normal"], bufs["position"], bufs["depth"],
-                        bufs["variance"], bufs["ids"], bufs["emission"], method, weights, dict(params))
-    return _finish(_wrap_like(out, color), ldr, alpha)
+    out, rep = _core.denoise(color, albedo, normal, position, depth, variance, ids, emission, method or "",
+                             str(device), _weights_arg(learned_weights), dict(params), bool(report))
+    image = _finish(_wrap_like(out, color), ldr, _alpha_of(color))
+    return (image, dict(rep)) if report else image
+
+
+def _alpha_of(color: Any) -> Any:
+    """The 4th channel of an H x W x 4 colour (a view), else None: the library reads the first three."""
+    shape = getattr(color, "shape", None)
+    if shape is None:
+        color = np.asarray(color)
+        shape = color.shape
+    return color[:, :, 3:] if len(shape) == 3 and shape[2] == 4 else None
 
 
 def _finish(out: Any, ldr: bool, alpha: Any) -> Any:
@@ -372,49 +305,38 @@ def _finish(out: Any, ldr: bool, alpha: Any) -> Any:
         import torch
 
         a = alpha if _framework(alpha) == "torch" else torch.from_numpy(np.ascontiguousarray(alpha))
-        return torch.cat([out, a.to(out.device)], dim=2)
+        return torch.cat([out, a.to(device=out.device, dtype=out.dtype)], dim=2)
     if fw == "cupy":  # pragma: no cover - needs a GPU
         import cupy
 
-        return cupy.concatenate([out, cupy.asarray(alpha)], axis=2)
-    return np.concatenate([out, np.asarray(alpha)], axis=2)
+        return cupy.concatenate([out, cupy.asarray(alpha, dtype=out.dtype)], axis=2)
+    return np.concatenate([out, np.asarray(alpha, dtype=out.dtype)], axis=2)
 
 
-def learned_planes(color: Any, variance: Any = None, albedo: Any = None, normal: Any = None,
-                   depth: Any = None, emission: Any = None, **params: Any) -> Dict[str, np.ndarray]:
-    """The planes the learned filter reads (docs/learned.md), from the library's own preparation:
-    what :func:`denoise` does before any filter (NaN/Inf repair, the emission split and the
-    emission filter, the firefly clamp, the per-pixel noise estimate without a variance, albedo
-    demodulation), on the CPU. For training: the network then sees exactly what it sees in the
-    library.
+def prepared_planes(color: Any, variance: Any = None, albedo: Any = None, normal: Any = None,
+                    depth: Any = None, emission: Any = None, *, position: Any = None, ids: Any = None,
+                    method: Optional[str] = None, **params: Any) -> Dict[str, np.ndarray]:
+    """The planes a still method's cascade reads (C++ preparePlanes, docs/learned.md), from the
+    library's own preparation: what :func:`denoise` does before any filter (NaN/Inf repair, the
+    emission split and the emission filter, the firefly clamp, the per-pixel noise estimate without
+    a variance, albedo demodulation), on the CPU. For training: the network then sees exactly what
+    it sees in the library; and for checking a cascade against :func:`denoise`.
 
-    The arguments, keywords and errors are those of :func:`denoise` (numpy arrays only). Returns a
-    dict of H x W x C float32 arrays: ``d`` (3: the demodulated, firefly-clamped colour), ``var``
-    (3: its variance, given or estimated, demodulated), ``albedo`` (3: the sanitised albedo the
-    colour was divided by; absent without an albedo or with demodulate=False), ``normal`` (3),
-    ``depth`` (1; both absent when not given), ``mod`` (3: the per-pixel factor the library's
-    output multiplies the filtered ``d`` by; 1 without an albedo) and ``emission`` (3: the
-    filtered emission added after; 0 without one). With the safety net off, the library's output
-    is ``filtered(d) * mod + emission``.
+    method: the method whose preparation this is (None: the learned filter's, the first of
+    :data:`WEIGHTED_METHODS`); the other arguments, keywords and errors are those of
+    :func:`denoise` (host arrays only). Returns a dict of H x W x C float32 arrays, named as the
+    C++ PreparedPlanes' fields: ``color`` (3: the demodulated, firefly-clamped colour),
+    ``variance`` (3: its variance, given or estimated, demodulated), ``albedo`` (3: the sanitised
+    albedo the colour was divided by; absent without an albedo or with demodulate=False),
+    ``normal`` (3), ``position`` (3), ``depth`` (1), ``ids`` (2; each absent when not given or not
+    read by the method),
+    ``modulation`` (3: the per-pixel factor the library's output multiplies the filtered
+    ``color`` by; 1 without an albedo) and ``emission`` (3: the filtered emission added after; 0
+    without one). With the safety net off, the library's output is
+    ``filtered(color) * modulation + emission``.
     """
-    c = _prepare(color, "color", allow_gray=False)
-    bufs = {name: _prepare(val, name)
-            for name, val in (("variance", variance), ("albedo", albedo), ("normal", normal),
-                              ("depth", depth), ("emission", emission))}
-    for name, b in (("color", c), *bufs.items()):
-        if b is not None and _is_cuda(b):
-            raise ValueError(f"{name}: learned_planes takes host (numpy) arrays")
-    return dict(_core.learned_planes(c, bufs["variance"], bufs["albedo"], bufs["normal"], bufs["depth"],
-                                     bufs["emission"], dict(params)))
-
-
-def _denoise_numpy_on_gpu(c, bufs, method, weights, params):  # pragma: no cover - needs a GPU
-    import cupy
-
-    up = {k: (None if v is None else cupy.asarray(v)) for k, v in bufs.items()}
-    out = _core.denoise(cupy.asarray(c), up["albedo"], up["normal"], up["position"], up["depth"],
-                        up["variance"], up["ids"], up["emission"], method, weights, dict(params))
-    return cupy.asnumpy(cupy.from_dlpack(out))
+    return dict(_core.prepared_planes(color, variance, albedo, normal, depth, emission, position, ids, method or "",
+                                      dict(params)))
 
 
 def render(scene: str, **settings: Any) -> Dict[str, np.ndarray]:
@@ -509,27 +431,13 @@ def write_image(path: PathLike, image: Any) -> None:
     a bad shape or dtype, an unknown extension or a directory that does not exist or cannot be
     written; RuntimeError when the encoder itself fails.
     """
-    p = os.fsdecode(os.fspath(path))
-    _core.write_image(p, _prepare(image, p, channels=(3, 4)))
-
-
-def _list_params(rows) -> str:
-    out = []
-    for r in rows:
-        extra = " (" + " | ".join(r["choices"]) + ")" if r["choices"] else ""
-        out.append(r["name"] + extra + "".join(", " + a for a in r["aliases"]))
-    return textwrap.fill(", ".join(out) + ".", width=96, initial_indent="    ", subsequent_indent="    ",
-                         break_on_hyphens=False)
+    _core.write_image(os.fsdecode(os.fspath(path)), image)
 
 
 # The docstrings list the keywords from the library's table, so they cannot fall behind it.
 if denoise.__doc__:
-    denoise.__doc__ = denoise.__doc__.replace("{params}", _list_params(denoise_params()))
+    denoise.__doc__ = denoise.__doc__.replace("{params}", _list_params(denoise_params())).replace(
+        "{methods}", _list_methods(denoise_methods()))
 if render.__doc__:
     render.__doc__ = render.__doc__.replace("{params}", _list_params(render_params()))
 
-
-# The metrics (measure.py) and the sequence methods (sequence.py) use _prepare above.
-from .measure import metrics, relmse, temporal_metrics, tonemap  # noqa: E402
-from .sequence import (SequenceDenoiser, Svgf, denoise_sequence, denoise_temporal, denoise_window,  # noqa: E402
-                       sequence_methods, sequence_params)

@@ -14,17 +14,16 @@ from __future__ import annotations
 import os
 from typing import Any, Dict, Optional, Sequence, Union
 
-from . import _core, _list_params, _prepare, _weights_arg, _wrap_like, svgf_params
+from . import _core
+from ._shared import list_params as _list_params, wrap_like as _wrap_like
+from .names import SVGF, TEMPORAL
+from .vocabulary import _weights_arg
 
 __all__ = ["sequence_methods", "sequence_params", "SequenceDenoiser", "Svgf", "denoise_window", "denoise_temporal",
            "denoise_sequence"]
 
-_FRAME_KEYS = ("color", "albedo", "normal", "position", "depth", "variance", "ids", "emission", "motion")
-
-# The rows :class:`Svgf` and :func:`denoise_temporal` run (their names, from the registry's own
-# files), for code that is about one of them (the evaluation's SVGF study).
-SVGF = str(_core.SVGF_METHOD)
-TEMPORAL = str(_core.TEMPORAL_METHOD)
+# SVGF and TEMPORAL (atrous.names): the rows :class:`Svgf` and :func:`denoise_temporal` run, their
+# names from the registry's own files, for code that is about one of them (the evaluation's SVGF study).
 
 
 def sequence_methods() -> list:
@@ -40,17 +39,6 @@ def sequence_methods() -> list:
 def sequence_params(method: str) -> list:
     """The keywords of a sequence method's own table, in the form of :func:`atrous.denoise_params`."""
     return [dict(r) for r in _core.sequence_params(str(method))]
-
-
-def _frame(frame: Dict[str, Any], at: str) -> Dict[str, Any]:
-    """A frame dict as the library takes it: known keys only, arrays by the module's array rule."""
-    if not isinstance(frame, dict):
-        raise ValueError(f"{at} must be a dict of arrays")
-    unknown = sorted(set(frame) - set(_FRAME_KEYS) - {"time"})  # render_sequence's items carry their time
-    if unknown:
-        raise ValueError(f"{at}: unknown buffer {unknown[0]!r} (expected {', '.join(_FRAME_KEYS)})")
-    return {k: _prepare(v, f"{at}.{k}", allow_gray=k != "color", channels=(2, 3) if k in ("motion", "ids") else (3,))
-            for k, v in frame.items() if v is not None and k != "time"}
 
 
 class SequenceDenoiser:
@@ -74,16 +62,16 @@ class SequenceDenoiser:
     emission, motion); each result comes back on its frame's colour's device. Raises ValueError for
     bad input."""
 
-    def __init__(self, method: Optional[str] = None, *, device: str = "auto", spatial: str = "auto",
+    def __init__(self, method: Optional[str] = None, *, device: str = "auto", spatial: Optional[str] = None,
                  learned_weights: Union["os.PathLike", Any, None] = None, causal: bool = False,
                  motion_given: bool = True, params: Optional[Dict[str, Any]] = None, **still: Any) -> None:
         name = str(method) if method is not None else str(_core.sequence_methods()[0]["name"])
-        self._impl = _core.SequenceDenoiser(name, str(device), str(spatial), _weights_arg(learned_weights),
+        self._impl = _core.SequenceDenoiser(name, str(device), str(spatial or ""), _weights_arg(learned_weights),
                                             dict(params or {}), dict(still), bool(causal), bool(motion_given))
 
     def push(self, frame: Dict[str, Any]) -> None:
         """The next frame (checked now; denoised by a later :meth:`next`)."""
-        self._impl.push(_frame(frame, "frame"))
+        self._impl.push(frame)
 
     @property
     def ready(self) -> bool:
@@ -145,20 +133,19 @@ class Svgf(SequenceDenoiser):
 
 
 if Svgf.__doc__:
-    Svgf.__doc__ = Svgf.__doc__.replace("{params}", _list_params(svgf_params()))
+    Svgf.__doc__ = Svgf.__doc__.replace("{params}", _list_params(_core.svgf_params()))
 
 
 def _frames(frames: Sequence[Dict[str, Any]], center: int) -> list:
     if not isinstance(frames, (list, tuple)) or not frames:
         raise ValueError("frames must be a non-empty list of dicts")
-    core = [_frame(f, f"frame {i}") for i, f in enumerate(frames)]
     if isinstance(center, bool) or not isinstance(center, int) or not 0 <= int(center) < len(frames):
         raise ValueError(f"center must be a frame index in 0..{len(frames) - 1}, got {center!r}")
-    return core
+    return list(frames)
 
 
 def denoise_window(method: str, frames: Sequence[Dict[str, Any]], center: int, *, device: str = "auto",
-                   spatial: str = "auto", learned_weights: Union["os.PathLike", Any, None] = None,
+                   spatial: Optional[str] = None, learned_weights: Union["os.PathLike", Any, None] = None,
                    params: Optional[Dict[str, Any]] = None, **still: Any) -> Any:
     """Denoises frames[center] with the frames around it, through a sequence method without history
     (each frame depends on its window only: temporal, not svgf): the frames its window reads are
@@ -169,12 +156,12 @@ def denoise_window(method: str, frames: Sequence[Dict[str, Any]], center: int, *
     import numpy as np
 
     core = _frames(frames, center if not isinstance(center, np.integer) else int(center))
-    out = _core.denoise_window(str(method), core, int(center), str(device), str(spatial), _weights_arg(learned_weights),
+    out = _core.denoise_window(str(method), core, int(center), str(device), str(spatial or ""), _weights_arg(learned_weights),
                                dict(params or {}), dict(still))
     return _wrap_like(out, frames[int(center)]["color"])
 
 
-def denoise_temporal(frames: Sequence[Dict[str, Any]], center: int, *, method: str = "auto",
+def denoise_temporal(frames: Sequence[Dict[str, Any]], center: int, *, method: Optional[str] = None,
                      device: str = "auto", learned_weights: Union["os.PathLike", Any, None] = None,
                      temporal: Optional[Dict[str, Any]] = None, **params: Any) -> Any:
     """Denoises frames[center] of an animation with the frames around it (docs/temporal.md): the
@@ -196,7 +183,7 @@ def denoise_temporal(frames: Sequence[Dict[str, Any]], center: int, *, method: s
 
 
 def denoise_sequence(input: "os.PathLike", out: "os.PathLike", *, method: Optional[str] = None,
-                     spatial: str = "auto", device: str = "auto",
+                     spatial: Optional[str] = None, device: str = "auto",
                      learned_weights: Union["os.PathLike", Any, None] = None,
                      passes: Optional[Dict[str, str]] = None, layer: str = "", add_pass: str = "",
                      start: Optional[int] = None, end: Optional[int] = None, step: int = 1,
@@ -227,6 +214,6 @@ def denoise_sequence(input: "os.PathLike", out: "os.PathLike", *, method: Option
     pass_specs = [f"{k}={v}" for k, v in (passes or {}).items()]
     weights = _weights_arg(learned_weights)
     return _core.denoise_sequence(os.fsdecode(os.fspath(input)), os.fsdecode(os.fspath(out)), str(method or ""),
-                                  str(spatial), device, weights, pass_specs, layer, add_pass,
+                                  str(spatial or ""), device, weights, pass_specs, layer, add_pass,
                                   -1 if start is None else int(start), -1 if end is None else int(end), int(step),
                                   float(exposure), bool(pngs), bool(preview), own, dict(params), on_frame)

@@ -8,6 +8,7 @@
 #include <nanobind/stl/vector.h>
 #include <nanobind/stl/unordered_map.h>
 
+#include <algorithm>
 #include <cmath>
 #include <initializer_list>
 #include <memory>
@@ -45,7 +46,7 @@ LearnedWeights weightsFrom(nb::handle h);  // vocabulary.cpp: None, "", a path o
 namespace {
 
 using python::Array;
-using python::Buffers;
+using python::Arrays;
 using python::fromImage;
 using python::toImage;
 using python::weightsFrom;
@@ -81,75 +82,124 @@ nb::list stillMethodRows() {
         d["uses_weights"] = readsWeights(i);
         d["registered"] = i.registered(), d["params"] = "denoise";
         // What the row reads (its cascade's buffers with the default options, and its parameter groups).
-        nb::list reads, groups;
+        nb::list reads;
         const BufferMask use = methodReads(i, DenoiseOptions{});
         for (int b = 0; b < kBufferCount; ++b)
             if (use.has(Buffer(b))) reads.append(bufferName(Buffer(b)));
+        std::vector<std::string> groups;
         for (const ParamField<DenoiseOptions>& f : denoiseParams())
-            if (readsParamGroup(i, f.group) && !groups.contains(f.group)) groups.append(f.group);
+            if (readsParamGroup(i, f.group) && std::find(groups.begin(), groups.end(), f.group) == groups.end())
+                groups.push_back(f.group);
         d["reads"] = reads;
         d["param_groups"] = groups;
+        // A row that denoise() resolves into another per call (auto), with no cascade of its own.
+        d["resolves"] = i.kind == CascadeKind::Auto;
+        nb::list combines;
+        for (DenoiseMethod c : i.reads.combines) combines.append(denoiseMethodName(c));
+        d["combines"] = combines;
         rows.append(d);
     }
     return rows;
 }
 
-nb::object pyDenoise(const Array& color, nb::handle albedo, nb::handle normal, nb::handle position, nb::handle depth,
-                     nb::handle variance, nb::handle ids, nb::handle emission, const std::string& method,
-                     nb::handle learnedWeights, nb::dict params) {
-    using B = io::Buffer;
-    Image c = toImage(color, "color");
-    io::requireFinitePixel(c, "");  // host arrays; CUDA ones are not looked at here
-    Buffers b(c);
-    b.add({{albedo, B::Albedo, "albedo"}, {normal, B::Normal, "normal"}, {position, B::Position, "position"},
-           {depth, B::Depth, "depth"}, {variance, B::Variance, "variance"}, {ids, B::ObjectId, "ids"},
-           {emission, B::Emission, "emission"}});
-    DenoiseOptions o;
-    o.method = parseDenoiseMethod(method);
-    if (readsWeights(denoiseMethodInfo(o.method))) o.weights = weightsFrom(learnedWeights);  // auto's too
-    o.device = c.device();
-    for (auto [k, v] : params) applyParam(o, denoiseParams(), nb::cast<std::string>(k), v, "denoise");
-    // The colour, variance and emission are the binding's own copies (toImage): handed over, the
-    // filter works in their storage instead of copying them again (as the CLI does).
-    DenoiseBuffers db = io::handOver(b.refs, c, b.ownedCopy(B::Variance), b.ownedCopy(B::Emission));
-    Image out;
-    {
-        nb::gil_scoped_release release;
-        out = denoise(db, o);
-    }
-    // denoise() ran on the colour's device and left its result there (o.device = c.device()).
-    return fromImage(std::move(out));
+// The report of a denoise() call as a dict (atrous.denoise(..., report=True)).
+nb::dict reportDict(const DenoiseReport& r) {
+    nb::dict d;
+    d["method_used"] = denoiseMethodName(r.methodUsed);
+    d["noise_estimated"] = r.noiseEstimated, d["variance_ignored"] = r.varianceIgnored;
+    d["noise_sigma"] = nb::make_tuple(r.noiseSigma[0], r.noiseSigma[1], r.noiseSigma[2]);
+    d["non_finite_pixels"] = r.nonFinitePixels, d["fireflies_clamped"] = r.firefliesClamped;
+    d["buffers_used"] = r.buffersUsed, d["milliseconds"] = r.milliseconds;
+    nb::list stages;
+    for (const StageTime& s : r.stages) stages.append(nb::make_tuple(s.name, s.milliseconds));
+    d["stages"] = stages;
+    d["copies"] = r.copies;
+    return d;
 }
 
-// The learned filter's prepared planes (preparePlanes with method learned): d, var, albedo,
-// normal, depth (the last three only when given), mod and emission, on the host, for training.
-nb::dict pyLearnedPlanes(const Array& color, nb::handle variance, nb::handle albedo, nb::handle normal,
-                         nb::handle depth, nb::handle emission, nb::dict params) {
-    using B = io::Buffer;
-    Image c = toImage(color, "color");
-    if (c.device() != Device::Cpu) throw InputError("learned_planes: color must be a host (numpy) array");
-    Buffers b(c);
-    b.add({{albedo, B::Albedo, "albedo"}, {normal, B::Normal, "normal"}, {depth, B::Depth, "depth"},
-           {variance, B::Variance, "variance"}, {emission, B::Emission, "emission"}});
-    const DenoiseInputs in = b.refs;
+// A frame of the caller's arrays, borrowed where they are (Arrays::strided: no copy), every
+// buffer on the colour's device.
+struct ArrayFrame {
+    Arrays held;
+    Frame frame;
+    struct Arg {
+        nb::handle obj;
+        Buffer buffer;
+        const char* what;  // the keyword
+    };
+    ArrayFrame(nb::handle color, std::initializer_list<Arg> args) {
+        if (color.is_none()) throw InputError("color: an array is required");
+        frame.color = held.strided(color, "color");
+        for (const Arg& a : args) {
+            const StridedImage s = held.strided(a.obj, a.what);
+            if (s.valid() && s.device != frame.color.device())
+                throw InputError(std::string(a.what) + ": lives on a different device than color");
+            frame.set(a.buffer, s);
+        }
+    }
+};
+
+// atrous.denoise: the arrays handed to denoise() as they are (the colour, variance and emission
+// are converted into the filter's planes by its first pass; the features the cascade reads are
+// copied into planar storage, named in the report's `copies`). Returns (image, report or None).
+nb::tuple pyDenoise(nb::handle color, nb::handle albedo, nb::handle normal, nb::handle position, nb::handle depth,
+                    nb::handle variance, nb::handle ids, nb::handle emission, const std::string& method,
+                    const std::string& device, nb::handle learnedWeights, nb::dict params, bool report) {
+    ArrayFrame in(color, {{albedo, Buffer::Albedo, "albedo"}, {normal, Buffer::Normal, "normal"},
+                          {position, Buffer::Position, "position"}, {depth, Buffer::Depth, "depth"},
+                          {variance, Buffer::Variance, "variance"}, {ids, Buffer::ObjectId, "ids"},
+                          {emission, Buffer::Emission, "emission"}});
+    DenoiseOptions o;
+    if (!method.empty()) o.method = parseDenoiseMethod(method);  // "": the library's default
+    if (readsWeights(denoiseMethodInfo(o.method))) o.weights = weightsFrom(learnedWeights);  // auto's too
+    // auto: the arrays' device (a CUDA colour on the GPU, numpy on the CPU); a result of a host
+    // colour comes back to the host, one of a GPU colour stays there.
+    o.device = device == "auto" ? in.frame.color.device() : parseDevice(device);
+    if (o.device == Device::Cpu && in.frame.color.device() != Device::Cpu)
+        throw InputError("device='cpu' with CUDA arrays: move them to the host first");
+    for (auto [k, v] : params) applyParam(o, denoiseParams(), nb::cast<std::string>(k), v, "denoise");
+    DenoiseResult r;
+    {
+        nb::gil_scoped_release release;
+        if (report)
+            r = denoiseWithReport(in.frame, o);
+        else
+            r.image = denoise(in.frame, o);
+    }
+    nb::object out = fromImage(std::move(r.image));
+    return nb::make_tuple(out, report ? nb::object(reportDict(r.report)) : nb::none());
+}
+
+// The prepared planes of a still method (preparePlanes, by default the learned filter's): color,
+// variance, albedo, normal, position, depth, ids (the features only when given and read),
+// modulation and emission, on the host, for training and for checking a cascade.
+nb::dict pyPreparedPlanes(nb::handle color, nb::handle variance, nb::handle albedo, nb::handle normal,
+                          nb::handle depth, nb::handle emission, nb::handle position, nb::handle ids,
+                          const std::string& method, nb::dict params) {
+    ArrayFrame in(color, {{albedo, Buffer::Albedo, "albedo"}, {normal, Buffer::Normal, "normal"},
+                          {position, Buffer::Position, "position"}, {depth, Buffer::Depth, "depth"},
+                          {variance, Buffer::Variance, "variance"}, {ids, Buffer::ObjectId, "ids"},
+                          {emission, Buffer::Emission, "emission"}});
+    if (in.frame.color.device() != Device::Cpu) throw InputError("color: prepared_planes takes host (numpy) arrays");
     DenoiseOptions o;
     for (auto [k, v] : params) applyParam(o, denoiseParams(), nb::cast<std::string>(k), v, "denoise");
-    o.method = DenoiseMethod::Learned;  // the planes of the learned method, whatever the keywords say
+    // The planes of the learned method unless another is named, whatever the keywords say.
+    o.method = method.empty() ? DenoiseMethod::Learned : parseDenoiseMethod(method);
     PreparedPlanes p;
     {
         nb::gil_scoped_release release;
-        p = preparePlanes(in, o);
+        p = preparePlanes(in.frame, o);
     }
     nb::dict d;
-    const std::pair<const char*, Image*> planes[] = {{"d", &p.color},        {"var", &p.variance}, {"albedo", &p.albedo},
-                                                     {"normal", &p.normal}, {"depth", &p.depth},  {"mod", &p.modulation},
-                                                     {"emission", &p.emission}};
+    const std::pair<const char*, Image*> planes[] = {
+        {"color", &p.color},       {"variance", &p.variance}, {"albedo", &p.albedo},         {"normal", &p.normal},
+        {"position", &p.position}, {"depth", &p.depth},       {"ids", &p.ids},               {"modulation", &p.modulation},
+        {"emission", &p.emission}};
     for (const auto& [name, img] : planes)
         if (!img->empty()) d[name] = fromImage(std::move(*img));
     return d;
 }
 
-// One render's files (readRenderFiles, include/atrous/io.h) as a dict of host arrays by buffer name.
 // Python's keywords are the render table's rows (params.h); the library validates the ranges.
 RenderSettings renderSettings(nb::dict params) {
     RenderSettings rs;
@@ -219,11 +269,13 @@ NB_MODULE(_core, m) {
             PyErr_SetString(PyExc_RuntimeError, e.what());
         }
     });
-    m.def("denoise", &pyDenoise, nb::arg("color"), nb::arg("albedo").none(), nb::arg("normal").none(),
+    m.def("denoise", &pyDenoise, nb::arg("color").none(), nb::arg("albedo").none(), nb::arg("normal").none(),
           nb::arg("position").none(), nb::arg("depth").none(), nb::arg("variance").none(), nb::arg("ids").none(),
-          nb::arg("emission").none(), nb::arg("method"), nb::arg("learned_weights").none(), nb::arg("params"));
-    m.def("learned_planes", &pyLearnedPlanes, nb::arg("color"), nb::arg("variance").none(), nb::arg("albedo").none(),
-          nb::arg("normal").none(), nb::arg("depth").none(), nb::arg("emission").none(), nb::arg("params"));
+          nb::arg("emission").none(), nb::arg("method"), nb::arg("device"), nb::arg("learned_weights").none(),
+          nb::arg("params"), nb::arg("report"));
+    m.def("prepared_planes", &pyPreparedPlanes, nb::arg("color").none(), nb::arg("variance").none(),
+          nb::arg("albedo").none(), nb::arg("normal").none(), nb::arg("depth").none(), nb::arg("emission").none(),
+          nb::arg("position").none(), nb::arg("ids").none(), nb::arg("method"), nb::arg("params"));
     m.def("render", &pyRender, nb::arg("scene"), nb::arg("params"));
     m.def("render_frame", &pyRenderFrame, nb::arg("scene"), nb::arg("frame"), nb::arg("frames"), nb::arg("camera_path"),
           nb::arg("params"));
@@ -231,6 +283,12 @@ NB_MODULE(_core, m) {
     m.def("denoise_params", [] { return paramRows(denoiseParams()); });
     // The still methods (denoiseMethods()): atrous.METHODS and the rows of atrous.denoise_methods().
     m.def("denoise_methods", &stillMethodRows);
+    // The built-in rows' names, for code about one of them (atrous.names), and the default.
+    m.attr("EAW_METHOD") = denoiseMethodName(DenoiseMethod::Eaw);
+    m.attr("SURE_METHOD") = denoiseMethodName(DenoiseMethod::Sure);
+    m.attr("LEARNED_METHOD") = denoiseMethodName(DenoiseMethod::Learned);
+    m.attr("BLEND_METHOD") = denoiseMethodName(DenoiseMethod::Blend);
+    m.attr("DEFAULT_METHOD") = denoiseMethodName(DenoiseOptions{}.method);
     m.def("svgf_params", [] { return paramRows(svgfParams()); });
     m.def("temporal_params", [] { return paramRows(temporalParams()); });
     m.def("temporal_window_radius", [](nb::dict temporal) {

@@ -15,6 +15,7 @@
 
 #include "arrays.h"
 #include "atrous/error.h"
+#include "atrous/interop.h"
 #include "atrous/io.h"
 #include "atrous/io/alpha.h"
 #include "atrous/io/image_io.h"
@@ -73,15 +74,14 @@ nb::object pyReadImage(const std::string& path, bool alpha) {
     return fromImage(std::move(img));
 }
 
-// `image` is H x W x 3, H x W x 4 (alpha), H x W x 1 or H x W float32 (python/atrous/__init__.py
-// converts other float dtypes); one channel stays one channel so that PFM writes grey ("Pf") and EXR
-// repeats it.
-void pyWriteImage(const std::string& path, const Array& image) {
-    const int channels = image.ndim() == 3 ? int(image.shape(2)) : 1;
-    if (image.ndim() == 3 && channels != 1 && channels != 3 && channels != 4)
-        throw InputError(path + ": expected an array of shape (H, W, 3), (H, W, 4), (H, W, 1) or (H, W), got " +
-                         std::to_string(channels) + " channels");
-    Image img = toImage(image, path.c_str(), channels);
+// `image` is H x W x 3, H x W x 4 (alpha), H x W x 1 or H x W (the array rule, arrays.h); one
+// channel stays one channel so that PFM writes grey ("Pf") and EXR repeats it.
+void pyWriteImage(const std::string& path, nb::handle image) {
+    Arrays held;
+    const StridedImage s = held.strided(image, path.c_str());
+    if (s.channels == 2)
+        throw InputError(path + ": expected an array of shape (H, W, 3), (H, W, 4), (H, W, 1) or (H, W), got 2 channels");
+    Image img = importImage(s, s.channels, path.c_str());
     if (img.device() != Device::Cpu) img = img.to(Device::Cpu);  // the writers read host memory
     nb::gil_scoped_release release;
     atrous::writeImage(path, img);
@@ -92,7 +92,7 @@ void pyWriteImage(const std::string& path, const Array& image) {
 void bindFiles(nb::module_& m) {
     m.def("read_image", &pyReadImage, nb::arg("path"), nb::arg("alpha") = false);
     m.def("read_buffers", &pyReadBuffers, nb::arg("path"), nb::arg("passes"), nb::arg("layer"));
-    m.def("write_image", &pyWriteImage, nb::arg("path"), nb::arg("image"));
+    m.def("write_image", &pyWriteImage, nb::arg("path"), nb::arg("image").none());
 }
 
 }  // namespace atrous::python

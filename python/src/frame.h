@@ -1,6 +1,7 @@
-// One frame's arrays as the library's images (for every binding file): the arrays become the
-// binding's own planar images, put into the one input assembly (io::BufferRefs, the Frame every
-// denoiser takes), as the CLI and the viewer do.
+// One frame's arrays as the library's images, for the sequence methods (which take Images): the
+// arrays become the binding's own planar images, put into the one input assembly (io::BufferRefs,
+// the Frame every denoiser takes), as the CLI and the viewer do. atrous.denoise hands its arrays
+// over where they are instead (bindings.cpp).
 #pragma once
 #include <nanobind/nanobind.h>
 
@@ -12,6 +13,7 @@
 
 #include "arrays.h"
 #include "atrous/error.h"
+#include "atrous/interop.h"
 #include "atrous/io/buffer_set.h"
 
 namespace atrous::python {
@@ -23,13 +25,6 @@ struct Buffers {
     const Image& color;
     io::BufferRefs refs;
     explicit Buffers(const Image& c) : color(c) { refs.set(io::Buffer::Color, &c); }
-    // The binding's own copy of buffer b (toImage's), which denoise(DenoiseBuffers&) may filter in
-    // its storage; null when b was not given.
-    Image* ownedCopy(io::Buffer b) {
-        for (auto& o : owned)
-            if (o.get() == refs.get(b)) return o.get();
-        return nullptr;
-    }
     struct Arg {
         nb::handle obj;
         io::Buffer buffer;
@@ -41,12 +36,13 @@ struct Buffers {
     }
     void add(const Arg& arg) {
         if (arg.obj.is_none()) return;
-        Array a = nb::cast<Array>(arg.obj);
         // Motion vectors and ids of 2 or more channels keep them (dx, dy; object, material id); one
         // channel is repeated into 3, as for every other buffer.
         const bool ownCount = arg.buffer == io::Buffer::Motion || arg.buffer == io::Buffer::ObjectId;
-        const int channels = ownCount && a.ndim() == 3 && a.shape(2) >= 2 ? int(a.shape(2)) : 3;
-        owned.push_back(std::make_unique<Image>(toImage(a, arg.what, channels)));
+        Arrays held;
+        const StridedImage a = held.strided(arg.obj, arg.what);
+        const int channels = ownCount && a.channels >= 2 ? a.channels : 3;
+        owned.push_back(std::make_unique<Image>(importImage(a, channels, arg.what)));
         const Image& img = *owned.back();
         if (!img.view().sameSize(color.view()))
             throw InputError(std::string(arg.what) + ": size " + std::to_string(img.width()) + "x" +

@@ -2,6 +2,8 @@
 // the one relMSE every evaluation, test and training script reports.
 #include <nanobind/nanobind.h>
 
+#include <cstdint>
+
 #include "arrays.h"
 #include "atrous/metrics.h"
 
@@ -9,12 +11,12 @@ namespace atrous::python {
 
 namespace {
 
-Image hostImage(const Array& a, const char* what) {
+Image hostImage(nb::handle a, const char* what) {
     Image img = toImage(a, what);
     return img.device() == Device::Cpu ? std::move(img) : img.to(Device::Cpu);
 }
 
-nb::dict pyMetrics(const Array& image, const Array& reference) {
+nb::dict pyMetrics(nb::handle image, nb::handle reference) {
     const Image a = hostImage(image, "image"), r = hostImage(reference, "reference");
     ImageMetrics m = computeMetrics(a, r);
     nb::dict d;
@@ -28,8 +30,7 @@ nb::dict pyMetrics(const Array& image, const Array& reference) {
 }
 
 // One step of a sequence: relMSE of the frame differences against the reference's, and tPSNR.
-nb::dict pyTemporalMetrics(const Array& image, const Array& previous, const Array& reference,
-                           const Array& previousReference) {
+nb::dict pyTemporalMetrics(nb::handle image, nb::handle previous, nb::handle reference, nb::handle previousReference) {
     const TemporalMetrics m = computeTemporalMetrics(hostImage(image, "image"), hostImage(previous, "previous"),
                                                      hostImage(reference, "reference"),
                                                      hostImage(previousReference, "previous_reference"));
@@ -40,21 +41,33 @@ nb::dict pyTemporalMetrics(const Array& image, const Array& previous, const Arra
 }
 
 // The tonemap of the PSNR and SSIM (tonemapForMetrics), as an H x W x 3 array: what the metrics
-// compare, and what ColorVideoVDP is shown (atrous.eval.cvvdp).
-nb::object pyTonemap(const Array& image) {
+// compare, and what ColorVideoVDP is shown (atrous.eval.cvvdp); with eight_bit, the library's
+// 8-bit preview of it (tonemap8: the evaluation's crops, the corpus previews), uint8.
+nb::object pyTonemap(nb::handle image, bool eightBit) {
     Image img = hostImage(image, "image");
     float* v = img.data();
-    for (size_t i = 0, n = img.plane() * size_t(img.channels()); i < n; ++i) v[i] = tonemapForMetrics(v[i]);
-    return fromImage(std::move(img));
+    const size_t n = img.plane() * size_t(img.channels());
+    if (!eightBit) {
+        for (size_t i = 0; i < n; ++i) v[i] = tonemapForMetrics(v[i]);
+        return fromImage(std::move(img));
+    }
+    const int w = img.width(), h = img.height(), ch = img.channels();
+    auto* bytes = new uint8_t[n];
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < ch; ++c) bytes[(size_t(y) * w + x) * ch + c] = tonemap8(img(x, y, c));
+    nb::capsule owner(bytes, [](void* p) noexcept { delete[] static_cast<uint8_t*>(p); });
+    const size_t shape[3] = {size_t(h), size_t(w), size_t(ch)};
+    return nb::ndarray<nb::numpy, uint8_t>(bytes, 3, shape, owner).cast();
 }
 
 }  // namespace
 
 void bindMetrics(nb::module_& m) {
-    m.def("metrics", &pyMetrics, nb::arg("image"), nb::arg("reference"));
-    m.def("temporal_metrics", &pyTemporalMetrics, nb::arg("image"), nb::arg("previous"), nb::arg("reference"),
-          nb::arg("previous_reference"));
-    m.def("tonemap", &pyTonemap, nb::arg("image"));
+    m.def("metrics", &pyMetrics, nb::arg("image").none(), nb::arg("reference").none());
+    m.def("temporal_metrics", &pyTemporalMetrics, nb::arg("image").none(), nb::arg("previous").none(),
+          nb::arg("reference").none(), nb::arg("previous_reference").none());
+    m.def("tonemap", &pyTonemap, nb::arg("image").none(), nb::arg("eight_bit"));
 }
 
 }  // namespace atrous::python

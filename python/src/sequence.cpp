@@ -34,12 +34,12 @@ std::shared_ptr<FrameArrays> frameArrays(const nb::handle& frame, const std::str
     nb::dict d = nb::cast<nb::dict>(frame);
     for (auto [k, v] : d) {
         const std::string key = nb::cast<std::string>(k);
-        bool known = key == "color";
+        bool known = key == "color" || key == "time";  // atrous.render_sequence's items carry their time
         for (const auto& [name, b] : kKeys) known = known || key == name;
         if (!known) throw InputError(at + "unknown buffer '" + key + "'");
     }
     if (!d.contains("color")) throw InputError(at + "has no color");
-    auto f = std::make_shared<FrameArrays>(toImage(nb::cast<Array>(d["color"]), "color"));
+    auto f = std::make_shared<FrameArrays>(toImage(d["color"], "color"));
     for (const auto& [name, b] : kKeys)
         if (d.contains(name)) f->buffers.add({d[name], b, name});
     return f;
@@ -94,7 +94,8 @@ SequenceSetup setupOf(const std::string& method, const std::string& device, cons
     s.device = parseDevice(device);
     s.params = params;
     const SequenceMethodInfo* row = findSequenceMethod(method);
-    s.still.method = parseDenoiseMethod(row ? spatial : method);
+    const std::string& stillName = row ? spatial : method;
+    if (!stillName.empty()) s.still.method = parseDenoiseMethod(stillName);  // "": the library's default
     ParamSet stillSet = ParamSet::bind(denoiseParams(), s.still);
     applyParams(stillSet, still, "denoise");
     const bool stillWeights = readsWeights(denoiseMethodInfo(s.still.method));

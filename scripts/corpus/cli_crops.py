@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Side-by-side images of the CLI's output on the third-party corpus: noisy | EAW | SURE | reference
 (or noisy | the --methods given | reference),
-tonemapped (x / (1 + x), sRGB-like gamma), one PNG per scene and spp.
+tonemapped (the library's 8-bit preview, atrous.tonemap: x / (1 + x), gamma 1/2.2), one PNG per scene and spp.
 
   .venv/bin/python scripts/corpus/cli_crops.py --corpus out/corpus/full --out docs/images \\
       --scenes mi_glass,cy_glass_mirror --spp 16 [--atrous build/atrous] [--methods sure,learned]
@@ -37,8 +37,9 @@ def rgb(path):
 
 
 def tonemap(x):
-    x = np.maximum(np.nan_to_num(x), 0.0)
-    return (np.clip(x / (1.0 + x), 0.0, 1.0) ** (1 / 2.2) * 255.0 + 0.5).astype(np.uint8)
+    import atrous
+
+    return atrous.tonemap(x[..., :3], np.uint8)
 
 
 def main():

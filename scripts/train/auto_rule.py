@@ -8,7 +8,7 @@ is set on data the test tables never see. Run with the project venv (it needs at
 
 Per scene and spp (4 and 16; our renders with their variance and without it) it prints relMSE of
 SURE and learned and rho = the median over pixels of sqrt(mean_c var_c) / (mean_c d_c + 0.01) on
-the driver's prepared planes (d demodulated colour, var its rendered or estimated variance), then
+the driver's prepared planes (color: the demodulated colour, variance: its rendered or estimated variance), then
 the geometric mean of every candidate rule: always SURE, always learned, learned iff a variance
 buffer was given, learned iff rho > t for each t."""
 from __future__ import annotations
@@ -31,8 +31,8 @@ relmse = atrous.relmse  # docs/eval.md's relMSE, as the library computes it
 
 
 def rho_of(planes) -> float:
-    sd = np.sqrt(np.maximum(np.mean(planes["var"], axis=2), 0.0))
-    m = np.mean(np.maximum(planes["d"], 0.0), axis=2) + 0.01
+    sd = np.sqrt(np.maximum(np.mean(planes["variance"], axis=2), 0.0))
+    m = np.mean(np.maximum(planes["color"], 0.0), axis=2) + 0.01
     return float(np.median(sd / m))
 
 
@@ -60,7 +60,7 @@ def main() -> int:
     rows = []
     for name, spp, given, b, var, ref in cases(Path(a.data), a.limit):
         kw = dict(albedo=b["albedo"], normal=b["normal"], depth=b["depth"], emission=b["emission"], variance=var)
-        planes = atrous.learned_planes(b["color"], **kw)
+        planes = atrous.prepared_planes(b["color"], **kw)
         r = {"scene": name, "spp": spp, "variance": given, "rho": rho_of(planes),
              "noisy": relmse(b["color"], ref),
              "sure": relmse(atrous.denoise(b["color"], method="sure", **kw), ref),

@@ -1,11 +1,11 @@
 #!/usr/bin/env python3
 """Writes tests/learned_fixture.bin (the learned filter v4's parity fixture): synthetic prepared
-planes (what the still driver hands the learned cascade: d, var, albedo, normal, depth), a weight
+planes (what the still driver hands the learned cascade: color, variance, albedo, normal, depth), a weight
 file with random non-trivial weights and the JAX d_out on them, which tests/learned_test.cpp (C++
 inference) and tests/python/test_learn.py (the JAX code as it is now) compare with.
 Layout (little-endian):
   "ATRF" | u32 version (4) | u32 width | u32 height | u32 n (weight-file bytes) | the weight file
-  | planes d(3), var(3), albedo(3), normal(3), depth(1), out_d(3): f32, planar, channel-major
+  | planes color(3), variance(3), albedo(3), normal(3), depth(1), out_d(3): f32, planar, channel-major
     (atrous's Image layout: channel c's plane is height x width row-major)."""
 import struct
 import sys
@@ -17,7 +17,7 @@ import numpy as np
 
 from atrous.learn import context, features, model, weights
 
-PLANES = (("d", 3), ("var", 3), ("albedo", 3), ("normal", 3), ("depth", 1))
+PLANES = (("color", 3), ("variance", 3), ("albedo", 3), ("normal", 3), ("depth", 1))
 VERSION = 4  # the fixture's own version: 4 holds a version-4 weight file and the v4 d_out
 
 
@@ -44,7 +44,7 @@ def make_planes(w: int = 42, h: int = 37, seed: int = 5) -> dict:
     d[12, 3] = 0.0  # a black pixel: kappa's 0.01
     var = (0.2 * d * d + 0.005).astype(np.float32)
     var[:2, -3:] = 0.0  # no variance: input 10 reads log1p(0)
-    return {"d": d, "var": var, "albedo": albedo, "normal": normal, "depth": depth}
+    return {"color": d, "variance": var, "albedo": albedo, "normal": normal, "depth": depth}
 
 
 def fixture_params(seed: int = 16) -> dict:
@@ -70,11 +70,11 @@ def d_out_np(params: dict, planes: dict, box: bool = True, v_scale: float = 1.0,
     """JAX d_out; box=False zeroes the box inputs, v_scale scales the noise plane (the inputs unchanged),
     ctx=False drops the context branch."""
     x = features.inputs_of(planes)
-    cells = jnp.asarray(context.cell_inputs(x, planes["d"])[None]) if ctx else None
+    cells = jnp.asarray(context.cell_inputs(x, planes["color"])[None]) if ctx else None
     if not box:
         x[..., features.BOX] = 0.0
-    v = v_scale * features.variance_plane(planes["var"])
-    out = model.denoise_d(params, jnp.asarray(x[None]), cells, jnp.asarray(planes["d"][None]), jnp.asarray(v[None]),
+    v = v_scale * features.variance_plane(planes["variance"])
+    out = model.denoise_d(params, jnp.asarray(x[None]), cells, jnp.asarray(planes["color"][None]), jnp.asarray(v[None]),
                           **ablate)
     return np.asarray(out[0])
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Turns the raw training scenes (out/train/data/<split>/*.npz: color/variance/albedo/normal/depth/
 emission at each spp + reference, from scripts/train/dataset.py or scripts/corpus) into the learned
-filter's prepared planes, made by the library itself (atrous.learned_planes: the still driver's
+filter's prepared planes, made by the library itself (atrous.prepared_planes: the still driver's
 sanitise, emission split, firefly clamp, noise estimate, demodulation), so that the network trains
 on exactly what it sees in atrous::denoise (docs/learned.md, "Training").
 
@@ -10,9 +10,10 @@ Each scene is prepared twice where it has a variance buffer: `given` (the render
 `noem` (variance and emission withheld: what a renderer that writes neither gives, e.g. Mitsuba's
 aov integrator; a visible light then stays in d and its edge must be kept by the network itself).
 Scenes without one (the corpus training split) get `est` only. Output: out/train/prep/<split>/
-<name>.npz with keys "<variant>_<spp>_<plane>" (plane: d, var, albedo, normal, depth, mod,
-emission; absent planes have no key) and "reference"; written under a temporary name and renamed,
-so a rerun skips what is done. Needs the atrous module (.venv):
+<name>.npz with keys "<variant>_<spp>_<plane>" (plane: color, variance, albedo, normal, depth,
+modulation, emission: the C++ PreparedPlanes' names; absent planes have no key) and "reference";
+written under a temporary name and renamed, so a rerun skips what is done (and redoes a file of
+the older plane names d, var, mod). Needs the atrous module (.venv):
 
   .venv/bin/python scripts/train/prepare.py --splits train test corpus_train
 """
@@ -26,7 +27,15 @@ from pathlib import Path
 
 import numpy as np
 
-PLANES = ("d", "var", "albedo", "normal", "depth", "mod", "emission")
+PLANES = ("color", "variance", "albedo", "normal", "depth", "modulation", "emission")
+
+
+def _current(target: Path) -> bool:
+    """Whether a prepared file has this version's plane names (an older one's "_d" keys are redone)."""
+    try:
+        return any(k.endswith("_color") for k in np.load(target).files)
+    except (OSError, ValueError):
+        return False
 
 
 def spps_of(z) -> list:
@@ -69,7 +78,7 @@ def main(argv=None, planes_fn=None) -> int:
     if planes_fn is None:
         import atrous
 
-        planes_fn = atrous.learned_planes
+        planes_fn = atrous.prepared_planes
     t0, n = time.time(), 0
     for split in a.splits:
         dest = Path(a.out) / split
@@ -78,7 +87,7 @@ def main(argv=None, planes_fn=None) -> int:
             if f.endswith(".tmp.npz"):  # a scene being written (dataset.py renames it when done)
                 continue
             target = dest / Path(f).name
-            if target.exists() and target.stat().st_mtime >= Path(f).stat().st_mtime:
+            if target.exists() and target.stat().st_mtime >= Path(f).stat().st_mtime and _current(target):
                 continue  # prepared from this version of the scene (dataset.py redraws a changed one)
             try:
                 planes = prepare_scene(np.load(f), planes_fn, a.variants)

@@ -35,7 +35,7 @@ def main() -> int:
     p.add_argument("--eps", type=float, help="the loss's relMSE epsilon (default 0.01, the metric's)")
     p.add_argument("--no-colour", dest="colour", action="store_const", const=False)
     p.add_argument("--no-vcolour", dest="vcolour", action="store_const", const=False)
-    p.add_argument("--no-blend", dest="blend", action="store_const", const=False)
+    p.add_argument("--no-blend", dest="level_blend", action="store_const", const=False)
     p.add_argument("--no-box", dest="box", action="store_const", const=False)
     p.add_argument("--no-context", dest="context", action="store_const", const=False,
                    help="train without the context branch (version 3's network; the file still has it, zero)")
@@ -43,7 +43,7 @@ def main() -> int:
     p.add_argument("--export", action="store_true", help="write src/filters/learned_weights_default.cpp")
     a = p.parse_args()
     over = {k: getattr(a, k) for k in ("splits", "spps", "variants", "batch", "crop", "lr", "eps", "loss", "corpus_share", "colour", "vcolour",
-                                       "blend", "box", "context")}
+                                       "level_blend", "box", "context")}
     params = train.train(Path(a.prep), Path(a.out), a.steps, seed=a.seed, minutes=a.minutes, init=a.init, **over)
     if a.eval:
         cfg = dict(train.DEFAULTS, **{k: v for k, v in over.items() if v is not None})

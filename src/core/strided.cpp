@@ -71,6 +71,19 @@ bool interleavedRgb32(const StridedImage& s) {
            s.pixelStride == 12 && s.channelStride == 4;
 }
 
+// Interleaved float32 on the host with pixels of K = 1..4 floats holding the channels read: K, or 0.
+int interleavedFloats(const StridedImage& s) {
+    if (s.device != Device::Cpu || s.type != DataType::Float32 || (s.channels > 1 && s.channelStride != 4)) return 0;
+    const int64_t k = s.pixelStride / 4;
+    return s.pixelStride % 4 == 0 && k >= 1 && k <= 4 && k >= s.channels ? int(k) : 0;
+}
+
+template <int K>
+void gatherInterleaved(const StridedImage& s, const ImageView& v) {
+    parallelForRowsCpu(s.height, detail::GatherInterleaved<K>{static_cast<const float*>(s.data), s.rowStride / 4,
+                                                              s.channels, v});
+}
+
 }  // namespace
 
 Image importImage(const StridedImage& src, int outChannels, const char* what) {
@@ -89,6 +102,9 @@ Image importImage(const StridedImage& src, int outChannels, const char* what) {
         parallelForRowsCpu(
             src.height,
             detail::GatherInterleaved3{static_cast<const float*>(src.data), src.rowStride / 4, v});
+    else if (const int k = interleavedFloats(src))  // a feature's first channels of an RGB array, grey
+        k == 1 ? gatherInterleaved<1>(src, v)
+               : k == 2 ? gatherInterleaved<2>(src, v) : k == 3 ? gatherInterleaved<3>(src, v) : gatherInterleaved<4>(src, v);
     else if (src.type == DataType::Float16)
         parallelFor2dCpu(src.width, src.height, detail::ImportStrided<DataType::Float16>{src, v});
     else

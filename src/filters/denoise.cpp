@@ -306,7 +306,9 @@ PreparedView PreparedPlanes::view() const {
 }
 
 PreparedPlanes preparePlanes(const Frame& given, const DenoiseOptions& options) {
-    Frame in = given;
+    ImportedFrame imported;  // buffers given as strided memory, as denoise() takes them
+    importStrided(given, nullptr, imported);
+    Frame in = imported.frame;
     DenoiseOptions o = options;
     o.device = Device::Cpu;
     o.method = resolveDenoiseMethod(options.method, in);

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "atrous/error.h"
+#include "atrous/srgb.h"
 #include "core/parallel.h"
 #include "filters/flicker.h"
 #include "filters/svgf_gbuffer.h"
@@ -139,6 +140,8 @@ float tonemapForMetrics(float x) {
     float t = std::pow(x / (1.0f + x), 1.0f / 2.2f);
     return t < 0 ? 0 : (t > 1 ? 1 : t);
 }
+
+unsigned char tonemap8(float x) { return displayByte(tonemapForMetrics(x)); }
 
 ImageMetrics computeMetrics(const Image& a, const Image& r) {
     checkPair(a, r);

@@ -237,6 +237,10 @@ void scanHost(Frame& in, CheckedInputs& p, DenoiseReport& rep, bool* varianceDro
     if (scan.colorBad != SIZE_MAX)
         throw outOfRangeError("color", color.data()[scan.colorBad], kMaxInputColor, scan.colorBad % color.plane(), color.width());
     rep.nonFinitePixels = scan.nonFinite;
+    // An all-NaN render would come out black (every pixel repaired from nothing): refused, with the
+    // message the readers give (io::requireFinitePixel), for every caller alike.
+    if (color.plane() > 0 && size_t(scan.nonFinite) == color.plane())
+        throw InputError("color buffer has no finite pixel (every pixel has a NaN or an infinite value): nothing to denoise");
     p.meanLuminanceIn = scan.lumCount > 0 ? scan.lumSum / scan.lumCount : 0.0;
     if (varianceDropped && hostVariance && !scan.varianceInformative) {
         // All zero (or non-finite): no information, dropped before its values are checked.

@@ -282,11 +282,11 @@ void writePng(const std::string& path, const Image& img, float exposure) {
             for (int c = 0; c < 3; ++c) {
                 float v = img(x, y, img.channels() >= 3 ? c : 0) * exposure;
                 if (!std::isfinite(v)) v = 0.0f;
-                px[(size_t(y) * w + x) * n + c] = (unsigned char)std::lround(srgbEncode(v) * 255.0f);
+                px[(size_t(y) * w + x) * n + c] = displayByte(srgbEncode(v));
             }
             if (n == 4) {
                 const float a = img(x, y, 3);
-                px[(size_t(y) * w + x) * n + 3] = (unsigned char)std::lround((a > 0.0f ? (a < 1.0f ? a : 1.0f) : 0.0f) * 255.0f);
+                px[(size_t(y) * w + x) * n + 3] = displayByte(a);
             }
         }
     writeFileAtomically(path, [&](const std::string& tmp) {

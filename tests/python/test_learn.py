@@ -50,7 +50,7 @@ def test_fixture_exercises_every_term():
     for name, kw in make_fixture.ABLATIONS:
         assert np.abs(make_fixture.d_out_np(params, planes, **kw) - out).max() > 0.01 * scale, name
     # The fixture has sky depth, black albedo and a bright pixel (the cases the spec names).
-    assert planes["depth"].max() >= 1e30 and planes["albedo"].min() == 0.0 and planes["d"].max() > 40
+    assert planes["depth"].max() >= 1e30 and planes["albedo"].min() == 0.0 and planes["color"].max() > 40
 
 
 def test_inputs_follow_the_spec():
@@ -176,9 +176,9 @@ def _tiny_prep(folder, rng):
     z = {"reference": ref}
     for spp, sd in ((1, 0.8), (64, 0.1)):
         d = np.clip(ref + rng.normal(0, sd, ref.shape), 0, None).astype(np.float32)
-        planes = {"d": d, "var": np.full((h, w, 3), sd * sd, np.float32), "albedo": np.ones((h, w, 3), np.float32),
+        planes = {"color": d, "variance": np.full((h, w, 3), sd * sd, np.float32), "albedo": np.ones((h, w, 3), np.float32),
                   "normal": np.tile(np.float32([0, 0, 1]), (h, w, 1)), "depth": np.ones((h, w, 1), np.float32),
-                  "mod": np.ones((h, w, 3), np.float32), "emission": np.zeros((h, w, 3), np.float32)}
+                  "modulation": np.ones((h, w, 3), np.float32), "emission": np.zeros((h, w, 3), np.float32)}
         z.update({f"given_{spp}_{k}": v for k, v in planes.items()})
     (folder / "train").mkdir(parents=True)
     np.savez(folder / "train" / "scene_0000.npz", **z)

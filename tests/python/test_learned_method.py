@@ -1,4 +1,4 @@
-"""The learned method from Python: atrous.learned_planes (the driver's prepared planes the network
+"""The learned method from Python: atrous.prepared_planes (the driver's prepared planes the network
 is trained on, docs/learned.md) and atrous.denoise(method="learned" | "auto")."""
 import numpy as np
 import pytest
@@ -27,14 +27,14 @@ def test_planes_without_albedo_are_the_colour_minus_the_emission():
     # emission comes back as given. A hook copying another buffer (var into d, the colour before
     # the emission split, ...) fails the exact comparisons.
     b = _synthetic()
-    p = atrous.learned_planes(b["color"], variance=b["variance"], emission=b["emission"], firefly=False,
+    p = atrous.prepared_planes(b["color"], variance=b["variance"], emission=b["emission"], firefly=False,
                               emission_levels=0)
-    assert set(p) == {"d", "var", "mod", "emission"}
+    assert set(p) == {"color", "variance", "modulation", "emission"}
     for k, v in p.items():
         assert v.dtype == np.float32 and v.shape == (H, W, 3), k
-    np.testing.assert_array_equal(p["d"], b["color"] - b["emission"])
-    np.testing.assert_array_equal(p["var"], b["variance"])
-    np.testing.assert_array_equal(p["mod"], np.ones((H, W, 3), np.float32))
+    np.testing.assert_array_equal(p["color"], b["color"] - b["emission"])
+    np.testing.assert_array_equal(p["variance"], b["variance"])
+    np.testing.assert_array_equal(p["modulation"], np.ones((H, W, 3), np.float32))
     np.testing.assert_array_equal(p["emission"], b["emission"])
 
 
@@ -44,31 +44,31 @@ def test_planes_with_every_buffer_remodulate_to_the_colour():
     # rtol 1e-6), and var * mod^2 = the variance. The features come back as given (finite), depth
     # as one channel. emission_levels=0 so that the emission is added back as given.
     b = _synthetic(2)
-    p = atrous.learned_planes(b["color"], variance=b["variance"], albedo=b["albedo"], normal=b["normal"],
+    p = atrous.prepared_planes(b["color"], variance=b["variance"], albedo=b["albedo"], normal=b["normal"],
                               depth=b["depth"], emission=b["emission"], firefly=False, emission_levels=0)
-    assert set(p) == {"d", "var", "albedo", "normal", "depth", "mod", "emission"}
+    assert set(p) == {"color", "variance", "albedo", "normal", "depth", "modulation", "emission"}
     assert p["depth"].shape == (H, W, 1)
-    np.testing.assert_array_equal(p["mod"], b["albedo"])
+    np.testing.assert_array_equal(p["modulation"], b["albedo"])
     np.testing.assert_array_equal(p["albedo"], b["albedo"])
     np.testing.assert_array_equal(p["normal"], b["normal"])
     np.testing.assert_array_equal(p["depth"][..., 0], b["depth"][..., 0])
-    np.testing.assert_allclose(p["d"] * p["mod"] + p["emission"], b["color"], rtol=1e-6, atol=0)
-    np.testing.assert_allclose(p["var"] * p["mod"] ** 2, b["variance"], rtol=1e-6, atol=0)
+    np.testing.assert_allclose(p["color"] * p["modulation"] + p["emission"], b["color"], rtol=1e-6, atol=0)
+    np.testing.assert_allclose(p["variance"] * p["modulation"] ** 2, b["variance"], rtol=1e-6, atol=0)
     # Not the colour itself: the demodulation happened.
-    assert np.abs(p["d"] - b["color"]).max() > 0.1
+    assert np.abs(p["color"] - b["color"]).max() > 0.1
 
 
 def test_black_albedo_is_left_demodulated_by_the_rule():
     # Where the albedo is 0 the rule's divisor fades to 1 (albedo_floor): mod = 1 there, d = c - e.
     b = _synthetic(3)
     b["albedo"][10:14, 10:14] = 0.0
-    p = atrous.learned_planes(b["color"], variance=b["variance"], albedo=b["albedo"], firefly=False)
-    np.testing.assert_array_equal(p["mod"][11:13, 11:13], 1.0)
-    np.testing.assert_array_equal(p["d"][11:13, 11:13], b["color"][11:13, 11:13])
+    p = atrous.prepared_planes(b["color"], variance=b["variance"], albedo=b["albedo"], firefly=False)
+    np.testing.assert_array_equal(p["modulation"][11:13, 11:13], 1.0)
+    np.testing.assert_array_equal(p["color"][11:13, 11:13], b["color"][11:13, 11:13])
     # demodulate=False: no albedo plane, mod 1 everywhere.
-    q = atrous.learned_planes(b["color"], variance=b["variance"], albedo=b["albedo"], demodulate=False)
+    q = atrous.prepared_planes(b["color"], variance=b["variance"], albedo=b["albedo"], demodulate=False)
     assert "albedo" not in q
-    np.testing.assert_array_equal(q["mod"], 1.0)
+    np.testing.assert_array_equal(q["modulation"], 1.0)
 
 
 def test_planes_follow_the_preparation_fireflies_nan_and_estimated_noise():
@@ -78,24 +78,24 @@ def test_planes_follow_the_preparation_fireflies_nan_and_estimated_noise():
     color[3, 4, 1] = np.nan       # repaired by the sanitise stage
     normal = b["normal"].copy()
     normal[2, 2] = np.inf         # a non-finite feature reads 0
-    p = atrous.learned_planes(color, albedo=b["albedo"], normal=normal)  # no variance: estimated
+    p = atrous.prepared_planes(color, albedo=b["albedo"], normal=normal)  # no variance: estimated
     for k, v in p.items():
         assert np.isfinite(v).all(), k
-    assert p["d"][7, 9].max() * p["mod"][7, 9].max() < 50.0
+    assert p["color"][7, 9].max() * p["modulation"][7, 9].max() < 50.0
     np.testing.assert_array_equal(p["normal"][2, 2], 0.0)
-    assert (p["var"] > 0).all()
+    assert (p["variance"] > 0).all()
 
 
-def test_learned_planes_checks_inputs_like_denoise():
+def test_prepared_planes_checks_inputs_like_denoise():
     b = _synthetic()
     with pytest.raises(ValueError, match="albedo"):
-        atrous.learned_planes(b["color"], albedo=b["albedo"][:-1])
+        atrous.prepared_planes(b["color"], albedo=b["albedo"][:-1])
     with pytest.raises(ValueError, match="sigma_normal"):
-        atrous.learned_planes(b["color"], sigma_normal=-1.0)
+        atrous.prepared_planes(b["color"], sigma_normal=-1.0)
     with pytest.raises(ValueError, match="unknown denoise parameter"):
-        atrous.learned_planes(b["color"], no_such_thing=1)
+        atrous.prepared_planes(b["color"], no_such_thing=1)
     with pytest.raises(ValueError, match="variance"):
-        atrous.learned_planes(b["color"], variance=-b["variance"])
+        atrous.prepared_planes(b["color"], variance=-b["variance"])
 
 
 def _fixture_weights(tmp_path):
@@ -173,7 +173,7 @@ def test_bad_weights_raise_value_error_naming_the_file(tmp_path):
         atrous.denoise(b["color"], albedo=b["albedo"], normal=b["normal"], method="auto", learned_weights=junk)
     with pytest.raises(ValueError, match="junk.atrl"):
         atrous.load_weights(junk)
-    with pytest.raises(ValueError, match="unknown method"):
+    with pytest.raises(ValueError, match="unknown denoise method"):
         atrous.denoise(b["color"], method="learnt")
 
 

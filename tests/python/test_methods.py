@@ -47,11 +47,11 @@ def test_denoise_is_the_cascade_on_the_prepared_planes_then_remodulation():
     for albedo in (b["albedo"], None):
         got = atrous.denoise(b["color"], albedo=albedo, normal=b["normal"], variance=b["variance"],
                              emission=b["emission"], method="pytoy")
-        p = atrous.learned_planes(b["color"], variance=b["variance"], albedo=albedo, normal=b["normal"],
+        p = atrous.prepared_planes(b["color"], variance=b["variance"], albedo=albedo, normal=b["normal"],
                                   emission=b["emission"])
-        f = np.empty_like(p["d"])
-        toy_plugin.toy_cascade({"color": p["d"], "albedo": p.get("albedo")}, f)
-        want = f * p["mod"] + p["emission"]
+        f = np.empty_like(p["color"])
+        toy_plugin.toy_cascade({"color": p["color"], "albedo": p.get("albedo")}, f)
+        want = f * p["modulation"] + p["emission"]
         # The library's remodulation is one float32 multiply-add per sample, as numpy's here.
         np.testing.assert_allclose(got, want, rtol=1e-6, atol=1e-7)
         assert not np.array_equal(got, b["color"])
@@ -131,8 +131,8 @@ def test_a_cascade_that_leaves_nan_or_inf_never_reaches_the_output():
     assert np.isfinite(got).all()
     # Where the cascade was finite its value is kept (an identity cascade: the prepared colour,
     # remodulated; the replaced samples are the prepared colour too, so the whole is that).
-    p = atrous.learned_planes(b["color"], albedo=b["albedo"], normal=b["normal"])
-    np.testing.assert_allclose(got, p["d"] * p["mod"] + p["emission"], rtol=1e-6, atol=1e-7)
+    p = atrous.prepared_planes(b["color"], albedo=b["albedo"], normal=b["normal"])
+    np.testing.assert_allclose(got, p["color"] * p["modulation"] + p["emission"], rtol=1e-6, atol=1e-7)
 
 
 def test_the_evaluation_takes_a_plugins_method(tmp_path):

@@ -5,6 +5,7 @@
 #include <deque>
 #include <string>
 
+#include "atrous/denoise.h"
 #include "atrous/param_set.h"
 #include "atrous/render.h"
 
@@ -20,7 +21,7 @@ struct ViewerOptions {
         r.spp = 1;
         return r;
     }();
-    std::string method = "blend";  // slot A: a name of methodNames() (blend: auto's choice, the renderer gives every buffer)
+    std::string method = denoiseMethodName(DenoiseMethod::Blend);  // slot A: a name of methodNames() (blend: auto's choice, the renderer gives every buffer)
     std::string compare;         // slot B for the split screen (empty: no split)
     bool noAccumulate = false;
     std::string bufferView = "result";  // initial buffer view (see docs/viewer.md)

@@ -33,9 +33,9 @@ class AtrousSettings(bpy.types.PropertyGroup):
         description="A sequence method: each frame with the frames around it or before it (the first, "
                     "the default); a still method: each frame alone")
     spatial: bpy.props.EnumProperty(
-        name="Spatial", items=_STILL, default="auto",
+        name="Spatial", items=_STILL, default=atrous.names.DEFAULT,
         description="The still method: what a sequence method that ends with one runs (on "
-                    "its average), and what denoises the Render Result (auto: by the passes given)")
+                    "its average), and what denoises the Render Result (the default, auto: by the passes given)")
     output: bpy.props.StringProperty(
         name="Output", subtype="DIR_PATH", default="",
         description="Folder for frame_NNNN.exr (empty: FRAMES_denoised beside the rendered frames' folder)")

@@ -29,6 +29,7 @@ from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 import atrous
+from atrous import names
 
 __all__ = ["EvalConfig", "run_eval", "main", "load_oidn", "oidn_inputs", "time_call", "score"]
 
@@ -39,10 +40,10 @@ def all_methods() -> tuple:
     return ("noisy",) + atrous.METHODS + ("oidn",)
 
 
-# The default set (--methods not given). learned (the learned à-trous filter, docs/learned.md) and
-# auto (learned with an albedo and a normal, which every render here has: the same as learned) are
-# taken when asked for: --methods noisy,eaw,sure,learned,oidn.
-DEFAULT_METHODS = ("noisy", "eaw", "sure", "oidn")
+# The default set (--methods not given): the wavelet filters EAW and SURE (their names from the
+# registry) between the input and OIDN. learned (the learned à-trous filter, docs/learned.md),
+# blend and auto are taken when asked for: --methods noisy,eaw,sure,learned,oidn.
+DEFAULT_METHODS = ("noisy", names.EAW, names.SURE, "oidn")
 QUICK_SCENES = ("cornell", "cornell-spheres")
 
 

@@ -17,6 +17,7 @@ import sys
 import time
 
 from atrous.eval.machine import cpu_model
+from atrous.names import EAW, SURE  # the two filters compared, by their names in the registry
 
 SCENES = ["cornell", "cornell-point", "cornell-spheres", "sphere-env"]
 
@@ -55,7 +56,7 @@ def main(argv=None):
             run([args.atrous, "render", "--scene", scene, "--width", str(args.size), "--height", str(args.size),
                  "--spp", str(spp), "--seed", "1", "--out", noisy_dir])
             outs, times = {}, {}
-            for m in ["eaw", "sure"]:
+            for m in (EAW, SURE):
                 o = os.path.join(noisy_dir, "denoised-%s.exr" % m)
                 text, _ = run([args.atrous, "denoise", "--in", noisy_dir, "--method", m, "--out", o]
                               + args.denoise_args.split())
@@ -66,10 +67,10 @@ def main(argv=None):
                     if "fireflies clamped" in line:
                         times["firefly"] = line.split("denoise: ")[1]
             text, _ = run([args.atrous, "compare", "--json", "--ref", os.path.join(ref_dir, "color.exr"),
-                           os.path.join(noisy_dir, "color.exr"), outs["eaw"], outs["sure"]])
+                           os.path.join(noisy_dir, "color.exr"), outs[EAW], outs[SURE]])
             imgs = json.loads(text)["images"]
-            row = {"scene": scene, "spp": spp, "noisy": imgs[0], "eaw": imgs[1], "sure": imgs[2],
-                   "eaw_ms": times.get("eaw"), "sure_ms": times.get("sure"), "firefly": times.get("firefly", "")}
+            row = {"scene": scene, "spp": spp, "noisy": imgs[0], EAW: imgs[1], SURE: imgs[2],
+                   EAW + "_ms": times.get(EAW), SURE + "_ms": times.get(SURE), "firefly": times.get("firefly", "")}
             rows.append(row)
             print("%-16s %3d spp  MSE noisy %.4g  EAW %.4g (%.1fx)  SURE %.4g (%.1fx)  SURE/EAW %.2f" % (
                 scene, spp, imgs[0]["mse"], imgs[1]["mse"], imgs[0]["mse"] / imgs[1]["mse"], imgs[2]["mse"],
@@ -82,7 +83,7 @@ def main(argv=None):
     lines.append("| scene | spp | MSE noisy | MSE EAW | MSE SURE | noisy/EAW | EAW/SURE | relMSE noisy | relMSE EAW | relMSE SURE | SSIM EAW | SSIM SURE |")
     lines.append("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
-        n, e, s = r["noisy"], r["eaw"], r["sure"]
+        n, e, s = r["noisy"], r[EAW], r[SURE]
         lines.append("| %s | %d | %.4g | %.4g | %.4g | %.1f× | %.2f× | %.4g | %.4g | %.4g | %.3f | %.3f |" % (
             r["scene"], r["spp"], n["mse"], e["mse"], s["mse"], n["mse"] / e["mse"], e["mse"] / s["mse"],
             n["relmse"], e["relmse"], s["relmse"], e["ssim"], s["ssim"]))

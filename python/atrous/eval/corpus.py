@@ -21,6 +21,13 @@ from pathlib import Path
 
 import numpy as np
 
+import atrous
+from atrous.names import EAW, SURE
+
+# The atrous filters run on the corpus (their names from the library's registry) and the columns.
+FILTERS = (EAW, SURE)
+COLUMNS = ("noisy", "oidn") + FILTERS
+
 ROOT = Path.cwd()  # the repository root: run from it (its out/ and build/ are the defaults)
 
 import OpenEXR  # noqa: E402  (python/requirements.txt puts it in .venv, as in .venv-corpus)
@@ -158,7 +165,7 @@ def run_methods(b, oidn, want):
         t = time.perf_counter()
         out["oidn"] = np.asarray(oidn(b), np.float32)
         times["oidn"] = time.perf_counter() - t
-    for m in ("eaw", "sure"):
+    for m in FILTERS:
         if m in want:
             t = time.perf_counter()
             out[m] = np.asarray(atrous.denoise(b["color"], method=m, **feats), np.float32)
@@ -167,8 +174,7 @@ def run_methods(b, oidn, want):
 
 
 def tonemap(img):
-    x = np.maximum(np.nan_to_num(np.asarray(img, np.float32), nan=0.0, posinf=1e6), 0.0)
-    return (np.clip((x / (1.0 + x)) ** (1.0 / 2.2), 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
+    return atrous.tonemap(img, np.uint8)  # the library's one 8-bit preview
 
 
 def save_png(path, rgb8):
@@ -198,7 +204,7 @@ def crop_strip(images, ref, size):
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="python -m atrous.eval corpus", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--corpus", default=None, help="corpus root (default out/corpus/full, else out/corpus/quick)")
-    ap.add_argument("--methods", default="noisy,oidn,eaw,sure")
+    ap.add_argument("--methods", default=",".join(COLUMNS))
     ap.add_argument("--crops", action="store_true", help="write side-by-side PNG crops")
     ap.add_argument("--crop-size", type=int, default=96)
     ap.add_argument("--preview", action="store_true", help="tonemapped PNG of every reference")
@@ -220,7 +226,7 @@ def main(argv=None):
                 print(f"quality: OIDN skipped: {note}", file=sys.stderr)
         except Exception as e:  # pragma: no cover
             print(f"quality: OIDN skipped: {e}", file=sys.stderr)
-    cols = [m for m in ("noisy", "oidn", "eaw", "sure") if m in want and (m != "oidn" or oidn is not None)]
+    cols = [m for m in COLUMNS if m in want and (m != "oidn" or oidn is not None)]
     only = set(a.scenes.split(",")) if a.scenes else None
     results = []
     crops_dir = corpus / "crops"
@@ -256,7 +262,7 @@ def main(argv=None):
             print(fmt_row(row, cols), flush=True)
             if a.crops:
                 crops_dir.mkdir(parents=True, exist_ok=True)
-                order = [m for m in ("noisy", "oidn", "eaw", "sure") if m in imgs]
+                order = [m for m in COLUMNS if m in imgs]
                 save_png(crops_dir / f"{name}_spp{e['spp']:04d}.png",
                          crop_strip([imgs[m] for m in order] + [ref], ref, a.crop_size))
     out = Path(a.out) if a.out else corpus / "quality.json"

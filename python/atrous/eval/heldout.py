@@ -17,10 +17,13 @@ from pathlib import Path
 import numpy as np
 
 import atrous
+from atrous.names import BLEND, LEARNED, SURE
 
 ROOT = Path.cwd()  # the repository root: run from it (its out/ and build/ are the defaults)
 BUFS = ("color", "variance", "albedo", "normal", "depth", "emission")
-METHODS = ("noisy", "eaw", "sure", "learned", "blend", "oidn")
+# The input, every still method of the registry with a cascade of its own (not auto, which is one of
+# them per call; registered ones too), and OIDN.
+METHODS = ("noisy", *(str(r["name"]) for r in atrous.denoise_methods() if not r["resolves"]), "oidn")
 
 
 def buffers(z, spp: int) -> dict:
@@ -31,8 +34,6 @@ def buffers(z, spp: int) -> dict:
 
 
 def run_method(method: str, b: dict, weights):
-    import atrous
-
     if method == "noisy":
         return b["color"]
     if method == "oidn":
@@ -42,7 +43,7 @@ def run_method(method: str, b: dict, weights):
         return pyoidn.denoise(c, np.clip(np.nan_to_num(b["albedo"]), 0, 1).astype(np.float32),
                               np.clip(np.nan_to_num(b["normal"]), -1, 1).astype(np.float32), hdr=True, quality="high")
     kw = {k: v for k, v in b.items() if k != "color"}
-    extra = {"learned_weights": weights} if method in ("learned", "blend") and weights else {}
+    extra = {"learned_weights": weights} if method in atrous.WEIGHTED_METHODS and weights else {}
     return atrous.denoise(b["color"], method=method, device="cpu", **kw, **extra)
 
 
@@ -52,14 +53,13 @@ def summary(res: dict, spps=(4, 16)) -> dict:
         rows = {k: v for k, v in res.items() if k.endswith(f" {spp}spp")}
         ms = [m for m in METHODS if rows and all(m in v for v in rows.values())]
         s = {m: math.exp(np.mean([math.log(v[m]) for v in rows.values()])) for m in ms}
-        if "learned" in ms and "sure" in ms:
-            s["learned_beats_sure"] = sum(v["learned"] < v["sure"] for v in rows.values())
-            s["learned_over_sure_max"] = max(v["learned"] / v["sure"] for v in rows.values())
-        if "blend" in ms and "sure" in ms:
-            s["blend_beats_sure"] = sum(v["blend"] < v["sure"] for v in rows.values())
-            s["blend_over_sure_max"] = max(v["blend"] / v["sure"] for v in rows.values())
-        if "learned" in ms and "oidn" in ms:
-            s["learned_over_oidn_max"] = max(v["learned"] / v["oidn"] for v in rows.values())
+        # The figures docs/learned.md quotes (keys named after the methods, as the table's columns).
+        for a, b in ((LEARNED, SURE), (BLEND, SURE)):
+            if a in ms and b in ms:
+                s[f"{a}_beats_{b}"] = sum(v[a] < v[b] for v in rows.values())
+                s[f"{a}_over_{b}_max"] = max(v[a] / v[b] for v in rows.values())
+        if LEARNED in ms and "oidn" in ms:
+            s[f"{LEARNED}_over_oidn_max"] = max(v[LEARNED] / v["oidn"] for v in rows.values())
         s["scenes"] = len(rows)
         out[f"{spp}spp"] = s
     return out

@@ -12,8 +12,11 @@ import numpy as np
 
 import atrous
 
-COLORS = {"noisy": "#7f7f7f", "eaw": "#1f77b4", "sure": "#2ca02c", "learned": "#ff7f0e", "blend": "#17becf", "auto": "#8c564b",
-          "oidn": "#d62728", "render 1 spp": "#000000"}
+COLORS = {"noisy": "#7f7f7f", "oidn": "#d62728", "render 1 spp": "#000000"}
+# The still methods' colours, in the registry's order (eaw, sure, learned, blend, auto, then a
+# registered method's).
+_STILL_COLORS = ("#1f77b4", "#2ca02c", "#ff7f0e", "#17becf", "#8c564b", "#7f7f00", "#aec7e8")
+COLORS.update({str(r["name"]): _STILL_COLORS[i % len(_STILL_COLORS)] for i, r in enumerate(atrous.denoise_methods())})
 # The sequence methods' colours, in the registry's order (temporal, svgf, then a plugin's).
 _SEQUENCE_COLORS = ("#e377c2", "#9467bd", "#bcbd22", "#8c564b", "#aec7e8")
 COLORS.update({str(r["name"]): _SEQUENCE_COLORS[i % len(_SEQUENCE_COLORS)]
@@ -258,9 +261,9 @@ def write_plots(data: Dict[str, Any], out: Path) -> Dict[str, str]:
 # ------------------------------------------------------------------------------------ images
 
 def tonemap(img: np.ndarray) -> np.ndarray:
-    """Linear HDR -> 8-bit display: x / (1 + x), gamma 1/2.2 (the metrics' tonemap)."""
-    x = np.maximum(np.nan_to_num(np.asarray(img, np.float32), nan=0.0, posinf=1e6), 0.0)
-    return (np.clip((x / (1.0 + x)) ** (1.0 / 2.2), 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
+    """Linear HDR -> 8-bit display: the library's one preview (atrous.tonemap as uint8: the metrics'
+    x / (1 + x), gamma 1/2.2, rounded to 8 bits; non-finite values 0)."""
+    return atrous.tonemap(img, np.uint8)
 
 
 def png_bytes(rgb8: np.ndarray, palette: int = 0) -> bytes:

@@ -19,9 +19,9 @@ import subprocess
 import sys
 import time
 
-from atrous.sequence import SVGF
+from atrous.names import EAW, SURE, SVGF
 
-METHODS = [SVGF, "eaw", "sure"]
+METHODS = [SVGF, EAW, SURE]
 
 
 def run(cmd, quiet=True):
@@ -51,7 +51,7 @@ def mean(v):
 def svg_plot(path, title, series, key):
     """A small line plot (per frame, log-free, y from 0) written as plain SVG."""
     w, h, ml, mb, mt, mr = 520, 240, 60, 30, 24, 90
-    colors = {"noisy": "#999999", SVGF: "#d62728", "eaw": "#1f77b4", "sure": "#2ca02c"}
+    colors = {"noisy": "#999999", SVGF: "#d62728", EAW: "#1f77b4", SURE: "#2ca02c"}
     ys = [y for s in series.values() for y in s[key] if y is not None]
     n = max(len(s[key]) for s in series.values())
     ymax = max(ys) * 1.05 if ys else 1.0
@@ -141,7 +141,7 @@ def main(argv=None):
               "denoise_via": "atrous denoise --sequence" if use_cli else "bench/svgf_sequence_tool denoise",
               "skip_frames": a.skip_frames, "svgf_args": a.svgf_args, "scenes": []}
     for spec in a.scenes.split(","):
-        name, path = (spec.split(":") + ["auto"])[:2]
+        name, path = (spec.split(":") + ["auto"])[:2]  # the camera path: auto unless given
         seq = os.path.join(a.work, "%s_%s_%d" % (name, path, a.size))
         stamp = os.path.join(seq, "settings.json")
         settings = {"scene": name, "path": path, "frames": a.frames, "size": a.size, "ref": a.reference_spp, "seed": a.seed}
@@ -194,11 +194,11 @@ def main(argv=None):
                 "mean_relmse_after_skip": mean(series[k]["relmse"][s:]),
                 "mean_temporal_after_skip": mean(series[k]["temporal"][s:]),
                 "mean_temporal_no_emitters_after_skip": mean(series[k]["temporal_no_emitters"][s:])}
-        sv, ea = series[SVGF]["relmse"][s:], series["eaw"]["relmse"][s:]
+        sv, ea = series[SVGF]["relmse"][s:], series[EAW]["relmse"][s:]
         scene["svgf_beats_eaw_frames"] = "%d/%d" % (sum(1 for x, y in zip(sv, ea) if x < y), len(sv))
-        scene["temporal_eaw_over_svgf"] = scene["methods"]["eaw"]["mean_temporal_after_skip"] / \
+        scene["temporal_eaw_over_svgf"] = scene["methods"][EAW]["mean_temporal_after_skip"] / \
             scene["methods"][SVGF]["mean_temporal_after_skip"]
-        scene["temporal_no_emitters_eaw_over_svgf"] = scene["methods"]["eaw"]["mean_temporal_no_emitters_after_skip"] / \
+        scene["temporal_no_emitters_eaw_over_svgf"] = scene["methods"][EAW]["mean_temporal_no_emitters_after_skip"] / \
             scene["methods"][SVGF]["mean_temporal_no_emitters_after_skip"]
         if a.plots:
             os.makedirs(a.plots, exist_ok=True)

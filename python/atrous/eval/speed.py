@@ -35,8 +35,14 @@ import time
 from pathlib import Path
 
 from atrous.eval.machine import cpu_model, emit, git_commit
+from atrous.names import LEARNED
 
 import numpy as np
+
+import atrous
+
+# The still methods timed: every row of the registry with a cascade of its own (auto is one of them).
+_FILTERS = tuple(str(r["name"]) for r in atrous.denoise_methods() if not r["resolves"] and not r["registered"])
 
 ROOT = Path.cwd()  # the repository root: run from it (its out/ and build/ are the defaults)
 
@@ -147,7 +153,7 @@ def main(argv=None) -> int:
             p.error(f"--sizes: '{s}' is not WxH")
         sizes.append((w, h))
 
-    cmd = [a.atrous, "bench", "--json", "--what", "eaw,sure,learned,blend", "--sizes", a.sizes, "--runs", str(a.runs),
+    cmd = [a.atrous, "bench", "--json", "--what", ",".join(_FILTERS), "--sizes", a.sizes, "--runs", str(a.runs),
            "--warmup", str(a.warmup), "--scene", a.scene, "--device", a.device]
     if a.learned_weights:
         cmd += ["--learned-weights", a.learned_weights]
@@ -157,21 +163,19 @@ def main(argv=None) -> int:
         return 2
     bench = json.loads(proc.stdout)
 
-    import atrous  # the project's package (.venv): the same renderer and inputs as `atrous bench`
-
     rows = []
     for w, h in sizes:
         row = {"width": w, "height": h}
         for r in bench["results"]:
-            if r["width"] == w and r["height"] == h and r["what"] in ("eaw", "sure", "learned", "blend"):
+            if r["width"] == w and r["height"] == h and r["what"] in _FILTERS:
                 row[f"{r['what']}_ms"] = r["median_ms"]
                 row[f"{r['what']}_total_ms"] = r["total_ms"]
         b = atrous.render(a.scene, width=w, height=h, spp=2, seed=7)
         row.update(time_oidn(b, a.runs, a.warmup))
         row.update(time_default_alternating(b, a.runs, a.warmup))
         for k in ("oidn_denoise_ms", "oidn_filter_ms"):
-            if row.get("learned_ms") and row.get(k):
-                row["learned_over_" + k[:-3]] = row["learned_ms"] / row[k]
+            if row.get(f"{LEARNED}_ms") and row.get(k):
+                row[f"{LEARNED}_over_" + k[:-3]] = row[f"{LEARNED}_ms"] / row[k]
         rows.append(row)
 
     doc = {

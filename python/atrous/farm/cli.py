@@ -11,6 +11,7 @@ import re
 import sys
 from typing import Any, Dict, List, Optional, Sequence
 
+from .. import names
 from . import jobs
 from .items import EVAL_METHODS, FarmInputError, denoise_choices, eval_choices, parse_assignments
 from .runner import JobResult, print_summary
@@ -67,8 +68,8 @@ def _parser() -> argparse.ArgumentParser:
     d.add_argument("--in", dest="inputs", action="append", required=True,
                    help="a render directory (color.exr, ...), a frame sequence (frame_NNNN/) or a directory of "
                         "them, such as a render job's --out; repeat or comma-separate")
-    d.add_argument("--method", default="auto",
-                   help=f"{', '.join(denoise_choices())} (default auto: blend with an albedo and a normal, else sure)")
+    d.add_argument("--method", default=names.DEFAULT,
+                   help=f"{', '.join(denoise_choices())} (default {names.DEFAULT}: the library's default)")
     d.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                    help="a filter parameter, named as atrous.denoise's keywords (levels=4, sigma_color=0.5)")
     d.add_argument("--plugin", action="append", default=[], metavar="FILE.py|MODULE",
@@ -84,8 +85,8 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("--runs", type=int, default=3, help="timed denoise runs per item after a warm-up (median kept)")
     _run_flags(e)
 
-    s = sub.add_parser("sweep", help="a parameter grid of eaw or sure scored against references")
-    s.add_argument("--method", default="sure", help="eaw or sure")
+    s = sub.add_parser("sweep", help=f"a parameter grid of {names.EAW} or {names.SURE} scored against references")
+    s.add_argument("--method", default=names.SURE, help=f"{names.EAW} or {names.SURE}")
     s.add_argument("--grid", action="append", required=True, metavar="NAME=V1,V2,...",
                    help="a parameter and its values; repeat for more (the grid is their product)")
     s.add_argument("--scenes", default="cornell")

@@ -18,6 +18,7 @@ from typing import Any, Dict, Iterable, List, Optional, Sequence
 import numpy as np
 
 import atrous
+from atrous import names
 
 __all__ = ["Item", "FarmInputError", "scene_label", "check_scenes", "parse_value", "check_denoise_params",
            "discover_inputs", "denoise_choices", "EVAL_METHODS", "eval_choices", "sequence_row",
@@ -35,7 +36,7 @@ def sequence_row(method: str) -> Optional[Dict[str, Any]]:
     return next((r for r in atrous.sequence_methods() if r["name"] == method), None)
 
 
-EVAL_METHODS = ("noisy", "eaw", "sure", "oidn")  # the default set
+EVAL_METHODS = ("noisy", names.EAW, names.SURE, "oidn")  # the default set
 
 
 def eval_choices() -> tuple:
@@ -165,11 +166,11 @@ def split_sequence_params(method: str, params: Dict[str, Any]):
     method's; one that does not takes its own table's names as they are."""
     row = sequence_row(method) or {}
     if not row.get("still_method"):
-        return dict(params), "auto", {}
+        return dict(params), names.DEFAULT, {}
     prefix = f"{row['params']}_"
     own = {k[len(prefix):]: v for k, v in params.items() if k.startswith(prefix)}
     still = {k: v for k, v in params.items() if not k.startswith(prefix) and k != "spatial"}
-    return own, str(params.get("spatial", "auto")), still
+    return own, str(params.get("spatial", names.DEFAULT)), still
 
 
 def check_denoise_params(method: str, params: Dict[str, Any], flag: str) -> None:

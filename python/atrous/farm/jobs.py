@@ -80,7 +80,7 @@ def render_dataset(out: PathLike, spec: Union[Dict[str, Any], PathLike], **run: 
     return run_job("render", {"dataset": s}, items, Path(out), **run)
 
 
-def denoise(out: PathLike, inputs: Any, method: str = "auto", params: Optional[Dict[str, Any]] = None,
+def denoise(out: PathLike, inputs: Any, method: Optional[str] = None, params: Optional[Dict[str, Any]] = None,
             plugins: Any = None, **run: Any) -> JobResult:
     """Render directories and frame sequences through one method: OUT/<name>/denoised_<method>.exr
     and .png per render directory, OUT/<sequence>/frame_NNNN.exr and .png per frame (a sequence
@@ -94,6 +94,7 @@ def denoise(out: PathLike, inputs: Any, method: str = "auto", params: Optional[D
         load_plugins(plugins)
     except PluginError as e:
         raise FarmInputError(str(e)) from None
+    method = method or atrous.names.DEFAULT  # the library's default still method
     if method not in denoise_choices():
         raise FarmInputError(f"method: unknown '{method}' (expected {', '.join(denoise_choices())})")
     params = dict(params or {})

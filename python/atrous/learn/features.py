@@ -1,5 +1,5 @@
 """The learned filter's per-pixel inputs (docs/learned.md, "Inputs"), in numpy, from the still
-driver's prepared planes (atrous.learned_planes: d, var, albedo, normal, depth), exactly as
+driver's prepared planes (atrous.prepared_planes: color, variance, albedo, normal, depth), exactly as
 src/filters/learned.h computes them. No JAX here: the inputs are not differentiated.
 
     0-2   log1p(max(d_c, 0))
@@ -64,5 +64,5 @@ def variance_plane(var) -> np.ndarray:
 def inputs_of(planes: dict, suffix: str = "") -> np.ndarray:
     """inputs() of a dict holding d, var and optionally albedo, normal, depth (keys + suffix)."""
     g = planes.get
-    return inputs(planes["d" + suffix], planes["var" + suffix], g("albedo" + suffix), g("normal" + suffix),
+    return inputs(planes["color" + suffix], planes["variance" + suffix], g("albedo" + suffix), g("normal" + suffix),
                   g("depth" + suffix))

@@ -23,7 +23,7 @@ DEFAULTS = {
     "variants": ["given", "est", "noem"],  # rendered variance / the driver's estimate / also no emission
     "batch": 4, "crop": 96, "lr": 3e-3, "eps": 0.01,
     "corpus_share": None,  # None: crops drawn uniformly from all images; else this fraction from corpus_train
-    "colour": True, "vcolour": True, "blend": True, "box": True,  # ablations (C++ implements all four)
+    "colour": True, "vcolour": True, "level_blend": True, "box": True,  # ablations (C++ implements all four)
     "context": True,  # version 4's context branch (False: train the MLP alone, as version 3)
     # "relmse": the mean relMSE of the batch; "log": the mean of each crop's log relMSE, the metric's geometric
     # mean over images, so a crop of a near-clean input (64, 256 spp) counts as much as a 1-spp one; "sqrt": the
@@ -35,13 +35,14 @@ DEFAULTS = {
 def item_of(z, variant: str, spp: int, box: bool = True):
     """(x, d, v, mod, e, ref) of one prepared image, or None when the npz lacks it."""
     pre = f"{variant}_{spp}_"
-    if pre + "d" not in z:
+    if pre + "color" not in z:
         return None
     planes = {k[len(pre):]: z[k] for k in z if k.startswith(pre)}
     x = features.inputs_of(planes)
     if not box:
         x[..., features.BOX] = 0.0
-    return x, planes["d"], features.variance_plane(planes["var"]), planes["mod"], planes["emission"], z["reference"]
+    return (x, planes["color"], features.variance_plane(planes["variance"]), planes["modulation"], planes["emission"],
+            z["reference"])
 
 
 def load_items(folder: Path, spps, variants, box: bool = True, limit: int | None = None) -> list:
@@ -92,7 +93,7 @@ def evaluate(params: dict, prep_test: Path, cfg: dict, spps=(4, 16, 64, 256), va
     """JAX relMSE on a held-out split (default variant `given`, full images): per image and geomean/spp."""
     ctx = cfg.get("context", True)
     fwd = jax.jit(lambda p, x, c, d, v, m, e: model.forward(p, x, c if ctx else None, d, v, m, e, cfg["colour"],
-                                                            cfg["blend"], cfg["vcolour"]))
+                                                            cfg["level_blend"], cfg["vcolour"]))
     res = {}
     for x, d, v, mod, e, ref, name in load_items(prep_test, spps, list(variants), cfg["box"]):
         cells = context.cell_inputs(x, d)
@@ -142,7 +143,7 @@ def train(prep: Path, out: Path, steps: int, seed: int = 1, minutes: float | Non
     rng = np.random.default_rng([seed, start])
 
     def loss_fn(p, x, c, d, v, m, e, r):
-        out = model.forward(p, x, c if cfg["context"] else None, d, v, m, e, cfg["colour"], cfg["blend"], cfg["vcolour"])
+        out = model.forward(p, x, c if cfg["context"] else None, d, v, m, e, cfg["colour"], cfg["level_blend"], cfg["vcolour"])
         per = model.relmse(out, r, cfg["eps"], axis=tuple(range(1, out.ndim)))  # each crop's
         if cfg["loss"] == "log":
             return jnp.mean(jnp.log(per + 1e-7)), jnp.mean(per)
