@@ -102,7 +102,7 @@ int main(int argc, char** argv) {
             std::printf("]}\n");
             return out.empty() ? 1 : 0;
         }
-        const DenoiseInputs di = set.inputs();
+        const Frame di = set.inputs();
         std::vector<double> filter, total;
         std::vector<std::string> names;
         std::vector<std::vector<double>> stage;

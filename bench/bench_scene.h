@@ -42,13 +42,13 @@ struct BoxScene {
             }
     }
     // Every buffer (bench_denoise); colour, variance, albedo, normal and depth (bench_learned).
-    DenoiseInputs allInputs() const {
-        DenoiseInputs in = learnedInputs();
+    Frame allInputs() const {
+        Frame in = learnedInputs();
         in.position = &position, in.ids = &ids;
         return in;
     }
-    DenoiseInputs learnedInputs() const {
-        DenoiseInputs in;
+    Frame learnedInputs() const {
+        Frame in;
         in.color = &color, in.variance = &variance, in.albedo = &albedo, in.normal = &normal, in.depth = &depth;
         return in;
     }

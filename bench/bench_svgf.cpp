@@ -125,7 +125,7 @@ int main(int argc, char** argv) {
             std::vector<double> ms, cpuMs;
             for (int i = 0; i < warmup + runs; ++i) {
                 const BenchFrame& f = frames[i % frames.size()];
-                SvgfFrame in;
+                Frame in;
                 in.color = &f.color, in.albedo = &f.albedo, in.normal = &f.normal;
                 in.depth = &f.depth, in.ids = &f.ids, in.motion = &f.motion;
                 double cpu0 = processCpuMs();

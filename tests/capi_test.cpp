@@ -73,7 +73,7 @@ struct CFilter {
         atrousSetFilterImage(f, name, held.back().data(), floatFormat(img->channels()), kW, kH, 0,
                              0, 0);
     }
-    void setAll(const DenoiseInputs& in) {
+    void setAll(const Frame& in) {
         set("color", in.color), set("variance", in.variance), set("albedo", in.albedo),
             set("normal", in.normal);
         set("position", in.position), set("depth", in.depth), set("ids", in.ids),
@@ -94,9 +94,9 @@ struct CFilter {
     }
 };
 
-DenoiseInputs allBuffers() {
+Frame allBuffers() {
     const Rendered& r = scene();
-    DenoiseInputs in = r.inputs();
+    Frame in = r.inputs();
     in.position = &r.b.position, in.ids = &r.b.ids;
     return in;
 }
@@ -121,7 +121,7 @@ TEST(CApi, EveryMethodWithEveryBufferEqualsDenoise) {
 
 TEST(CApi, ParametersByNameAndTheReport) {
     CFilter run("eaw");
-    const DenoiseInputs in = scene().inputs();
+    const Frame in = scene().inputs();
     run.set("color", in.color), run.set("albedo", in.albedo), run.set("normal", in.normal);
     atrousSetFilterInt(run.f, "levels", 3);
     atrousSetFilterFloat(run.f, "sigma_normal", 0.25f);
@@ -137,7 +137,7 @@ TEST(CApi, ParametersByNameAndTheReport) {
     o.eaw.levels = 3, o.eaw.sigmaNormal = 0.25f, o.firefly.enabled = false, o.eaw.colorScale = 4.0f,
     o.demodulate = false;
     o.sure.mode = SureMode::JamesStein, o.sure.candidates = {0.0f, 0.5f, 1.0f};
-    DenoiseInputs only;
+    Frame only;
     only.color = in.color, only.albedo = in.albedo, only.normal = in.normal;
     const DenoiseResult want = denoiseWithReport(only, o);
     EXPECT_TRUE(test::sameImages(got, want.image));
@@ -180,7 +180,7 @@ TEST(CApi, ParametersByNameAndTheReport) {
 
 // Half inputs are their values exactly: the same output as denoise() of those values in float.
 TEST(CApi, HalfGreyAndNarrowedInputsAreTheirValues) {
-    const DenoiseInputs in = scene().inputs();
+    const Frame in = scene().inputs();
     auto quantised = [](const Image& img) {
         std::vector<uint16_t> h(img.size());
         exportImage(img.view(),
@@ -208,7 +208,7 @@ TEST(CApi, HalfGreyAndNarrowedInputsAreTheirValues) {
     const Image grey3 = importImage(grey.strided(), 3, "grey");
     Image depth1(kW, kH, 1);
     std::memcpy(depth1.data(), in.depth->data(), depth1.size() * sizeof(float));
-    DenoiseInputs q;
+    Frame q;
     q.color = &qc, q.normal = &qn, q.albedo = &grey3, q.depth = &depth1;
     DenoiseOptions o;
     o.method = DenoiseMethod::Sure;
@@ -218,7 +218,7 @@ TEST(CApi, HalfGreyAndNarrowedInputsAreTheirValues) {
 // Padded rows and pixels in, an RGBA output with padded rows (alpha and padding left alone), a
 // half output within half an ulp of the float one, the output in the colour's own memory.
 TEST(CApi, LayoutsAndInPlace) {
-    const DenoiseInputs in = scene().inputs();
+    const Frame in = scene().inputs();
     CFilter ref("eaw");
     ref.set("color", in.color), ref.set("albedo", in.albedo);
     Image want;
@@ -296,7 +296,7 @@ TEST(CApi, DevicesAndReferences) {
     }
     EXPECT_EQ(takeError(nullptr), "") << "reading an error clears it";
     // A filter keeps its device: the device released first, the filter still runs and reports.
-    const DenoiseInputs in = scene().inputs();
+    const Frame in = scene().inputs();
     AtrousDevice d = atrousNewDevice("cpu");
     AtrousFilter f = atrousNewFilter(d, "eaw");
     atrousRetainFilter(f);
@@ -342,7 +342,7 @@ void expectRefused(CFilter& run, AtrousError want, const std::string& message) {
 // Each bad call: its code, a message naming the function and the argument, the first error kept
 // until read, and the output untouched (the filter refuses to run until committed again).
 TEST(CApi, BadInputIsAnErrorAndWritesNothing) {
-    const DenoiseInputs in = scene().inputs();
+    const Frame in = scene().inputs();
     std::vector<float> albedo = interleaved(*in.albedo);
     struct ImageCase {
         const char* name;
@@ -415,7 +415,7 @@ TEST(CApi, OnACudaDeviceTheSameAsDenoiseOnCuda) {
     AtrousDevice d = atrousNewDevice("cuda");
     ASSERT_NE(d, nullptr);
     EXPECT_STREQ(atrousGetDeviceType(d), "cuda");
-    const DenoiseInputs in = scene().inputs();
+    const Frame in = scene().inputs();
     AtrousFilter f = atrousNewFilter(d, "eaw");
     std::vector<float> c = interleaved(*in.color), a = interleaved(*in.albedo), out(c.size());
     atrousSetFilterImage(f, "color", c.data(), ATROUS_FORMAT_FLOAT3, kW, kH, 0, 0, 0);
@@ -424,7 +424,7 @@ TEST(CApi, OnACudaDeviceTheSameAsDenoiseOnCuda) {
     atrousCommitFilter(f);
     atrousExecuteFilter(f);
     EXPECT_EQ(takeError(d), "");
-    DenoiseInputs only;
+    Frame only;
     only.color = in.color, only.albedo = in.albedo;
     DenoiseOptions o;
     o.method = DenoiseMethod::Eaw, o.device = Device::Cuda;

@@ -68,7 +68,7 @@ TEST(DenoiseBuffers, HandedOverImagesGiveTheConstOverloadsResult) {
                     o.firefly.enabled = firefly == 1;
                     DenoiseReport r1, r2;
                     Image zero(53, 41, 3);
-                    DenoiseInputs in = sc.s.inputs();
+                    Frame in = sc.s.inputs();
                     in.variance = variance == 0 ? &sc.s.variance : (variance == 1 ? nullptr : &zero);
                     if (emission) in.emission = &sc.emission;
                     const Image want = test::denoiseReporting(in, o, r1);
@@ -102,7 +102,7 @@ TEST(DenoiseBuffers, DepthInOneChannelAndIdsInTwoAreTheSame) {
             DenoiseOptions o;
             o.method = m;
             o.eaw.sigmaDepth = 0.1f;  // the depth stop reads depth too
-            DenoiseInputs in = s.inputs();
+            Frame in = s.inputs();
             if (!variance) in.variance = nullptr;
             const Image want = denoise(in, o);
             in.depth = &depth1, in.ids = &ids2;
@@ -111,7 +111,7 @@ TEST(DenoiseBuffers, DepthInOneChannelAndIdsInTwoAreTheSame) {
         }
     Image ids1 = firstChannels(s.ids, 1), idsZero = firstChannels(s.ids, 2);
     std::fill(idsZero.data() + idsZero.plane(), idsZero.data() + 2 * idsZero.plane(), 0.0f);
-    DenoiseInputs in = s.inputs();
+    Frame in = s.inputs();
     in.ids = &idsZero;
     const Image want = denoise(in, DenoiseOptions{});
     in.ids = &ids1;
@@ -135,7 +135,7 @@ TEST(DenoiseBuffers, UninformativeVarianceIsDroppedBeforeItsValuesAreChecked) {
     Image var(30, 20, 3);
     var.fill(-INFINITY);
     var(3, 4, 1) = 0.0f;
-    DenoiseInputs in = s.inputs();
+    Frame in = s.inputs();
     in.variance = &var;
     DenoiseReport rep;
     DenoiseOptions o;

@@ -21,10 +21,10 @@ Image denoiseReporting(In&& in, const DenoiseOptions& o, DenoiseReport& rep) {
     return std::move(r.image);
 }
 
-// DenoiseInputs over seven buffers the caller keeps alive (emission unset). Also bench_denoise's.
-inline DenoiseInputs inputsOf(const Image& color, const Image& variance, const Image& albedo, const Image& normal,
+// Frame over seven buffers the caller keeps alive (emission unset). Also bench_denoise's.
+inline Frame inputsOf(const Image& color, const Image& variance, const Image& albedo, const Image& normal,
                               const Image& position, const Image& depth, const Image& ids) {
-    DenoiseInputs in;
+    Frame in;
     in.color = &color;
     in.variance = &variance;
     in.albedo = &albedo;
@@ -36,7 +36,7 @@ inline DenoiseInputs inputsOf(const Image& color, const Image& variance, const I
 }
 
 // The message of the InputError that denoise(in, o) throws, or "" when it returns.
-inline std::string inputErrorOf(const DenoiseInputs& in, const DenoiseOptions& o) {
+inline std::string inputErrorOf(const Frame& in, const DenoiseOptions& o) {
     try {
         denoise(in, o);
     } catch (const InputError& e) {
@@ -45,9 +45,9 @@ inline std::string inputErrorOf(const DenoiseInputs& in, const DenoiseOptions& o
     return "";
 }
 
-// DenoiseInputs of a colour and its variance only (no feature buffers).
-inline DenoiseInputs inputsOf(const Image& color, const Image& variance) {
-    DenoiseInputs in;
+// Frame of a colour and its variance only (no feature buffers).
+inline Frame inputsOf(const Image& color, const Image& variance) {
+    Frame in;
     in.color = &color;
     in.variance = &variance;
     return in;
@@ -55,7 +55,7 @@ inline DenoiseInputs inputsOf(const Image& color, const Image& variance) {
 
 struct SyntheticScene {
     Image truth, noisy, variance, albedo, normal, position, depth, ids;
-    DenoiseInputs inputs() const { return inputsOf(noisy, variance, albedo, normal, position, depth, ids); }
+    Frame inputs() const { return inputsOf(noisy, variance, albedo, normal, position, depth, ids); }
 };
 
 // Region 0: back wall at z = 5 (normal +z), 1: a box face at z = 3, 2: a disk at z = 2 (normal

@@ -78,7 +78,7 @@ TEST(Eaw, UnitWeightsEqualPlainB3Atrous) {
     for (int levels : {1, 3, 5}) {
         for (bool fast : {true, false}) {
             filters::eawCpuFastPath() = fast;
-            DenoiseInputs in;
+            Frame in;
             in.color = &s.noisy;
             Image got = denoise(in, unitWeightOptions(levels));
             Image ref = plainAtrous(s.noisy, levels);
@@ -95,7 +95,7 @@ TEST(Eaw, ConstantImageStaysConstant) {
     flat.fill(0.37f);
     Image var(40, 40, 3);
     var.fill(0.01f);
-    DenoiseInputs in = s.inputs();
+    Frame in = s.inputs();
     in.color = &flat;
     in.variance = &var;
     for (auto m : {DenoiseMethod::Eaw, DenoiseMethod::Sure}) {
@@ -207,13 +207,13 @@ TEST(Eaw, RejectsOutOfRangeParameters) {
 TEST(Eaw, RejectsBadBuffers) {
     SyntheticScene s = makeScene(16, 16, 0.3f, 7);
     Image small(8, 16, 3);
-    DenoiseInputs in = s.inputs();
+    Frame in = s.inputs();
     in.normal = &small;
     EXPECT_THROW(denoise(in, DenoiseOptions{}), InputError);
     in = s.inputs();
     s.variance(3, 4, 1) = -0.5f;
     EXPECT_THROW(denoise(in, DenoiseOptions{}), InputError);
-    DenoiseInputs none;
+    Frame none;
     EXPECT_THROW(denoise(none, DenoiseOptions{}), InputError);
 }
 
@@ -233,7 +233,7 @@ TEST(Eaw, EmissionIsFilteredAroundAndAddedBack) {
     for (auto m : {DenoiseMethod::Eaw, DenoiseMethod::Sure}) {
         DenoiseOptions o;
         o.method = m;
-        DenoiseInputs in = s.inputs();
+        Frame in = s.inputs();
         const Image without = denoise(in, o);
         in.emission = &emission;
         const Image with = denoise(in, o);

@@ -90,7 +90,7 @@ TEST(EmissionFilter, DenoiseWithEmissionLevelsZeroAddsEmissionBackAsIs) {
                 color(x, y, c) = s.emission(x, y, c) + 0.5f;  // a flat reflected part
                 variance(x, y, c) = s.variance(x, y, c) + 1e-4f;
             }
-    DenoiseInputs in;
+    Frame in;
     in.color = &color;
     in.variance = &variance;
     in.emission = &s.emission;
@@ -119,7 +119,7 @@ TEST(EmissionFilter, DenoiseWithEmissionLevelsZeroAddsEmissionBackAsIs) {
 
 TEST(EmissionFilter, RejectsBadParameters) {
     Image color(8, 8, 3);
-    DenoiseInputs in;
+    Frame in;
     in.color = &color;
     DenoiseOptions o;
     o.eaw.emissionLevels = 11;

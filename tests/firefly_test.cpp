@@ -25,7 +25,7 @@ struct Flat {
         for (size_t i = 0; i < color.size(); ++i) color.data()[i] = 0.5f + g(rng);
         var.fill(0.05f * 0.05f);
     }
-    DenoiseInputs inputs() const { return inputsOf(color, var); }
+    Frame inputs() const { return inputsOf(color, var); }
     // A bright pixel: `value` in R, G, B with a variance of the mean of sd² per channel.
     void spike(int x, int y, float value, float sd) {
         for (int c = 0; c < 3; ++c) {
@@ -160,7 +160,7 @@ TEST(NonFinite, NanAndInfNeverSpread) {
     s.depth(3, 3, 0) = INFINITY;
     for (auto m : {DenoiseMethod::Eaw, DenoiseMethod::Sure}) {
         for (bool estimate : {false, true}) {
-            DenoiseInputs in = s.inputs();
+            Frame in = s.inputs();
             if (estimate) in.variance = nullptr;
             DenoiseReport rep;
             DenoiseOptions o;

@@ -79,11 +79,7 @@ ALLOWED = {
 
 # Includes that break the drawing and are being removed (file, included header): each is reported
 # as known while it is there, and as stale once it is gone, so that this list only shrinks.
-PENDING = {
-    # DenoiseBuffers, handOver, DenoiseBufferUse and methodReads: the still path's rework (issue 48)
-    # replaces them with what the registry rows read.
-    ("include/atrous/io/buffer_set.h", "include/atrous/denoise.h"),
-}
+PENDING = set()  # empty since issue 48 (io/buffer_set.h no longer includes denoise.h)
 
 # Folders an #include "..." is looked up in (besides the including file's own), as the build's
 # include paths: include/ and src/ for the library, apps/atrous for the viewer's view/*.h.

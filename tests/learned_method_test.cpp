@@ -50,8 +50,8 @@ struct Synth {
         // A firefly: a rare huge sample, which raises its pixel's variance too (prepass.h).
         for (int c = 0; c < 3; ++c) s.noisy(12, 20, c) += 40.0f, s.variance(12, 20, c) = 1600.0f;
     }
-    DenoiseInputs inputs(bool variance = true) const {
-        DenoiseInputs in = s.inputs();
+    Frame inputs(bool variance = true) const {
+        Frame in = s.inputs();
         in.emission = &emission;
         if (!variance) in.variance = nullptr;
         return in;
@@ -108,7 +108,7 @@ TEST(LearnedMethod, IsRunLearnedOnThePreparedPlanesThenRemodulate) {
     };
     for (const Case& k : {Case{true, true, true, true}, Case{false, true, true, true}, Case{true, false, true, true},
                           Case{true, true, false, true}, Case{true, true, true, false}}) {
-        DenoiseInputs in = sc.inputs(k.variance);
+        Frame in = sc.inputs(k.variance);
         if (!k.albedo) in.albedo = nullptr;
         if (!k.normal) in.normal = nullptr;
         if (!k.depth) in.depth = nullptr;
@@ -215,7 +215,7 @@ TEST_F(LearnedSynth, AutoPicksBlendWithAlbedoAndNormalElseSure) {
     };
     for (const Case& c : {Case{true, true, DenoiseMethod::Blend}, Case{true, false, DenoiseMethod::Sure},
                           Case{false, true, DenoiseMethod::Sure}, Case{false, false, DenoiseMethod::Sure}}) {
-        DenoiseInputs in = sc.inputs();
+        Frame in = sc.inputs();
         if (!c.albedo) in.albedo = nullptr;
         if (!c.normal) in.normal = nullptr;
         const Image got = test::denoiseReporting(in, autoO, rep);
@@ -267,7 +267,7 @@ TEST(LearnedMethod, BlendIsTheMeanOfLearnedAndSure) {
     const std::string wpath = writeFixtureWeights(dir);
     const Synth sc;
     for (int k = 0; k < 3; ++k) {
-        DenoiseInputs in = sc.inputs(k != 1);
+        Frame in = sc.inputs(k != 1);
         DenoiseOptions l = learnedOptions(wpath), su = learnedOptions(wpath), b = learnedOptions(wpath);
         su.method = DenoiseMethod::Sure;
         b.method = DenoiseMethod::Blend;
@@ -397,7 +397,7 @@ TEST(LearnedMethod, LoadedWeightsAreUsed) {
     test::TempDir dir;
     const std::string wpath = writeFixtureWeights(dir);
     const Synth sc;
-    const DenoiseInputs in = sc.inputs(true);
+    const Frame in = sc.inputs(true);
     const DenoiseOptions byPath = learnedOptions(wpath);
     DenoiseOptions builtin = learnedOptions("");
     DenoiseOptions builtinObject = learnedOptions("");

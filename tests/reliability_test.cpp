@@ -383,7 +383,7 @@ TEST(Reliability, NulInAPathIsRefused) {
 TEST(Reliability, TinyFilterParametersAreRejected) {
     Image color(16, 16, 3), albedo(16, 16, 3);
     for (size_t i = 0; i < color.plane() * 3; ++i) color.data()[i] = 0.5f, albedo.data()[i] = 0.5f;
-    DenoiseInputs in;
+    Frame in;
     in.color = &color;
     in.albedo = &albedo;
     auto with = [&](auto set) {
@@ -405,7 +405,7 @@ TEST(Reliability, TinyFilterParametersAreRejected) {
 TEST(Reliability, ColourAndVarianceBeyondTheirRangeAreRejected) {
     Image color(16, 16, 3), var(16, 16, 3);
     for (size_t i = 0; i < color.plane() * 3; ++i) color.data()[i] = 0.5f, var.data()[i] = 0.01f;
-    const DenoiseInputs in = test::inputsOf(color, var);
+    const Frame in = test::inputsOf(color, var);
     for (DenoiseMethod m : {DenoiseMethod::Eaw, DenoiseMethod::Sure}) {
         DenoiseOptions o;
         o.method = m;
@@ -440,7 +440,7 @@ TEST(Reliability, NonFiniteInputsNeverReachTheOutput) {
     for (Image* img : {&color, &var, &albedo, &normal, &position, &depth, &emission, &motion})
         for (int j = 0; j < 6; ++j, ++k)  // -Inf variance is negative: an error of its own
             (*img)((k * 7) % w, (k * 5) % h, k % 3) = img == &var ? bad[k % 2] : bad[k % 3];
-    DenoiseInputs in;
+    Frame in;
     in.color = &color, in.variance = &var, in.albedo = &albedo, in.normal = &normal, in.position = &position;
     in.depth = &depth, in.ids = &ids, in.emission = &emission;
     for (DenoiseMethod m : {DenoiseMethod::Eaw, DenoiseMethod::Sure}) {
@@ -452,7 +452,7 @@ TEST(Reliability, NonFiniteInputsNeverReachTheOutput) {
         in.variance = &var;
     }
     SvgfDenoiser svgf;
-    SvgfFrame f;  // by name: Frame's order is not SvgfFrame's old one
+    Frame f;  // by name: Frame's order is not Frame's old one
     f.color = &color, f.albedo = &albedo, f.normal = &normal, f.depth = &depth, f.ids = &ids, f.motion = &motion;
     f.emission = &emission;
     for (int i = 0; i < 3; ++i) EXPECT_TRUE(allFinite(svgf.denoiseFrame(f))) << "svgf frame " << i;

@@ -133,7 +133,7 @@ TEST(RenderCli, BadInputIsOneLineExitTwoNothingWritten) {
 }
 
 // render --denoise and denoise of the buffers it wrote take their inputs from the one assembly
-// (io::BufferRefs): every buffer, emission included. The buffers are written as 32-bit float
+// (Frame): every buffer, emission included. The buffers are written as 32-bit float
 // EXR and the CPU filters are deterministic, so the images must be equal bit for bit; without
 // emission.exr the result differs (so the comparison sees whether emission was used).
 TEST(RenderCli, DenoiseEqualsDenoiseOfTheWrittenBuffers) {

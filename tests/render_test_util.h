@@ -18,13 +18,13 @@ inline RenderSettings smallRender(int w, int h, int spp, uint32_t seed) {
 }
 
 // A small render of a built-in scene with the buffers the still filters read (colour, variance,
-// albedo, normal, depth, emission), as DenoiseInputs.
+// albedo, normal, depth, emission), as Frame.
 struct RenderedInputs {
     RenderBuffers b;
     RenderedInputs(const char* scene, int w, int h, int spp, uint32_t seed)
         : b(render(Scene::builtin(scene), smallRender(w, h, spp, seed))) {}
-    DenoiseInputs inputs() const {
-        DenoiseInputs in;
+    Frame inputs() const {
+        Frame in;
         in.color = &b.color, in.variance = &b.variance, in.albedo = &b.albedo, in.normal = &b.normal;
         in.depth = &b.depth, in.emission = &b.emission;
         return in;

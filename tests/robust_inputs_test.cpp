@@ -70,7 +70,7 @@ TEST(RobustInputs, WhiteFireflyWithTheVarianceOfOneOutlierIsClamped) {
     for (size_t i = 0; i < c.size(); ++i) c.data()[i] = 0.1f, v.data()[i] = 1e-4f;
     for (float var : {9.0f, 13.0f, 35.0f}) {
         for (int ch = 0; ch < 3; ++ch) c(16, 16, ch) = 6.0f, v(16, 16, ch) = var;
-        DenoiseInputs in;
+        Frame in;
         in.color = &c;
         in.variance = &v;
         for (DenoiseMethod m : {DenoiseMethod::Eaw, DenoiseMethod::Sure}) {
@@ -81,7 +81,7 @@ TEST(RobustInputs, WhiteFireflyWithTheVarianceOfOneOutlierIsClamped) {
     }
     // A highlight most samples see (std 1, well below E/2) is kept.
     for (int ch = 0; ch < 3; ++ch) v(16, 16, ch) = 1.0f;
-    DenoiseInputs in;
+    Frame in;
     in.color = &c;
     in.variance = &v;
     EXPECT_GT(denoise(in, DenoiseOptions{})(16, 16, 0), 5.0f);
@@ -156,7 +156,7 @@ TEST(NoiseEstimate, LocalVarianceFollowsTheNoiseAndNotTheEdges) {
 
 TEST(NoiseEstimate, DenoiseWithoutVarianceSmoothsACaustic) {
     TwoNoise s;
-    DenoiseInputs in;
+    Frame in;
     in.color = &s.noisy;
     in.normal = &s.normal;
     in.depth = &s.depth;
@@ -181,8 +181,8 @@ struct NoisyWall {
     bool hasAlbedo;
     NoisyWall(int n, bool withAlbedo)
         : truth(n, n, 3), noisy(n, n, 3), variance(n, n, 3), albedo(n, n, 3), hasAlbedo(withAlbedo) {}
-    DenoiseInputs inputs(bool withVariance = true) const {
-        DenoiseInputs in;
+    Frame inputs(bool withVariance = true) const {
+        Frame in;
         in.color = &noisy;
         if (hasAlbedo) in.albedo = &albedo;
         if (withVariance) in.variance = &variance;
@@ -345,7 +345,7 @@ TEST(RobustInputs, ThinSlatsAgainstABlackAlbedoSkyDoNotLightTheSky) {
     Image normal(48, 48, 3);
     for (int y = 0; y < 48; ++y)
         for (int x = 0; x < 48; ++x) normal(x, y, 2) = 1.0f;
-    DenoiseInputs in = s.inputs(false);
+    Frame in = s.inputs(false);
     in.normal = &normal;
     for (DenoiseMethod m : {DenoiseMethod::Eaw, DenoiseMethod::Sure, DenoiseMethod::Auto}) {
         DenoiseOptions o;
@@ -374,7 +374,7 @@ TEST(RobustInputs, VisibleLightWithoutEmissionBufferKeepsItsEdge) {
         return light ? NoisyWall::Pixel{20.0f, 0.0f, 0.0f} : NoisyWall::Pixel{0.3f, 0.6f, 0.01f};
     });
     for (bool withVariance : {true, false}) {
-        const DenoiseInputs in = s.inputs(withVariance);
+        const Frame in = s.inputs(withVariance);
         for (DenoiseMethod m : {DenoiseMethod::Eaw, DenoiseMethod::Sure}) {
             DenoiseOptions o;
             o.method = m;
@@ -414,7 +414,7 @@ TEST(NoiseEstimate, BackgroundSkyIsNotSmoothed) {
                 noisy(x, y, c) = t + (sky ? 0.0f : 0.3f * gauss(rng));
             }
         }
-    DenoiseInputs in;
+    Frame in;
     in.color = &noisy;
     in.albedo = &albedo;
     in.normal = &normal;

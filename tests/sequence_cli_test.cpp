@@ -35,7 +35,7 @@ TEST(SequenceCli, SvgfEawAndSureDenoiseEveryFrame) {
 }
 
 // Per-frame EAW/SURE of a sequence uses every buffer of each frame, emission included, through the
-// same input assembly as `denoise --in FRAME_DIR` (io::BufferRefs). Same buffers, deterministic
+// same input assembly as `denoise --in FRAME_DIR` (Frame). Same buffers, deterministic
 // CPU filters: equal bit for bit. A frame without its emission.exr denoises differently, so the
 // equality shows the emission was read.
 TEST(SequenceCli, PerFrameMethodsEqualDenoiseOfEachFrame) {

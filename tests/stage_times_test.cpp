@@ -55,7 +55,7 @@ TEST(StageTimes, NoiseEstimateStagesWithoutAVariance) {
     o.method = DenoiseMethod::Eaw;
     o.eaw.levels = 2;
     DenoiseReport rep;
-    DenoiseInputs in = scene.inputs();
+    Frame in = scene.inputs();
     in.variance = nullptr;
     in.albedo = nullptr;
     test::denoiseReporting(in, o, rep);
@@ -72,7 +72,7 @@ TEST(StageTimes, SvgfReportFollowsTheFramesWhileTimed) {
     p.feedbackTap = 0;
     p.taa = true;
     SvgfDenoiser d(p);
-    SvgfFrame f;
+    Frame f;
     f.color = &scene.noisy;
     f.albedo = &scene.albedo;
     f.normal = &scene.normal;

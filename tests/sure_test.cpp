@@ -222,7 +222,7 @@ TEST(Sure, EstimatesTheNoiseWithoutAVarianceBuffer) {
     for (int yy = 0; yy < h; ++yy)
         for (int x = 0; x < w; ++x)
             for (int c = 0; c < 3; ++c) y(x, yy, c) = 0.3f + 0.2f * std::sin(x * 0.1f) * std::cos(yy * 0.07f) + g(rng);
-    DenoiseInputs in;
+    Frame in;
     in.color = &y;
     DenoiseReport rep;
     DenoiseOptions o;
@@ -245,7 +245,7 @@ TEST(Sure, IgnoresAnAllZeroVarianceBuffer) {
         for (int x = 0; x < w; ++x)
             for (int c = 0; c < 3; ++c) y(x, yy, c) = 0.3f + 0.2f * std::sin(x * 0.1f) + g(rng);
     for (DenoiseMethod m : {DenoiseMethod::Eaw, DenoiseMethod::Sure}) {
-        DenoiseInputs without, withZero;
+        Frame without, withZero;
         without.color = withZero.color = &y;
         withZero.variance = &zero;
         DenoiseOptions o;
@@ -262,7 +262,7 @@ TEST(Sure, IgnoresAnAllZeroVarianceBuffer) {
     }
     // One nonzero value is information: the buffer is used as given.
     zero(3, 4, 1) = 1e-6f;
-    DenoiseInputs in;
+    Frame in;
     in.color = &y;
     in.variance = &zero;
     DenoiseReport rep;

@@ -295,7 +295,7 @@ TEST(SvgfAtrousCpu, PipelineWithAndWithoutTheFastPathAgree) {
                         color(x, y, c) = (0.5f + 0.1f * float(c)) * noise(rng);
             for (int y = 0; y < h; ++y)
                 for (int x = 0; x < w; ++x) motion(x, y, 0) = 1.0f;
-            SvgfFrame f;
+            Frame f;
             f.color = &color, f.normal = &scene.normal, f.depth = &scene.depth, f.motion = &motion;
             outs[fast] = d.denoiseFrame(f);
         }

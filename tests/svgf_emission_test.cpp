@@ -210,7 +210,7 @@ TEST(SvgfEmission, PipelineAccumulatesEmissionAndEmissionAlphaOneIsTheRawEmissio
                         color(x, y, c) = emission(x, y, c) + albedo(x, y, c) * (light ? 0.2f : 1.0f);
                     }
                 }
-            SvgfFrame f;
+            Frame f;
             f.color = &color, f.albedo = &albedo, f.normal = &normal, f.depth = &depth, f.ids = &ids;
             f.motion = &motion, f.emission = &emission;
             Image out = d.denoiseFrame(f);

@@ -59,8 +59,8 @@ struct LightScene {
                 motion(x, y, 0) = motion(x, y, 1) = 0.0f;
             }
     }
-    SvgfFrame inputs() const {
-        SvgfFrame f;
+    Frame inputs() const {
+        Frame f;
         f.color = &color, f.albedo = &albedo, f.normal = &normal, f.depth = &depth, f.ids = &ids, f.motion = &motion;
         if (withEmission) f.emission = &emission;
         return f;
@@ -89,7 +89,7 @@ Errors runScene(LightScene& scene, int frames) {
     Errors r;
     for (int t = 0; t < frames; ++t) {
         scene.frame(t);
-        const SvgfFrame f = scene.inputs();
+        const Frame f = scene.inputs();
         const Image oa = a.denoiseFrame(f), ob = b.denoiseFrame(f);
         const Image os = denoise(f, DenoiseOptions{});
         EXPECT_TRUE(allFinite(ob)) << "frame " << t;

@@ -228,7 +228,7 @@ TEST(SvgfRobustness, NanInputsAndWildMotionGiveFiniteOutput) {
         f.motion(10, 30, 0) = 1e20f;   // far outside
         f.motion(11, 30, 1) = -3e4f;   // outside
         f.motion(12, 30, 0) = 200.0f;  // outside
-        SvgfFrame in = f.frame();
+        Frame in = f.frame();
         in.emission = &emission;
         pipe.run(in);
         ASSERT_TRUE(allFinite(*pipe.state().result)) << "frame " << t;
@@ -254,8 +254,8 @@ TEST(SvgfRobustness, NanInputsAndWildMotionGiveFiniteOutput) {
 TEST(SvgfRobustness, BadFramesAndParamsAreInputErrors) {
     Image c(8, 8, 3), small(4, 8, 3), grey(8, 8, 1);
     SvgfDenoiser d;
-    EXPECT_THROW(d.denoiseFrame(SvgfFrame{}), InputError);
-    SvgfFrame f;
+    EXPECT_THROW(d.denoiseFrame(Frame{}), InputError);
+    Frame f;
     f.color = &c;
     f.albedo = &small;
     try {

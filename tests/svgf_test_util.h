@@ -26,8 +26,8 @@ struct SceneOptions {
 
 struct SynthFrame {
     Image color, albedo, normal, depth, ids, motion, truth, emission;
-    SvgfFrame frame() const {
-        SvgfFrame f;
+    Frame frame() const {
+        Frame f;
         if (!emission.empty()) f.emission = &emission;
         f.color = &color;
         f.albedo = &albedo;

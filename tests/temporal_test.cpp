@@ -36,8 +36,8 @@ std::vector<SynthFrame> makeFrames(const SceneOptions& o, int n) {
     return f;
 }
 
-std::vector<SvgfFrame> framesOf(const std::vector<SynthFrame>& s) {
-    std::vector<SvgfFrame> f;
+std::vector<Frame> framesOf(const std::vector<SynthFrame>& s) {
+    std::vector<Frame> f;
     for (const SynthFrame& x : s) f.push_back(x.frame());
     return f;
 }
@@ -87,8 +87,8 @@ TEST(TemporalGather, TracksAMovingBoxThroughFramesOnBothSides) {
     TemporalGather g = gatherTemporal(framesOf(synth), 3, p);
     EXPECT_EQ(boxFullCount(g, true), 1.0);
 
-    std::vector<SvgfFrame> still = framesOf(synth);
-    for (SvgfFrame& f : still) f.motion = nullptr;
+    std::vector<Frame> still = framesOf(synth);
+    for (Frame& f : still) f.motion = nullptr;
     EXPECT_LT(boxFullCount(gatherTemporal(still, 3, p), false), 0.2);
 }
 
@@ -196,8 +196,8 @@ TEST(TemporalGather, PixelsThatNeverMoveTakeTheStaticWindow) {
     EXPECT_NEAR(regionMean(gatherTemporal(framesOf(zeros), 6, p).frames, false), nEff, 0.05 * nEff);
     // Frames without motion are taken as still: nothing then tells the box from the ground, and
     // the static window is off.
-    std::vector<SvgfFrame> noMotion = framesOf(synth);
-    for (SvgfFrame& f : noMotion) f.motion = nullptr;
+    std::vector<Frame> noMotion = framesOf(synth);
+    for (Frame& f : noMotion) f.motion = nullptr;
     EXPECT_NEAR(regionMean(gatherTemporal(noMotion, 6, p).frames, false), nEff, 0.05 * nEff);
 
     p.staticRadius = 0;
@@ -238,7 +238,7 @@ TEST(TemporalGather, AStillEdgePixelAveragesWhateverItsSamplesHit) {
         // for a first frame (no sign of what moves), and turns the static window off.
         motion.back()(15, 7, 0) = 1.0f;
     }
-    std::vector<SvgfFrame> frames(n);
+    std::vector<Frame> frames(n);
     for (int t = 0; t < n; ++t) {
         frames[t].color = &color[t], frames[t].albedo = &albedo[t], frames[t].normal = &normal[t];
         frames[t].depth = &depth[t], frames[t].ids = &ids[t], frames[t].motion = &motion[t];
@@ -344,7 +344,7 @@ TEST(TemporalGather, CacheOverASlidingWindowChangesNothing) {
         for (size_t step = 0; step < synth.size(); ++step) {
             const size_t t = fireflyK == 16.0f ? step : synth.size() - 1 - step;
             const size_t lo = t >= 3 ? t - 3 : 0, hi = std::min(synth.size() - 1, t + 3);
-            std::vector<SvgfFrame> window;
+            std::vector<Frame> window;
             std::vector<long long> ids;
             for (size_t i = lo; i <= hi; ++i) window.push_back(synth[i].frame()), ids.push_back((long long)i);
             const TemporalGather a = gatherTemporal(window, t - lo, p, &cache, &ids);
@@ -353,7 +353,7 @@ TEST(TemporalGather, CacheOverASlidingWindowChangesNothing) {
             EXPECT_TRUE(sameImages(a.frames, b.frames)) << t;
         }
     }
-    std::vector<SvgfFrame> window = framesOf(synth);
+    std::vector<Frame> window = framesOf(synth);
     EXPECT_THROW(gatherTemporal(window, 1, TemporalParams{}, &cache, nullptr), InputError);
     std::vector<long long> shortIds = {0, 1};
     EXPECT_THROW(gatherTemporal(window, 1, TemporalParams{}, &cache, &shortIds), InputError);
@@ -377,7 +377,7 @@ TEST(TemporalStream, IsDenoiseTemporalOverEachWindow) {
     EXPECT_EQ(d->lookahead(), 1);
     EXPECT_EQ(d->lookbehind(), 1);
     auto expected = [&](size_t t, bool withIds) {
-        std::vector<SvgfFrame> window;
+        std::vector<Frame> window;
         for (size_t i = t > 0 ? t - 1 : 0; i <= std::min(synth.size() - 1, t + 1); ++i) {
             window.push_back(synth[i].frame());
             if (!withIds) window.back().ids = nullptr;
@@ -429,18 +429,18 @@ TEST(TemporalStream, IsDenoiseTemporalOverEachWindow) {
 TEST(TemporalGather, BadWindowsThrow) {
     SceneOptions o;
     auto synth = makeFrames(o, 3);
-    std::vector<SvgfFrame> f = framesOf(synth);
+    std::vector<Frame> f = framesOf(synth);
     EXPECT_THROW(gatherTemporal(f, 3, TemporalParams{}), InputError);
     TemporalParams bad;
     bad.radius = 17;
     EXPECT_THROW(gatherTemporal(f, 1, bad), ParamError);
-    std::vector<SvgfFrame> missing = f;
+    std::vector<Frame> missing = f;
     missing[0].albedo = nullptr;
     EXPECT_THROW(gatherTemporal(missing, 1, TemporalParams{}), InputError);
     SceneOptions small = o;
     small.width = 32;
     SynthFrame other = makeFrame(small, 0);
-    std::vector<SvgfFrame> sizes = f;
+    std::vector<Frame> sizes = f;
     sizes[2] = other.frame();
     EXPECT_THROW(gatherTemporal(sizes, 1, TemporalParams{}), InputError);
     // Out of the radius, a frame is not looked at.
@@ -537,7 +537,7 @@ TEST(TemporalGather, CausalUsesTheFramesBeforeOnly) {
     p.falloff = p.causalFalloff = 0.0f;
     p.causal = true;
     const TemporalGather g = gatherTemporal(all, 3, p);
-    const std::vector<SvgfFrame> past(all.begin(), all.begin() + 4);
+    const std::vector<Frame> past(all.begin(), all.begin() + 4);
     const TemporalGather h = gatherTemporal(past, 3, p);
     EXPECT_TRUE(sameImages(g.color, h.color));
     EXPECT_NEAR(meanOf(g.frames, 0), 4.0, 0.2);

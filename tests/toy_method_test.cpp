@@ -97,7 +97,7 @@ TEST(ToyMethod, IsARowOfTheRegistry) {
 TEST(ToyMethod, IsItsCascadeOnThePreparedPlanesThenRemodulate) {
     const Rendered r;
     for (bool albedo : {true, false}) {
-        DenoiseInputs in = r.inputs();
+        Frame in = r.inputs();
         if (!albedo) in.albedo = nullptr;
         DenoiseOptions o;
         o.method = toy::toyMethod();

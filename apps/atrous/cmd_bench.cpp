@@ -119,7 +119,7 @@ nlohmann::json stats(const std::vector<double>& ms) {
 // present pass structure, not of the method: fusing the pre-passes and storing the features in
 // half precision lower it (docs/benchmarks.md, "CUDA: bandwidth floor"). Keep it in step with
 // the driver when passes change.
-double cudaDenoiseTrafficBytes(const DenoiseOptions& o, const DenoiseInputs& in, int w, int h) {
+double cudaDenoiseTrafficBytes(const DenoiseOptions& o, const Frame& in, int w, int h) {
     const bool sure = o.method == DenoiseMethod::Sure;
     auto has = [](const Image* i) { return i != nullptr; };
     double planes = 12;  // SanitizeColor: colour + variance in, c_0 + v_0 out
@@ -284,7 +284,7 @@ void run(const BenchArgs& a) {
         for (const DenoiseMethodInfo& info : denoiseMethods()) {
             const char* m = info.name;
             if (info.method == DenoiseMethod::Auto || !wants(m)) continue;
-            DenoiseInputs in = inputs.frame();
+            Frame in = inputs.frame();
             DenoiseOptions o;
             o.method = parseDenoiseMethod(m);
             o.weights = weights;

@@ -260,7 +260,7 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     const bool albedoGiven = set.get(io::Buffer::Albedo) != nullptr;
     // The colour, variance and emission were read to be denoised: the filter works in their
     // storage (DenoiseBuffers) and they are not read afterwards.
-    DenoiseBuffers in = io::handOver(io::refsOf(set), color, &set.image[int(io::Buffer::Variance)],
+    DenoiseBuffers in = handOver(io::refsOf(set), color, &set.image[int(io::Buffer::Variance)],
                                      &set.image[int(io::Buffer::Emission)]);
     static constexpr io::Buffer kLabelled[] = {io::Buffer::Color,    io::Buffer::Variance, io::Buffer::Albedo,
                                               io::Buffer::Normal,   io::Buffer::Position, io::Buffer::Depth,

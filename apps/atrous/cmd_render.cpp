@@ -171,7 +171,7 @@ void run(const RenderArgs& a) {
     if (!methods.empty()) {
         // Every buffer, emission included: filtering color - emission keeps a visible light's
         // anti-aliased edge out of its surroundings.
-        DenoiseInputs in = b.frame();
+        Frame in = b.frame();
         Timer dt;
         for (DenoiseMethod m : methods) {
             DenoiseOptions opt;

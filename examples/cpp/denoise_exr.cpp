@@ -78,7 +78,7 @@ int main(int argc, char** argv) {
             auto it = images.find(name);
             return it == images.end() ? nullptr : &it->second;
         };
-        atrous::DenoiseInputs inputs;
+        atrous::Frame inputs;
         inputs.color = &color;
         inputs.variance = find("variance");
         inputs.albedo = find("albedo");

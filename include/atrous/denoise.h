@@ -28,12 +28,11 @@ namespace atrous {
 // Registered methods (registerDenoiseMethod, below) take the values after Blend.
 enum class DenoiseMethod : int { Eaw, Sure, Learned, Auto, Blend };
 
-// The buffers of a denoise() call: one Frame (atrous/buffers.h, where each buffer's channels and
-// conventions are stated). Only `color` is required; a missing feature simply removes its edge
+// The buffers of a denoise() call are one Frame (atrous/buffers.h, where each buffer's channels
+// and conventions are stated). Only `color` is required; a missing feature simply removes its edge
 // stop. Motion is not read. With an emission buffer the filters work on color - emission and add
 // it back through an edge-avoiding filter of its own (EawParams::emissionLevels), which averages
 // a visible light's partly covered edge pixels with each other and with nothing else.
-using DenoiseInputs = Frame;
 
 // Edge-avoiding à-trous cascade (docs/denoising.md). Also the cascade that SURE runs on.
 // Edge-stopping weight of a tap: w = exp(-(Δc²/σ_c,i² + Δn²/σ_n,i² + Δx²/σ_x² + (Δz/(σ_z z))² + ids)).
@@ -164,7 +163,7 @@ struct DenoiseReport {
 // InputError for mismatched sizes, missing colour, negative variance or parameters out of range.
 // A buffer may be given as strided memory in the caller's layout (BufferRef: float32 or float16,
 // interleaved or planar; DenoiseReport::copies says what was copied).
-Image denoise(const DenoiseInputs& inputs, const DenoiseOptions& options);
+Image denoise(const Frame& inputs, const DenoiseOptions& options);
 
 // The same, with what the run did (the CLI's line, the benchmarks' stage times). The image is bit
 // for bit denoise()'s; on CUDA the stages are timed with events on the stream, which the plain call
@@ -173,7 +172,7 @@ struct DenoiseResult {
     Image image;
     DenoiseReport report;
 };
-DenoiseResult denoiseWithReport(const DenoiseInputs& inputs, const DenoiseOptions& options);
+DenoiseResult denoiseWithReport(const Frame& inputs, const DenoiseOptions& options);
 
 // The inputs of a denoise() call whose caller hands its colour, variance and emission images over
 // to the filter, as a one-shot caller does that read them from files only to denoise them (the
@@ -183,7 +182,7 @@ DenoiseResult denoiseWithReport(const DenoiseInputs& inputs, const DenoiseOption
 // pixel beyond its inputs for EAW (docs/architecture.md, "Memory"). After the call each of the
 // three is empty or holds intermediate values: the caller must not read them. Images the filter
 // cannot use (on the GPU, not 3 channels) are copied as by the const overload, whose results
-// this one's equal bit for bit. The other buffers are read only, as in DenoiseInputs.
+// this one's equal bit for bit. The other buffers are read only, as in Frame.
 struct DenoiseBuffers {
     Image* color = nullptr;           // required
     Image* variance = nullptr;
@@ -196,6 +195,10 @@ struct DenoiseBuffers {
 };
 Image denoise(DenoiseBuffers& buffers, const DenoiseOptions& options);
 DenoiseResult denoiseWithReport(DenoiseBuffers& buffers, const DenoiseOptions& options);
+// A frame's buffers for the overloads above: `color`, `variance` and `emission` the caller's own
+// images, handed over (the CLI's decoded files, those the frame points at); the features the
+// frame's, read only. An empty (or null) variance or emission is absent.
+DenoiseBuffers handOver(const Frame& frame, Image& color, Image* variance, Image* emission);
 
 // denoiseWithReport() with method Sure on the CPU, and SURE's kept fraction s_i(p) of each level's
 // detail (one channel per level; levels below sure.firstLevel are 0): the viewer's debug view.
@@ -205,7 +208,7 @@ struct SureFractionsResult {
     Image fractions;
     DenoiseReport report;
 };
-SureFractionsResult denoiseWithSureFractions(const DenoiseInputs& inputs, const DenoiseOptions& options);
+SureFractionsResult denoiseWithSureFractions(const Frame& inputs, const DenoiseOptions& options);
 
 // Throws ParamError (atrous/params.h: an InputError naming the field, `sigma_normal`) when a
 // parameter is out of range; the ranges are the rows of denoiseParams().
@@ -324,7 +327,7 @@ DenoiseMethod parseDenoiseMethod(const std::string& name);
 const char* denoiseMethodName(DenoiseMethod m);
 // What Auto becomes for these inputs: Blend with an albedo and a normal buffer, else Sure; any
 // other method is returned as it is.
-DenoiseMethod resolveDenoiseMethod(DenoiseMethod m, const DenoiseInputs& inputs);
+DenoiseMethod resolveDenoiseMethod(DenoiseMethod m, const Frame& inputs);
 // The same rule from whether an albedo and a normal are given (a reader deciding what to decode).
 DenoiseMethod resolveDenoiseMethod(DenoiseMethod m, bool albedo, bool normal);
 

@@ -80,13 +80,12 @@ constexpr const char* kSvgfMethod = "svgf";
 // parameter is out of range.
 void validateSvgfParams(const SvgfParams& p);
 
-// One frame's buffers (atrous/buffers.h: channels and conventions). SVGF reads color (1 spp),
+// A frame's buffers are a Frame (atrous/buffers.h: channels and conventions). SVGF reads color (1 spp),
 // albedo, normal, depth, ids (channel 0), motion and emission; it estimates its own variance and
 // has no use for positions. Only `color` is required; a missing buffer takes a neutral default
 // (albedo 1, normal +z, depth 1, id 0, motion 0, emission 0). Non-finite values anywhere are
 // treated as missing for that pixel (a non-finite colour is no sample; non-finite motion means
 // "no history"). Demodulation divides by max(albedo, 1e-3), fading to 1 below 0.1.
-using SvgfFrame = Frame;
 
 // What the last timed frame did: per-stage times (SvgfDenoiser::lastReport).
 struct SvgfReport {
@@ -113,11 +112,11 @@ public:
 
     // Denoises one frame and returns the 3-channel linear HDR result on the host. Throws InputError
     // when `color` is missing or a buffer's size or channel count does not match the colour's.
-    Image denoiseFrame(const SvgfFrame& frame);
+    Image denoiseFrame(const Frame& frame);
     // The same, but the result stays on the denoiser's device, owned by the denoiser and valid
     // until the next call (no copy back to the host: for GPU pipelines and benchmarks). The
     // device's work is finished when it returns.
-    const Image& denoiseFrameOnDevice(const SvgfFrame& frame);
+    const Image& denoiseFrameOnDevice(const Frame& frame);
     // Forgets all history (next frame is treated as the first).
     void reset();
     // Times the stages of each later denoiseFrame* call (off: no timing, the default). On CUDA the

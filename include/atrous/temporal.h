@@ -77,7 +77,7 @@ void validateTemporalParams(const TemporalParams& p);
 // The checks every frame of a window gets (sizes and channels against its colour, the colour's
 // range): InputError naming the buffer. A caller that reads frames one at a time can run it on
 // each as it arrives, so that the message can name that frame's file.
-void checkTemporalFrame(const SvgfFrame& frame);
+void checkTemporalFrame(const Frame& frame);
 
 // The window averaged onto its centre frame: what the still method then filters.
 struct TemporalGather {
@@ -104,11 +104,11 @@ public:
 };
 
 // Reprojects and averages window[center - r .. center + r] (r = temporalWindowRadius(params),
-// clipped to the window; center - radius .. center with params.causal) onto window[center]. Every frame must have the centre's buffers and size (SvgfFrame's
+// clipped to the window; center - radius .. center with params.causal) onto window[center]. Every frame must have the centre's buffers and size (Frame's
 // conventions: depth and ids in channel 0, motion previous - current in pixels). Frames without
 // motion are taken as still; what moved is then rejected by the depth, normal and id test.
 // Non-finite values of a neighbour are left out; the centre's own pass through. Host images.
-TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t center, const TemporalParams& params,
+TemporalGather gatherTemporal(const std::vector<Frame>& window, size_t center, const TemporalParams& params,
                               TemporalCache* cache = nullptr, const std::vector<long long>* ids = nullptr);
 
 // What denoiseTemporal did.
@@ -120,7 +120,7 @@ struct TemporalReport {
 
 // gatherTemporal, then `spatial` (a still method's options: auto, eaw, ...) on the average, with
 // the centre frame's depth, ids and position. Returns the denoised frame on the host.
-Image denoiseTemporal(const std::vector<SvgfFrame>& window, size_t center, const TemporalParams& params,
+Image denoiseTemporal(const std::vector<Frame>& window, size_t center, const TemporalParams& params,
                       const DenoiseOptions& spatial, TemporalCache* cache = nullptr,
                       const std::vector<long long>* ids = nullptr);
 // The same, with what it did (the image is bit for bit denoiseTemporal's).
@@ -128,7 +128,7 @@ struct TemporalResult {
     Image image;
     TemporalReport report;
 };
-TemporalResult denoiseTemporalWithReport(const std::vector<SvgfFrame>& window, size_t center,
+TemporalResult denoiseTemporalWithReport(const std::vector<Frame>& window, size_t center,
                                          const TemporalParams& params, const DenoiseOptions& spatial,
                                          TemporalCache* cache = nullptr, const std::vector<long long>* ids = nullptr);
 
@@ -149,7 +149,7 @@ struct CameraFit {
     bool project(const double P[3], double& u, double& v) const;  // false behind the camera
 };
 CameraFit fitCamera(const Image& position);  // host image, 3 channels; 0 or non-finite = nothing hit
-// 2 channels, previous − current in pixels (SvgfFrame's motion). Where nothing is hit (the sky),
+// 2 channels, previous − current in pixels (Frame's motion). Where nothing is hit (the sky),
 // the direction through the pixel, mapped by the two cameras. NaN where either camera is not `ok`
 // or the point is behind one.
 Image motionFromPositions(const Image& position, const CameraFit& current, const CameraFit& previous);

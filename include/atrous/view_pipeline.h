@@ -189,7 +189,7 @@ class ViewPipeline {
     void computeEmission();
     void runSlot(int i, Method m, const PipelineSettings& s);
     // The running means (colour, variance, features, emission) as the EAW/SURE slots filter them.
-    DenoiseInputs accumulatedInputs() const;
+    Frame accumulatedInputs() const;
     DenoiseOptions denoiseOptions(Method m, const PipelineSettings& s) const;
 
     Scene mScene;

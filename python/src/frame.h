@@ -1,5 +1,5 @@
 // One frame's arrays as the library's images, for the sequence methods (which take Images): the
-// arrays become the binding's own planar images, put into the one input assembly (io::BufferRefs,
+// arrays become the binding's own planar images, put into the one input assembly (Frame,
 // the Frame every denoiser takes), as the CLI and the viewer do. atrous.denoise hands its arrays
 // over where they are instead (bindings.cpp).
 #pragma once
@@ -23,7 +23,7 @@ namespace nb = nanobind;
 struct Buffers {
     std::vector<std::unique_ptr<Image>> owned;
     const Image& color;
-    io::BufferRefs refs;
+    Frame refs;
     explicit Buffers(const Image& c) : color(c) { refs.set(io::Buffer::Color, &c); }
     struct Arg {
         nb::handle obj;

@@ -298,8 +298,8 @@ void ViewPipeline::computeEmission() {
     }
 }
 
-DenoiseInputs ViewPipeline::accumulatedInputs() const {
-    io::BufferRefs r;
+Frame ViewPipeline::accumulatedInputs() const {
+    Frame r;
     r.set(io::Buffer::Color, &mColor).set(io::Buffer::Albedo, &mAlbedo).set(io::Buffer::Normal, &mNormal);
     r.set(io::Buffer::Position, &mPosition).set(io::Buffer::Depth, &mDepth).set(io::Buffer::ObjectId, &mIds);
     // At one sample per pixel there is no variance estimate: the filter then estimates the noise
@@ -377,7 +377,7 @@ void ViewPipeline::runSlot(int i, Method m, const PipelineSettings& s) {
         runSequence(i, *m.sequence, s, r);
         return;
     }
-    DenoiseInputs in = accumulatedInputs();
+    Frame in = accumulatedInputs();
     DenoiseOptions o = denoiseOptions(m, s);
     Timer t;
     try {
@@ -524,7 +524,7 @@ void ViewPipeline::step(const PipelineSettings& s) {
         // not depend on the total), so d_i = c_i - c_{i+1} = EAW(i levels) - EAW(i + 1 levels),
         // both remodulated by the albedo. c_0 is taken as the colour before firefly suppression.
         try {
-            const DenoiseInputs in = accumulatedInputs();
+            const Frame in = accumulatedInputs();
             DenoiseOptions o = denoiseOptions(Method::of(DenoiseMethod::Eaw), s);
             const int L = s.detailLevel;
             // A debug view: on CUDA both results are brought to the host (the view shows them

@@ -262,6 +262,16 @@ Frame frameOf(const DenoiseBuffers& b) {
 
 }  // namespace
 
+DenoiseBuffers handOver(const Frame& frame, Image& color, Image* variance, Image* emission) {
+    DenoiseBuffers b;
+    b.color = &color;
+    b.variance = variance && !variance->empty() ? variance : nullptr;
+    b.emission = emission && !emission->empty() ? emission : nullptr;
+    b.albedo = frame.albedo, b.normal = frame.normal, b.position = frame.position, b.depth = frame.depth;
+    b.ids = frame.ids;
+    return b;
+}
+
 Image denoise(const Frame& given, const DenoiseOptions& options) {
     DenoiseReport rep;
     return denoiseWith(given, options, nullptr, rep, false);

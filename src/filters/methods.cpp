@@ -128,7 +128,7 @@ DenoiseMethod resolveDenoiseMethod(DenoiseMethod m, bool albedo, bool normal) {
     return albedo && normal ? DenoiseMethod::Blend : DenoiseMethod::Sure;
 }
 
-DenoiseMethod resolveDenoiseMethod(DenoiseMethod m, const DenoiseInputs& in) {
+DenoiseMethod resolveDenoiseMethod(DenoiseMethod m, const Frame& in) {
     return resolveDenoiseMethod(m, in.albedo && !in.albedo->empty(), in.normal && !in.normal->empty());
 }
 

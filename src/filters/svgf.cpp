@@ -17,7 +17,7 @@ void validateSvgfParams(const SvgfParams& p) { validateParams(p, svgfParams()); 
 
 namespace svgf {
 
-void checkFrame(const SvgfFrame& f) {
+void checkFrame(const Frame& f) {
     if (!f.color || f.color->empty()) throw InputError("SVGF frame: the color buffer is missing");
     const int w = f.color->width(), h = f.color->height();
     auto check = [&](const Image* img, const char* name, int channels) {
@@ -73,9 +73,9 @@ SvgfDenoiser::~SvgfDenoiser() = default;
 SvgfDenoiser::SvgfDenoiser(SvgfDenoiser&&) noexcept = default;
 SvgfDenoiser& SvgfDenoiser::operator=(SvgfDenoiser&&) noexcept = default;
 
-Image SvgfDenoiser::denoiseFrame(const SvgfFrame& frame) { return mImpl->denoiseFrame(frame); }
+Image SvgfDenoiser::denoiseFrame(const Frame& frame) { return mImpl->denoiseFrame(frame); }
 
-const Image& SvgfDenoiser::denoiseFrameOnDevice(const SvgfFrame& frame) { return mImpl->denoiseFrameOnDevice(frame); }
+const Image& SvgfDenoiser::denoiseFrameOnDevice(const Frame& frame) { return mImpl->denoiseFrameOnDevice(frame); }
 
 void SvgfDenoiser::reset() { mImpl->reset(); }
 

@@ -29,8 +29,8 @@ namespace atrous::detail {
 class SvgfBackend {
 public:
     virtual ~SvgfBackend() = default;
-    virtual Image denoiseFrame(const SvgfFrame& frame) = 0;
-    virtual const Image& denoiseFrameOnDevice(const SvgfFrame& frame) = 0;
+    virtual Image denoiseFrame(const Frame& frame) = 0;
+    virtual const Image& denoiseFrameOnDevice(const Frame& frame) = 0;
     virtual void reset() = 0;
     virtual void setTiming(bool on) = 0;
     virtual SvgfReport lastReport() const = 0;
@@ -47,7 +47,7 @@ namespace atrous::svgf {
 
 // Checks the frame's buffers (colour present; every given buffer of the colour's size with enough
 // channels) and returns nothing; throws InputError naming the buffer and the problem.
-void checkFrame(const SvgfFrame& frame);
+void checkFrame(const Frame& frame);
 
 struct SvgfState {
     int width = 0, height = 0;
@@ -115,7 +115,7 @@ public:
     }
 
     // Runs every stage on `frame`; the result is left in *state().result on the executor's device.
-    void run(const SvgfFrame& frame) {
+    void run(const Frame& frame) {
         checkFrame(frame);
         const Device dev = mExec.device();
         const int w = frame.color->width(), h = frame.color->height();
@@ -295,7 +295,7 @@ public:
     }
 
     // run() and a copy of the result on the host.
-    Image denoiseFrame(const SvgfFrame& frame) {
+    Image denoiseFrame(const Frame& frame) {
         run(frame);
         return mState.result->to(Device::Cpu);
     }
@@ -324,8 +324,8 @@ template <class Exec>
 class SvgfBackendImpl final : public detail::SvgfBackend {
 public:
     explicit SvgfBackendImpl(const SvgfParams& p) : mPipeline(p) {}
-    Image denoiseFrame(const SvgfFrame& frame) override { return mPipeline.denoiseFrame(frame); }
-    const Image& denoiseFrameOnDevice(const SvgfFrame& frame) override {
+    Image denoiseFrame(const Frame& frame) override { return mPipeline.denoiseFrame(frame); }
+    const Image& denoiseFrameOnDevice(const Frame& frame) override {
         mPipeline.run(frame);
         return *mPipeline.state().result;
     }

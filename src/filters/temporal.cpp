@@ -18,7 +18,7 @@
 namespace atrous {
 
 namespace svgf {
-void checkFrame(const SvgfFrame& frame);  // svgf.cpp: sizes, channels, the colour's range
+void checkFrame(const Frame& frame);  // svgf.cpp: sizes, channels, the colour's range
 }
 
 void validateTemporalParams(const TemporalParams& p) { validateParams(p, temporalParams()); }
@@ -30,7 +30,7 @@ int temporalWindowRadius(const TemporalParams& p) {
     return std::max(p.radius, p.staticRadius);
 }
 
-void checkTemporalFrame(const SvgfFrame& frame) { svgf::checkFrame(frame); }
+void checkTemporalFrame(const Frame& frame) { svgf::checkFrame(frame); }
 
 // A frame as the hops read it: its sanitised G-buffer and colour statistics, owned here.
 struct PreparedFrame {
@@ -58,7 +58,7 @@ namespace {
 
 ImageView viewOf(const Image* img) { return img ? img->view() : ImageView{}; }
 
-void prepare(const CpuExec& exec, const SvgfFrame& f, bool stats, float fireflyK, PreparedFrame& p) {
+void prepare(const CpuExec& exec, const Frame& f, bool stats, float fireflyK, PreparedFrame& p) {
     const int w = f.color->width(), h = f.color->height();
     p.depth = Image::uninitialized(w, h, 1);
     p.normal = Image::uninitialized(w, h, 3);
@@ -116,7 +116,7 @@ Image cloneOrEmpty(const Image* img) { return img ? img->clone() : Image(); }
 
 // The frames lo .. hi of a window and what gatherTemporal reads of them.
 struct WindowSpan {
-    const std::vector<SvgfFrame>& frames;
+    const std::vector<Frame>& frames;
     size_t center, lo, hi;
     const std::vector<long long>* ids;
     TemporalCache::Impl* cache;  // null: no cache
@@ -134,7 +134,7 @@ void keepCacheFor(TemporalCache::Impl* cache, int w, int h, bool stats, float fi
 }
 
 // The variance and position of frame i against the centre's: the same size and channels.
-void checkExtraBuffers(const SvgfFrame& f, const SvgfFrame& c, size_t i, int w, int h) {
+void checkExtraBuffers(const Frame& f, const Frame& c, size_t i, int w, int h) {
     for (const Image* extra : {f.variance, f.position}) {
         if (!extra) continue;
         const bool variance = extra == f.variance;
@@ -149,11 +149,11 @@ void checkExtraBuffers(const SvgfFrame& f, const SvgfFrame& c, size_t i, int w, 
 // Every frame of the span is checked (unless the cache knows it) and must carry the centre's
 // buffers (a missing one would read as a neutral default) at the centre's size.
 void checkSpan(const WindowSpan& s, int w, int h) {
-    const SvgfFrame& c = s.frames[s.center];
+    const Frame& c = s.frames[s.center];
     if (!s.known(s.center)) svgf::checkFrame(c);
     auto same = [&](const Image* a, const Image* b) { return (a == nullptr) == (b == nullptr); };
     for (size_t i = s.lo; i <= s.hi; ++i) {
-        const SvgfFrame& f = s.frames[i];
+        const Frame& f = s.frames[i];
         if (i != s.center && !s.known(i)) svgf::checkFrame(f);
         if (f.color->width() != w || f.color->height() != h)
             throw InputError("temporal window: frame " + std::to_string(i) + " is " + std::to_string(f.color->width()) +
@@ -241,19 +241,19 @@ void gatherSide(const CpuExec& exec, const WindowSpan& s, const std::vector<Prep
 
 }  // namespace
 
-TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t center, const TemporalParams& params,
+TemporalGather gatherTemporal(const std::vector<Frame>& window, size_t center, const TemporalParams& params,
                               TemporalCache* cache, const std::vector<long long>* ids) {
     validateTemporalParams(params);
     if ((cache == nullptr) != (ids == nullptr) || (ids && ids->size() != window.size()))
         throw InputError("temporal window: a cache needs one id per frame of the window");
     if (center >= window.size()) throw InputError("temporal window: the centre frame is outside the window");
-    const SvgfFrame& c = window[center];
+    const Frame& c = window[center];
     if (!c.color || c.color->empty()) svgf::checkFrame(c);  // throws: the colour is missing
     const int w = c.color->width(), h = c.color->height();
     // Frames without motion are taken as still, so nothing would tell a moving object from the
     // background: the static window needs every frame's motion.
     TemporalParams own = params;
-    for (const SvgfFrame& f : window) own.staticRadius = f.motion ? own.staticRadius : 0;
+    for (const Frame& f : window) own.staticRadius = f.motion ? own.staticRadius : 0;
     const size_t r = size_t(temporalWindowRadius(own));
     const size_t lo = center > r ? center - r : 0, hi = params.causal ? center : std::min(window.size() - 1, center + r);
     const bool stats = params.colorSigmas > 0.0f;
@@ -288,7 +288,7 @@ TemporalGather gatherTemporal(const std::vector<SvgfFrame>& window, size_t cente
 
 namespace {
 
-Image denoiseTemporalWith(const std::vector<SvgfFrame>& window, size_t center, const TemporalParams& params,
+Image denoiseTemporalWith(const std::vector<Frame>& window, size_t center, const TemporalParams& params,
                           const DenoiseOptions& spatial, TemporalReport* report, TemporalCache* cache,
                           const std::vector<long long>* ids) {
     Timer timer;
@@ -299,7 +299,7 @@ Image denoiseTemporalWith(const std::vector<SvgfFrame>& window, size_t center, c
         for (size_t i = 0; i < g.frames.plane(); ++i) sum += g.frames.data()[i];  // channel 0
         report->meanFrames = sum / double(g.frames.plane());
     }
-    const SvgfFrame& c = window[center];
+    const Frame& c = window[center];
     DenoiseBuffers b;
     b.color = &g.color;
     b.variance = g.variance.empty() ? nullptr : &g.variance;
@@ -317,12 +317,12 @@ Image denoiseTemporalWith(const std::vector<SvgfFrame>& window, size_t center, c
 
 }  // namespace
 
-Image denoiseTemporal(const std::vector<SvgfFrame>& window, size_t center, const TemporalParams& params,
+Image denoiseTemporal(const std::vector<Frame>& window, size_t center, const TemporalParams& params,
                       const DenoiseOptions& spatial, TemporalCache* cache, const std::vector<long long>* ids) {
     return denoiseTemporalWith(window, center, params, spatial, nullptr, cache, ids);
 }
 
-TemporalResult denoiseTemporalWithReport(const std::vector<SvgfFrame>& window, size_t center,
+TemporalResult denoiseTemporalWithReport(const std::vector<Frame>& window, size_t center,
                                          const TemporalParams& params, const DenoiseOptions& spatial,
                                          TemporalCache* cache, const std::vector<long long>* ids) {
     TemporalResult r;

@@ -30,32 +30,21 @@ Image composeIds(const Image* object, const Image* material, int w, int h) {
 
 }  // namespace
 
-DenoiseInputs BufferSet::inputs() const { return refsOf(*this); }
+Frame BufferSet::inputs() const { return refsOf(*this); }
 
-BufferRefs refsOf(const BufferSet& set) {
-    BufferRefs r;
+Frame refsOf(const BufferSet& set) {
+    Frame r;
     for (int b = 0; b < kBufferCount; ++b)
         if (Buffer(b) != Buffer::MaterialId) r.set(Buffer(b), &set.image[b]);  // its values are the ids' channel 1
     return r;
 }
 
-BufferRefs refsOf(const SequenceFrame& f) {
-    BufferRefs r;
+Frame refsOf(const SequenceFrame& f) {
+    Frame r;
     r.set(Buffer::Color, &f.color).set(Buffer::Variance, &f.variance).set(Buffer::Albedo, &f.albedo);
     r.set(Buffer::Normal, &f.normal).set(Buffer::Position, &f.position).set(Buffer::Depth, &f.depth);
     r.set(Buffer::ObjectId, &f.ids).set(Buffer::Emission, &f.emission).set(Buffer::Motion, &f.motion);
     return r;
-}
-
-
-DenoiseBuffers handOver(const BufferRefs& r, Image& color, Image* variance, Image* emission) {
-    const DenoiseInputs& in = r;
-    DenoiseBuffers b;
-    b.color = &color;
-    b.variance = variance && !variance->empty() ? variance : nullptr;
-    b.emission = emission && !emission->empty() ? emission : nullptr;
-    b.albedo = in.albedo, b.normal = in.normal, b.position = in.position, b.depth = in.depth, b.ids = in.ids;
-    return b;
 }
 
 

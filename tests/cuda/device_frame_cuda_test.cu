@@ -132,7 +132,7 @@ TEST(DeviceFrameCuda, DenoiseOnDeviceInputsMatchesHostInputsAndItsReport) {
     emission(20, 20, 0) = emission(20, 20, 1) = emission(20, 20, 2) = 4.0f;
     DenoiseOptions o;
     o.device = Device::Cuda;
-    DenoiseInputs hin = s.inputs();
+    Frame hin = s.inputs();
     hin.emission = &emission;
     DenoiseReport hostRep, devRep;
     const Image hostOut = test::denoiseReporting(hin, o, hostRep);  // host inputs: uploaded, result downloaded
@@ -140,7 +140,7 @@ TEST(DeviceFrameCuda, DenoiseOnDeviceInputsMatchesHostInputsAndItsReport) {
     const Image c = s.noisy.to(Device::Cuda), v = s.variance.to(Device::Cuda), a = s.albedo.to(Device::Cuda),
                 n = s.normal.to(Device::Cuda), p = s.position.to(Device::Cuda), d = s.depth.to(Device::Cuda),
                 id = s.ids.to(Device::Cuda), e = emission.to(Device::Cuda);
-    DenoiseInputs din;
+    Frame din;
     din.color = &c, din.variance = &v, din.albedo = &a, din.normal = &n, din.position = &p, din.depth = &d;
     din.ids = &id, din.emission = &e;
     const Image devOut = test::denoiseReporting(din, o, devRep);  // device inputs: in place, result stays on the GPU

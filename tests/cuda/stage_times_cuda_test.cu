@@ -39,7 +39,7 @@ TEST(StageTimesCuda, SvgfReportOnTheGpu) {
     p.levels = 3;
     SvgfDenoiser d(p, Device::Cuda);
     d.setTiming(true);
-    SvgfFrame f;
+    Frame f;
     f.color = &scene.noisy;
     f.albedo = &scene.albedo;
     f.normal = &scene.normal;

@@ -50,8 +50,8 @@ CudaTestFrame makeFrame(int w, int h, int t) {
 }
 
 // The SVGF inputs of a test frame.
-SvgfFrame inputsOf(const CudaTestFrame& f) {
-    SvgfFrame in;
+Frame inputsOf(const CudaTestFrame& f) {
+    Frame in;
     in.color = &f.color, in.albedo = &f.albedo, in.normal = &f.normal;
     in.depth = &f.depth, in.ids = &f.ids, in.motion = &f.motion, in.emission = &f.emission;
     return in;
@@ -79,7 +79,7 @@ TEST(SvgfCuda, MatchesTheCpuBackend) {
         SvgfDenoiser cpu(p, Device::Cpu), gpu(p, Device::Cuda);
         for (int t = 0; t < 5; ++t) {
             CudaTestFrame f = makeFrame(96, 64, t);
-            const SvgfFrame in = inputsOf(f);
+            const Frame in = inputsOf(f);
             Image a = cpu.denoiseFrame(in);
             Image b = gpu.denoiseFrame(in);  // host inputs are uploaded by the driver
             const float maxDiff = maxRelDiff(a, b);
@@ -103,7 +103,7 @@ TEST(SvgfCuda, LearnedSpatialMatchesTheCpuBackend) {
         SvgfDenoiser cpu(p, Device::Cpu), gpu(p, Device::Cuda);
         for (int t = 0; t < 5; ++t) {
             CudaTestFrame f = makeFrame(96, 64, t);
-            const SvgfFrame in = inputsOf(f);
+            const Frame in = inputsOf(f);
             Image a = cpu.denoiseFrame(in);
             Image b = gpu.denoiseFrame(in);
             const float maxDiff = maxRelDiff(a, b);
@@ -126,7 +126,7 @@ TEST(SvgfCuda, LearnedSpatialRunsTheGivenWeightsAcrossSizes) {
     for (const auto& sz : sizes) {
         for (int t = 0; t < 3; ++t) {
             CudaTestFrame f = makeFrame(sz[0], sz[1], t);
-            const SvgfFrame in = inputsOf(f);
+            const Frame in = inputsOf(f);
             Image a = cpu.denoiseFrame(in), b = gpu.denoiseFrame(in), c = gpuBuiltin.denoiseFrame(in);
             const float maxDiff = maxRelDiff(a, b);
             float other = 0.0f;

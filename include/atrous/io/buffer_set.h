@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "atrous/denoise.h"
+#include "atrous/buffers.h"
 #include "atrous/image.h"
 #include "atrous/io/exr_layers.h"
 #include "atrous/io/pass_map.h"
@@ -36,21 +36,15 @@ struct BufferSet {
     std::vector<std::string> notes;    // conventions applied, passes not found, ...
     std::vector<Buffer> skipped;       // present but not decoded (BufferFiles::wanted)
     const Image* get(Buffer b) const { return image[int(b)].empty() ? nullptr : &image[int(b)]; }
-    DenoiseInputs inputs() const;  // refsOf(*this)
+    Frame inputs() const;  // refsOf(*this)
 };
 
 // One set of buffers, not owned: a Frame (atrous/buffers.h; ids in the object_id slot, as in
 // BufferSet). Every entry point (render --denoise, denoise, denoise --sequence, the viewer,
 // Python) puts what it holds here and hands it to the denoisers as it is, so a new buffer reaches
 // all of them at once (a render's: RenderBuffers::frame(), atrous/render.h).
-using BufferRefs = Frame;
-BufferRefs refsOf(const BufferSet& set);
-BufferRefs refsOf(const SequenceFrame& f);  // all but the reference
-
-// The buffers of denoise(DenoiseBuffers&): the colour, variance and emission are the caller's own
-// images (those r points at), handed over, so the filter works in their storage and they are not
-// read afterwards; the features are read only. An empty (or null) variance or emission is absent.
-DenoiseBuffers handOver(const BufferRefs& r, Image& color, Image* variance, Image* emission);
+Frame refsOf(const BufferSet& set);
+Frame refsOf(const SequenceFrame& f);  // all but the reference
 
 // Every file loadBuffers(files) reads or could read: the explicit files, `in` when it is a file,
 // and for a render directory each buffer's file name in it (color.exr, albedo.exr, ...: present
