@@ -17,14 +17,9 @@
 
 using namespace atrous;
 
-namespace {
+using test::firstBitDifference;
 
-long firstBitDifference(const Image& a, const Image& b) {
-    if (a.size() != b.size() || a.channels() != b.channels()) return 0;
-    for (size_t i = 0; i < a.size(); ++i)
-        if (std::memcmp(a.data() + i, b.data() + i, sizeof(float)) != 0) return long(i);
-    return -1;
-}
+namespace {
 
 Image firstChannels(const Image& src, int channels) {
     Image out(src.width(), src.height(), channels);

@@ -17,14 +17,9 @@
 
 using namespace atrous;
 
-namespace {
+using test::firstBitDifference;
 
-long firstBitDifference(const Image& a, const Image& b) {
-    if (a.size() != b.size() || a.channels() != b.channels()) return 0;
-    for (size_t i = 0; i < a.size(); ++i)
-        if (std::memcmp(a.data() + i, b.data() + i, sizeof(float)) != 0) return long(i);
-    return -1;
-}
+namespace {
 
 // An image's values interleaved (H x W x C) as float32, with `pad` extra floats after each row.
 std::vector<float> interleaved(const Image& img, int pad = 0) {

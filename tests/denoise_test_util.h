@@ -2,6 +2,7 @@
 // (background plane, a box face, a disk) and Gaussian noise of known per-pixel variance.
 #pragma once
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include <string>
@@ -113,6 +114,15 @@ inline double maxAbsDiff(const Image& a, const Image& b) {
     double m = 0;
     for (size_t i = 0; i < a.size(); ++i) m = std::max(m, double(std::fabs(a.data()[i] - b.data()[i])));
     return m;
+}
+
+// The index of the first float that differs bit for bit (-1: none; 0 when the sizes or channel
+// counts differ). NaNs compare by their bits.
+inline long firstBitDifference(const Image& a, const Image& b) {
+    if (a.size() != b.size() || a.channels() != b.channels()) return 0;
+    for (size_t i = 0; i < a.size(); ++i)
+        if (std::memcmp(a.data() + i, b.data() + i, sizeof(float)) != 0) return long(i);
+    return -1;
 }
 
 inline bool allFinite(const Image& a) {
