@@ -71,7 +71,7 @@ void addViewCommand(CLI::App& app) {
     cmd->add_option("--exposure", o.exposure, "Display exposure (linear scale)")
         ->capture_default_str();
     cmd->add_option("--frames", o.frames,
-                    "Headless: render N frames, save --screenshot/--dump, exit");
+                    "Headless: render N frames (with --sequence: show its first N frames in turn), save --screenshot/--dump, exit");
     cmd->add_option("--screenshot", o.screenshot,
                     "Headless: PNG of the window's framebuffer after the last frame");
     cmd->add_option("--dump", o.dumpDir,

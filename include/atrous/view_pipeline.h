@@ -156,6 +156,9 @@ class ViewPipeline {
     // settings the renderer rejects; filter parameter errors land in SlotResult::error.
     void step(const PipelineSettings& s);
 
+    // Whether the last step() filtered anything (always when rendering; a loaded frame's step only
+    // when a slot's method, parameters or frame changed): its times() are then this step's.
+    bool stepFiltered() const { return mStepFiltered; }
     int framesAccumulated() const { return mFrames; }
     int samplesPerPixel() const { return mFrames * mSppAccumulated; }
     const StageTimes& times() const { return mTimes; }
@@ -279,6 +282,7 @@ class ViewPipeline {
     Image mDetail, mSureS;
     int mDetailLevelShown = -1;
     StageTimes mTimes;
+    bool mStepFiltered = false;
 };
 
 // A pinhole camera that orbits a pivot: yaw about world +y, pitch about the camera's right axis.

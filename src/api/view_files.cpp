@@ -142,6 +142,7 @@ void ViewPipeline::stepLoaded(const PipelineSettings& settings) {
     }
     lap(times.debug, times.debugCpu);
     if (changed) mTimes = times;  // the panel keeps the times of the last filtering
+    mStepFiltered = changed;
     mCameraMoved = false;
     mHistoryResetPending = false;
 }

@@ -457,6 +457,7 @@ void ViewPipeline::step(const PipelineSettings& s) {
         return;
     }
     mTimes = StageTimes{};
+    mStepFiltered = true;
     for (bool& v : mHostValid) v = false;  // this step rewrites the buffers
     if (s.sppPerFrame != mSppAccumulated) {
         mAccumulating = false;  // a running mean mixes frames of one spp only

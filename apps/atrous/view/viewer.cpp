@@ -209,6 +209,7 @@ void runViewer(const ViewerOptions& opt) {
         glfwGetFramebufferSize(win, &fbw, &fbh);
         const ImageRect rect = imageRect(fbw, fbh, st.uiVisible, w, h);
         bool moved = !headless && !files && input.update(win, orbit, pl.sceneRadius(), rect.h, dt);
+        if (files && headless) st.frameWanted = frame;  // headless: a sequence plays, one frame per frame
         if (files) stepFrames(pl, *files, st.frameWanted, st);
         if (files) st.frameWanted = files->current();
         if (opt.orbitDegPerFrame != 0.0f && !st.paused && frame > 0 && !files) {
@@ -280,7 +281,7 @@ void runViewer(const ViewerOptions& opt) {
         ft.displayMs = displayTime;
         ft.stages = pl.times();
         timings.push_back(ft);
-        if (doStep) {
+        if (doStep && pl.stepFiltered()) {  // a loaded frame's step that filtered nothing is no sample
             const std::vector<StageTime> stages = frameStages(pl, ps.split, displayTime);
             stageHistory.add(stages);
             if (frame > 0 && (opt.benchmark || headless)) benchStages.add(stages);  // for the JSON line
