@@ -20,11 +20,10 @@
 #include "atrous/io/image_io.h"
 #include "atrous/view_pipeline.h"
 #include "test_util.h"
+#include "xvfb_util.h"
 
 using namespace atrous;
-using atrous::test::CliResult;
-using atrous::test::runCli;
-using atrous::test::TempDir;
+using namespace atrous::test;
 namespace fs = std::filesystem;
 
 namespace {
@@ -171,33 +170,6 @@ TEST(ViewFiles, ASequencesFramesReplaceTheFrameAndFeedTheSequenceMethods) {
 
 namespace {
 
-bool viewerBuilt() {
-    static const bool built = runCli("view --help").output.find("--write-image") != std::string::npos;
-    return built;
-}
-
-bool haveXvfb() { return std::system("command -v xvfb-run > /dev/null 2>&1") == 0; }
-
-// The viewer under xvfb-run in a hard time limit, on a display number of its own (ctest runs
-// test processes side by side), retried once when the X server failed to start.
-CliResult runUnderXvfb(const std::string& args) {
-    static int calls = 0;
-    CliResult r;
-    for (int attempt = 0; attempt < 2; ++attempt) {
-        const int display = 4200 + int((unsigned(getpid()) * 31u + unsigned(calls++) * 11u) % 3000u);
-        r = atrous::test::runShell("timeout -k 5 120 xvfb-run -a -n " + std::to_string(display) +
-                                   " -s '-screen 0 1024x768x24' " + std::string(ATROUS_CLI) + " " + args);
-        if (r.exitCode == 0 || r.output.find("Xvfb failed to start") == std::string::npos) break;
-    }
-    return r;
-}
-
-#define REQUIRE_VIEWER_AND_XVFB()                                                                       \
-    do {                                                                                                \
-        if (!viewerBuilt()) GTEST_SKIP() << "atrous built without the viewer";                          \
-        if (!haveXvfb()) GTEST_SKIP() << "xvfb-run (Xvfb) is not installed: the viewer needs an X server"; \
-    } while (0)
-
 // A headless run's screenshot of the image alone (--hide-ui), read back.
 Image screenshot(const std::string& args, const std::string& png, int frames = 2) {
     const CliResult r = runUnderXvfb(args + " --frames " + std::to_string(frames) + " --hide-ui --screenshot " + png);
@@ -228,7 +200,7 @@ void expectCommandReproduces(const TempDir& dir, const std::string& args, const 
     EXPECT_NE(r.output.find(cmd), std::string::npos) << "the command is printed too:\n" << r.output;
     const std::string viewer = readBytes(exr);
     fs::remove(exr);
-    const CliResult d = atrous::test::runShell(std::string(ATROUS_CLI) + cmd.substr(6));
+    const CliResult d = runShell(std::string(ATROUS_CLI) + cmd.substr(6));
     ASSERT_EQ(d.exitCode, 0) << cmd << "\n" << d.output;
     EXPECT_TRUE(readBytes(exr) == viewer) << tag << ": " << cmd;
 }

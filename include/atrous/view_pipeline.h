@@ -16,6 +16,7 @@
 #include "atrous/io/buffer_set.h"
 #include "atrous/render.h"
 #include "atrous/stage_time.h"
+#include "atrous/timer.h"
 #include "atrous/param_set.h"
 #include "atrous/sequence_methods.h"
 #include "atrous/camera.h"
@@ -102,6 +103,18 @@ struct StageTimes {
 
 // Process CPU time (user + system, all threads) in milliseconds.
 double processCpuMs();
+
+// Times consecutive stages: lap(wall, cpu) sets the wall clock and the process CPU time (ms) since
+// the previous lap, or since construction.
+class StageLap {
+  public:
+    StageLap();
+    void operator()(double& wall, double& cpu);
+
+  private:
+    Timer mTimer;
+    double mCpu;
+};
 
 // One slot's result.
 struct SlotResult {

@@ -89,15 +89,7 @@ void ViewPipeline::stepLoaded(const PipelineSettings& settings) {
     s.deviceResults = false;  // the display of a loaded frame is the host path
     StageTimes times;
     bool changed = false;
-    Timer t;
-    double c = processCpuMs();
-    auto lap = [&](double& wall, double& cpu) {
-        wall = t.ms();
-        const double now = processCpuMs();
-        cpu = now - c;
-        c = now;
-        t.reset();
-    };
+    StageLap lap;
     // What makes slot m's result: the method, the parameters it reads, the frame.
     auto keyOf = [&](Method m) {
         SlotKey k;

@@ -83,6 +83,16 @@ double processCpuMs() {
            (double(u.ru_utime.tv_usec) + double(u.ru_stime.tv_usec)) * 1e-3;
 }
 
+StageLap::StageLap() : mCpu(processCpuMs()) {}
+
+void StageLap::operator()(double& wall, double& cpu) {
+    wall = mTimer.ms();
+    const double now = processCpuMs();
+    cpu = now - mCpu;
+    mCpu = now;
+    mTimer.reset();
+}
+
 // ---- pipeline ----
 
 ViewPipeline::ViewPipeline(const Scene& scene, int width, int height, Device device, uint32_t seed)
@@ -463,15 +473,7 @@ void ViewPipeline::step(const PipelineSettings& s) {
         mAccumulating = false;  // a running mean mixes frames of one spp only
         mSppAccumulated = s.sppPerFrame;
     }
-    Timer t;
-    double c = processCpuMs();
-    auto lap = [&](double& wall, double& cpu) {
-        wall = t.ms();
-        const double now = processCpuMs();
-        cpu = now - c;
-        c = now;
-        t.reset();
-    };
+    StageLap lap;
     const bool ownSamples = s.methodA.ownSamples() || (s.split && s.methodB.ownSamples());
     renderFrame(s, ownSamples);
     lap(mTimes.render, mTimes.renderCpu);
