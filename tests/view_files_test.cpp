@@ -279,6 +279,8 @@ TEST(ViewFiles, BadInputIsOneLineNamingTheFileAndExitCode2) {
         {"view --sequence " + json, "a JSON scene, not a render"},
         {"view --in " + render + " --scene cornell", "--in and --scene"},
         {"view --scene " + render, "open it with --in"},
+        {"view --in " + render + " --spp 4", "--spp: a render read from files"},
+        {"view --layer ViewLayer", "give exactly one of --in"},
         {"view --sequence " + std::string(dir / "nothing"), "nothing"},
     };
     for (const auto& [args, needle] : cases) {

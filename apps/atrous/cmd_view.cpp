@@ -23,6 +23,22 @@ std::string methodList() {
     for (const std::string& n : view::methodNames()) s += (s.empty() ? "" : " | ") + n;
     return s;
 }
+// Flags that cannot apply are refused, never ignored: the render's (its table's flags, --orbit,
+// --no-accumulate) with a render read from files, the input's own with a scene.
+void refuseInapplicable(const CLI::App& cmd, const view::ViewerOptions& o) {
+    const bool files = o.input.any() || !o.sequenceInput.empty();
+    std::vector<std::string> flags{"--orbit", "--no-accumulate"};
+    for (const ParamField<RenderSettings>& f : renderParams()) flags.push_back(renderParams().flag(f));
+    if (!files) flags = {"--pass", "--layer"};
+    std::string given;
+    for (const std::string& f : flags)
+        if (cmd.get_option_no_throw(f) && cmd.count(f) > 0) given += (given.empty() ? "" : ", ") + f;
+    if (given.empty()) return;
+    throw InputError(given + (files ? ": a render read from files (--in, --sequence) is not rendered; drop "
+                                    : ": read a render's passes (give --in or --sequence); drop ") +
+                     (given.find(',') == std::string::npos ? "it" : "them"));
+}
+
 }  // namespace
 
 void addViewCommand(CLI::App& app) {
@@ -88,6 +104,7 @@ void addViewCommand(CLI::App& app) {
                   "Print a JSON line of frame and stage timings at exit");
     cmd->callback([opt, cmd] {
         opt->sceneGiven = cmd->count("--scene") > 0;
+        refuseInapplicable(*cmd, *opt);
         for (const char* f : {"--start", "--end", "--step"})
             if (cmd->count(f) > 0 && opt->sequenceInput.empty()) throw InputError(std::string(f) + ": picks frames of a --sequence; give one");
         view::runViewer(*opt);
