@@ -17,46 +17,16 @@
 #include "atrous/image.h"
 #include "atrous/io/image_io.h"
 #include "test_util.h"
+#include "xvfb_util.h"
 
 using atrous::Image;
 using atrous::test::CliResult;
 using atrous::test::runCli;
+using atrous::test::runUnderXvfb;
+using atrous::test::viewerBuilt;
 using atrous::test::TempDir;
 
 namespace {
-
-bool viewerBuilt() {
-    static const bool built =
-        runCli("view --help").output.find("--screenshot") != std::string::npos;
-    return built;
-}
-
-bool haveXvfb() {
-    return std::system("command -v xvfb-run > /dev/null 2>&1") == 0;
-}
-
-// runCli's shape, with the CLI started by xvfb-run inside a hard time limit. ctest runs test
-// processes in parallel, and two `xvfb-run -a` starting at once can race for the same display
-// number: each process starts its search at its own number, and a run whose X server failed to
-// start is retried once.
-CliResult runUnderXvfb(const std::string& args) {
-    static int calls = 0;
-    CliResult r;
-    for (int attempt = 0; attempt < 2; ++attempt) {
-        const int display = 100 + int((unsigned(getpid()) * 37u + unsigned(calls++) * 7u) % 4000u);
-        std::string cmd = "timeout -k 5 120 xvfb-run -a -n " + std::to_string(display) +
-                          " -s '-screen 0 1024x768x24' " + std::string(ATROUS_CLI) + " " + args;
-        r = atrous::test::runShell(cmd);
-        if (r.exitCode == 0 || r.output.find("Xvfb failed to start") == std::string::npos) break;
-    }
-    return r;
-}
-
-#define REQUIRE_VIEWER_AND_XVFB()                                              \
-    do {                                                                       \
-        if (!viewerBuilt()) GTEST_SKIP() << "atrous built without the viewer"; \
-        if (!haveXvfb()) GTEST_SKIP() << "xvfb-run is not installed";          \
-    } while (0)
 
 double mse(const Image& a, const Image& b, int x0 = 0, int x1 = -1) {
     if (x1 < 0) x1 = a.width();

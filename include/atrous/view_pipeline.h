@@ -13,8 +13,10 @@
 
 #include "atrous/denoise.h"
 #include "atrous/image.h"
+#include "atrous/io/buffer_set.h"
 #include "atrous/render.h"
 #include "atrous/stage_time.h"
+#include "atrous/timer.h"
 #include "atrous/param_set.h"
 #include "atrous/sequence_methods.h"
 #include "atrous/camera.h"
@@ -102,6 +104,18 @@ struct StageTimes {
 // Process CPU time (user + system, all threads) in milliseconds.
 double processCpuMs();
 
+// Times consecutive stages: lap(wall, cpu) sets the wall clock and the process CPU time (ms) since
+// the previous lap, or since construction.
+class StageLap {
+  public:
+    StageLap();
+    void operator()(double& wall, double& cpu);
+
+  private:
+    Timer mTimer;
+    double mCpu;
+};
+
 // One slot's result.
 struct SlotResult {
     Method method = Method::none();
@@ -122,6 +136,19 @@ class ViewPipeline {
     // Cuda renders with a persistent CudaBvhRenderer (scene and BVH uploaded once, the viewer's
     // camera passed per frame) and runs the filters on the GPU.
     ViewPipeline(const Scene& scene, int width, int height, Device device, uint32_t seed);
+    // A frame read from files (`atrous view --in`, `--sequence`; src/api/view_files.cpp): no
+    // renderer, no camera and no accumulation. The loaded buffers are the frame: the still methods
+    // take them as `atrous denoise --in` hands them over (io::refsOf), the sequence methods as one
+    // frame of a stream. A slot is filtered again only when its method, its parameters or the frame
+    // changed (step() is cheap otherwise). The buffer views show host copies (3 planes each; zero
+    // where the files had no such buffer); the filters run on `device`.
+    ViewPipeline(io::BufferSet frame, Device device);
+    // Replaces the loaded frame (a sequence's other frame: the same size, else InputError).
+    // follows: it comes right after the current one, and the sequence methods continue their
+    // history; otherwise they start a new one at this frame.
+    void setFrame(io::BufferSet frame, bool follows);
+    bool fromFiles() const { return mLoaded != nullptr; }
+    const io::BufferSet* loadedFrame() const { return mLoaded.get(); }
     ~ViewPipeline();
 
     int width() const { return mWidth; }
@@ -142,6 +169,9 @@ class ViewPipeline {
     // settings the renderer rejects; filter parameter errors land in SlotResult::error.
     void step(const PipelineSettings& s);
 
+    // Whether the last step() filtered anything (always when rendering; a loaded frame's step only
+    // when a slot's method, parameters or frame changed): its times() are then this step's.
+    bool stepFiltered() const { return mStepFiltered; }
     int framesAccumulated() const { return mFrames; }
     int samplesPerPixel() const { return mFrames * mSppAccumulated; }
     const StageTimes& times() const { return mTimes; }
@@ -188,6 +218,16 @@ class ViewPipeline {
     void computeMotion();
     void computeEmission();
     void runSlot(int i, Method m, const PipelineSettings& s);
+    void computeDetail(const PipelineSettings& s);
+    // The frame a sequence method takes: this frame's render with the pipeline's motion and
+    // emission, or the loaded frame; a copy of its own when the method holds frames (own).
+    SequenceInput renderedSequenceInput(bool own) const;
+    SequenceInput loadedSequenceInput(bool own) const;
+    Image noisyHost() const;  // the noisy colour on the host (a refused filter's stand-in)
+    // From files: loadDisplayBuffers() fills the display copies from mLoaded; stepLoaded() is
+    // step() for a loaded frame (each slot filtered again only when its key changed).
+    void loadDisplayBuffers();
+    void stepLoaded(const PipelineSettings& s);
     // The running means (colour, variance, features, emission) as the EAW/SURE slots filter them.
     Frame accumulatedInputs() const;
     DenoiseOptions denoiseOptions(Method m, const PipelineSettings& s) const;
@@ -235,9 +275,27 @@ class ViewPipeline {
     SequenceDenoiser& sequenceDenoiser(int i, const SequenceMethodInfo& m, const PipelineSettings& s, bool onDevice);
     void runSequence(int i, const SequenceMethodInfo& m, const PipelineSettings& s, SlotResult& r);
     bool mHistoryResetPending = false;
+    // From files: the loaded frame, its generation (one per setFrame) and the one it follows (0:
+    // none); per slot, what its result was made from and the frame last pushed to its sequence
+    // method.
+    std::unique_ptr<io::BufferSet> mLoaded;
+    uint64_t mGeneration = 0, mFollows = 0;
+    struct SlotKey {
+        bool valid = false;
+        Method method;
+        DenoiseOptions still;
+        ParamSet sequence;
+        uint64_t generation = 0;
+        bool sureFractions = false, onDevice = false;
+        int detailLevel = -1;
+    };
+    SlotKey mKey[2], mDetailKey;
+    uint64_t mPushed[2] = {0, 0};
+    static bool sameKey(const SlotKey& a, const SlotKey& b);
     Image mDetail, mSureS;
     int mDetailLevelShown = -1;
     StageTimes mTimes;
+    bool mStepFiltered = false;
 };
 
 // A pinhole camera that orbits a pivot: yaw about world +y, pitch about the camera's right axis.

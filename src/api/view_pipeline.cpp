@@ -55,8 +55,6 @@ Method parseMethod(const std::string& name) {
 
 namespace {
 
-constexpr float kPi = 3.14159265358979f;
-
 size_t sequenceIndex(const SequenceMethodInfo& m) {
     const auto& rows = sequenceMethods();
     for (size_t i = 0; i < rows.size(); ++i)
@@ -85,40 +83,14 @@ double processCpuMs() {
            (double(u.ru_utime.tv_usec) + double(u.ru_stime.tv_usec)) * 1e-3;
 }
 
-// ---- orbit camera ----
+StageLap::StageLap() : mCpu(processCpuMs()) {}
 
-OrbitCamera OrbitCamera::fromCamera(const pt::Camera& c, float pivotDistance) {
-    OrbitCamera o;
-    o.distance = std::max(pivotDistance, 1e-3f);
-    o.target = c.position + c.forward * o.distance;
-    const Vec3 off = c.position - o.target;
-    o.yaw = std::atan2(off.x, off.z);
-    o.pitch = std::asin(std::clamp(off.y / o.distance, -1.0f, 1.0f));
-    o.tanHalfFov = c.tanHalfFov;
-    return o;
-}
-
-pt::Camera OrbitCamera::camera() const {
-    const Vec3 off(std::cos(pitch) * std::sin(yaw), std::sin(pitch),
-                   std::cos(pitch) * std::cos(yaw));
-    pt::Camera c = pt::makeLookAtCamera(target + off * distance, target, Vec3(0, 1, 0), 45.0f);
-    c.tanHalfFov = tanHalfFov;
-    return c;
-}
-
-void OrbitCamera::orbit(float dYaw, float dPitch) {
-    yaw += dYaw;
-    // Short of the poles, where the look-at basis (world up) degenerates.
-    const float limit = 89.0f * kPi / 180.0f;
-    pitch = std::clamp(pitch + dPitch, -limit, limit);
-}
-
-void OrbitCamera::pan(const pt::Camera& c, float right, float up, float forward) {
-    target += c.right * right + c.up * up + c.forward * forward;
-}
-
-void OrbitCamera::zoom(float factor) {
-    distance = std::clamp(distance * factor, 1e-3f, 1e6f);
+void StageLap::operator()(double& wall, double& cpu) {
+    wall = mTimer.ms();
+    const double now = processCpuMs();
+    cpu = now - mCpu;
+    mCpu = now;
+    mTimer.reset();
 }
 
 // ---- pipeline ----
@@ -167,6 +139,7 @@ void ViewPipeline::setCamera(const pt::Camera& c) {
 void ViewPipeline::resetAccumulation() {
     mAccumulating = false;
     mHistoryResetPending = true;
+    mKey[0] = mKey[1] = mDetailKey = SlotKey{};  // a loaded frame: filter it again
 }
 
 void ViewPipeline::renderFrame(const PipelineSettings& s, bool ownSamples) {
@@ -299,6 +272,7 @@ void ViewPipeline::computeEmission() {
 }
 
 Frame ViewPipeline::accumulatedInputs() const {
+    if (mLoaded) return io::refsOf(*mLoaded);  // as `atrous denoise --in` hands them over
     Frame r;
     r.set(io::Buffer::Color, &mColor).set(io::Buffer::Albedo, &mAlbedo).set(io::Buffer::Normal, &mNormal);
     r.set(io::Buffer::Position, &mPosition).set(io::Buffer::Depth, &mDepth).set(io::Buffer::ObjectId, &mIds);
@@ -430,6 +404,31 @@ SequenceDenoiser& ViewPipeline::sequenceDenoiser(int i, const SequenceMethodInfo
     return *slot.denoiser;
 }
 
+SequenceInput ViewPipeline::renderedSequenceInput(bool own) const {
+    SequenceInput in;
+    if (own) {
+        auto copy = std::make_shared<RenderBuffers>();
+        for (const RenderBufferField& field : kRenderBufferFields) {
+            const bool pipelines = field.image == &RenderBuffers::motion || field.image == &RenderBuffers::emission;
+            if (!pipelines && !(frame().*field.image).empty()) copy.get()->*field.image = (frame().*field.image).clone();
+        }
+        copy->motion = mMotion.clone();
+        copy->emission = mEmission.clone();
+        in.buffers = copy->frame();
+        in.owner = copy;
+    } else {
+        Frame refs = frame().frame();
+        refs.set(io::Buffer::Motion, &mMotion).set(io::Buffer::Emission, &mEmission);
+        in.buffers = refs;
+    }
+    return in;
+}
+
+Image ViewPipeline::noisyHost() const {
+    const Image& c = mLoaded ? mLoaded->image[int(io::Buffer::Color)] : frame().color;
+    return c.device() == Device::Cpu ? c.clone() : c.to(Device::Cpu);
+}
+
 // A sequence method takes this frame's own samples, not the running mean, with the pipeline's
 // motion and emission. On CUDA all of them are device images, which a method that reads them there
 // (SVGF) reads in place. A method that holds frames beyond this step (a window: temporal) gets its
@@ -437,22 +436,14 @@ SequenceDenoiser& ViewPipeline::sequenceDenoiser(int i, const SequenceMethodInfo
 void ViewPipeline::runSequence(int i, const SequenceMethodInfo& m, const PipelineSettings& s, SlotResult& r) {
     try {
         SequenceDenoiser& den = sequenceDenoiser(i, m, s, s.deviceResults && mDevice == Device::Cuda);
-        SequenceInput in;
-        if (den.lookbehind() + den.lookahead() > 0) {
-            auto own = std::make_shared<RenderBuffers>();
-            for (const RenderBufferField& field : kRenderBufferFields) {
-                const bool pipelines = field.image == &RenderBuffers::motion || field.image == &RenderBuffers::emission;
-                if (!pipelines && !(frame().*field.image).empty()) own.get()->*field.image = (frame().*field.image).clone();
-            }
-            own->motion = mMotion.clone();
-            own->emission = mEmission.clone();
-            in.buffers = own->frame();
-            in.owner = own;
-        } else {
-            Frame refs = frame().frame();
-            refs.set(io::Buffer::Motion, &mMotion).set(io::Buffer::Emission, &mEmission);
-            in.buffers = refs;
+        if (mLoaded) {
+            // A loaded frame: the history goes on only from the frame this one follows (a step
+            // that filters the same frame again, or one after a jump, starts a new stream).
+            if (mPushed[i] == 0 || mPushed[i] != mFollows) den.reset();
+            mPushed[i] = mGeneration;
         }
+        const bool own = den.lookbehind() + den.lookahead() > 0;
+        SequenceInput in = mLoaded ? loadedSequenceInput(own) : renderedSequenceInput(own);
         Timer t;
         den.push(std::move(in));
         SequenceOutput out = den.next();
@@ -464,27 +455,25 @@ void ViewPipeline::runSequence(int i, const SequenceMethodInfo& m, const Pipelin
             r.deviceImage = std::move(out.image);  // valid until the slot changes
     } catch (const InputError& e) {
         mSequence[i] = SequenceSlot{};
+        mPushed[i] = 0;
         r.error = e.what();
-        r.image = mDevice == Device::Cpu ? frame().color.clone() : frame().color.to(Device::Cpu);
+        r.image = noisyHost();
     }
 }
 
 void ViewPipeline::step(const PipelineSettings& s) {
+    if (mLoaded) {
+        stepLoaded(s);
+        return;
+    }
     mTimes = StageTimes{};
+    mStepFiltered = true;
     for (bool& v : mHostValid) v = false;  // this step rewrites the buffers
     if (s.sppPerFrame != mSppAccumulated) {
         mAccumulating = false;  // a running mean mixes frames of one spp only
         mSppAccumulated = s.sppPerFrame;
     }
-    Timer t;
-    double c = processCpuMs();
-    auto lap = [&](double& wall, double& cpu) {
-        wall = t.ms();
-        const double now = processCpuMs();
-        cpu = now - c;
-        c = now;
-        t.reset();
-    };
+    StageLap lap;
     const bool ownSamples = s.methodA.ownSamples() || (s.split && s.methodB.ownSamples());
     renderFrame(s, ownSamples);
     lap(mTimes.render, mTimes.renderCpu);
@@ -517,6 +506,15 @@ void ViewPipeline::step(const PipelineSettings& s) {
         mSlots[1] = SlotResult{};
     lap(mTimes.denoiseB, mTimes.denoiseBCpu);
 
+    computeDetail(s);
+    lap(mTimes.debug, mTimes.debugCpu);
+
+    mPrevCamera = mCamera;
+    mCameraMoved = false;
+    mHistoryResetPending = false;
+}
+
+void ViewPipeline::computeDetail(const PipelineSettings& s) {
     mDetail = Image();
     mDetailLevelShown = -1;
     if (s.detailLevel >= 0 && s.detailLevel < s.denoise.eaw.levels) {
@@ -546,11 +544,6 @@ void ViewPipeline::step(const PipelineSettings& s) {
             mDetail = Image();
         }
     }
-    lap(mTimes.debug, mTimes.debugCpu);
-
-    mPrevCamera = mCamera;
-    mCameraMoved = false;
-    mHistoryResetPending = false;
 }
 
 std::vector<std::string> ViewPipeline::saveBuffers(const std::string& dir) const {

@@ -67,11 +67,14 @@ void stageTable(const StageHistory& h) {
 void statusSection(const ViewPipeline& pl, const StageHistory& history, const PanelInfo& info) {
     const StageTimes& t = pl.times();
     const double lastMs = info.lastFrameMs;
-    ImGui::Text("%s  %dx%d  %s", info.sceneName.c_str(), pl.width(), pl.height(), deviceToString(pl.device()));
-    ImGui::Text("frame %d   %d spp   %.1f ms (%.1f fps)", info.frame + 1, pl.samplesPerPixel(),
-                lastMs, lastMs > 0 ? 1000.0 / lastMs : 0.0);
-    ImGui::Text("render %.1f  accum %.1f  motion %.1f ms", t.render, t.accumulate,
-                t.motion);
+    ImGui::TextWrapped("%s  %dx%d  %s", info.sceneName.c_str(), pl.width(), pl.height(), deviceToString(pl.device()));
+    if (pl.fromFiles()) {
+        ImGui::Text("read from files   %.1f ms (%.1f fps)", lastMs, lastMs > 0 ? 1000.0 / lastMs : 0.0);
+    } else {
+        ImGui::Text("frame %d   %d spp   %.1f ms (%.1f fps)", info.frame + 1, pl.samplesPerPixel(), lastMs,
+                    lastMs > 0 ? 1000.0 / lastMs : 0.0);
+        ImGui::Text("render %.1f  accum %.1f  motion %.1f ms", t.render, t.accumulate, t.motion);
+    }
     ImGui::Text("filter A %.1f (%s %.1f)  B %.1f ms", t.denoiseA,
                 methodName(pl.slot(0).method), pl.slot(0).filterMs, t.denoiseB);
     ImGui::Text("debug views %.1f  display %.1f ms", t.debug, info.displayMs);
@@ -146,6 +149,21 @@ void renderSection(ViewerState& st, CameraInput& input, ViewPipeline& pl, PanelA
     if (ImGui::Button("reset camera")) a.resetCamera = true;
     ImGui::TextDisabled(
         "drag: left orbit, right/middle pan\nwheel zoom, WASD move, Q/E down/up");
+}
+
+// A render read from files: its frame (a sequence's slider and buttons, keys Left/Right/Home/End),
+// the exposure, and filtering again.
+void fileSection(ViewerState& st, ViewPipeline& pl, const PanelInfo& info) {
+    if (info.frameCount > 1) {
+        int k = st.frameWanted + 1;
+        if (ImGui::SliderInt("frame", &k, 1, info.frameCount)) st.frameWanted = k - 1;
+        if (ImGui::Button("< prev")) st.frameWanted = std::max(0, st.frameWanted - 1);
+        ImGui::SameLine();
+        if (ImGui::Button("next >")) st.frameWanted = std::min(info.frameCount - 1, st.frameWanted + 1);
+        ImGui::TextDisabled("Left/Right: previous/next frame, Home/End");
+    }
+    ImGui::SliderFloat("exposure", &st.exposure, 0.05f, 16.0f, "%.2f", ImGuiSliderFlags_Logarithmic);
+    if (ImGui::Button("filter again")) pl.resetAccumulation();
 }
 
 // Methods A and B, the split, the buffer view and its level, the view's note, the slots' errors.
@@ -242,13 +260,18 @@ PanelActions drawPanel(ViewerState& st, CameraInput& input, ViewPipeline& pl, co
     ImGui::PushItemWidth(150.0f);  // leaves the labels their room
     statusSection(pl, history, info);
     ImGui::Separator();
-    renderSection(st, input, pl, a);
+    if (pl.fromFiles())
+        fileSection(st, pl, info);
+    else
+        renderSection(st, input, pl, a);
     ImGui::Separator();
     methodSection(st, pl);
     filterSections(st);
     ImGui::Separator();
     if (ImGui::Button("save snapshot (F12 / P)")) a.snapshot = true;
     ImGui::TextDisabled("to %s/snap_NNNN/", info.outDir.c_str());
+    if (ImGui::Button("write image + command (O)")) a.write = true;
+    ImGui::TextDisabled("to %s/view_NNNN.exr/.png/.txt", info.outDir.c_str());
     if (!st.status.empty()) ImGui::TextWrapped("%s", st.status.c_str());
     ImGui::TextDisabled("Tab hides this panel, Esc quits");
     ImGui::PopItemWidth();

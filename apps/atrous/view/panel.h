@@ -22,9 +22,10 @@ struct ViewerState {
     float splitPos = 0.5f;  // the split line, in [0, 1] of the image width
     int level = 0;          // of the per-level buffer views
     bool paused = false;
+    int frameWanted = 0;    // a sequence's frame to show (0-based; the slider and keys set it)
     bool uiVisible = true;
     char candidatesText[128] = "0,0.2,0.4,0.6,0.8,1";  // SURE's candidates as typed
-    std::string status;    // the last snapshot's outcome
+    std::string status;    // the last snapshot's or write's outcome
     std::string viewNote;  // why the buffer view shows nothing (from the display)
 };
 
@@ -42,7 +43,8 @@ void drawImage(unsigned texture, const ImageRect& r, const ViewerState& st);
 
 // What the panel shows but does not change.
 struct PanelInfo {
-    std::string sceneName;
+    std::string sceneName;    // or the render's file or folder (its frame in a sequence)
+    int frameCount = 0;       // a render: its frames (1 for a still); 0 for a scene
     int frame = 0;            // 0-based
     double lastFrameMs = 0;   // the previous frame's wall clock (0 before the first)
     double displayMs = 0;     // this frame's display update
@@ -55,6 +57,7 @@ struct PanelInfo {
 struct PanelActions {
     bool resetCamera = false;
     bool snapshot = false;
+    bool write = false;  // the image and its `atrous denoise` command (write_result.h)
 };
 
 // Draws the control panel (between NewFrame and Render). A change of spp, depth or accumulation

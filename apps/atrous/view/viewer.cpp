@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -25,11 +26,13 @@
 #include "view/buffer_view.h"
 #include "view/camera_input.h"
 #include "view/display.h"
+#include "view/file_source.h"
 #include "view/frame_timing.h"
 #include "view/panel.h"
 #include "view/stage_history.h"
 #include "atrous/view_pipeline.h"
 #include "view/window.h"
+#include "view/write_result.h"
 
 namespace atrous::view {
 namespace {
@@ -45,6 +48,8 @@ ViewerState checkOptions(const ViewerOptions& opt) {
     ps.sppPerFrame = opt.render.spp;
     ps.maxDepth = opt.render.maxDepth;
     ps.accumulate = !opt.noAccumulate;
+    ps.denoise = opt.denoise;
+    ParamSet::bind(denoiseParams(), ps.denoise).validate();  // ParamError naming the field; main.cpp shows its flag
     for (const ParamSet& p : opt.sequence) {
         p.validate();  // ParamError naming the field; main.cpp shows its flag
         ps.sequence.push_back(p);
@@ -58,6 +63,7 @@ ViewerState checkOptions(const ViewerOptions& opt) {
         const std::filesystem::path parent = std::filesystem::path(opt.screenshot).parent_path();
         io::ensureWritableDirectory(parent.empty() ? "." : parent.string());
     }
+    if (opt.writeImage && opt.frames == 0) throw InputError("--write-image needs --frames N (headless mode; interactively: the O key)");
     if (!opt.dumpDir.empty()) {
         if (opt.frames == 0) throw InputError("--dump needs --frames N (headless mode)");
         io::ensureWritableDirectory(opt.dumpDir);
@@ -100,6 +106,61 @@ std::string saveSnapshot(const ViewPipeline& pl, const std::string& outDir, int 
     return status;
 }
 
+// What --scene, --in and --sequence open: a FileSource for a render (null for a scene). A render
+// given where a scene is expected, or both at once, is refused with what to type instead.
+std::unique_ptr<FileSource> openFiles(const ViewerOptions& opt) {
+    const bool still = opt.input.any() && opt.sequenceInput.empty(), sequence = !opt.sequenceInput.empty();
+    if (opt.sceneGiven && (still || sequence))
+        throw InputError(std::string(still ? "--in" : "--sequence") + " and --scene: give one (--scene renders a scene, " +
+                         (still ? "--in opens a render" : "--sequence opens a rendered sequence") + ")");
+    if (!still && !sequence) {
+        namespace fs = std::filesystem;
+        const std::string ext = io::extensionOf(opt.scene);
+        std::error_code ec;
+        if (ext == ".exr" || ext == ".pfm" || ext == ".png" || ext == ".jpg" || ext == ".jpeg" || fs::is_directory(opt.scene, ec))
+            throw InputError("--scene " + opt.scene + ": a render, not a scene: open it with --in " + opt.scene);
+        return nullptr;
+    }
+    return std::make_unique<FileSource>(opt.input, opt.sequenceInput, opt.range);
+}
+
+// The O key, the panel's button and --write-image: the image and its command (write_result.h).
+// Returns the status line; the command goes to stdout.
+std::string writeImageAndCommand(const ViewPipeline& pl, const PipelineSettings& ps, const FileSource* files,
+                                 const ViewerOptions& opt) {
+    try {
+        const WrittenResult w = writeResult(pl, ps, files, opt.device, opt.outDir);
+        if (!w.command.empty()) std::printf("%s\n", w.command.c_str());
+        std::fflush(stdout);
+        std::fprintf(stderr, "atrous view: wrote %s, %s and %s%s\n", w.exr.c_str(), w.png.c_str(), w.txt.c_str(),
+                     w.note.empty() ? "" : (" (" + w.note + ")").c_str());
+        return "wrote " + w.exr + " (+ .png, .txt)" + (w.command.empty() ? ": " + w.note : ": command in the .txt");
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "atrous view: write failed: %s\n", e.what());
+        return std::string("write failed: ") + e.what();
+    }
+}
+
+// A sequence's keys (Left/Right, Home/End) and the panel's frame slider: loads the frame asked for.
+void stepFrames(ViewPipeline& pl, FileSource& files, int wanted, ViewerState& st) {
+    if (!ImGui::GetIO().WantCaptureKeyboard) {
+        if (ImGui::IsKeyPressed(GLFW_KEY_RIGHT, true)) wanted = files.current() + 1;
+        if (ImGui::IsKeyPressed(GLFW_KEY_LEFT, true)) wanted = files.current() - 1;
+        if (ImGui::IsKeyPressed(GLFW_KEY_HOME, false)) wanted = 0;
+        if (ImGui::IsKeyPressed(GLFW_KEY_END, false)) wanted = files.frameCount() - 1;
+    }
+    wanted = std::clamp(wanted, 0, files.frameCount() - 1);
+    if (wanted == files.current()) return;
+    const int from = files.current();
+    try {
+        pl.setFrame(files.load(wanted), wanted == from + 1);
+        st.status.clear();
+    } catch (const InputError& e) {
+        st.status = e.what();  // the frame stays; the message in the panel
+        std::fprintf(stderr, "atrous view: %s\n", e.what());
+    }
+}
+
 }  // namespace
 
 void runViewer(const ViewerOptions& opt) {
@@ -107,19 +168,25 @@ void runViewer(const ViewerOptions& opt) {
     const Device device = parseDevice(opt.device);  // "cuda" without a GPU: InputError
     ViewerState st = checkOptions(opt);
     PipelineSettings& ps = st.ps;
-    Scene scene = Scene::loadByNameOrFile(opt.scene);  // InputError naming the scene or file
+    std::unique_ptr<FileSource> files = openFiles(opt);  // InputError naming the file and the problem
+    Scene scene = files ? Scene() : Scene::loadByNameOrFile(opt.scene);  // InputError naming the scene or file
+    // A render's frame is read before the window opens: its errors end the command like a bad flag.
+    std::unique_ptr<ViewPipeline> pipeline =
+        files ? std::make_unique<ViewPipeline>(files->load(0), device)
+              : std::make_unique<ViewPipeline>(scene, opt.render.width, opt.render.height, device, opt.render.seed);
+    ViewPipeline& pl = *pipeline;
+    const std::string name = files ? files->frameName(0) : scene.name();
     const bool headless = opt.frames > 0;
 
     GlfwSession session;
-    const int winW = opt.hideUi ? opt.render.width : opt.render.width + int(kPanelWidth);
-    const int winH = opt.hideUi ? opt.render.height : std::max(opt.render.height, 720);
-    openWindow(session, winW, winH, "atrous view: " + scene.name(), headless);
+    const int w = pl.width(), h = pl.height();
+    const int winW = opt.hideUi ? w : std::min(w, 1600) + int(kPanelWidth);
+    const int winH = opt.hideUi ? h : std::max(std::min(h, 1000), 720);
+    openWindow(session, winW, winH, "atrous view: " + (files ? files->title() : name), headless);
     GLFWwindow* win = session.window;
     const ImGuiIO& io = ImGui::GetIO();
-
-    ViewPipeline pl(scene, opt.render.width, opt.render.height, device, opt.render.seed);
-    const int w = opt.render.width, h = opt.render.height;
-    FrameDisplay display(session, device, w, h);
+    // A render's frame is shown from the host (the filters still run on `device`).
+    FrameDisplay display(session, files ? Device::Cpu : device, w, h);
 
     CameraInput input;
     OrbitCamera orbit = orbitAroundScene(pl.camera(), pl);
@@ -141,14 +208,18 @@ void runViewer(const ViewerOptions& opt) {
         int fbw = 0, fbh = 0;
         glfwGetFramebufferSize(win, &fbw, &fbh);
         const ImageRect rect = imageRect(fbw, fbh, st.uiVisible, w, h);
-        bool moved = !headless && input.update(win, orbit, pl.sceneRadius(), rect.h, dt);
-        if (opt.orbitDegPerFrame != 0.0f && !st.paused && frame > 0) {
+        bool moved = !headless && !files && input.update(win, orbit, pl.sceneRadius(), rect.h, dt);
+        if (files && headless) st.frameWanted = frame;  // headless: a sequence plays, one frame per frame
+        if (files) stepFrames(pl, *files, st.frameWanted, st);
+        if (files) st.frameWanted = files->current();
+        if (opt.orbitDegPerFrame != 0.0f && !st.paused && frame > 0 && !files) {
             orbit.orbit(opt.orbitDegPerFrame * 3.14159265f / 180.0f, 0.0f);
             moved = true;
         }
         if (moved) pl.setCamera(orbit.camera());
         bool snapshot = ImGui::IsKeyPressed(GLFW_KEY_F12, false) ||
                         (!io.WantCaptureKeyboard && ImGui::IsKeyPressed(GLFW_KEY_P, false));
+        bool write = !io.WantCaptureKeyboard && ImGui::IsKeyPressed(GLFW_KEY_O, false);
         if (!io.WantCaptureKeyboard && ImGui::IsKeyPressed(GLFW_KEY_TAB, false))
             st.uiVisible = !st.uiVisible;
         if (!io.WantCaptureKeyboard && ImGui::IsKeyPressed(GLFW_KEY_ESCAPE, false))
@@ -172,7 +243,8 @@ void runViewer(const ViewerOptions& opt) {
         PanelActions actions;
         if (st.uiVisible) {
             PanelInfo info;
-            info.sceneName = scene.name();
+            info.sceneName = files ? files->title() : name;
+            info.frameCount = files ? files->frameCount() : 0;
             info.frame = frame;
             info.lastFrameMs = timings.empty() ? 0.0 : timings.back().frameMs;
             info.displayMs = displayTime;
@@ -182,7 +254,8 @@ void runViewer(const ViewerOptions& opt) {
             actions = drawPanel(st, input, pl, stageHistory, info);
         }
         snapshot = snapshot || actions.snapshot;
-        if (actions.resetCamera) {
+        write = write || actions.write;
+        if (actions.resetCamera && !files) {
             orbit = orbitAroundScene(pl.sceneCamera(), pl);
             pl.setCamera(pl.sceneCamera());
         }
@@ -194,6 +267,7 @@ void runViewer(const ViewerOptions& opt) {
 
         // ---- snapshots, the headless run's files ----
         if (snapshot) st.status = saveSnapshot(pl, opt.outDir, ++snapCounter, fbw, fbh);
+        if (write || (last && opt.writeImage)) st.status = writeImageAndCommand(pl, ps, files.get(), opt);
         if (last) {
             if (!opt.screenshot.empty()) saveFramebuffer(opt.screenshot, fbw, fbh);
             if (!opt.dumpDir.empty()) pl.saveBuffers(opt.dumpDir);
@@ -207,7 +281,7 @@ void runViewer(const ViewerOptions& opt) {
         ft.displayMs = displayTime;
         ft.stages = pl.times();
         timings.push_back(ft);
-        if (doStep) {
+        if (doStep && pl.stepFiltered()) {  // a loaded frame's step that filtered nothing is no sample
             const std::vector<StageTime> stages = frameStages(pl, ps.split, displayTime);
             stageHistory.add(stages);
             if (frame > 0 && (opt.benchmark || headless)) benchStages.add(stages);  // for the JSON line
@@ -217,7 +291,7 @@ void runViewer(const ViewerOptions& opt) {
 
     if (opt.benchmark || headless) {
         BenchmarkRun run;
-        run.scene = scene.name();
+        run.scene = name;
         run.width = w;
         run.height = h;
         run.settings = ps;

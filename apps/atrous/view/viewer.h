@@ -7,12 +7,23 @@
 
 #include "atrous/denoise.h"
 #include "atrous/param_set.h"
+#include "atrous/io/sequence.h"
 #include "atrous/render.h"
+#include "input_flags.h"
 
 namespace atrous::view {
 
 struct ViewerOptions {
     std::string scene = "cornell";
+    bool sceneGiven = false;  // --scene was on the command line (not only its default)
+    // A render to open instead of a scene (docs/viewer.md, "Your render"): a still as `atrous
+    // denoise --in` reads it, or a sequence (a folder or a pattern, the frames of `range`).
+    cli::InputFlags input;
+    std::string sequenceInput;  // --sequence
+    io::FrameRange range;
+    // The still methods' parameters: the start values of the panel (the flags of `atrous denoise`).
+    DenoiseOptions denoise;
+    bool writeImage = false;  // headless: after the last frame, write the image and its command (the O key)
     std::string device = "cpu";
     // Image size, samples per pixel per frame, bounces and seed (flags from the render parameter
     // table, atrous/params.h); one sample per pixel per frame by default.
