@@ -339,7 +339,7 @@ void addDenoiseCommand(CLI::App& app) {
     cmd->add_option("--layer", a->layer, "View layer of a layered EXR with several (Blender: the ViewLayer name)");
     cmd->add_option("--add-pass", a->addPass,
                     "With --in FILE.exr: write --out as a copy of FILE with the denoised colour added as this pass "
-                    "(with --sequence of layered EXRs: each frame_NNNN.exr is such a copy of its frame)");
+                    "(with --sequence of layered EXRs: each output frame is such a copy of its frame)");
     cmd->add_option("--sequence", a->sequence,
                     "Sequence directory: frame_NNNN/ folders (atrous render --frames), numbered frame folders of "
                     "another renderer (0001/ with LuxCore's RGB.exr, ALBEDO.exr ...), numbered files per buffer "
@@ -363,10 +363,13 @@ void addDenoiseCommand(CLI::App& app) {
     cmd->add_option("--ids", a->ids, "Mesh id (R) / material id (G) buffer")->group(kGroupBuffers);
     cmd->add_option("--emission", a->emission, "Emitted radiance of the primary hit (filtered around, added back)")->group(kGroupBuffers);
     cmd->add_option("--out,-o", a->out,
-                    "Output file (.exr, .pfm or .png); with --sequence, an output directory, written only once every "
-                    "frame is denoised (on error it is left as it was). An existing one keeps its other files; this "
-                    "run's frame_NNNN.exr/.png replace the old ones, and those of an earlier run that this run does "
-                    "not write (and an old preview.mp4) are removed, named in a note on stderr")
+                    "Output file (.exr, .pfm or .png); with --sequence, an output directory where each frame keeps "
+                    "its input's name (render0001.exr -> OUT/render0001.exr, a frame folder 0001/ -> OUT/0001.exr; "
+                    "+ .png previews, + preview.mp4), or a pattern OUT/clean####.exr (or %04d): the frame number "
+                    "zero-padded to the count of #'s. Written only once every frame is denoised (on error it is "
+                    "left as it was); an existing folder keeps its other files, files of the same name are "
+                    "replaced, and an earlier run's frame_NNNN.exr/.png this run does not write (and an old "
+                    "preview.mp4) are removed, named in a note on stderr")
         ->required();
     std::string methodHelp;
     for (const DenoiseMethodInfo& m : denoiseMethods()) methodHelp += std::string(m.name) + ": " + m.summary + "; ";
