@@ -19,6 +19,7 @@
 #include "atrous/sequence_methods.h"
 #include "atrous/temporal.h"
 #include "atrous/timer.h"
+#include "atrous/io/alpha.h"
 #include "atrous/io/buffer_set.h"
 #include "atrous/io/image_io.h"
 #include "atrous/io/paths.h"
@@ -151,7 +152,7 @@ private:
     void checkAgainstPrevious(const io::SequenceFrame& f, size_t i, bool estimated);
     void push(FramePtr f);
     void outputFrame();
-    void writeFrame(const std::string& name, std::shared_ptr<io::ExrInfo> layered, Image out);
+    void writeFrame(const std::string& name, const FramePtr& frame, Image out);
     void finishFrame(SequenceFrameReport& r, const SequenceOutput& out, const std::string& name);
     void writePreviewAndCommit();
 
@@ -279,13 +280,18 @@ void Session::push(FramePtr f) {
     while (mDenoiser->ready()) outputFrame();
 }
 
-void Session::writeFrame(const std::string& name, std::shared_ptr<io::ExrInfo> layered, Image out) {
+// The frame's colour alpha (an RGBA EXR's A, Blender's Combined.A), read on the writing thread, is
+// written beside the denoised colour unchanged (io/alpha.h, as the still path does).
+void Session::writeFrame(const std::string& name, const FramePtr& frame, Image out) {
     if (mWriting.valid()) mWriting.get();  // frame N-1's files, and its errors, before frame N's
     const std::string stage = mStaged->stage();
-    mWriting = std::async(std::launch::async, [this, stage, name, layered, img = std::make_shared<Image>(std::move(out))] {
+    mWriting = std::async(std::launch::async, [this, stage, name, frame, rgb = std::make_shared<Image>(std::move(out))] {
         const std::string exrOut = (fs::path(stage) / (name + ".exr")).string();
+        const auto img = std::make_shared<Image>(io::withAlpha(std::move(*rgb), io::readFrameAlpha(*frame, mLayers)));
+        const std::vector<std::string> channels = img->channels() == 4 ? std::vector<std::string>{"R", "G", "B", "A"}
+                                                                       : std::vector<std::string>{"R", "G", "B"};
         if (!mArgs.addPass.empty())
-            io::writeExrWithLayers(exrOut, *layered, {io::ExrOutLayer{mArgs.addPass, img.get()}});
+            io::writeExrWithLayers(exrOut, *frame->layered, {io::ExrOutLayer{mArgs.addPass, img.get(), channels}});
         else
             writeImage(exrOut, *img);
         if (mArgs.pngs) io::writePng((fs::path(stage) / (name + ".png")).string(), *img, mArgs.exposure);
@@ -327,7 +333,7 @@ void Session::outputFrame() {
     mFilterMs += r.milliseconds;
     if (r.hasReference) r.mse = meanSquaredError(out.image, f->reference);
     mPending.pop_front();
-    writeFrame(name, f->layered, std::move(out.image));
+    writeFrame(name, f, std::move(out.image));
     finishFrame(r, out, name);
 }
 
