@@ -122,7 +122,7 @@ TEST(RendererLayouts, NumberedFrameFoldersWithLuxCoreNamesAreASequence) {
     fs::remove_all(lux + "/0002");
     r = runCli("denoise --sequence " + lux + " --method eaw --out " + out2);
     EXPECT_EQ(r.exitCode, 2) << r.output;
-    EXPECT_NE(r.output.find("2 (a numbered frame folder) is missing"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("0002 (a numbered frame folder) is missing"), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(out2));
     // Numbered folders without a colour file are not frames.
     fs::remove_all(lux);

@@ -119,3 +119,33 @@ TEST(SequenceNames, AlphaPassesThroughBitForBit) {
         }
     }
 }
+
+// An entry named like a frame that is not one (render0002.exr a directory) used to cut the
+// sequence short without a word (frame 1 only, "1 frames", exit 0): refused, naming it.
+TEST(SequenceNames, EntriesNamedLikeFramesMustBeFiles) {
+    TempDir dir;
+    const std::string seq = writeFrames(dir, "renders", "render", 1, 1);
+    fs::create_directories(seq + "/render0002.exr");
+    const std::string out = dir / "out";
+    auto r = expectCli("denoise --method eaw --sequence " + seq + " --out " + out, 2, {"render0002.exr", "a directory"});
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+    r = expectCli("denoise --method eaw --sequence '" + seq + "/render####.exr' --out " + out, 2,
+                  {"render0002.exr", "not a regular file"});
+    EXPECT_FALSE(fs::exists(out));
+}
+
+// A gap in the numbering names the file expected as the others are named (render0002.exr, not
+// render2) and says how to denoise a range.
+TEST(SequenceNames, AGapNamesTheFileExpected) {
+    TempDir dir;
+    const std::string seq = writeFrames(dir, "renders", "render", 1, 3);
+    fs::remove(seq + "/render0002.exr");
+    const std::string out = dir / "out";
+    expectCli("denoise --method eaw --sequence " + seq + " --out " + out, 2, {"render0002.exr is missing", "--start"});
+    const std::string per = writeFrames(dir, "per", "color_", 1, 3);
+    fs::remove(per + "/color_0002.exr");
+    expectCli("denoise --method eaw --sequence " + per + " --out " + out, 2, {"color_0002.exr is missing"});
+    // --start/--end pick the frames present.
+    expectCli("denoise --method eaw --sequence " + seq + " --start 3 --end 3 --out " + out, 0);
+    EXPECT_TRUE(fs::exists(out + "/render0003.exr"));
+}

@@ -3,8 +3,12 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
 
 #include "atrous/error.h"
+#include "atrous/io/sequence.h"
 
 namespace fs = std::filesystem;
 
@@ -50,6 +54,31 @@ std::string findNumber(const std::string& name, size_t& from, size_t& to, int& w
 }
 
 }  // namespace
+
+// Declared in io/sequence.h (the frame files of an earlier run that StagedDir::commit removes).
+std::vector<std::string> removeSequenceEntries(const std::string& dir, const std::string& suffix,
+                                               const std::function<bool(int)>& keep) {
+    std::vector<fs::path> doomed;
+    std::error_code ec;
+    for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
+        const std::string name = it->path().filename().string();
+        if (name.size() <= suffix.size() || name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0) continue;
+        std::error_code ec2;
+        // Directories for frame_NNNN, regular files for frame_NNNN.exr: never anything else.
+        if (suffix.empty() ? !it->is_directory(ec2) : !it->is_regular_file(ec2)) continue;
+        const int index = parseSequenceFrameName(name.substr(0, name.size() - suffix.size()));
+        if (index >= 0 && !keep(index)) doomed.push_back(it->path());
+    }
+    if (ec) throw RuntimeError(dir + ": cannot list the directory (" + ec.message() + ")");
+    std::sort(doomed.begin(), doomed.end());
+    std::vector<std::string> removed;
+    for (const auto& p : doomed) {
+        fs::remove_all(p, ec);
+        if (ec) throw RuntimeError(p.string() + ": cannot remove a stale entry of an earlier run (" + ec.message() + ")");
+        removed.push_back(p.filename().string());
+    }
+    return removed;
+}
 
 std::string sequenceInputStem(const std::string& frame) {
     const fs::path p(frame);
