@@ -43,7 +43,31 @@ struct DenoiseArgs {
     DenoiseOptions opt;  // the filter parameters' flags write here (params.h's table)
     std::string learnedWeights;  // --learned-weights: loaded once into opt.weights
     std::deque<ParamSet> sequenceParams;  // each sequence method's parameters (sequenceMethods()' order): their flags write here
+    std::vector<std::string> positional;  // `atrous denoise IN OUT`: IN as --in takes it, OUT as --out
 };
+
+// `atrous denoise IN OUT` (or `--in IN OUT`, `IN --out OUT`, `--sequence DIR OUT`): the
+// positionals fill --out first (the last one), then --in; a positional that differs from its
+// flag's value, or one too many, is an InputError.
+void takePositionals(DenoiseArgs& a) {
+    std::vector<std::string> pos = a.positional;
+    if (pos.size() > 2) throw InputError("'" + pos[2] + "': one argument too many (atrous denoise IN OUT)");
+    auto fill = [&](std::string& slot, const char* flag, const char* what) {
+        if (pos.empty()) return;
+        if (!slot.empty() && slot != pos.back())
+            throw InputError(std::string(flag) + " '" + slot + "' and the " + what + " '" + pos.back() +
+                             "' differ: give it once (atrous denoise IN OUT, or --in IN --out OUT)");
+        slot = pos.back();
+        pos.pop_back();
+    };
+    if (pos.size() == 2 || a.out.empty()) fill(a.out, "--out", "positional OUT");
+    const bool inGiven = !a.color.empty() || !a.ldrColor.empty() || !a.sequence.empty();
+    if (!pos.empty() && inGiven)
+        throw InputError("'" + pos.back() + "': one argument too many (the input is given by " +
+                         (a.sequence.empty() ? "--color/--hdr/--ldr" : "--sequence") + ")");
+    fill(a.inDir, "--in", "positional IN");
+    if (a.out.empty()) throw InputError("--out is required (atrous denoise IN OUT, or --in IN --out OUT)");
+}
 
 // Option groups: the flags of one method are ignored by the others (a note says which).
 const char* const kGroupBuffers = "Buffers (without --sequence)";
@@ -194,6 +218,7 @@ void runSequence(const DenoiseArgs& a, const ParamSet* params) {
 }
 
 void run(DenoiseArgs& a, const CLI::App& cmd) {
+    takePositionals(a);
     if (!a.ldrColor.empty()) {
         if (!a.color.empty()) throw InputError("--ldr: give the colour once (--color/--hdr or --ldr)");
         a.color = a.ldrColor;
@@ -330,7 +355,11 @@ void addDenoiseCommand(CLI::App& app) {
     auto* cmd = app.add_subcommand(
         "denoise", "Denoise a render with EAW, SURE-based a-trous wavelets or the learned a-trous filter, or an animated "
                    "sequence (also SVGF)");
-    cmd->add_option("--in", a->inDir,
+    cmd->add_option("IN OUT", a->positional,
+                    "atrous denoise IN OUT: IN as --in takes it (a render folder, a layered EXR), OUT as --out (the "
+                    "flags do the same; with --sequence DIR or --color FILE, one positional is OUT)")
+        ->type_name("");
+    cmd->add_option("--in,-i", a->inDir,
                     "Render directory (color.exr, variance.exr, albedo.exr, normal.exr, ...) or a layered EXR "
                     "(Blender multilayer, Mitsuba aov): its passes are taken by name (atrous inspect FILE shows which)");
     cmd->add_option("--pass", a->passes,
@@ -369,8 +398,7 @@ void addDenoiseCommand(CLI::App& app) {
                     "zero-padded to the count of #'s. Written only once every frame is denoised (on error it is "
                     "left as it was); an existing folder keeps its other files, files of the same name are "
                     "replaced, and an earlier run's frame_NNNN.exr/.png this run does not write (and an old "
-                    "preview.mp4) are removed, named in a note on stderr")
-        ->required();
+                    "preview.mp4) are removed, named in a note on stderr (or OUT, the last positional)");
     std::string methodHelp;
     for (const DenoiseMethodInfo& m : denoiseMethods()) methodHelp += std::string(m.name) + ": " + m.summary + "; ";
     for (const SequenceMethodInfo& m : sequenceMethods())
