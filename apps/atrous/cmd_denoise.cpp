@@ -18,6 +18,7 @@
 #include "commands.h"
 #include "atrous/timer.h"
 #include "denoise_sequence.h"
+#include "progress.h"
 #include "still_output.h"
 #include "atrous/srgb.h"
 #include "atrous/io/buffer_set.h"
@@ -144,7 +145,7 @@ void noteIgnoredFlags(const CLI::App& cmd, const std::string& method, const Deno
         if (unused) ignored += (ignored.empty() ? "" : ", ") + opt->get_name();
         if (g == kGroupBuffers && sequence) ignoredSeq += (ignoredSeq.empty() ? "" : ", ") + opt->get_name();
     }
-    if (!ignored.empty()) std::printf("denoise: note: ignored with --method %s: %s\n", method.c_str(), ignored.c_str());
+    if (!ignored.empty()) logLine("denoise: note: ignored with --method %s: %s\n", method.c_str(), ignored.c_str());
     // A buffer file given beside --sequence would not be read: refused, not noted (issue 29).
     if (!ignoredSeq.empty())
         throw InputError(ignoredSeq + ": a sequence's frames bring their own buffers (--sequence DIR); drop " +
@@ -320,31 +321,35 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
                                          (rep.methodUsed == DenoiseMethod::Blend ? " (albedo and normal given)"
                                                                                 : " (the learned filter needs an albedo and a normal)")
                                    : std::string(denoiseMethodName(o.method));
-    std::printf("denoise: method %s on %s, %dx%d, buffers used: %s\n", method.c_str(), deviceToString(o.device), width, height,
+    // Results on stdout (the method that ran, the file written); the rest on stderr (progress.h).
+    resultLine("denoise: method %s on %s, %dx%d, buffers used: %s\n", method.c_str(), deviceToString(o.device), width, height,
                 rep.buffersUsed.c_str());
     if (rep.noiseEstimated)
-        std::printf("denoise: no variance buffer: noise estimated from the image, per pixel (docs/algorithms.md), at least "
+        logLine("denoise: no variance buffer: noise estimated from the image, per pixel (docs/algorithms.md), at least "
                     "the global MAD sigma = %.4g %.4g %.4g%s\n",
                     rep.noiseSigma[0], rep.noiseSigma[1], rep.noiseSigma[2], albedoGiven && o.demodulate ? " (of the demodulated colour)" : "");
-    std::printf("%s", stillExtrasLines(extras, a.out, alphaDropped).c_str());
+    logLine("%s", stillExtrasLines(extras, a.out, alphaDropped).c_str());
     if (rep.nonFinitePixels > 0)
-        std::printf("denoise: %d pixels had NaN/Inf colour, treated as missing\n", rep.nonFinitePixels);
+        logLine("denoise: %d pixels had NaN/Inf colour, treated as missing\n", rep.nonFinitePixels);
     if (o.firefly.enabled)
-        std::printf("denoise: fireflies clamped: %d pixels, mean luminance %.6g -> %.6g\n", rep.firefliesClamped,
+        verbose("denoise: fireflies clamped: %d pixels, mean luminance %.6g -> %.6g\n", rep.firefliesClamped,
                     rep.meanLuminanceIn, rep.meanLuminanceAfterFirefly);
     if (!set.skipped.empty()) {
         std::string list;
         for (io::Buffer b : set.skipped)
             if (b != io::Buffer::MaterialId) list += (list.empty() ? "" : ", ") + std::string(io::bufferName(b));
-        std::printf("denoise: not read (unused by %s): %s\n", denoiseMethodName(rep.methodUsed), list.c_str());
+        verbose("denoise: not read (unused by %s): %s\n", denoiseMethodName(rep.methodUsed), list.c_str());
     }
-    std::printf("denoise: read %.2f ms, filter %.2f ms, total %.2f ms, write %.2f ms, wrote %s\n", readMs, rep.milliseconds, ms,
+    resultLine("denoise: read %.2f ms, filter %.2f ms, total %.2f ms, write %.2f ms, wrote %s\n", readMs, rep.milliseconds, ms,
                 writeMs, a.out.c_str());
-    if (!rep.stages.empty()) {  // the filter's own stages (DenoiseReport::stages)
-        std::printf("denoise: stages ms:");
-        for (size_t i = 0; i < rep.stages.size(); ++i)
-            std::printf("%s %s %.2f", i ? "," : "", rep.stages[i].name.c_str(), rep.stages[i].milliseconds);
-        std::printf("\n");
+    if (!rep.stages.empty()) {  // the filter's own stages (DenoiseReport::stages), with -v
+        std::string line = "denoise: stages ms:";
+        char buf[96];
+        for (size_t i = 0; i < rep.stages.size(); ++i) {
+            std::snprintf(buf, sizeof buf, "%s %.2f", rep.stages[i].name.c_str(), rep.stages[i].milliseconds);
+            line += std::string(i ? ", " : " ") + buf;
+        }
+        verbose("%s\n", line.c_str());
     }
 }
 
@@ -427,6 +432,7 @@ void addDenoiseCommand(CLI::App& app) {
     // One flag per parameter (params.h): --levels, --sigma-normal, --no-firefly, --sure-window, ...
     addParamOptions(*cmd, a->opt, denoiseParams(), paramHelpGroup);
     addSequenceOptions(*cmd, a->sequenceParams);
+    addVerbosityFlags(*cmd);
     cmd->callback([a, cmd] { run(*a, *cmd); });
 }
 

@@ -50,6 +50,7 @@ struct SequenceDenoiseOptions {
 // One denoised frame, as it is done.
 struct SequenceFrameReport {
     int index = 0;          // the frame's number in the input
+    int position = 0, count = 0;  // this is the position-th frame (1-based) of the run's count (k/N counters)
     std::string input;      // the frame's file or folder
     std::string output;     // OUT/NAME.exr (where it will be once the run is done; NAME: the input's, or the pattern's)
     std::string method;     // the method and its SequenceOutput::detail: "temporal (+-3 frames, 3.8 averaged per pixel in 6 ms; then auto -> blend)"

@@ -317,6 +317,8 @@ void Session::outputFrame() {
     const std::string name = mNames.stem(f->dir, f->index);
     SequenceFrameReport r;
     r.index = f->index;
+    r.position = int(mReport.frames.size()) + 1;
+    r.count = int(mFrames.size());
     r.input = f->dir;
     r.output = (fs::path(mNames.dir) / (name + ".exr")).string();
     if (mArgs.pngs) mPngs.push_back(name + ".png");
