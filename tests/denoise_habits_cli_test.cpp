@@ -10,12 +10,8 @@
 #include "atrous/io/image_io.h"
 #include "test_util.h"
 
-using atrous::test::expectCli;
-using atrous::test::randomImage;
-using atrous::test::runShell;
-using atrous::test::sameImages;
-using atrous::test::TempDir;
 namespace fs = std::filesystem;
+using namespace atrous::test;  // TempDir, expectCli, randomImage, runShell, sameImages
 
 namespace {
 
@@ -91,4 +87,46 @@ TEST(DenoiseHabits, QuietVerboseAndStreams) {
     EXPECT_NE(seqErr.find("ETA"), std::string::npos) << seqErr;
     EXPECT_NE(seqErr.find("denoise: frame 3/3 ("), std::string::npos) << seqErr;
     EXPECT_EQ(runShell(atrous::test::cliPath() + " " + run + " --quiet").output, "");
+}
+
+// --threads N limits TBB for the run; the CPU filters are deterministic, so the output is the same
+// bit for bit. Out of range: one line naming the flag.
+TEST(DenoiseHabits, ThreadsKeepsTheOutput) {
+    TempDir dir;
+    const std::string in = noisyExr(dir);
+    expectCli("denoise --method sure --device cpu " + in + " " + (dir / "all.exr"), 0);
+    expectCli("denoise --method sure --device cpu --threads 1 " + in + " " + (dir / "one.exr"), 0);
+    EXPECT_TRUE(sameImages(atrous::readImage(dir / "all.exr"), atrous::readImage(dir / "one.exr")));
+    expectCli("denoise --method sure --threads -1 " + in + " " + (dir / "x.exr"), 2, {"--threads"});
+    expectCli("bench --what eaw --sizes 16x16 --runs 1 --warmup 0 --device cpu --threads 1", 0);
+    expectCli("render --scene cornell --width 8 --height 8 --spp 1 --threads 1 --denoise eaw --out " + (dir / "r"), 0);
+}
+
+// --method none writes the colour as read: an EXR copy is the same pixels, a PNG a preview; the
+// line says so. --exposure scales a PNG (and a sequence's previews), never an EXR.
+TEST(DenoiseHabits, MethodNoneAndExposure) {
+    TempDir dir;
+    const std::string in = noisyExr(dir);
+    expectCli("denoise --method none " + in + " " + (dir / "copy.exr"), 0, {"method none (no filter"});
+    EXPECT_TRUE(sameImages(atrous::readImage(in), atrous::readImage(dir / "copy.exr")));
+    expectCli("denoise --method none " + in + " " + (dir / "a.png"), 0, {"wrote " + (dir / "a.png")});
+    expectCli("denoise --method none --exposure 0.25 " + in + " " + (dir / "b.png"), 0);
+    const atrous::Image a = atrous::readImage(dir / "a.png"), b = atrous::readImage(dir / "b.png");
+    double sa = 0, sb = 0;
+    for (size_t i = 0; i < a.size(); ++i) sa += a.data()[i], sb += b.data()[i];
+    EXPECT_LT(sb, 0.5 * sa);  // a quarter of the light: darker
+    expectCli("denoise --method none --exposure 2 " + in + " " + (dir / "x.exr"), 2, {"--exposure"});
+    expectCli("denoise --method sure --exposure 0 " + in + " " + (dir / "x.png"), 2, {"--exposure"});
+    EXPECT_FALSE(fs::exists(dir / "x.exr") || fs::exists(dir / "x.png"));
+    // A sequence's previews.
+    const std::string seq = dir / "seq";
+    fs::create_directories(seq);
+    for (int i = 1; i <= 2; ++i) fs::copy_file(in, seq + "/r000" + std::to_string(i) + ".exr");
+    expectCli("denoise --method eaw --sequence " + seq + " " + (dir / "s1"), 0);
+    expectCli("denoise --method eaw --exposure 0.25 --sequence " + seq + " " + (dir / "s2"), 0);
+    const atrous::Image p1 = atrous::readImage(dir / "s1/r0001.png"), p2 = atrous::readImage(dir / "s2/r0001.png");
+    double s1 = 0, s2 = 0;
+    for (size_t i = 0; i < p1.size(); ++i) s1 += p1.data()[i], s2 += p2.data()[i];
+    EXPECT_LT(s2, 0.5 * s1);
+    EXPECT_TRUE(sameImages(atrous::readImage(dir / "s1/r0001.exr"), atrous::readImage(dir / "s2/r0001.exr")));
 }

@@ -13,11 +13,8 @@
 #include "atrous/io/image_io.h"
 #include "test_util.h"
 
-using atrous::test::countEntries;
-using atrous::test::expectCli;
-using atrous::test::randomImage;
-using atrous::test::TempDir;
 namespace fs = std::filesystem;
+using namespace atrous::test;  // TempDir, expectCli, randomImage, runShell, sameImages
 
 namespace {
 
@@ -141,7 +138,7 @@ TEST(SequenceNames, AGapNamesTheFileExpected) {
     const std::string seq = writeFrames(dir, "renders", "render", 1, 3);
     fs::remove(seq + "/render0002.exr");
     const std::string out = dir / "out";
-    expectCli("denoise --method eaw --sequence " + seq + " --out " + out, 2, {"render0002.exr is missing", "--start"});
+    expectCli("denoise --method eaw --sequence " + seq + " --out " + out, 2, {"render0002.exr is missing", "--start and --end pick a range"});
     const std::string per = writeFrames(dir, "per", "color_", 1, 3);
     fs::remove(per + "/color_0002.exr");
     expectCli("denoise --method eaw --sequence " + per + " --out " + out, 2, {"color_0002.exr is missing"});

@@ -1,5 +1,6 @@
 // `atrous denoise`: EAW, SURE-À-Trous or the learned filter on a render directory or on individual EXR/PFM buffers.
 #include <algorithm>
+#include <cmath>
 #include <utility>
 #include <vector>
 #include <cstdio>
@@ -45,6 +46,8 @@ struct DenoiseArgs {
     std::string learnedWeights;  // --learned-weights: loaded once into opt.weights
     std::deque<ParamSet> sequenceParams;  // each sequence method's parameters (sequenceMethods()' order): their flags write here
     std::vector<std::string> positional;  // `atrous denoise IN OUT`: IN as --in takes it, OUT as --out
+    int threads = 0;                      // --threads: 0 = all cores
+    float exposure = 1.0f;                // --exposure: of a .png output and a sequence's previews
 };
 
 // `atrous denoise IN OUT` (or `--in IN OUT`, `IN --out OUT`, `--sequence DIR OUT`): the
@@ -180,8 +183,62 @@ io::BufferFiles bufferFiles(const DenoiseArgs& a) {
     return f;
 }
 
+// The files of a still (--in/--color, --out checked): InputError before anything is read.
+io::BufferFiles stillFiles(const DenoiseArgs& a) {
+    const std::string ext = io::extensionOf(a.out);
+    if (ext != ".exr" && ext != ".pfm" && ext != ".png")
+        throw InputError("--out '" + a.out + "': unsupported extension (use .exr, .pfm or .png)");
+    if (a.exposure != 1.0f && ext != ".png")
+        throw InputError("--exposure: scales a .png output (and a sequence's .png previews); --out is " + ext);
+    if (a.inDir.empty() == a.color.empty())
+        throw InputError("give exactly one of --in RENDER_DIR, --in LAYERED.exr or --color FILE (--hdr/--ldr)");
+    checkOutputFile(a.out);
+    io::BufferFiles files = bufferFiles(a);
+    io::refuseOverwrite("--out", a.out, io::inputFiles(files));
+    return files;
+}
+
+// Writes a still's output: a copy of the layered input with the pass added (--add-pass), a .png
+// at --exposure, else by the extension.
+void writeStill(const DenoiseArgs& a, const io::BufferSet& set, const Image& out) {
+    if (!a.addPass.empty())
+        io::writeExrWithLayers(a.out, *set.layered,
+                               {io::ExrOutLayer{a.addPass, &out, out.channels() == 4 ? std::vector<std::string>{"R", "G", "B", "A"}
+                                                                                    : std::vector<std::string>{"R", "G", "B"}}});
+    else if (io::extensionOf(a.out) == ".png")
+        io::writePng(a.out, out, a.exposure);
+    else
+        atrous::writeImage(a.out, out);
+}
+
 void srgbToLinear(Image& img) {
     for (size_t i = 0; i < img.plane() * size_t(img.channels()); ++i) img.data()[i] = srgbDecode(img.data()[i]);
+}
+
+// --method none: no filter, the colour written as read (a format conversion: a noisy EXR to a PNG
+// preview), with its alpha, an LDR input's clamp and --srgb as for a denoised colour; a NaN/Inf
+// value is written as 0 (said so), as no output holds one.
+void runNone(const DenoiseArgs& a) {
+    if (!a.sequence.empty()) throw InputError("--method none: converts a still (--in/--color), not a --sequence");
+    io::BufferFiles files = stillFiles(a);
+    files.wanted = [](io::Buffer b, const bool*) { return b == io::Buffer::Color; };
+    io::BufferSet set = io::loadBuffers(files);
+    if (!a.addPass.empty() && (!set.layered || io::extensionOf(a.out) != ".exr"))
+        throw InputError("--add-pass '" + a.addPass + "' writes a copy of a layered EXR: give --in FILE.exr and --out COPY.exr");
+    const StillExtras extras = readStillExtras(files, set, a.ldr);
+    Image& color = set.image[int(io::Buffer::Color)];
+    if (a.srgb && !extras.ldrFile) srgbToLinear(color);
+    int nonFinite = 0;
+    for (size_t i = 0; i < color.plane() * size_t(color.channels()); ++i)
+        if (!std::isfinite(color.data()[i])) color.data()[i] = 0.0f, ++nonFinite;
+    const int width = color.width(), height = color.height();
+    bool alphaDropped = false;
+    const Image out = stillOutput(std::move(color), extras, a.srgb, a.out, &alphaDropped);
+    writeStill(a, set, out);
+    resultLine("denoise: method none (no filter: the colour written as read), %dx%d\n", width, height);
+    logLine("%s", stillExtrasLines(extras, a.out, alphaDropped).c_str());
+    if (nonFinite > 0) logLine("denoise: %d NaN/Inf colour values written as 0\n", nonFinite);
+    resultLine("denoise: wrote %s\n", a.out.c_str());
 }
 
 // --spatial, the still method of a sequence method that ends with one (`row`): whether it applies;
@@ -215,11 +272,14 @@ void runSequence(const DenoiseArgs& a, const ParamSet* params) {
     so.viewLayer = a.layer;
     so.addPass = a.addPass;
     so.start = a.range.start, so.end = a.range.end, so.step = a.range.step;
+    so.exposure = a.exposure;
     runSequenceDenoise(s);
 }
 
 void run(DenoiseArgs& a, const CLI::App& cmd) {
     takePositionals(a);
+    const auto threadLimit = limitThreads(a.threads);  // for the whole run
+    if (!(a.exposure > 0.0f) || !std::isfinite(a.exposure)) throw InputError("--exposure: must be > 0");
     if (!a.ldrColor.empty()) {
         if (!a.color.empty()) throw InputError("--ldr: give the colour once (--color/--hdr or --ldr)");
         a.color = a.ldrColor;
@@ -230,6 +290,10 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
         throw InputError("-f/--filter: '" + a.oidnFilter + "' is not supported (atrous denoises RT images: use RT)");
     DenoiseOptions& o = a.opt;
     const bool sequence = !a.sequence.empty();
+    if (a.method == "none") {
+        runNone(a);
+        return;
+    }
     for (const char* f : {"--start", "--end", "--step"})
         if (!sequence && cmd.count(f) > 0) throw InputError(std::string(f) + ": picks frames of a --sequence; give one");
     // A sequence without --method: the first sequence method (temporal: the frames around each one).
@@ -261,13 +325,7 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
         return;
     }
     const std::string ext = io::extensionOf(a.out);
-    if (ext != ".exr" && ext != ".pfm" && ext != ".png")
-        throw InputError("--out '" + a.out + "': unsupported extension (use .exr, .pfm or .png)");
-    if (a.inDir.empty() == a.color.empty())
-        throw InputError("give exactly one of --in RENDER_DIR, --in LAYERED.exr or --color FILE (--hdr/--ldr)");
-    checkOutputFile(a.out);
-    io::BufferFiles files = bufferFiles(a);
-    io::refuseOverwrite("--out", a.out, io::inputFiles(files));
+    io::BufferFiles files = stillFiles(a);
     // Only the buffers the method reads are decoded (auto: by the buffers present).
     files.wanted = [&](io::Buffer b, const bool present[io::kBufferCount]) {
         const DenoiseMethod m = resolveDenoiseMethod(o.method, present[int(io::Buffer::Albedo)], present[int(io::Buffer::Normal)]);
@@ -309,12 +367,7 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     bool alphaDropped = false;
     const Image out = stillOutput(std::move(result.image), extras, a.srgb, a.out, &alphaDropped);
     Timer writeTimer;
-    if (!a.addPass.empty())
-        io::writeExrWithLayers(a.out, *set.layered,
-                               {io::ExrOutLayer{a.addPass, &out, out.channels() == 4 ? std::vector<std::string>{"R", "G", "B", "A"}
-                                                                                    : std::vector<std::string>{"R", "G", "B"}}});
-    else
-        atrous::writeImage(a.out, out);
+    writeStill(a, set, out);
     const double writeMs = writeTimer.ms();
     const std::string method = o.method == DenoiseMethod::Auto
                                    ? std::string("auto -> ") + denoiseMethodName(rep.methodUsed) +
@@ -370,10 +423,10 @@ void addDenoiseCommand(CLI::App& app) {
     cmd->add_option("--pass", a->passes,
                     "BUFFER=NAME: take BUFFER (color, variance, albedo, normal, position, depth, object_id, "
                     "material_id, emission, motion) from the layer or channel NAME of a layered EXR (repeatable)");
-    cmd->add_option("--layer", a->layer, "View layer of a layered EXR with several (Blender: the ViewLayer name)");
     cmd->add_option("--add-pass", a->addPass,
                     "With --in FILE.exr: write --out as a copy of FILE with the denoised colour added as this pass "
                     "(with --sequence of layered EXRs: each output frame is such a copy of its frame)");
+    cmd->add_option("--layer", a->layer, "View layer of a layered EXR with several (Blender: the ViewLayer name)");
     cmd->add_option("--sequence", a->sequence,
                     "Sequence directory: frame_NNNN/ folders (atrous render --frames), numbered frame folders of "
                     "another renderer (0001/ with LuxCore's RGB.exr, ALBEDO.exr ...), numbered files per buffer "
@@ -408,7 +461,8 @@ void addDenoiseCommand(CLI::App& app) {
     for (const DenoiseMethodInfo& m : denoiseMethods()) methodHelp += std::string(m.name) + ": " + m.summary + "; ";
     for (const SequenceMethodInfo& m : sequenceMethods())
         methodHelp += std::string(m.name) + " (with --sequence): " + m.summary + "; ";
-    cmd->add_option("--method", a->method, methodHelp + "the output line says which method ran")
+    cmd->add_option("--method", a->method, methodHelp + "none: no filter, the colour written as read (a conversion: a "
+                    "noisy EXR to a PNG); the output line says which method ran")
         ->capture_default_str();
     for (const SequenceMethodInfo& m : sequenceMethods())
         if (m.stillMethod) {  // in the first such method's group
@@ -432,6 +486,11 @@ void addDenoiseCommand(CLI::App& app) {
     // One flag per parameter (params.h): --levels, --sigma-normal, --no-firefly, --sure-window, ...
     addParamOptions(*cmd, a->opt, denoiseParams(), paramHelpGroup);
     addSequenceOptions(*cmd, a->sequenceParams);
+    cmd->add_option("--threads", a->threads, "CPU worker threads (TBB; 0 = all cores)")->capture_default_str();
+    cmd->add_option("--exposure", a->exposure,
+                    "Exposure of a .png output and of a sequence's .png previews: png = srgb(clamp(exposure x value, 0, "
+                    "1)), as Python's exposure; the EXRs are never scaled")
+        ->capture_default_str();
     addVerbosityFlags(*cmd);
     cmd->callback([a, cmd] { run(*a, *cmd); });
 }

@@ -228,6 +228,9 @@ void addRenderCommand(CLI::App& app) {
     addVerbosityFlags(*cmd);
     cmd->callback([args, frames] {
         args->framesGiven = frames->count() > 0;
+        // --threads (the render table's row: the path tracer's arena) also limits the rest of the
+        // run, the --denoise filters and the writers, through TBB's global_control (cli_flags.h).
+        const auto threadLimit = limitThreads(args->settings.threads);
         run(*args);
     });
 }

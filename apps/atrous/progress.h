@@ -26,6 +26,12 @@ namespace atrous::cli {
 
 inline bool stderrIsTerminal() { return ::isatty(STDERR_FILENO) == 1; }
 
+// Erases the terminal's current line (a progress line drawn in place).
+inline void eraseLine() {
+    std::fputs("\r\033[K", stderr);
+    std::fflush(stderr);
+}
+
 enum class Verbosity { Quiet, Normal, Verbose };
 // The command's --quiet / -v (addVerbosityFlags); Normal unless given.
 inline Verbosity& verbosity() {
@@ -129,9 +135,7 @@ private:
         mShown = mTty;
     }
     void clear() {
-        if (!mShown) return;
-        std::fputs("\r\033[K", stderr);
-        std::fflush(stderr);
+        if (mShown) eraseLine();
         mShown = false;
     }
 
@@ -214,9 +218,7 @@ private:
     }
 
     void clearLocked() {
-        if (!mShown) return;
-        std::fputs("\r\033[K", stderr);
-        std::fflush(stderr);
+        if (mShown) eraseLine();
         mShown = false;
     }
 

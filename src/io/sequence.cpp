@@ -417,7 +417,7 @@ std::vector<std::string> keepFrameRange(const std::string& dir, FrameListing l, 
             throw InputError("sequence " + dir + ": " + l.label(kept[i - 1].first + range.step) + " is missing (gap between " +
                              fs::path(kept[i - 1].second).filename().string() + " and " +
                              fs::path(kept[i].second).filename().string() +
-                             "; --start N --end M denoise the frames from N to M only)");
+                             "; --start and --end pick a range of frames)");
         out.push_back(kept[i].second);
     }
     if (range.end >= 0 && kept.back().first + range.step <= last)
