@@ -44,3 +44,19 @@ def test_alpha_passes_through_bit_for_bit(rgba_frames, tmp_path, method):
         got = atrous.read_image(tmp_path / method / f"render{i:04d}.exr", alpha=True)
         assert got.shape == (16, 24, 4)
         np.testing.assert_array_equal(got[..., 3], src[..., 3])
+
+
+def test_errors_name_pythons_keywords(rgba_frames, tmp_path):
+    with pytest.raises(ValueError) as e:
+        atrous.denoise_sequence(rgba_frames, tmp_path / "a", method="eaw", start=1, end=9)
+    assert "render0004.exr is missing (end 9)" in str(e.value) and "--" not in str(e.value)
+    (rgba_frames / "render0002.exr").unlink()
+    with pytest.raises(ValueError) as e:
+        atrous.denoise_sequence(rgba_frames, tmp_path / "a", method="eaw")
+    assert "render0002.exr is missing" in str(e.value) and "start and end pick a range" in str(e.value)
+    assert "--" not in str(e.value)
+    with pytest.raises(ValueError, match=r"^out '"):
+        atrous.denoise_sequence(rgba_frames, tmp_path / "a" / "x##y##.exr", method="eaw")
+    with pytest.raises(ValueError, match=r"^step 2: "):
+        atrous.denoise_sequence(rgba_frames, tmp_path / "a", method="temporal", step=2)
+    assert not (tmp_path / "a").exists()
