@@ -56,6 +56,8 @@ struct DenoiseArgs {
 void takePositionals(DenoiseArgs& a) {
     std::vector<std::string> pos = a.positional;
     if (pos.size() > 2) throw InputError("'" + pos[2] + "': one argument too many (atrous denoise IN OUT)");
+    for (const std::string& p : pos)
+        if (p.empty()) throw InputError("IN OUT: an empty path (atrous denoise IN OUT)");
     auto fill = [&](std::string& slot, const char* flag, const char* what) {
         if (pos.empty()) return;
         if (!slot.empty() && slot != pos.back())
@@ -432,7 +434,8 @@ void addDenoiseCommand(CLI::App& app) {
                     "another renderer (0001/ with LuxCore's RGB.exr, ALBEDO.exr ...), numbered files per buffer "
                     "(color_0001.exr, albedo_0001.exr ...) or numbered layered EXRs (Blender's render0001.exr ...; "
                     "--pass, --layer and --add-pass apply to every frame); or a pattern (DIR/render####.exr, "
-                    "DIR/render%04d.exr). --out is then a directory, never the sequence directory or inside it");
+                    "DIR/render%04d.exr). --out is then a directory (never the sequence directory or inside it) or a "
+                    "pattern such as clean/####.exr");
     cmd->add_option("--start", a->range.start, "With --sequence: the first frame number to denoise (default: the first)");
     cmd->add_option("--end", a->range.end, "With --sequence: the last frame number to denoise (default: the last)");
     cmd->add_option("--step", a->range.step, "With --sequence: denoise every step-th frame from --start")
