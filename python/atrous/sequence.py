@@ -209,7 +209,8 @@ def denoise_sequence(input: "os.PathLike", out: "os.PathLike", *, method: Option
     preview.mp4 unless pngs/preview are False, only when every frame is done; `out` must not be
     inside the input's folder. Returns the run's
     report: width, height, buffers (the names every frame has), frames (one dict each: index,
-    input, output, method, method_used, ms, reprojected, mse, mse_input, line),
+    input, output, method, method_used, ms, reprojected, mse, mse_input, line, and position and
+    count: the k-th of the run's N frames, for a k/N counter),
     filter_ms_per_frame, wall_ms_per_frame, preview (the video's path, or None) and notes.
     Raises ValueError for bad input (nothing is written then)."""
     tables = {str(r["params"]) for r in _core.sequence_methods() if r["params"]}

@@ -247,6 +247,7 @@ nb::dict pyDenoiseSequence(const std::string& input, const std::string& out, con
         d["mse"] = f.hasReference ? nb::cast(f.mse) : nb::none();
         d["mse_input"] = f.hasReference ? nb::cast(f.mseInput) : nb::none();
         d["line"] = f.line;
+        d["position"] = f.position, d["count"] = f.count;  // the k-th of the run's N frames (k/N counters)
         return d;
     };
     SequenceEvents events;

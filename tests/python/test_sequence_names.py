@@ -26,6 +26,7 @@ def test_outputs_keep_the_inputs_names(rgba_frames, tmp_path):
     r = atrous.denoise_sequence(rgba_frames, tmp_path / "clean", method="eaw", preview=False)
     assert names(tmp_path / "clean") == [f"render{i:04d}.{e}" for i in range(1, 4) for e in ("exr", "png")]
     assert [f["output"] for f in r["frames"]] == [str(tmp_path / "clean" / f"render{i:04d}.exr") for i in range(1, 4)]
+    assert [(f["position"], f["count"]) for f in r["frames"]] == [(1, 3), (2, 3), (3, 3)]  # k/N
 
 
 def test_a_pattern_names_the_outputs(rgba_frames, tmp_path):

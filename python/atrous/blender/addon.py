@@ -115,7 +115,7 @@ class ATROUS_OT_denoise_animation(bpy.types.Operator):
         def progress(frame: dict) -> None:
             done[0] += 1
             wm.progress_update(done[0])
-            print("atrous:", frame["line"])
+            print(f"atrous: {frame['position']}/{frame['count']} {frame['line']}")
 
         wm.progress_begin(0, total)
         try:
