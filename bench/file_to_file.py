@@ -128,7 +128,7 @@ def main(argv=None) -> int:
         oidn = {q: [] for q in ("fast", "high")}
         for it in range(a.runs + 1):  # round 0 is the warm-up (page cache, first loads)
             for m in methods:
-                cmd = [a.atrous, "denoise", "--in", str(d), "--out", str(work / f"out_{w}x{h}_{m}.exr")]
+                cmd = [a.atrous, "denoise", "-v", "--in", str(d), "--out", str(work / f"out_{w}x{h}_{m}.exr")]  # -v: the stage times
                 if m != "default":
                     cmd += ["--method", m]
                 r = run_with_rss(cmd)

@@ -197,7 +197,7 @@ int main(int argc, char** argv) {
             app.add_option("--method", a.options.method)->required();
             app.add_option("--sequence", a.sequenceDir)->required();
             app.add_option("--out", a.outDir)->required();
-            app.add_flag("--quiet", a.quiet);
+            atrous::cli::addVerbosityFlags(app);  // --quiet, -v (progress.h, through denoise_sequence.cpp)
             std::deque<atrous::ParamSet> params;  // each sequence method's flags (--svgf-*, --temporal-*)
             atrous::cli::addSequenceOptions(app, params);
             try {

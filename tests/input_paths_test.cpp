@@ -208,7 +208,7 @@ TEST(InputPaths, SequenceAppliesLayerPassAndAddPassToEveryFrame) {
             auto s = runCli("denoise --method eaw --device cpu --in " + seq + "/render000" + std::to_string(f) + ".exr --layer " +
                             layer + " --out " + one);
             ASSERT_EQ(s.exitCode, 0) << s.output;
-            const Image a = atrous::readImage(one), b = atrous::readImage(out + "/frame_000" + std::to_string(f) + ".exr");
+            const Image a = atrous::readImage(one), b = atrous::readImage(out + "/render000" + std::to_string(f) + ".exr");
             ASSERT_EQ(a.size(), b.size());
             EXPECT_TRUE(std::equal(a.data(), a.data() + a.size(), b.data())) << layer << " frame " << f;
         }
@@ -218,7 +218,7 @@ TEST(InputPaths, SequenceAppliesLayerPassAndAddPassToEveryFrame) {
     r = runCli("denoise --method eaw --device cpu --sequence " + seq + " --pass color=Shade.Combined --pass 'albedo=Shade.Denoising "
                "Albedo' --pass 'normal=Sun.Denoising Normal' --add-pass Denoised --out " + out);
     ASSERT_EQ(r.exitCode, 0) << r.output;
-    const io::ExrInfo info = io::inspectExr(out + "/frame_0002.exr");
+    const io::ExrInfo info = io::inspectExr(out + "/render0002.exr");
     std::vector<std::string> layers;
     for (const auto& l : info.layers) layers.push_back(l.name);
     EXPECT_NE(std::find(layers.begin(), layers.end(), "Sun.Denoised"), layers.end()) << io::layerList(info);

@@ -362,12 +362,12 @@ TEST(LayeredCli, SequenceOfLayeredFilesWithSignAndIdChecks) {
     writePanSequence(a.str(), 1.0f, false);
     CliResult r = runCli("denoise --method svgf --sequence " + a.str() + " --out " + (out / "a"));
     ASSERT_EQ(r.exitCode, 0) << r.output;
-    EXPECT_NE(r.output.find("frame_0002: svgf"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("render0002: svgf"), std::string::npos) << r.output;
     // 47 of 48 columns: the last one moves out of the image.
     EXPECT_NE(r.output.find("98% reprojects onto the previous frame"), std::string::npos) << r.output;
     EXPECT_EQ(r.output.find("opposite sign"), std::string::npos) << r.output;
     EXPECT_EQ(r.output.find("ids change"), std::string::npos) << r.output;
-    EXPECT_TRUE(std::filesystem::exists(out / "a/frame_0003.exr"));
+    EXPECT_TRUE(std::filesystem::exists(out / "a/render0003.exr"));
     // The other sign convention: named in a warning.
     writePanSequence(b.str(), -1.0f, false);
     r = runCli("denoise --method svgf --sequence " + b.str() + " --out " + (out / "b"));

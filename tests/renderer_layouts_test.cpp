@@ -96,7 +96,7 @@ TEST(RendererLayouts, NumberedFrameFoldersWithLuxCoreNamesAreASequence) {
     r = runCli("denoise --sequence " + lux + " --method eaw --out " + out);
     ASSERT_EQ(r.exitCode, 0) << r.output;
     for (int f = 1; f <= 3; ++f) {
-        const std::string got = out + "/frame_000" + std::to_string(f) + ".exr";
+        const std::string got = out + "/000" + std::to_string(f) + ".exr";  // the frame folder's name
         ASSERT_TRUE(fs::exists(got)) << r.output;
         // Each frame as `--in FOLDER` denoises it.
         const std::string want = dir / ("one_" + std::to_string(f) + ".exr");
@@ -122,7 +122,7 @@ TEST(RendererLayouts, NumberedFrameFoldersWithLuxCoreNamesAreASequence) {
     fs::remove_all(lux + "/0002");
     r = runCli("denoise --sequence " + lux + " --method eaw --out " + out2);
     EXPECT_EQ(r.exitCode, 2) << r.output;
-    EXPECT_NE(r.output.find("2 (a numbered frame folder) is missing"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("0002 (a numbered frame folder) is missing"), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(out2));
     // Numbered folders without a colour file are not frames.
     fs::remove_all(lux);
@@ -151,7 +151,7 @@ TEST(RendererLayouts, NumberedFilesPerBufferAreASequence) {
             fs::copy_file(per + "/" + b + "_000" + std::to_string(f) + ".exr", one + "/" + b + ".exr");
         auto r1 = runCli("denoise --in " + one + " --method sure --out " + one + ".exr");
         ASSERT_EQ(r1.exitCode, 0) << r1.output;
-        const std::string got = out + "/frame_000" + std::to_string(f) + ".exr";
+        const std::string got = out + "/color_000" + std::to_string(f) + ".exr";  // the colour file's name
         ASSERT_TRUE(fs::exists(got)) << r.output;
         EXPECT_TRUE(sameImages(atrous::readImage(got), atrous::readImage(one + ".exr"))) << f;
     }
@@ -178,10 +178,11 @@ TEST(RendererLayouts, PatternsWithStartEndAndStep) {
     struct Case {
         std::string flags;
         std::vector<int> frames;
+        std::string stem;  // the outputs keep the inputs' names
     };
-    for (const Case& c : {Case{"'" + src + "/render####.exr' --start 2 --end 4", {2, 3, 4}},
-                          Case{"'" + src + "/render%04d.exr' --step 2", {1, 3, 5}},
-                          Case{"'" + src + "/other%04d.exr' --start 4", {4, 5}}}) {
+    for (const Case& c : {Case{"'" + src + "/render####.exr' --start 2 --end 4", {2, 3, 4}, "render"},
+                          Case{"'" + src + "/render%04d.exr' --step 2", {1, 3, 5}, "render"},
+                          Case{"'" + src + "/other%04d.exr' --start 4", {4, 5}, "other"}}) {
         const std::string out = dir / "out";
         fs::remove_all(out);
         r = runCli("denoise --method eaw --out " + out + " --sequence " + c.flags);
@@ -191,7 +192,7 @@ TEST(RendererLayouts, PatternsWithStartEndAndStep) {
             if (e.path().extension() == ".exr") got.push_back(e.path().filename().string());
         std::sort(got.begin(), got.end());
         std::vector<std::string> want;
-        for (int f : c.frames) want.push_back("frame_000" + std::to_string(f) + ".exr");
+        for (int f : c.frames) want.push_back(c.stem + "000" + std::to_string(f) + ".exr");
         EXPECT_EQ(got, want) << c.flags;
     }
     // Bad ranges and gaps: one line, exit 2, nothing written.

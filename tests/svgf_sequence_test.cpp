@@ -56,8 +56,8 @@ void writeSequence(const std::string& dir, const SceneOptions& o, int count, int
     }
 }
 
-// Writes `count` frames of a w x h scene (noise σ `noise`) to dir/seq; returns the quiet arguments
-// that denoise it into dir/out.
+// Writes `count` frames of a w x h scene (noise σ `noise`) to dir/seq; returns the arguments
+// that denoise it into dir/out, the CLI set quiet.
 cli::SequenceDenoiseArgs sequenceArgs(const test::TempDir& dir, int w, int h, float noise, int count) {
     SceneOptions o;
     o.width = w, o.height = h;
@@ -66,7 +66,7 @@ cli::SequenceDenoiseArgs sequenceArgs(const test::TempDir& dir, int w, int h, fl
     cli::SequenceDenoiseArgs args;
     args.sequenceDir = dir / "seq";
     args.outDir = dir / "out";
-    args.quiet = true;
+    cli::verbosity() = cli::Verbosity::Quiet;  // the CLI's --quiet (progress.h)
     return args;
 }
 

@@ -4,6 +4,7 @@
 // parameter tables (params.h) for a field. No message is read to find its flag.
 #pragma once
 #include <CLI/CLI.hpp>
+#include <tbb/global_control.h>
 
 #include <functional>
 #include <memory>
@@ -31,6 +32,16 @@ auto withFlag(const std::string& flag, F&& f) -> decltype(f()) {
     } catch (const InputError& e) {
         rethrowWithFlag(flag, e);
     }
+}
+
+// --threads N of denoise, render and bench: TBB's global_control for the command's run (every
+// parallel loop of the library, the filters', the readers' and the renderer's); 0 = all cores
+// (none made). The ceiling is the render table's (tbb::task_arena aborts from 65537 threads).
+inline std::unique_ptr<tbb::global_control> limitThreads(int threads) {
+    if (threads < 0 || threads > 4096)
+        throw InputError("--threads: must be 0 (all cores) to 4096 (got " + std::to_string(threads) + ")");
+    if (threads == 0) return nullptr;
+    return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(threads));
 }
 
 // CLI11 reads an empty value ("--max-depth ''") as 0 without a word (found by tests/fuzz).

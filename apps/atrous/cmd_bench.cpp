@@ -20,6 +20,7 @@
 #include "atrous/learned.h"
 #include "atrous/render.h"
 #include "atrous/sequence_methods.h"
+#include "cli_flags.h"
 #include "commands.h"
 #include "atrous/timer.h"
 
@@ -54,6 +55,7 @@ struct BenchArgs {
     std::string scene = "cornell";
     int runs = 0;  // 0: 50 on CUDA, 10 on the CPU
     int warmup = 3;
+    int threads = 0;  // --threads: 0 = all cores
     bool json = false;
 };
 
@@ -191,6 +193,7 @@ nlohmann::json benchSequence(const SequenceMethodInfo& m, const RenderBuffers& i
 }
 
 void run(const BenchArgs& a) {
+    const auto threadLimit = limitThreads(a.threads);  // for the whole run
     const Device device = parseDevice(a.device);
     const int runs = a.runs > 0 ? a.runs : (device == Device::Cuda ? 50 : 10);
     if (a.warmup < 0) throw InputError("--warmup must be >= 0");
@@ -359,6 +362,7 @@ void addBenchCommand(CLI::App& app) {
                     "renders after one warm-up")
         ->check(CLI::Range(0, 1000000));
     cmd->add_option("--warmup", args->warmup, "untimed runs first")->check(CLI::Range(0, 1000000))->capture_default_str();
+    cmd->add_option("--threads", args->threads, "CPU worker threads (TBB; 0 = all cores)")->capture_default_str();
     cmd->add_flag("--json", args->json, "print JSON");
     cmd->callback([args] { run(*args); });
 }

@@ -21,6 +21,7 @@
 #include "atrous/metrics.h"
 #include "commands.h"
 #include "compare_flicker.h"
+#include "progress.h"
 #include "atrous/io/staged_dir.h"
 #include "atrous/io/image_io.h"
 #include "atrous/io/paths.h"
@@ -98,7 +99,7 @@ public:
     explicit FlipRunner(bool wanted) {
         if (wanted) mExe = io::findOnPath("flip");
         if (!mExe.empty() && runCommand(io::shellQuote(mExe) + " -h 2>&1").find("FLIP") == std::string::npos) {
-            std::fprintf(stderr, "note: no FLIP column: %s is not NVIDIA's FLIP (pip install flip-evaluator)\n",
+            logLine("note: no FLIP column: %s is not NVIDIA's FLIP (pip install flip-evaluator)\n",
                          mExe.c_str());
             mExe.clear();
             mNoted = true;
@@ -115,7 +116,7 @@ public:
                                            " 2>&1", &rc);
         const size_t at = out.find("Mean:");
         if (rc == 0 && at != std::string::npos) return std::strtod(out.c_str() + at + 5, nullptr);
-        std::fprintf(stderr, "note: FLIP (%s) failed on frame %d: %s\n", mExe.c_str(), index, out.substr(0, 200).c_str());
+        logLine("note: FLIP (%s) failed on frame %d: %s\n", mExe.c_str(), index, out.substr(0, 200).c_str());
         return std::nullopt;
     }
 
@@ -164,7 +165,7 @@ public:
         const std::string out = runCommand(io::shellQuote(mExe) + " --pairs " + io::shellQuote(list) + " 2>&1", &rc);
         const size_t at = out.find("JOD:");
         if (rc == 0 && at != std::string::npos) return std::strtod(out.c_str() + at + 4, nullptr);
-        std::fprintf(stderr, "note: ColorVideoVDP (%s) failed on %s: %s\n", mExe.c_str(), name.c_str(),
+        logLine("note: ColorVideoVDP (%s) failed on %s: %s\n", mExe.c_str(), name.c_str(),
                      lastLine(out).c_str());
         return std::nullopt;
     }
@@ -271,25 +272,25 @@ void runSequence(const CompareArgs& a) {
     j["sequences"] = nlohmann::json::array();
     FlipRunner flip(!a.noFlip);
     if (!a.noFlip && !flip.enabled() && !flip.noted())
-        std::fprintf(stderr, "note: no FLIP column: the flip command (pip install flip-evaluator; make python puts it in "
+        logLine("note: no FLIP column: the flip command (pip install flip-evaluator; make python puts it in "
                              ".venv/bin) is not on PATH\n");
     CvvdpRunner cvvdp(!a.noCvvdp);
-    if (!cvvdp.note().empty()) std::fprintf(stderr, "note: no CVVDP column: %s\n", cvvdp.note().c_str());
+    if (!cvvdp.note().empty()) logLine("note: no CVVDP column: %s\n", cvvdp.note().c_str());
     // Written once for both external metrics, only when one of them runs.
     const std::unique_ptr<FrameFiles> files = flip.enabled() || cvvdp.enabled() ? std::make_unique<FrameFiles>() : nullptr;
     std::vector<std::string> notes;
     const std::unique_ptr<FlickerGuide> guide = referenceGuide(a, &notes);
-    for (const std::string& n : notes) std::fprintf(stderr, "%s\n", n.c_str());
+    for (const std::string& n : notes) logLine("%s\n", n.c_str());
     if (guide) {
         // The measure's floor on this sequence: what the reference itself changes where it reprojects.
         const FlickerMetrics rf = guide->measure(ref, a.sequence);
         j["reference_flicker"] = rf.relMse;
         if (!a.json)
-            std::printf("flicker (no reference needed): the reference's own is %.6g, %.1f%% of its pixels reproject (motion of %s)\n",
+            resultLine("flicker (no reference needed): the reference's own is %.6g, %.1f%% of its pixels reproject (motion of %s)\n",
                         rf.relMse, 100.0 * rf.reprojected, guide->dir().c_str());
     }
     if (!a.json)
-        std::printf("%-32s %7s %14s %10s %8s %14s %10s%s%s%s\n", "sequence", "frames", "relMSE", "PSNR(dB)", "SSIM", "temporal relMSE",
+        resultLine("%-32s %7s %14s %10s %8s %14s %10s%s%s%s\n", "sequence", "frames", "relMSE", "PSNR(dB)", "SSIM", "temporal relMSE",
                     "tPSNR(dB)", guide ? "        flicker" : "", flip.enabled() ? "     FLIP" : "", cvvdp.enabled() ? " CVVDP(JOD)" : "");
     for (const std::string& dir : a.images) {
         auto seq = sequenceImages(dir, false);
@@ -337,12 +338,12 @@ void runSequence(const CompareArgs& a) {
         if (a.json) {
             j["sequences"].push_back(s);
         } else {
-            std::printf("%-32s %7zu %14.6g %10.3f %8.4f %14.6g %10.3f", dir.c_str(), seq.size(), rel / n, psnr / n, ssim / n,
+            resultLine("%-32s %7zu %14.6g %10.3f %8.4f %14.6g %10.3f", dir.c_str(), seq.size(), rel / n, psnr / n, ssim / n,
                         trel / steps, tpsnr / steps);
-            if (guide) std::printf(" %14.6g", flicker);
-            if (flip.enabled()) flipOk ? std::printf(" %8.4f", flipSum / n) : std::printf(" %8s", "-");
-            if (cvvdp.enabled()) jod ? std::printf(" %10.4f", *jod) : std::printf(" %10s", "-");
-            std::printf("\n");
+            if (guide) resultLine(" %14.6g", flicker);
+            if (flip.enabled()) flipOk ? resultLine(" %8.4f", flipSum / n) : resultLine(" %8s", "-");
+            if (cvvdp.enabled()) jod ? resultLine(" %10.4f", *jod) : resultLine(" %10s", "-");
+            resultLine("\n");
         }
         if (!a.video.empty()) all.push_back(std::move(seq));  // every frame has the reference's size (computeMetrics)
     }
@@ -352,9 +353,9 @@ void runSequence(const CompareArgs& a) {
         all.push_back(std::move(ref));
         writeVideo(a.video, names, all);
         j["video"] = a.video;
-        if (!a.json) std::printf("video: %s (%s | reference)\n", a.video.c_str(), a.images.size() == 1 ? a.images[0].c_str() : "the sequences");
+        if (!a.json) resultLine("video: %s (%s | reference)\n", a.video.c_str(), a.images.size() == 1 ? a.images[0].c_str() : "the sequences");
     }
-    if (a.json) std::printf("%s\n", j.dump(2).c_str());
+    if (a.json) resultLine("%s\n", j.dump(2).c_str());
 }
 
 void run(const CompareArgs& a) {
@@ -401,7 +402,7 @@ void run(const CompareArgs& a) {
     if (!ms.empty() && ms.front().referenceNonFinitePixels > 0)
         notes.push_back("note: reference " + a.ref + " has " + std::to_string(ms.front().referenceNonFinitePixels) +
                         " non-finite (NaN/Inf) pixels, counted as 0");
-    for (const std::string& n : notes) std::fprintf(stderr, "%s\n", n.c_str());
+    for (const std::string& n : notes) logLine("%s\n", n.c_str());
     if (!a.errorMaps.empty()) {
         for (size_t i = 0; i < imgs.size(); ++i) {
             const std::string stem = std::filesystem::path(a.images[i]).stem().string();
@@ -422,11 +423,11 @@ void run(const CompareArgs& a) {
                                    {"ssim", ms[i].ssim},
                                    {"non_finite_pixels", ms[i].nonFinitePixels}});
         j["reference_non_finite_pixels"] = ms.empty() ? 0 : ms.front().referenceNonFinitePixels;
-        std::printf("%s\n", j.dump(2).c_str());
+        resultLine("%s\n", j.dump(2).c_str());
     } else {
-        std::printf("%-40s %14s %14s %10s %8s\n", "image", "MSE", "relMSE", "PSNR(dB)", "SSIM");
+        resultLine("%-40s %14s %14s %10s %8s\n", "image", "MSE", "relMSE", "PSNR(dB)", "SSIM");
         for (size_t i = 0; i < ms.size(); ++i)
-            std::printf("%-40s %14.6g %14.6g %10.3f %8.4f\n", a.images[i].c_str(), ms[i].mse, ms[i].relMse, ms[i].psnr,
+            resultLine("%-40s %14.6g %14.6g %10.3f %8.4f\n", a.images[i].c_str(), ms[i].mse, ms[i].relMse, ms[i].psnr,
                         ms[i].ssim);
     }
 }
@@ -457,6 +458,7 @@ void addCompareCommand(CLI::App& app) {
                   "With --sequence: no ColorVideoVDP column (by default the JOD of each sequence when the atrous-cvvdp "
                   "command of the atrous Python package is on PATH and pip's cvvdp is installed beside it)");
     cmd->add_option("--error-maps", a->errorMaps, "Write <name>_se.exr and <name>_relse.exr error maps into DIR");
+    addVerbosityFlags(*cmd);
     cmd->callback([a] { run(*a); });
 }
 

@@ -1,5 +1,6 @@
 // `atrous denoise`: EAW, SURE-À-Trous or the learned filter on a render directory or on individual EXR/PFM buffers.
 #include <algorithm>
+#include <cmath>
 #include <utility>
 #include <vector>
 #include <cstdio>
@@ -18,6 +19,7 @@
 #include "commands.h"
 #include "atrous/timer.h"
 #include "denoise_sequence.h"
+#include "progress.h"
 #include "still_output.h"
 #include "atrous/srgb.h"
 #include "atrous/io/buffer_set.h"
@@ -43,7 +45,35 @@ struct DenoiseArgs {
     DenoiseOptions opt;  // the filter parameters' flags write here (params.h's table)
     std::string learnedWeights;  // --learned-weights: loaded once into opt.weights
     std::deque<ParamSet> sequenceParams;  // each sequence method's parameters (sequenceMethods()' order): their flags write here
+    std::vector<std::string> positional;  // `atrous denoise IN OUT`: IN as --in takes it, OUT as --out
+    int threads = 0;                      // --threads: 0 = all cores
+    float exposure = 1.0f;                // --exposure: of a .png output and a sequence's previews
 };
+
+// `atrous denoise IN OUT` (or `--in IN OUT`, `IN --out OUT`, `--sequence DIR OUT`): the
+// positionals fill --out first (the last one), then --in; a positional that differs from its
+// flag's value, or one too many, is an InputError.
+void takePositionals(DenoiseArgs& a) {
+    std::vector<std::string> pos = a.positional;
+    if (pos.size() > 2) throw InputError("'" + pos[2] + "': one argument too many (atrous denoise IN OUT)");
+    for (const std::string& p : pos)
+        if (p.empty()) throw InputError("IN OUT: an empty path (atrous denoise IN OUT)");
+    auto fill = [&](std::string& slot, const char* flag, const char* what) {
+        if (pos.empty()) return;
+        if (!slot.empty() && slot != pos.back())
+            throw InputError(std::string(flag) + " '" + slot + "' and the " + what + " '" + pos.back() +
+                             "' differ: give it once (atrous denoise IN OUT, or --in IN --out OUT)");
+        slot = pos.back();
+        pos.pop_back();
+    };
+    if (pos.size() == 2 || a.out.empty()) fill(a.out, "--out", "positional OUT");
+    const bool inGiven = !a.color.empty() || !a.ldrColor.empty() || !a.sequence.empty();
+    if (!pos.empty() && inGiven)
+        throw InputError("'" + pos.back() + "': one argument too many (the input is given by " +
+                         (a.sequence.empty() ? "--color/--hdr/--ldr" : "--sequence") + ")");
+    fill(a.inDir, "--in", "positional IN");
+    if (a.out.empty()) throw InputError("--out is required (atrous denoise IN OUT, or --in IN --out OUT)");
+}
 
 // Option groups: the flags of one method are ignored by the others (a note says which).
 const char* const kGroupBuffers = "Buffers (without --sequence)";
@@ -120,7 +150,7 @@ void noteIgnoredFlags(const CLI::App& cmd, const std::string& method, const Deno
         if (unused) ignored += (ignored.empty() ? "" : ", ") + opt->get_name();
         if (g == kGroupBuffers && sequence) ignoredSeq += (ignoredSeq.empty() ? "" : ", ") + opt->get_name();
     }
-    if (!ignored.empty()) std::printf("denoise: note: ignored with --method %s: %s\n", method.c_str(), ignored.c_str());
+    if (!ignored.empty()) logLine("denoise: note: ignored with --method %s: %s\n", method.c_str(), ignored.c_str());
     // A buffer file given beside --sequence would not be read: refused, not noted (issue 29).
     if (!ignoredSeq.empty())
         throw InputError(ignoredSeq + ": a sequence's frames bring their own buffers (--sequence DIR); drop " +
@@ -155,8 +185,62 @@ io::BufferFiles bufferFiles(const DenoiseArgs& a) {
     return f;
 }
 
+// The files of a still (--in/--color, --out checked): InputError before anything is read.
+io::BufferFiles stillFiles(const DenoiseArgs& a) {
+    const std::string ext = io::extensionOf(a.out);
+    if (ext != ".exr" && ext != ".pfm" && ext != ".png")
+        throw InputError("--out '" + a.out + "': unsupported extension (use .exr, .pfm or .png)");
+    if (a.exposure != 1.0f && ext != ".png")
+        throw InputError("--exposure: scales a .png output (and a sequence's .png previews); --out is " + ext);
+    if (a.inDir.empty() == a.color.empty())
+        throw InputError("give exactly one of --in RENDER_DIR, --in LAYERED.exr or --color FILE (--hdr/--ldr)");
+    checkOutputFile(a.out);
+    io::BufferFiles files = bufferFiles(a);
+    io::refuseOverwrite("--out", a.out, io::inputFiles(files));
+    return files;
+}
+
+// Writes a still's output: a copy of the layered input with the pass added (--add-pass), a .png
+// at --exposure, else by the extension.
+void writeStill(const DenoiseArgs& a, const io::BufferSet& set, const Image& out) {
+    if (!a.addPass.empty())
+        io::writeExrWithLayers(a.out, *set.layered,
+                               {io::ExrOutLayer{a.addPass, &out, out.channels() == 4 ? std::vector<std::string>{"R", "G", "B", "A"}
+                                                                                    : std::vector<std::string>{"R", "G", "B"}}});
+    else if (io::extensionOf(a.out) == ".png")
+        io::writePng(a.out, out, a.exposure);
+    else
+        atrous::writeImage(a.out, out);
+}
+
 void srgbToLinear(Image& img) {
     for (size_t i = 0; i < img.plane() * size_t(img.channels()); ++i) img.data()[i] = srgbDecode(img.data()[i]);
+}
+
+// --method none: no filter, the colour written as read (a format conversion: a noisy EXR to a PNG
+// preview), with its alpha, an LDR input's clamp and --srgb as for a denoised colour; a NaN/Inf
+// value is written as 0 (said so), as no output holds one.
+void runNone(const DenoiseArgs& a) {
+    if (!a.sequence.empty()) throw InputError("--method none: converts a still (--in/--color), not a --sequence");
+    io::BufferFiles files = stillFiles(a);
+    files.wanted = [](io::Buffer b, const bool*) { return b == io::Buffer::Color; };
+    io::BufferSet set = io::loadBuffers(files);
+    if (!a.addPass.empty() && (!set.layered || io::extensionOf(a.out) != ".exr"))
+        throw InputError("--add-pass '" + a.addPass + "' writes a copy of a layered EXR: give --in FILE.exr and --out COPY.exr");
+    const StillExtras extras = readStillExtras(files, set, a.ldr);
+    Image& color = set.image[int(io::Buffer::Color)];
+    if (a.srgb && !extras.ldrFile) srgbToLinear(color);
+    int nonFinite = 0;
+    for (size_t i = 0; i < color.plane() * size_t(color.channels()); ++i)
+        if (!std::isfinite(color.data()[i])) color.data()[i] = 0.0f, ++nonFinite;
+    const int width = color.width(), height = color.height();
+    bool alphaDropped = false;
+    const Image out = stillOutput(std::move(color), extras, a.srgb, a.out, &alphaDropped);
+    writeStill(a, set, out);
+    resultLine("denoise: method none (no filter: the colour written as read), %dx%d\n", width, height);
+    logLine("%s", stillExtrasLines(extras, a.out, alphaDropped).c_str());
+    if (nonFinite > 0) logLine("denoise: %d NaN/Inf colour values written as 0\n", nonFinite);
+    resultLine("denoise: wrote %s\n", a.out.c_str());
 }
 
 // --spatial, the still method of a sequence method that ends with one (`row`): whether it applies;
@@ -190,10 +274,14 @@ void runSequence(const DenoiseArgs& a, const ParamSet* params) {
     so.viewLayer = a.layer;
     so.addPass = a.addPass;
     so.start = a.range.start, so.end = a.range.end, so.step = a.range.step;
+    so.exposure = a.exposure;
     runSequenceDenoise(s);
 }
 
 void run(DenoiseArgs& a, const CLI::App& cmd) {
+    takePositionals(a);
+    const auto threadLimit = limitThreads(a.threads);  // for the whole run
+    if (!(a.exposure > 0.0f) || !std::isfinite(a.exposure)) throw InputError("--exposure: must be > 0");
     if (!a.ldrColor.empty()) {
         if (!a.color.empty()) throw InputError("--ldr: give the colour once (--color/--hdr or --ldr)");
         a.color = a.ldrColor;
@@ -204,6 +292,10 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
         throw InputError("-f/--filter: '" + a.oidnFilter + "' is not supported (atrous denoises RT images: use RT)");
     DenoiseOptions& o = a.opt;
     const bool sequence = !a.sequence.empty();
+    if (a.method == "none") {
+        runNone(a);
+        return;
+    }
     for (const char* f : {"--start", "--end", "--step"})
         if (!sequence && cmd.count(f) > 0) throw InputError(std::string(f) + ": picks frames of a --sequence; give one");
     // A sequence without --method: the first sequence method (temporal: the frames around each one).
@@ -235,13 +327,7 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
         return;
     }
     const std::string ext = io::extensionOf(a.out);
-    if (ext != ".exr" && ext != ".pfm" && ext != ".png")
-        throw InputError("--out '" + a.out + "': unsupported extension (use .exr, .pfm or .png)");
-    if (a.inDir.empty() == a.color.empty())
-        throw InputError("give exactly one of --in RENDER_DIR, --in LAYERED.exr or --color FILE (--hdr/--ldr)");
-    checkOutputFile(a.out);
-    io::BufferFiles files = bufferFiles(a);
-    io::refuseOverwrite("--out", a.out, io::inputFiles(files));
+    io::BufferFiles files = stillFiles(a);
     // Only the buffers the method reads are decoded (auto: by the buffers present).
     files.wanted = [&](io::Buffer b, const bool present[io::kBufferCount]) {
         const DenoiseMethod m = resolveDenoiseMethod(o.method, present[int(io::Buffer::Albedo)], present[int(io::Buffer::Normal)]);
@@ -283,43 +369,42 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     bool alphaDropped = false;
     const Image out = stillOutput(std::move(result.image), extras, a.srgb, a.out, &alphaDropped);
     Timer writeTimer;
-    if (!a.addPass.empty())
-        io::writeExrWithLayers(a.out, *set.layered,
-                               {io::ExrOutLayer{a.addPass, &out, out.channels() == 4 ? std::vector<std::string>{"R", "G", "B", "A"}
-                                                                                    : std::vector<std::string>{"R", "G", "B"}}});
-    else
-        atrous::writeImage(a.out, out);
+    writeStill(a, set, out);
     const double writeMs = writeTimer.ms();
     const std::string method = o.method == DenoiseMethod::Auto
                                    ? std::string("auto -> ") + denoiseMethodName(rep.methodUsed) +
                                          (rep.methodUsed == DenoiseMethod::Blend ? " (albedo and normal given)"
                                                                                 : " (the learned filter needs an albedo and a normal)")
                                    : std::string(denoiseMethodName(o.method));
-    std::printf("denoise: method %s on %s, %dx%d, buffers used: %s\n", method.c_str(), deviceToString(o.device), width, height,
+    // Results on stdout (the method that ran, the file written); the rest on stderr (progress.h).
+    resultLine("denoise: method %s on %s, %dx%d, buffers used: %s\n", method.c_str(), deviceToString(o.device), width, height,
                 rep.buffersUsed.c_str());
     if (rep.noiseEstimated)
-        std::printf("denoise: no variance buffer: noise estimated from the image, per pixel (docs/algorithms.md), at least "
+        logLine("denoise: no variance buffer: noise estimated from the image, per pixel (docs/algorithms.md), at least "
                     "the global MAD sigma = %.4g %.4g %.4g%s\n",
                     rep.noiseSigma[0], rep.noiseSigma[1], rep.noiseSigma[2], albedoGiven && o.demodulate ? " (of the demodulated colour)" : "");
-    std::printf("%s", stillExtrasLines(extras, a.out, alphaDropped).c_str());
+    logLine("%s", stillExtrasLines(extras, a.out, alphaDropped).c_str());
     if (rep.nonFinitePixels > 0)
-        std::printf("denoise: %d pixels had NaN/Inf colour, treated as missing\n", rep.nonFinitePixels);
+        logLine("denoise: %d pixels had NaN/Inf colour, treated as missing\n", rep.nonFinitePixels);
     if (o.firefly.enabled)
-        std::printf("denoise: fireflies clamped: %d pixels, mean luminance %.6g -> %.6g\n", rep.firefliesClamped,
+        verbose("denoise: fireflies clamped: %d pixels, mean luminance %.6g -> %.6g\n", rep.firefliesClamped,
                     rep.meanLuminanceIn, rep.meanLuminanceAfterFirefly);
     if (!set.skipped.empty()) {
         std::string list;
         for (io::Buffer b : set.skipped)
             if (b != io::Buffer::MaterialId) list += (list.empty() ? "" : ", ") + std::string(io::bufferName(b));
-        std::printf("denoise: not read (unused by %s): %s\n", denoiseMethodName(rep.methodUsed), list.c_str());
+        verbose("denoise: not read (unused by %s): %s\n", denoiseMethodName(rep.methodUsed), list.c_str());
     }
-    std::printf("denoise: read %.2f ms, filter %.2f ms, total %.2f ms, write %.2f ms, wrote %s\n", readMs, rep.milliseconds, ms,
+    resultLine("denoise: read %.2f ms, filter %.2f ms, total %.2f ms, write %.2f ms, wrote %s\n", readMs, rep.milliseconds, ms,
                 writeMs, a.out.c_str());
-    if (!rep.stages.empty()) {  // the filter's own stages (DenoiseReport::stages)
-        std::printf("denoise: stages ms:");
-        for (size_t i = 0; i < rep.stages.size(); ++i)
-            std::printf("%s %s %.2f", i ? "," : "", rep.stages[i].name.c_str(), rep.stages[i].milliseconds);
-        std::printf("\n");
+    if (!rep.stages.empty()) {  // the filter's own stages (DenoiseReport::stages), with -v
+        std::string line = "denoise: stages ms:";
+        char buf[96];
+        for (size_t i = 0; i < rep.stages.size(); ++i) {
+            std::snprintf(buf, sizeof buf, "%s %.2f", rep.stages[i].name.c_str(), rep.stages[i].milliseconds);
+            line += std::string(i ? ", " : " ") + buf;
+        }
+        verbose("%s\n", line.c_str());
     }
 }
 
@@ -330,22 +415,27 @@ void addDenoiseCommand(CLI::App& app) {
     auto* cmd = app.add_subcommand(
         "denoise", "Denoise a render with EAW, SURE-based a-trous wavelets or the learned a-trous filter, or an animated "
                    "sequence (also SVGF)");
-    cmd->add_option("--in", a->inDir,
+    cmd->add_option("IN OUT", a->positional,
+                    "atrous denoise IN OUT: IN as --in takes it (a render folder, a layered EXR), OUT as --out (the "
+                    "flags do the same; with --sequence DIR or --color FILE, one positional is OUT)")
+        ->type_name("");
+    cmd->add_option("--in,-i", a->inDir,
                     "Render directory (color.exr, variance.exr, albedo.exr, normal.exr, ...) or a layered EXR "
                     "(Blender multilayer, Mitsuba aov): its passes are taken by name (atrous inspect FILE shows which)");
     cmd->add_option("--pass", a->passes,
                     "BUFFER=NAME: take BUFFER (color, variance, albedo, normal, position, depth, object_id, "
                     "material_id, emission, motion) from the layer or channel NAME of a layered EXR (repeatable)");
-    cmd->add_option("--layer", a->layer, "View layer of a layered EXR with several (Blender: the ViewLayer name)");
     cmd->add_option("--add-pass", a->addPass,
                     "With --in FILE.exr: write --out as a copy of FILE with the denoised colour added as this pass "
-                    "(with --sequence of layered EXRs: each frame_NNNN.exr is such a copy of its frame)");
+                    "(with --sequence of layered EXRs: each output frame is such a copy of its frame)");
+    cmd->add_option("--layer", a->layer, "View layer of a layered EXR with several (Blender: the ViewLayer name)");
     cmd->add_option("--sequence", a->sequence,
                     "Sequence directory: frame_NNNN/ folders (atrous render --frames), numbered frame folders of "
                     "another renderer (0001/ with LuxCore's RGB.exr, ALBEDO.exr ...), numbered files per buffer "
                     "(color_0001.exr, albedo_0001.exr ...) or numbered layered EXRs (Blender's render0001.exr ...; "
                     "--pass, --layer and --add-pass apply to every frame); or a pattern (DIR/render####.exr, "
-                    "DIR/render%04d.exr). --out is then a directory, never the sequence directory or inside it");
+                    "DIR/render%04d.exr). --out is then a directory (never the sequence directory or inside it) or a "
+                    "pattern such as clean/####.exr");
     cmd->add_option("--start", a->range.start, "With --sequence: the first frame number to denoise (default: the first)");
     cmd->add_option("--end", a->range.end, "With --sequence: the last frame number to denoise (default: the last)");
     cmd->add_option("--step", a->range.step, "With --sequence: denoise every step-th frame from --start")
@@ -363,16 +453,19 @@ void addDenoiseCommand(CLI::App& app) {
     cmd->add_option("--ids", a->ids, "Mesh id (R) / material id (G) buffer")->group(kGroupBuffers);
     cmd->add_option("--emission", a->emission, "Emitted radiance of the primary hit (filtered around, added back)")->group(kGroupBuffers);
     cmd->add_option("--out,-o", a->out,
-                    "Output file (.exr, .pfm or .png); with --sequence, an output directory, written only once every "
-                    "frame is denoised (on error it is left as it was). An existing one keeps its other files; this "
-                    "run's frame_NNNN.exr/.png replace the old ones, and those of an earlier run that this run does "
-                    "not write (and an old preview.mp4) are removed, named in a note on stderr")
-        ->required();
+                    "Output file (.exr, .pfm or .png); with --sequence, an output directory where each frame keeps "
+                    "its input's name (render0001.exr -> OUT/render0001.exr, a frame folder 0001/ -> OUT/0001.exr; "
+                    "+ .png previews, + preview.mp4), or a pattern OUT/clean####.exr (or %04d): the frame number "
+                    "zero-padded to the count of #'s. Written only once every frame is denoised (on error it is "
+                    "left as it was); an existing folder keeps its other files, files of the same name are "
+                    "replaced, and an earlier run's frame_NNNN.exr/.png this run does not write (and an old "
+                    "preview.mp4) are removed, named in a note on stderr (or OUT, the last positional)");
     std::string methodHelp;
     for (const DenoiseMethodInfo& m : denoiseMethods()) methodHelp += std::string(m.name) + ": " + m.summary + "; ";
     for (const SequenceMethodInfo& m : sequenceMethods())
         methodHelp += std::string(m.name) + " (with --sequence): " + m.summary + "; ";
-    cmd->add_option("--method", a->method, methodHelp + "the output line says which method ran")
+    cmd->add_option("--method", a->method, methodHelp + "none: no filter, the colour written as read (a conversion: a "
+                    "noisy EXR to a PNG); the output line says which method ran")
         ->capture_default_str();
     for (const SequenceMethodInfo& m : sequenceMethods())
         if (m.stillMethod) {  // in the first such method's group
@@ -396,6 +489,12 @@ void addDenoiseCommand(CLI::App& app) {
     // One flag per parameter (params.h): --levels, --sigma-normal, --no-firefly, --sure-window, ...
     addParamOptions(*cmd, a->opt, denoiseParams(), paramHelpGroup);
     addSequenceOptions(*cmd, a->sequenceParams);
+    cmd->add_option("--threads", a->threads, "CPU worker threads (TBB; 0 = all cores)")->capture_default_str();
+    cmd->add_option("--exposure", a->exposure,
+                    "Exposure of a .png output and of a sequence's .png previews: png = srgb(clamp(exposure x value, 0, "
+                    "1)), as Python's exposure; the EXRs are never scaled")
+        ->capture_default_str();
+    addVerbosityFlags(*cmd);
     cmd->callback([a, cmd] { run(*a, *cmd); });
 }
 

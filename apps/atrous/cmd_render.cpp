@@ -33,7 +33,6 @@ struct RenderArgs {
     int referenceSpp = 0;
     std::string cameraPath = "auto";
     std::string device = "auto";
-    bool quiet = false;  // no progress line on stderr
 };
 
 // Seeds of the noisy and reference renders of frame f: every noisy frame gets its own noise (a
@@ -78,12 +77,12 @@ void runFrames(const RenderArgs& a) {
     const std::vector<std::string> stale =
         io::removeSequenceEntries(a.out, "", [&](int index) { return index < a.frames; });
     if (!stale.empty())
-        std::fprintf(stderr, "render: removed %zu frame director%s of an earlier run from %s (%s%s)\n", stale.size(),
+        logLine("render: removed %zu frame director%s of an earlier run from %s (%s%s)\n", stale.size(),
                      stale.size() == 1 ? "y" : "ies", a.out.c_str(), stale.front().c_str(),
                      stale.size() > 2 ? (", ..., " + stale.back()).c_str() : stale.size() == 2 ? (", " + stale.back()).c_str() : "");
     Timer total;
     const uint64_t frameSamples = uint64_t(s.width) * uint64_t(s.height) * uint64_t(s.spp + a.referenceSpp);
-    ProgressLine progress(!a.quiet && stderrIsTerminal(), "render", frameSamples * uint64_t(a.frames), a.frames);
+    ProgressLine progress(!quiet() && stderrIsTerminal(), "render", frameSamples * uint64_t(a.frames), a.frames);
     for (int f = 0; f < a.frames; ++f) {
         progress.setFrame(f);
         const float t = frameTime(f, a.frames);
@@ -119,10 +118,10 @@ void runFrames(const RenderArgs& a) {
         if (!ec) fs::rename(stage, dir, ec);
         if (ec) throw RuntimeError(dir + ": cannot move the frame into place (" + ec.message() + ")");
         progress.above(
-            [&] { std::printf("frame %d/%d (t = %.4f): %.3f s -> %s\n", f + 1, a.frames, t, seconds, dir.c_str()); });
+            [&] { resultLine("frame %d/%d (t = %.4f): %.3f s -> %s\n", f + 1, a.frames, t, seconds, dir.c_str()); });
     }
     progress.finish();
-    std::printf("rendered %s: %d frames, %dx%d, %d spp%s, %.3f s -> %s\n", scene.name().c_str(), a.frames, s.width,
+    resultLine("rendered %s: %d frames, %dx%d, %d spp%s, %.3f s -> %s\n", scene.name().c_str(), a.frames, s.width,
                 s.height, s.spp, a.referenceSpp > 0 ? (", reference " + std::to_string(a.referenceSpp) + " spp").c_str() : "",
                 total.seconds(), a.out.c_str());
 }
@@ -159,7 +158,7 @@ void run(const RenderArgs& a) {
     // The CUDA path tracer runs the same per-pixel kernel over a BVH built by Embree's builder
     // (no progress line there: it reports no tiles, and it is fast).
     RenderSettings rs = s;
-    ProgressLine progress(!a.quiet && stderrIsTerminal() && device == Device::Cpu, "render",
+    ProgressLine progress(!quiet() && stderrIsTerminal() && device == Device::Cpu, "render",
                           uint64_t(s.width) * uint64_t(s.height) * uint64_t(s.spp));
     rs.samplesDone = progress.counter();
     RenderBuffers b = render(scene, device == Device::Cuda ? s : rs, device);
@@ -193,10 +192,12 @@ void run(const RenderArgs& a) {
     }
 
     double samples = double(s.width) * s.height * s.spp;
-    std::printf("rendered %s on %s: %dx%d, %d spp, max depth %d, %.3f s, %.2f M samples/s", scene.name().c_str(),
-                deviceToString(device), s.width, s.height, s.spp, s.maxDepth, seconds, samples / seconds * 1e-6);
-    if (!denoised.empty()) std::printf(", denoised (%s) in %.3f s", a.denoise.c_str(), denoiseSeconds);
-    std::printf(" -> %s\n", a.out.c_str());
+    char secondsText[32];
+    std::snprintf(secondsText, sizeof secondsText, "%.3f", denoiseSeconds);
+    const std::string denoisedText = denoised.empty() ? "" : ", denoised (" + a.denoise + ") in " + secondsText + " s";
+    resultLine("rendered %s on %s: %dx%d, %d spp, max depth %d, %.3f s, %.2f M samples/s%s -> %s\n", scene.name().c_str(),
+           deviceToString(device), s.width, s.height, s.spp, s.maxDepth, seconds, samples / seconds * 1e-6, denoisedText.c_str(),
+           a.out.c_str());
 }
 
 }  // namespace
@@ -222,11 +223,14 @@ void addRenderCommand(CLI::App& app) {
                                    "Render an animation of this many frames into OUT/frame_NNNN/ (time t = f / max(F-1, 1))")->check(kNonEmptyNumber);
     cmd->add_option("--reference-spp", args->referenceSpp, "With --frames: also write reference.exr per frame at this spp (other seed)")->check(kNonEmptyNumber);
     cmd->add_option("--camera-path", args->cameraPath, "With --frames: auto, static, orbit, dolly or keyframes")->capture_default_str();
-    cmd->add_flag("--quiet", args->quiet,
-                  "No progress line on stderr (it is shown only when stderr is a terminal: per frame with an ETA "
-                  "for --frames, by finished tiles for a still image)");
+    // --quiet: nothing but errors (also no progress line, which is shown only when stderr is a terminal:
+    // per frame with an ETA for --frames, by finished tiles for a still image); -v.
+    addVerbosityFlags(*cmd);
     cmd->callback([args, frames] {
         args->framesGiven = frames->count() > 0;
+        // --threads (the render table's row: the path tracer's arena) also limits the rest of the
+        // run, the --denoise filters and the writers, through TBB's global_control (cli_flags.h).
+        const auto threadLimit = limitThreads(args->settings.threads);
         run(*args);
     });
 }

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "atrous/error.h"
+#include "progress.h"
 #include "atrous/io/sequence.h"
 #include "atrous/temporal.h"
 
@@ -95,7 +96,7 @@ void runFlickerCompare(const FlickerCompareArgs& a) {
     const FlickerGuide guide = FlickerGuide::load(a.input.empty() ? a.sequences[0] : a.input, &notes);
     std::vector<FlickerMetrics> ms;
     for (size_t k = 0; k < seqs.size(); ++k) ms.push_back(guide.measure(seqs[k], a.sequences[k]));
-    for (const std::string& n : notes) std::fprintf(stderr, "%s\n", n.c_str());
+    for (const std::string& n : notes) logLine("%s\n", n.c_str());
     std::vector<size_t> order(seqs.size());
     std::iota(order.begin(), order.end(), size_t(0));
     std::stable_sort(order.begin(), order.end(), [&](size_t x, size_t y) { return ms[x].relMse < ms[y].relMse; });
@@ -109,19 +110,19 @@ void runFlickerCompare(const FlickerCompareArgs& a) {
                                       {"reprojected", ms[k].reprojected}});
         j["ranking"] = nlohmann::json::array();
         for (size_t k : order) j["ranking"].push_back(a.sequences[k]);
-        std::printf("%s\n", j.dump(2).c_str());
+        resultLine("%s\n", j.dump(2).c_str());
         return;
     }
-    std::printf("no reference: flicker = relMSE of each frame against the one before it, warped by the motion of %s, "
+    resultLine("no reference: flicker = relMSE of each frame against the one before it, warped by the motion of %s, "
                 "where it reprojects\n", guide.dir().c_str());
-    std::printf("%-32s %7s %14s %12s\n", "sequence", "frames", "flicker", "reprojected");
+    resultLine("%-32s %7s %14s %12s\n", "sequence", "frames", "flicker", "reprojected");
     for (size_t k = 0; k < seqs.size(); ++k)
-        std::printf("%-32s %7zu %14.6g %11.1f%%\n", a.sequences[k].c_str(), seqs[k].size(), ms[k].relMse,
+        resultLine("%-32s %7zu %14.6g %11.1f%%\n", a.sequences[k].c_str(), seqs[k].size(), ms[k].relMse,
                     100.0 * ms[k].reprojected);
     if (seqs.size() > 1) {
-        std::printf("ranking (least flicker first):");
-        for (size_t i = 0; i < order.size(); ++i) std::printf("%s %s", i ? "," : "", a.sequences[order[i]].c_str());
-        std::printf("\n");
+        resultLine("ranking (least flicker first):");
+        for (size_t i = 0; i < order.size(); ++i) resultLine("%s %s", i ? "," : "", a.sequences[order[i]].c_str());
+        resultLine("\n");
     }
 }
 

@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "cli_flags.h"
+#include "progress.h"
 
 namespace atrous::cli {
 
@@ -23,24 +24,22 @@ void addSequenceOptions(CLI::App& cmd, std::deque<ParamSet>& params, bool (*keep
 }
 
 int runSequenceDenoise(const SequenceDenoiseArgs& args) {
+    // The frame lines and the summary are results (stdout); notes, warnings and the k/N counter
+    // are the log (stderr); --quiet silences all of them (progress.h).
+    FrameCounter counter("denoise", !quiet());
     SequenceEvents events;
-    events.note = [](const std::string& line) {
-        std::printf("%s\n", line.c_str());
-        std::fflush(stdout);
+    events.note = [&](const std::string& line) { counter.above([&] { logLine("%s\n", line.c_str()); }); };
+    events.warning = events.note;
+    events.frame = [&](const SequenceFrameReport& f) {
+        counter.above([&] { resultLine("%s\n", f.line.c_str()); });
+        counter.frameDone(f.position, f.count);
     };
-    events.warning = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
-    if (!args.quiet)
-        events.frame = [](const SequenceFrameReport& f) {
-            std::printf("%s\n", f.line.c_str());
-            std::fflush(stdout);
-        };
     const SequenceReport r = denoiseSequence(args.sequenceDir, args.outDir, args.options, events);
-    if (!args.quiet) {
-        std::printf("sequence: %zu frames, filter %.1f ms per frame, %.1f ms per frame in all (reading and writing "
-                    "overlapped with filtering)\n",
-                    r.frames.size(), r.filterMsPerFrame, r.wallMsPerFrame);
-        if (!r.preview.empty()) std::printf("animated preview: %s\n", r.preview.c_str());
-    }
+    counter.finish();
+    resultLine("sequence: %zu frames, filter %.1f ms per frame, %.1f ms per frame in all (reading and writing overlapped "
+           "with filtering)\n",
+           r.frames.size(), r.filterMsPerFrame, r.wallMsPerFrame);
+    if (!r.preview.empty()) resultLine("animated preview: %s\n", r.preview.c_str());
     return 0;
 }
 

@@ -1,6 +1,6 @@
 // `atrous denoise --sequence DIR --out OUTDIR [--method a sequence or still method]`: the CLI's
-// side of the library's sequence session (include/atrous/sequence.h): it prints the session's
-// notes and one line per frame, then a summary.
+// side of the library's sequence session (include/atrous/sequence.h): it prints one line per frame
+// and a summary (stdout), the session's notes and a k/N counter with an ETA (stderr; progress.h).
 #pragma once
 #include <CLI/CLI.hpp>
 
@@ -17,7 +17,6 @@ struct SequenceDenoiseArgs {
     std::string sequenceDir;        // --sequence: a folder or a frame pattern
     std::string outDir;             // --out
     SequenceDenoiseOptions options;  // everything else
-    bool quiet = false;             // no per-frame lines or summary on stdout (notes still print)
 };
 
 // Runs the session and prints as it goes. Throws InputError for bad input (the CLI turns it into

@@ -89,9 +89,11 @@ int main(int argc, char** argv) {
     // a value refuses an empty one.
     static const CLI::Validator kNonEmpty(
         [](std::string& v) { return v.empty() ? std::string("an empty value") : std::string(); }, "", "non-empty");
+    // (denoise's positionals IN OUT refuse an empty one themselves, after CLI11 has named an
+    // unknown flag whose empty value it took: `denoise --export ''` is about --export.)
     for (CLI::App* cmd : app.get_subcommands({}))
         for (CLI::Option* opt : cmd->get_options())
-            if (opt->get_expected_min() > 0) opt->check(kNonEmpty);
+            if (opt->get_expected_min() > 0 && !(opt->get_positional() && cmd->get_name() == "denoise")) opt->check(kNonEmpty);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

@@ -1,13 +1,19 @@
-// A progress line on stderr for long CLI runs (`atrous render`): "render: frame 3/32, 41%
-// (1 min 02 s, ETA 1 min 30 s)", redrawn in place once a second by a helper thread. Only when
-// stderr is a terminal (logs and tests see nothing) and --quiet was not given.
+// What the CLI prints, and where (docs/cli.md, "Output"): results, the lines a script parses, on
+// stdout (resultLine()); everything else, notes and what was done, on stderr (logLine()); the stage times
+// only with -v (verbose()); nothing but an error with --quiet. And a progress line on stderr
+// for long CLI runs (`atrous render`): "render: frame 3/32, 41% (1 min 02 s, ETA 1 min 30 s)",
+// redrawn in place once a second by a helper thread, only when stderr is a terminal (logs and
+// tests see nothing) and --quiet was not given; sequences count frames (FrameCounter).
 #pragma once
 #include <unistd.h>
+
+#include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <cstdarg>
 #include <cstdint>
 #include <cstdio>
 #include <mutex>
@@ -19,6 +25,60 @@
 namespace atrous::cli {
 
 inline bool stderrIsTerminal() { return ::isatty(STDERR_FILENO) == 1; }
+
+// Erases the terminal's current line (a progress line drawn in place).
+inline void eraseLine() {
+    std::fputs("\r\033[K", stderr);
+    std::fflush(stderr);
+}
+
+enum class Verbosity { Quiet, Normal, Verbose };
+// The command's --quiet / -v (addVerbosityFlags); Normal unless given.
+inline Verbosity& verbosity() {
+    static Verbosity v = Verbosity::Normal;
+    return v;
+}
+inline bool quiet() { return verbosity() == Verbosity::Quiet; }
+
+// --quiet and -v,--verbose on a command (denoise, render, compare). No -q: on denoise it is
+// oidnDenoise's --quality.
+inline void addVerbosityFlags(CLI::App& cmd) {
+    cmd.add_flag_callback("--quiet", [] { verbosity() = Verbosity::Quiet; },
+                          "Print nothing on success (an error is still one line on stderr, exit status 2)");
+    cmd.add_flag_callback("-v,--verbose", [] { verbosity() = Verbosity::Verbose; },
+                          "Also print the stage times (on stderr)");
+}
+
+// A result line on stdout (what a script parses); nothing with --quiet. Flushed.
+inline void resultLine(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
+inline void resultLine(const char* fmt, ...) {
+    if (quiet()) return;
+    va_list ap;
+    va_start(ap, fmt);
+    std::vprintf(fmt, ap);
+    va_end(ap);
+    std::fflush(stdout);
+}
+
+// A log line on stderr (notes, what was done); nothing with --quiet.
+inline void logLine(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
+inline void logLine(const char* fmt, ...) {
+    if (quiet()) return;
+    va_list ap;
+    va_start(ap, fmt);
+    std::vfprintf(stderr, fmt, ap);
+    va_end(ap);
+}
+
+// A line on stderr with -v only (stage times).
+inline void verbose(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
+inline void verbose(const char* fmt, ...) {
+    if (verbosity() != Verbosity::Verbose) return;
+    va_list ap;
+    va_start(ap, fmt);
+    std::vfprintf(stderr, fmt, ap);
+    va_end(ap);
+}
 
 // "42 s", "3 min 05 s", "1 h 02 min".
 inline std::string durationText(double seconds) {
@@ -32,6 +92,59 @@ inline std::string durationText(double seconds) {
         std::snprintf(buf, sizeof(buf), "%ld h %02ld min", s / 3600, (s / 60) % 60);
     return buf;
 }
+
+// "denoise: frame 3/24 (2 s, ETA 14 s)" on stderr as each frame of a sequence is done: redrawn in
+// place on a terminal, one line per frame otherwise (logs); nothing when disabled (--quiet). Called
+// from one thread (the sequence session's events).
+class FrameCounter {
+public:
+    FrameCounter(std::string label, bool enabled) : mLabel(std::move(label)), mEnabled(enabled), mTty(stderrIsTerminal()) {}
+    ~FrameCounter() { finish(); }
+    FrameCounter(const FrameCounter&) = delete;
+    FrameCounter& operator=(const FrameCounter&) = delete;
+
+    // Runs print() with the counter cleared, then draws it again (a terminal).
+    template <class F>
+    void above(F&& print) {
+        clear();
+        print();
+        std::fflush(stdout);
+        if (mTty && !mLine.empty()) draw();
+    }
+
+    // The k-th of n frames is done (1-based).
+    void frameDone(int k, int n) {
+        if (!mEnabled || k < 1 || n < 1) return;
+        const double elapsed = mTimer.seconds();
+        mLine = mLabel + ": frame " + std::to_string(k) + "/" + std::to_string(n) + " (" + durationText(elapsed) +
+                (k < n ? ", ETA " + durationText(elapsed / k * (n - k)) : std::string()) + ")";
+        draw();
+    }
+
+    // Clears the line on a terminal (idempotent).
+    void finish() {
+        clear();
+        mLine.clear();
+    }
+
+private:
+    void draw() {
+        if (!mEnabled) return;
+        std::fputs(((mTty ? "\r\033[K" : "") + mLine + (mTty ? "" : "\n")).c_str(), stderr);
+        std::fflush(stderr);
+        mShown = mTty;
+    }
+    void clear() {
+        if (mShown) eraseLine();
+        mShown = false;
+    }
+
+    const std::string mLabel;
+    const bool mEnabled, mTty;
+    std::string mLine;
+    bool mShown = false;
+    Timer mTimer;
+};
 
 class ProgressLine {
 public:
@@ -105,9 +218,7 @@ private:
     }
 
     void clearLocked() {
-        if (!mShown) return;
-        std::fputs("\r\033[K", stderr);
-        std::fflush(stderr);
+        if (mShown) eraseLine();
         mShown = false;
     }
 

@@ -5,9 +5,11 @@
 // layered EXRs such as Blender's renderNNNN.exr, or a pattern render####.exr / render%04d.exr),
 // checks every frame's headers before anything is written, denoises each frame through its
 // method's SequenceDenoiser (atrous/sequence_methods.h: temporal with the frames around it, svgf
-// with its history; a still method on its own), and moves
-// OUTDIR/frame_NNNN.exr (+ .png previews, + preview.mp4 through ffmpeg when it is on PATH) into
-// place only when every frame is done. Bad input throws InputError naming the frame's file.
+// with its history; a still method on its own), and moves the
+// output frames (+ .png previews, + preview.mp4 through ffmpeg when it is on PATH) into place only
+// when every frame is done. The outputs keep their input's names (render0001.exr ->
+// OUT/render0001.exr, a frame folder frame_0001/ -> OUT/frame_0001.exr), or follow a pattern
+// OUT = DIR/clean####.exr (atrous/io/sequence_output.h). Bad input throws InputError naming the frame's file.
 #pragma once
 #include <functional>
 #include <string>
@@ -41,15 +43,16 @@ struct SequenceDenoiseOptions {
     // The frames start .. end (inclusive; -1 = the first / the last present), every step-th.
     int start = -1, end = -1, step = 1;
     float exposure = 1.0f;  // of the PNG previews
-    bool pngs = true;       // OUTDIR/frame_NNNN.png beside each EXR
+    bool pngs = true;       // OUT/NAME.png beside each EXR
     bool preview = true;    // OUTDIR/preview.mp4 through ffmpeg when it is on PATH (needs pngs)
 };
 
 // One denoised frame, as it is done.
 struct SequenceFrameReport {
     int index = 0;          // the frame's number in the input
+    int position = 0, count = 0;  // this is the position-th frame (1-based) of the run's count (k/N counters)
     std::string input;      // the frame's file or folder
-    std::string output;     // OUTDIR/frame_NNNN.exr (where it will be once the run is done)
+    std::string output;     // OUT/NAME.exr (where it will be once the run is done; NAME: the input's, or the pattern's)
     std::string method;     // the method and its SequenceOutput::detail: "temporal (+-3 frames, 3.8 averaged per pixel in 6 ms; then auto -> blend)"
     std::string methodUsed; // the still method that ran (blend, sure, ...), else the sequence method's name
     double milliseconds = 0;
@@ -77,11 +80,13 @@ struct SequenceEvents {
     std::function<void(const std::string&)> warning;
 };
 
-// Denoises every frame of `input` (a folder or a frame pattern) into the folder `outDir` (created;
-// an existing one keeps its other files, and this run's frame files replace those of an earlier
-// one). Throws InputError for bad input or options (nothing reaches outDir then) and
-// RuntimeError when the output cannot be moved into place.
-SequenceReport denoiseSequence(const std::string& input, const std::string& outDir,
+// Denoises every frame of `input` (a folder or a frame pattern) into `out`: a folder (created; an
+// existing one keeps its other files, this run's files replace those of the same name and an
+// earlier run's frame_NNNN.exr/.png that this run does not write are removed), the frames keeping
+// their input's names, or a pattern DIR/NAME####.exr / DIR/NAME%04d.exr. Throws InputError for bad
+// input or options (a bad pattern, an output folder that is the input's or inside it: nothing
+// reaches the output then) and RuntimeError when the output cannot be moved into place.
+SequenceReport denoiseSequence(const std::string& input, const std::string& out,
                                const SequenceDenoiseOptions& options, const SequenceEvents& events = {});
 
 }  // namespace atrous

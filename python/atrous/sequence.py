@@ -203,10 +203,14 @@ def denoise_sequence(input: "os.PathLike", out: "os.PathLike", *, method: Option
     params: a sequence method's own keywords as a dict under its table's name (the ``params`` of
     :func:`sequence_methods`: temporal={"radius": 2}, svgf={...}); the other keywords are the
     still method's rows (:func:`atrous.denoise_params`). on_frame(dict) is called as each frame is
-    done. Writes out/frame_NNNN.exr (+ .png and preview.mp4 unless pngs/preview are False) only
-    when every frame is done; `out` must not be inside the input's folder. Returns the run's
+    done. Writes the frames into the folder `out` under their input's names (render0001.exr ->
+    out/render0001.exr, a frame folder frame_0001/ -> out/frame_0001.exr), or by a pattern `out` =
+    DIR/clean####.exr (the frame number zero-padded to the count of #'s; or %04d), + .png and
+    preview.mp4 unless pngs/preview are False, only when every frame is done; `out` must not be
+    inside the input's folder. Returns the run's
     report: width, height, buffers (the names every frame has), frames (one dict each: index,
-    input, output, method, method_used, ms, reprojected, mse, mse_input, line),
+    input, output, method, method_used, ms, reprojected, mse, mse_input, line, and position and
+    count: the k-th of the run's N frames, for a k/N counter),
     filter_ms_per_frame, wall_ms_per_frame, preview (the video's path, or None) and notes.
     Raises ValueError for bad input (nothing is written then)."""
     tables = {str(r["params"]) for r in _core.sequence_methods() if r["params"]}

@@ -18,6 +18,7 @@
 #include "atrous/temporal.h"
 #include "frame.h"
 #include "params.h"
+#include "words.h"
 
 namespace nb = nanobind;
 
@@ -246,6 +247,7 @@ nb::dict pyDenoiseSequence(const std::string& input, const std::string& out, con
         d["mse"] = f.hasReference ? nb::cast(f.mse) : nb::none();
         d["mse_input"] = f.hasReference ? nb::cast(f.mseInput) : nb::none();
         d["line"] = f.line;
+        d["position"] = f.position, d["count"] = f.count;  // the k-th of the run's N frames (k/N counters)
         return d;
     };
     SequenceEvents events;
@@ -255,9 +257,16 @@ nb::dict pyDenoiseSequence(const std::string& input, const std::string& out, con
             onFrame(frameDict(f));
         };
     SequenceReport r;
-    {
+    try {
         nb::gil_scoped_release release;
         r = denoiseSequence(input, out, o, events);
+    } catch (const InputError& e) {
+        // The session's messages name the CLI's flags: Python's keywords here (words.h).
+        throw InputError(pythonWords(e.what(), {{"--sequence", "input"}, {"--out", "out"}, {"--method", "method"},
+                                                {"--spatial", "spatial"}, {"--pass", "passes"}, {"--layer", "layer"},
+                                                {"--add-pass", "add_pass"}, {"--start", "start"}, {"--end", "end"},
+                                                {"--step", "step"}, {"--exposure", "exposure"}, {"--device", "device"},
+                                                {"--learned-weights", "learned_weights"}}));
     }
     nb::dict d;
     nb::list frames;

@@ -19,11 +19,13 @@
 #include "atrous/sequence_methods.h"
 #include "atrous/temporal.h"
 #include "atrous/timer.h"
+#include "atrous/io/alpha.h"
 #include "atrous/io/buffer_set.h"
 #include "atrous/io/image_io.h"
 #include "atrous/io/paths.h"
 #include "io/reprojection_check.h"
 #include "atrous/io/sequence.h"
+#include "atrous/io/sequence_output.h"
 #include "atrous/io/staged_dir.h"
 
 namespace fs = std::filesystem;
@@ -56,22 +58,35 @@ std::string format(const char* fmt, ...) {
     return buf;
 }
 
-// Encodes the staged PNGs into stage/preview.mp4 (24 fps). Returns "" when it did, else a note
+// Encodes the staged PNGs (`pngs`, in frame order, named as the frames are) into
+// stage/preview.mp4 (24 fps), through hard links numbered 0, 1, ... in a hidden folder of the
+// stage (the frames' own names need not share one numbering). Returns "" when it did, else a note
 // saying why not.
-std::string writeAnimatedPreview(const std::string& stage, int firstIndex, const std::string& finalDir) {
+std::string writeAnimatedPreview(const std::string& stage, const std::vector<std::string>& pngs, const std::string& finalDir) {
     const std::string ffmpeg = io::findOnPath("ffmpeg");
     if (ffmpeg.empty())
         return "ffmpeg is not on PATH: skipping the animated preview (the per-frame PNGs are in " + finalDir + ")";
+    const fs::path links = fs::path(stage) / ".preview-frames";
+    std::error_code ec;
+    fs::create_directories(links, ec);
+    for (size_t i = 0; i < pngs.size() && !ec; ++i) {
+        const fs::path from = fs::path(stage) / pngs[i], to = links / format("%06zu.png", i);
+        fs::create_hard_link(from, to, ec);
+        if (ec) fs::copy_file(from, to, ec);
+    }
+    if (ec) {
+        fs::remove_all(links, ec);
+        return "warning: could not prepare the frames of the animated preview; none written";
+    }
     const std::string finalPath = (fs::path(stage) / "preview.mp4").string();
     const std::string tmpPath = (fs::path(stage) / ".preview.tmp.mp4").string();
     // Even dimensions for yuv420p.
-    const std::string cmd = io::shellQuote(ffmpeg) + " -nostdin -y -loglevel error -framerate 24 -start_number " +
-                            std::to_string(firstIndex) + " -i " +
-                            io::shellQuote((fs::path(stage) / "frame_%04d.png").string()) + " -vf " +
+    const std::string cmd = io::shellQuote(ffmpeg) + " -nostdin -y -loglevel error -framerate 24 -start_number 0 -i " +
+                            io::shellQuote((links / "%06d.png").string()) + " -vf " +
                             io::shellQuote("pad=ceil(iw/2)*2:ceil(ih/2)*2") + " -pix_fmt yuv420p -f mp4 " +
                             io::shellQuote(tmpPath);
     const int rc = std::system(cmd.c_str());
-    std::error_code ec;
+    fs::remove_all(links, ec);
     if (rc != 0) {
         fs::remove(tmpPath, ec);
         return "warning: ffmpeg failed (exit status " + std::to_string(rc) + "); no animated preview written";
@@ -88,8 +103,7 @@ std::string writeAnimatedPreview(const std::string& stage, int firstIndex, const
 const SequenceMethodInfo* rowOf(const std::string& method) { return findSequenceMethod(method); }
 
 // What is checked before any frame is read.
-void checkOptions(const std::string& input, const std::string& outDir, const SequenceDenoiseOptions& o,
-                  const std::string& method) {
+void checkOptions(const std::string& input, const SequenceDenoiseOptions& o, const std::string& method) {
     const SequenceMethodInfo* row = rowOf(method);
     if (!row && !findDenoiseMethod(method))
         throw InputError("--method '" + method + "' cannot denoise a sequence (expected " + sequenceMethodNames() +
@@ -99,7 +113,6 @@ void checkOptions(const std::string& input, const std::string& outDir, const Seq
     if (row && o.step > 1)
         throw InputError("--step " + std::to_string(o.step) + ": " + row->acrossFrames +
                          ", and the motion vectors do not span skipped frames (use --step 1, or a per-frame --method)");
-    if (outDir.empty()) throw InputError("--out: no output directory given");
     if (!(o.exposure > 0.0f)) throw InputError("--exposure must be > 0");
     if (row && !o.params.empty()) {
         if (std::string(o.params.set()) != row->params.set())
@@ -139,11 +152,13 @@ private:
     void checkAgainstPrevious(const io::SequenceFrame& f, size_t i, bool estimated);
     void push(FramePtr f);
     void outputFrame();
-    void writeFrame(const std::string& name, std::shared_ptr<io::ExrInfo> layered, Image out);
+    void writeFrame(const std::string& name, const FramePtr& frame, Image out);
     void finishFrame(SequenceFrameReport& r, const SequenceOutput& out, const std::string& name);
     void writePreviewAndCommit();
 
     const std::string mInput, mOutDir;
+    io::SequenceOutputNames mNames;  // mOutDir parsed: the output folder, the frames' names
+    std::vector<std::string> mPngs;  // the previews written, in order (preview.mp4's frames)
     const SequenceDenoiseOptions& mArgs;
     const SequenceEvents& mEvents;
     const std::string mMethod;
@@ -159,7 +174,6 @@ private:
     std::vector<io::ReprojectionCheck> mChecks;
     StreamMotion mMotion;  // frames without motion vectors
     bool mIdsTrusted = true, mWarnedSign = false, mNotedMotion = false;
-    int mFirstIndex = 0;
     std::future<void> mWriting;
     double mFilterMs = 0.0;
 };
@@ -167,14 +181,15 @@ private:
 // Everything that can be checked before writing is checked first; what only decoding finds (a
 // truncated EXR) fails inside the loop, before anything reaches OUTDIR (StagedDir).
 void Session::start() {
-    checkOptions(mInput, mOutDir, mArgs, mMethod);
+    checkOptions(mInput, mArgs, mMethod);
+    mNames = io::parseSequenceOutput("--out", mOutDir);
     mLayers.passes = io::parsePassRequests(mArgs.passes);
     mLayers.viewLayer = mArgs.viewLayer;
     io::FrameRange range;
     range.start = mArgs.start, range.end = mArgs.end, range.step = mArgs.step;
-    // OUTDIR in the sequence directory would take its frame_NNNN.exr names (io/paths.h). (A
-    // pattern's frames are in its directory.)
-    io::refuseOutputInside("--out", mOutDir, io::sequenceFolder(mInput));
+    // Outputs never overwrite inputs: the output folder is neither the sequence's folder nor inside
+    // it (io/paths.h; a pattern's frames are in its folder), and the frames keep their names.
+    io::refuseOutputInside("--out", mNames.dir, io::sequenceFolder(mInput));
     mFrames = io::listSequenceFrames(mInput, range);
     if (!mArgs.addPass.empty() && !io::isLayeredSequenceFrame(mFrames.front()))
         throw InputError("--add-pass '" + mArgs.addPass + "': copies a layered EXR frame, and " + mInput +
@@ -190,7 +205,7 @@ void Session::start() {
     setup.motionGiven = std::find(mPresent.begin(), mPresent.end(), "motion") != mPresent.end();
     mDenoiser = makeSequenceDenoiser(mMethod, setup);
     mUsesMotion = mDenoiser->reads().has(Buffer::Motion);
-    mStaged = std::make_unique<io::StagedDir>("--out", mOutDir);
+    mStaged = std::make_unique<io::StagedDir>("--out", mNames.dir);
     mChecks.resize(mFrames.size());
 }
 
@@ -229,7 +244,7 @@ bool Session::fillMotion(io::SequenceFrame& f, size_t i) {
 // Other renderers' sequences: how much reprojects, with which sign, and whether ids hold (ids that
 // change between frames are left out of every frame from here on).
 void Session::checkAgainstPrevious(const io::SequenceFrame& f, size_t i, bool estimated) {
-    const std::string name = io::sequenceFrameName(f.index);
+    const std::string name = fs::path(f.dir).filename().string();
     io::ReprojectionCheck& check = mChecks[i];
     if (mPrev && !estimated)
         check = io::checkReprojection(f.depth, f.normal, f.ids, f.motion, mPrev->depth, mPrev->normal, mPrev->ids);
@@ -265,13 +280,18 @@ void Session::push(FramePtr f) {
     while (mDenoiser->ready()) outputFrame();
 }
 
-void Session::writeFrame(const std::string& name, std::shared_ptr<io::ExrInfo> layered, Image out) {
+// The frame's colour alpha (an RGBA EXR's A, Blender's Combined.A), read on the writing thread, is
+// written beside the denoised colour unchanged (io/alpha.h, as the still path does).
+void Session::writeFrame(const std::string& name, const FramePtr& frame, Image out) {
     if (mWriting.valid()) mWriting.get();  // frame N-1's files, and its errors, before frame N's
     const std::string stage = mStaged->stage();
-    mWriting = std::async(std::launch::async, [this, stage, name, layered, img = std::make_shared<Image>(std::move(out))] {
+    mWriting = std::async(std::launch::async, [this, stage, name, frame, rgb = std::make_shared<Image>(std::move(out))] {
         const std::string exrOut = (fs::path(stage) / (name + ".exr")).string();
+        const auto img = std::make_shared<Image>(io::withAlpha(std::move(*rgb), io::readFrameAlpha(*frame, mLayers)));
+        const std::vector<std::string> channels = img->channels() == 4 ? std::vector<std::string>{"R", "G", "B", "A"}
+                                                                       : std::vector<std::string>{"R", "G", "B"};
         if (!mArgs.addPass.empty())
-            io::writeExrWithLayers(exrOut, *layered, {io::ExrOutLayer{mArgs.addPass, img.get()}});
+            io::writeExrWithLayers(exrOut, *frame->layered, {io::ExrOutLayer{mArgs.addPass, img.get(), channels}});
         else
             writeImage(exrOut, *img);
         if (mArgs.pngs) io::writePng((fs::path(stage) / (name + ".png")).string(), *img, mArgs.exposure);
@@ -294,11 +314,14 @@ void Session::finishFrame(SequenceFrameReport& r, const SequenceOutput& out, con
 // The next frame out of the denoiser, written and reported.
 void Session::outputFrame() {
     const FramePtr f = mPending.front();
-    const std::string name = io::sequenceFrameName(f->index);
+    const std::string name = mNames.stem(f->dir, f->index);
     SequenceFrameReport r;
     r.index = f->index;
+    r.position = int(mReport.frames.size()) + 1;
+    r.count = int(mFrames.size());
     r.input = f->dir;
-    r.output = (fs::path(mOutDir) / (name + ".exr")).string();
+    r.output = (fs::path(mNames.dir) / (name + ".exr")).string();
+    if (mArgs.pngs) mPngs.push_back(name + ".png");
     r.hasReference = !f->reference.empty();
     r.mseInput = r.hasReference ? meanSquaredError(f->color, f->reference) : 0.0;
     Timer timer;
@@ -312,15 +335,15 @@ void Session::outputFrame() {
     mFilterMs += r.milliseconds;
     if (r.hasReference) r.mse = meanSquaredError(out.image, f->reference);
     mPending.pop_front();
-    writeFrame(name, f->layered, std::move(out.image));
+    writeFrame(name, f, std::move(out.image));
     finishFrame(r, out, name);
 }
 
 void Session::writePreviewAndCommit() {
     if (mArgs.preview && mArgs.pngs) {
-        const std::string problem = writeAnimatedPreview(mStaged->stage(), mFirstIndex, mOutDir);
+        const std::string problem = writeAnimatedPreview(mStaged->stage(), mPngs, mNames.dir);
         if (problem.empty())
-            mReport.preview = (fs::path(mOutDir) / "preview.mp4").string();
+            mReport.preview = (fs::path(mNames.dir) / "preview.mp4").string();
         else
             note(problem);
     }
@@ -339,7 +362,6 @@ SequenceReport Session::run() {
     for (size_t i = 0; i < mFrames.size(); ++i) {
         FramePtr f = std::make_shared<io::SequenceFrame>(next.get());
         if (i + 1 < mFrames.size()) next = std::async(std::launch::async, load, i + 1);
-        if (i == 0) mFirstIndex = f->index;
         const bool estimated = fillMotion(*f, i);
         checkAgainstPrevious(*f, i, estimated);
         mPrev = f;

@@ -96,6 +96,12 @@ std::string companion(const std::string& frame, const char* what) {
 
 std::string sizeText(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
 
+// `index` zero-padded to `width` digits (a missing frame named as its neighbours are: render0007).
+std::string padded(int index, size_t width) {
+    std::string n = std::to_string(index);
+    return std::string(width > n.size() ? width - n.size() : 0, '0') + n;
+}
+
 // The image size from the EXR header alone, after the size rule of exr_limits.h.
 void exrSize(const std::string& path, int& w, int& h) {
     try {
@@ -145,30 +151,6 @@ int parseSequenceFrameName(const std::string& name) {
     for (char c : digits)
         if (!std::isdigit(static_cast<unsigned char>(c))) return -1;
     return std::stoi(digits);
-}
-
-std::vector<std::string> removeSequenceEntries(const std::string& dir, const std::string& suffix,
-                                               const std::function<bool(int)>& keep) {
-    std::vector<fs::path> doomed;
-    std::error_code ec;
-    for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
-        const std::string name = it->path().filename().string();
-        if (name.size() <= suffix.size() || name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0) continue;
-        std::error_code ec2;
-        // Directories for frame_NNNN, regular files for frame_NNNN.exr: never anything else.
-        if (suffix.empty() ? !it->is_directory(ec2) : !it->is_regular_file(ec2)) continue;
-        const int index = parseSequenceFrameName(name.substr(0, name.size() - suffix.size()));
-        if (index >= 0 && !keep(index)) doomed.push_back(it->path());
-    }
-    if (ec) throw RuntimeError(dir + ": cannot list the directory (" + ec.message() + ")");
-    std::sort(doomed.begin(), doomed.end());
-    std::vector<std::string> removed;
-    for (const auto& p : doomed) {
-        fs::remove_all(p, ec);
-        if (ec) throw RuntimeError(p.string() + ": cannot remove a stale entry of an earlier run (" + ec.message() + ")");
-        removed.push_back(p.filename().string());
-    }
-    return removed;
 }
 
 bool isLayeredSequenceFrame(const std::string& frame) { return isLayeredFrame(frame); }
@@ -278,7 +260,9 @@ FrameListing listPatternFrames(const std::string& dir, const FramePattern& pat) 
     FrameListing l;
     for (auto it = fs::directory_iterator(pat.dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
         std::error_code ec2;
-        const int n = it->is_regular_file(ec2) ? matchFramePattern(pat, it->path().filename().string()) : -1;
+        const int n = matchFramePattern(pat, it->path().filename().string());
+        if (n >= 0 && !it->is_regular_file(ec2))
+            throw InputError("sequence " + dir + ": " + it->path().string() + " matches the pattern but is not a regular file");
         if (n >= 0) l.frames.emplace_back(n, it->path().string());
     }
     if (ec) throw InputError("sequence " + dir + ": cannot list " + pat.dir + " (" + ec.message() + ")");
@@ -293,6 +277,18 @@ FrameListing listPatternFrames(const std::string& dir, const FramePattern& pat) 
 struct DirectoryLayouts {
     NumberedPaths frameDirs, folders, perBuffer, files;
     std::string prefix, firstFile, folderPrefix, firstFolder, firstPerBuffer;
+
+    // An entry named as a frame (render0002.exr, frame_0002, color_0002.exr) that is not what a
+    // frame is (a directory named like a file, a file named like a frame folder, a socket, a
+    // broken link): refused, so that a sequence is never cut short without a word.
+    static void refuseOddEntry(const std::string& dir, const fs::path& path, bool isDir) {
+        const std::string name = path.filename().string();
+        const bool fileName = parseLayeredFrameName(name) >= 0 || !perBufferName(name, nullptr).empty();
+        const bool folderName = parseSequenceFrameName(name) >= 0;
+        if (isDir ? fileName : (fileName || folderName))
+            throw InputError("sequence " + dir + ": " + path.string() + " is named as a frame but is " +
+                             (isDir ? "a directory" : "not a regular file") + " (remove or rename it)");
+    }
 
     void addDirectory(const std::string& dir, const fs::path& path) {
         const std::string name = path.filename().string();
@@ -360,11 +356,17 @@ struct DirectoryLayouts {
         if (l.frames.empty())
             throw InputError("sequence " + dir + ": no frame_NNNN directories, numbered frame folders with a colour file "
                              "(color.exr or RGB.exr), numbered files per buffer (color_0001.exr ...) or numbered EXR files");
-        l.label = [layered, byFolder, byBuffer, prefix = prefix, folderPrefix = folderPrefix,
-                   firstPerBuffer = firstPerBuffer](int index) {
-            if (layered) return prefix + std::to_string(index) + " (a numbered EXR file)";
-            if (byFolder) return folderPrefix + std::to_string(index) + " (a numbered frame folder)";
-            if (byBuffer) return "frame " + std::to_string(index) + " (" + firstPerBuffer + "'s number)";
+        // A missing frame is named as the file or folder expected, its number padded as the first's.
+        std::string tail;
+        if (byBuffer) perBufferName(firstPerBuffer, &tail);  // "_0001.exr"
+        const size_t width = layered ? fs::path(firstFile).stem().string().size() - prefix.size()
+                                     : byFolder ? firstFolder.size() - folderPrefix.size() : tail.size() ? tail.size() - 5 : 4;
+        const std::string head = byBuffer ? firstPerBuffer.substr(0, firstPerBuffer.size() - tail.size() + 1) : "";
+        const std::string ext = layered ? fs::path(firstFile).extension().string() : ".exr";
+        l.label = [layered, byFolder, byBuffer, width, head, ext, prefix = prefix, folderPrefix = folderPrefix](int index) {
+            if (layered) return prefix + padded(index, width) + ext;
+            if (byFolder) return folderPrefix + padded(index, width) + " (a numbered frame folder)";
+            if (byBuffer) return head + padded(index, width) + ext;
             return sequenceFrameName(index);
         };
         return l;
@@ -377,10 +379,14 @@ FrameListing listDirectoryFrames(const std::string& dir) {
     DirectoryLayouts layouts;
     for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
         std::error_code ec2;
-        if (it->is_directory(ec2))
+        if (it->is_directory(ec2)) {
+            DirectoryLayouts::refuseOddEntry(dir, it->path(), true);
             layouts.addDirectory(dir, it->path());
-        else if (it->is_regular_file(ec2))
+        } else if (it->is_regular_file(ec2)) {
             layouts.addFile(dir, it->path());
+        } else {
+            DirectoryLayouts::refuseOddEntry(dir, it->path(), false);
+        }
     }
     if (ec) throw InputError("sequence " + dir + ": cannot list the directory (" + ec.message() + ")");
     return layouts.choose(dir);
@@ -410,7 +416,8 @@ std::vector<std::string> keepFrameRange(const std::string& dir, FrameListing l, 
         if (i > 0 && kept[i].first != kept[i - 1].first + range.step)
             throw InputError("sequence " + dir + ": " + l.label(kept[i - 1].first + range.step) + " is missing (gap between " +
                              fs::path(kept[i - 1].second).filename().string() + " and " +
-                             fs::path(kept[i].second).filename().string() + ")");
+                             fs::path(kept[i].second).filename().string() +
+                             "; --start and --end pick a range of frames)");
         out.push_back(kept[i].second);
     }
     if (range.end >= 0 && kept.back().first + range.step <= last)

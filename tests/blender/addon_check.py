@@ -138,7 +138,7 @@ def main():
         check("6 frames denoised (temporal, then" in s.last_result and "render_denoised" in s.last_result,
               f"the panel's summary names the method and the folder: {s.last_result!r}")
         for f in range(1, 7):
-            out = os.path.join(root, "render_denoised", f"frame_{f:04d}.exr")
+            out = os.path.join(root, "render_denoised", f"render{f:04d}.exr")  # the input's name
             if not os.path.isfile(out) or not os.path.isfile(out[:-4] + ".png"):
                 check(False, f"frame {f} written (EXR and PNG)")
                 continue
@@ -151,8 +151,8 @@ def main():
 
         s.method, s.output, s.preview = "eaw", os.path.join(root, "eaw"), False
         rc = bpy.ops.atrous.denoise_animation()
-        check(rc == {"FINISHED"} and os.path.isfile(os.path.join(root, "eaw", "frame_0006.exr"))
-              and not os.path.exists(os.path.join(root, "eaw", "frame_0006.png")),
+        check(rc == {"FINISHED"} and os.path.isfile(os.path.join(root, "eaw", "render0006.exr"))
+              and not os.path.exists(os.path.join(root, "eaw", "render0006.png")),
               "a per-frame still method (eaw) runs, without previews when they are off")
 
         # Bad input: nothing written, the operator cancelled with one message.

@@ -258,6 +258,11 @@ def classify(case, r, before, new_entries, input_bytes):
         return "wrong-code", "exit %d: %s" % (rc, stderr.strip()[:300])
     if rc == 2:
         lines = [l for l in stderr.strip().splitlines() if l.strip()]
+        # The log before the error (notes, a sequence's k/N counter: docs/cli.md) is not the message:
+        # the message is what follows "atrous: error:", and it must be one line.
+        starts = [i for i, l in enumerate(lines) if l.startswith("atrous: error:")]
+        if starts:
+            lines = lines[starts[0]:]
         if new_entries:
             return "partial-output", "left " + sorted(new_entries)[0]
         if not _message_ok(case, lines):

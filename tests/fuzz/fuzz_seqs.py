@@ -192,9 +192,10 @@ def build_seq(cid, rng, seeds, d, cli, klass, ordinal, seed):
 
 def _outputs_present(out):
     import fuzz_files
-    frames = sorted(f for f in os.listdir(out) if f.startswith("frame_") and f.endswith(".exr")) if \
+    # The outputs keep their input's names (render0001.exr, frame_0001.exr for a frame_0001/ folder).
+    frames = sorted(f for f in os.listdir(out) if not f.startswith(".") and f.endswith(".exr")) if \
         os.path.isdir(out) else []
     if not frames:
-        return "partial-output", "exit 0 but no frame_NNNN.exr in " + out
+        return "partial-output", "exit 0 but no output .exr in " + out
     ok, bad = fuzz_files.outputs_finite([os.path.join(out, f) for f in frames])
     return None if ok else ("nan-inf", bad)

@@ -80,7 +80,7 @@ def test_ldr_is_clamped_and_matches_the_cli_bit_for_bit(tmp_path, render):
         # The CLI reads the same PNG as LDR by itself; its output PNG is Python's, code for code.
         r = subprocess.run([cli, "denoise", "--color", str(tmp_path / "noisy.png"), "--out", str(tmp_path / "cli.exr")],
                            check=True, capture_output=True, text=True)
-        assert "LDR input" in r.stdout
+        assert "LDR input" in r.stderr  # a note: the log is on stderr, the results on stdout (docs/cli.md)
         np.testing.assert_array_equal(atrous.read_image(tmp_path / "cli.exr"), out)
     with pytest.raises(ValueError, match="variance: ldr=True"):
         atrous.denoise(ldr, ldr=True, variance=render["variance"])

@@ -5,7 +5,8 @@ Blender writes an animation as numbered Multi-Layer EXR files (render0001.exr, .
 passes a denoiser needs (Denoising Data: albedo and normal; Vector: motion). The add-on's operator
 (Properties > Output > "Denoise Animation (atrous)", or Render > "Denoise Animation (atrous)")
 hands those files, as Blender wrote them, to :func:`atrous.denoise_sequence` and writes
-frame_NNNN.exr (+ .png and preview.mp4) into a folder beside them.
+the denoised frames under the rendered frames' names (render0001.exr ..., + .png and preview.mp4)
+into a folder beside them.
 
 This module does not import bpy: :func:`register` and :func:`unregister` load the Blender classes
 (atrous.blender.addon) when Blender calls them. ``python -m atrous.blender FILE.py`` writes the small

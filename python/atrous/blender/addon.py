@@ -38,7 +38,7 @@ class AtrousSettings(bpy.types.PropertyGroup):
                     "its average), and what denoises the Render Result (the default, auto: by the passes given)")
     output: bpy.props.StringProperty(
         name="Output", subtype="DIR_PATH", default="",
-        description="Folder for frame_NNNN.exr (empty: FRAMES_denoised beside the rendered frames' folder)")
+        description="Folder for the denoised frames, named as the rendered ones (render0001.exr ...; empty: FRAMES_denoised beside the rendered frames' folder)")
     preview: bpy.props.BoolProperty(
         name="Preview video", default=True,
         description="Also write PNG previews and preview.mp4 (when ffmpeg is on PATH)")
@@ -115,7 +115,7 @@ class ATROUS_OT_denoise_animation(bpy.types.Operator):
         def progress(frame: dict) -> None:
             done[0] += 1
             wm.progress_update(done[0])
-            print("atrous:", frame["line"])
+            print(f"atrous: {frame['position']}/{frame['count']} {frame['line']}")
 
         wm.progress_begin(0, total)
         try:

@@ -18,8 +18,9 @@ def fmt_duration(s: Optional[float]) -> str:
 class Progress:
     """`[#####.....] 7/12 done, 1 failed, 2 running, 2 queued, 0:03 elapsed, ETA 0:04`.
 
-    On a terminal the line is redrawn in place (at most 10 times a second); elsewhere (a CI log) a
-    line is printed when an item finishes, at most one every 5 s, and at the end. The ETA is the
+    On a terminal the line is redrawn in place (at most 10 times a second); elsewhere (a CI log)
+    one line, without the bar, each time an item finishes, as `atrous denoise --sequence` counts
+    its frames (`7/12 done, ...`), and at the end. The ETA is the
     mean time per finished item of this run times the items left (with several workers, items
     finish several at a time, and so does the estimate).
     """
@@ -34,7 +35,7 @@ class Progress:
         self.done = self.failed = self.running = 0
         self.changed = False
 
-    def line(self) -> str:
+    def line(self, bar: bool = True) -> str:
         finished = self.done + self.failed
         left = self.total - finished
         elapsed = time.perf_counter() - self.t0
@@ -43,7 +44,7 @@ class Progress:
         width = 24
         fill = int(width * finished / self.total) if self.total else width
         queued = max(0, left - self.running)
-        return (f"[{'#' * fill}{'.' * (width - fill)}] {self.done}/{self.total} done"
+        return ((f"[{'#' * fill}{'.' * (width - fill)}] " if bar else "") + f"{self.done}/{self.total} done"
                 + (f" ({self.skipped} skipped)" if self.skipped else "")
                 + f", {self.failed} failed, {self.running} running, {queued} queued, "
                 + f"{fmt_duration(elapsed)} elapsed, ETA {fmt_duration(0.0 if left == 0 else eta)}")
@@ -60,8 +61,8 @@ class Progress:
                 self.stream.write("\r\x1b[2K" + self.line() + ("\n" if final else ""))
                 self.stream.flush()
                 self.last = now
-        elif final or (self.changed and now - self.last >= 5.0):
-            self.stream.write(self.line() + "\n")
+        elif final or self.changed:
+            self.stream.write(self.line(bar=False) + "\n")
             self.stream.flush()
             self.last, self.changed = now, False
 
