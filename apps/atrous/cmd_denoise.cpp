@@ -19,6 +19,7 @@
 #include "commands.h"
 #include "atrous/timer.h"
 #include "denoise_sequence.h"
+#include "input_flags.h"
 #include "progress.h"
 #include "still_output.h"
 #include "atrous/srgb.h"
@@ -31,9 +32,9 @@ namespace atrous::cli {
 namespace {
 
 struct DenoiseArgs {
-    std::string inDir, color, albedo, normal, position, depth, variance, ids, emission, out, sequence;
-    std::vector<std::string> passes;   // --pass BUFFER=NAME
-    std::string layer, addPass;        // --layer, --add-pass
+    InputFlags input;                  // --in, --color, ..., --pass, --layer (input_flags.h)
+    std::string out, sequence;
+    std::string addPass;               // --add-pass
     std::string ldrColor;              // oidnDenoise's --ldr FILE
     bool ldr = false, srgb = false;    // LDR input: output clamped to [0, 1]; --srgb: sRGB-encoded
     std::string oidnFilter = "RT", oidnQuality;  // oidnDenoise's -f, -q (accepted; see addOidnFlags)
@@ -67,11 +68,11 @@ void takePositionals(DenoiseArgs& a) {
         pos.pop_back();
     };
     if (pos.size() == 2 || a.out.empty()) fill(a.out, "--out", "positional OUT");
-    const bool inGiven = !a.color.empty() || !a.ldrColor.empty() || !a.sequence.empty();
+    const bool inGiven = !a.input.file[int(io::Buffer::Color)].empty() || !a.ldrColor.empty() || !a.sequence.empty();
     if (!pos.empty() && inGiven)
         throw InputError("'" + pos.back() + "': one argument too many (the input is given by " +
                          (a.sequence.empty() ? "--color/--hdr/--ldr" : "--sequence") + ")");
-    fill(a.inDir, "--in", "positional IN");
+    fill(a.input.in, "--in", "positional IN");
     if (a.out.empty()) throw InputError("--out is required (atrous denoise IN OUT, or --in IN --out OUT)");
 }
 
@@ -168,23 +169,6 @@ void checkOutputFile(const std::string& out) {
     if (fs::is_directory(out, ec)) throw InputError("--out '" + out + "': is a directory (give a file name)");
 }
 
-// The files of one denoise call (io::loadBuffers reads them).
-io::BufferFiles bufferFiles(const DenoiseArgs& a) {
-    io::BufferFiles f;
-    f.in = a.inDir;
-    f.file[int(io::Buffer::Color)] = a.color;
-    f.file[int(io::Buffer::Variance)] = a.variance;
-    f.file[int(io::Buffer::Albedo)] = a.albedo;
-    f.file[int(io::Buffer::Normal)] = a.normal;
-    f.file[int(io::Buffer::Position)] = a.position;
-    f.file[int(io::Buffer::Depth)] = a.depth;
-    f.file[int(io::Buffer::ObjectId)] = a.ids;
-    f.file[int(io::Buffer::Emission)] = a.emission;
-    f.viewLayer = a.layer;
-    f.passes = withFlag("--pass", [&] { return io::parsePassRequests(a.passes); });
-    return f;
-}
-
 // The files of a still (--in/--color, --out checked): InputError before anything is read.
 io::BufferFiles stillFiles(const DenoiseArgs& a) {
     const std::string ext = io::extensionOf(a.out);
@@ -192,10 +176,10 @@ io::BufferFiles stillFiles(const DenoiseArgs& a) {
         throw InputError("--out '" + a.out + "': unsupported extension (use .exr, .pfm or .png)");
     if (a.exposure != 1.0f && ext != ".png")
         throw InputError("--exposure: scales a .png output (and a sequence's .png previews); --out is " + ext);
-    if (a.inDir.empty() == a.color.empty())
+    if (a.input.in.empty() == a.input.file[int(io::Buffer::Color)].empty())
         throw InputError("give exactly one of --in RENDER_DIR, --in LAYERED.exr or --color FILE (--hdr/--ldr)");
     checkOutputFile(a.out);
-    io::BufferFiles files = bufferFiles(a);
+    io::BufferFiles files = bufferFiles(a.input);  // input_flags.h
     io::refuseOverwrite("--out", a.out, io::inputFiles(files));
     return files;
 }
@@ -259,7 +243,7 @@ bool checkSpatial(const DenoiseArgs& a, const CLI::App& cmd, const SequenceMetho
 // --sequence DIR: the library's session with the still options a.opt and the sequence method's
 // parameters (null for a still method).
 void runSequence(const DenoiseArgs& a, const ParamSet* params) {
-    if (!a.inDir.empty() || !a.color.empty())
+    if (!a.input.in.empty() || !a.input.file[int(io::Buffer::Color)].empty())
         throw InputError("--sequence DIR denoises the frames of DIR: drop --in/--color");
     SequenceDenoiseArgs s;
     s.sequenceDir = a.sequence;
@@ -269,9 +253,9 @@ void runSequence(const DenoiseArgs& a, const ParamSet* params) {
     so.device = a.opt.device;
     if (params) so.params = *params;
     so.frame = a.opt;
-    withFlag("--pass", [&] { return io::parsePassRequests(a.passes); });  // its own message first
-    so.passes = a.passes;
-    so.viewLayer = a.layer;
+    withFlag("--pass", [&] { return io::parsePassRequests(a.input.passes); });  // its own message first
+    so.passes = a.input.passes;
+    so.viewLayer = a.input.layer;
     so.addPass = a.addPass;
     so.start = a.range.start, so.end = a.range.end, so.step = a.range.step;
     so.exposure = a.exposure;
@@ -283,8 +267,8 @@ void run(DenoiseArgs& a, const CLI::App& cmd) {
     const auto threadLimit = limitThreads(a.threads);  // for the whole run
     if (!(a.exposure > 0.0f) || !std::isfinite(a.exposure)) throw InputError("--exposure: must be > 0");
     if (!a.ldrColor.empty()) {
-        if (!a.color.empty()) throw InputError("--ldr: give the colour once (--color/--hdr or --ldr)");
-        a.color = a.ldrColor;
+        if (!a.input.file[int(io::Buffer::Color)].empty()) throw InputError("--ldr: give the colour once (--color/--hdr or --ldr)");
+        a.input.file[int(io::Buffer::Color)] = a.ldrColor;
         a.ldr = true;
     }
     if (a.srgb && !a.ldr) throw InputError("--srgb: only with --ldr (an sRGB-encoded LDR colour)");
@@ -419,16 +403,10 @@ void addDenoiseCommand(CLI::App& app) {
                     "atrous denoise IN OUT: IN as --in takes it (a render folder, a layered EXR), OUT as --out (the "
                     "flags do the same; with --sequence DIR or --color FILE, one positional is OUT)")
         ->type_name("");
-    cmd->add_option("--in,-i", a->inDir,
-                    "Render directory (color.exr, variance.exr, albedo.exr, normal.exr, ...) or a layered EXR "
-                    "(Blender multilayer, Mitsuba aov): its passes are taken by name (atrous inspect FILE shows which)");
-    cmd->add_option("--pass", a->passes,
-                    "BUFFER=NAME: take BUFFER (color, variance, albedo, normal, position, depth, object_id, "
-                    "material_id, emission, motion) from the layer or channel NAME of a layered EXR (repeatable)");
+    addInputFlags(*cmd, a->input, "", kGroupBuffers);  // --in/-i, --pass, --layer, --color/--hdr; the buffers' files
     cmd->add_option("--add-pass", a->addPass,
                     "With --in FILE.exr: write --out as a copy of FILE with the denoised colour added as this pass "
                     "(with --sequence of layered EXRs: each output frame is such a copy of its frame)");
-    cmd->add_option("--layer", a->layer, "View layer of a layered EXR with several (Blender: the ViewLayer name)");
     cmd->add_option("--sequence", a->sequence,
                     "Sequence directory: frame_NNNN/ folders (atrous render --frames), numbered frame folders of "
                     "another renderer (0001/ with LuxCore's RGB.exr, ALBEDO.exr ...), numbered files per buffer "
@@ -440,18 +418,9 @@ void addDenoiseCommand(CLI::App& app) {
     cmd->add_option("--end", a->range.end, "With --sequence: the last frame number to denoise (default: the last)");
     cmd->add_option("--step", a->range.step, "With --sequence: denoise every step-th frame from --start")
         ->capture_default_str();
-    cmd->add_option("--color,--hdr", a->color, "Noisy colour (EXR/PFM, HDR; --hdr as in oidnDenoise). An 8-bit PNG/JPEG is LDR: sRGB-decoded to [0, 1], "
-                    "denoised, clamped to [0, 1] (docs/inputs.md, \"LDR input\"); its alpha, like an EXR's, is passed through");
     cmd->add_option("--ldr", a->ldrColor, "Noisy LDR colour in [0, 1] (oidnDenoise's --ldr): the output is clamped to [0, 1]");
     cmd->add_flag("--srgb", a->srgb, "With --ldr: the colour is sRGB-encoded (decoded before, encoded after; a PNG/JPEG always is, and a "
                   ".png output is always encoded)");
-    cmd->add_option("--variance", a->variance, "Per-channel variance of the pixel mean")->group(kGroupBuffers);
-    cmd->add_option("--albedo,--alb", a->albedo, "Albedo buffer (a layered EXR: its albedo pass)")->group(kGroupBuffers);
-    cmd->add_option("--normal,--nrm", a->normal, "Normal buffer, world or camera space")->group(kGroupBuffers);
-    cmd->add_option("--position", a->position, "World-space position buffer")->group(kGroupBuffers);
-    cmd->add_option("--depth", a->depth, "View depth buffer")->group(kGroupBuffers);
-    cmd->add_option("--ids", a->ids, "Mesh id (R) / material id (G) buffer")->group(kGroupBuffers);
-    cmd->add_option("--emission", a->emission, "Emitted radiance of the primary hit (filtered around, added back)")->group(kGroupBuffers);
     cmd->add_option("--out,-o", a->out,
                     "Output file (.exr, .pfm or .png); with --sequence, an output directory where each frame keeps "
                     "its input's name (render0001.exr -> OUT/render0001.exr, a frame folder 0001/ -> OUT/0001.exr; "

@@ -51,7 +51,7 @@ void addViewCommand(CLI::App& app) {
         ->capture_default_str();
     // A render instead of a scene: a still as `atrous denoise --in` reads it, or a sequence.
     const char* kGroupInput = "Your render (instead of --scene; docs/viewer.md)";
-    cli::addInputFlags(*cmd, o.input, kGroupInput);
+    cli::addInputFlags(*cmd, o.input, kGroupInput, kGroupInput);
     cmd->add_option("--sequence", o.sequenceInput,
                     "A rendered sequence as `atrous denoise --sequence` reads it (a folder or DIR/render####.exr): "
                     "Left/Right step through its frames")

@@ -39,19 +39,22 @@ bool InputFlags::any() const {
     return given;
 }
 
-void addInputFlags(CLI::App& cmd, InputFlags& f, const std::string& group) {
-    cmd.add_option("--in", f.in,
+void addInputFlags(CLI::App& cmd, InputFlags& f, const std::string& group, const std::string& bufferGroup) {
+    auto in = [&](CLI::Option* o, const std::string& g) {
+        if (!g.empty()) o->group(g);
+    };
+    in(cmd.add_option("--in,-i", f.in,
                    "Render directory (color.exr, variance.exr, albedo.exr, normal.exr, ...; LuxCore's RGB.exr, "
                    "ALBEDO.exr, ...) or a layered EXR (Blender multilayer, Mitsuba aov): its passes are taken by name "
-                   "(atrous inspect FILE shows which)")
-        ->group(group);
-    cmd.add_option("--pass", f.passes,
-                   "BUFFER=NAME: take BUFFER (color, variance, albedo, normal, position, depth, object_id, "
-                   "material_id, emission, motion) from the layer or channel NAME of a layered EXR (repeatable)")
-        ->group(group);
-    cmd.add_option("--layer", f.layer, "View layer of a layered EXR with several (Blender: the ViewLayer name)")
-        ->group(group);
-    for (const FileFlag& ff : kFileFlags) cmd.add_option(ff.names, f.file[int(ff.buffer)], ff.help)->group(group);
+                   "(atrous inspect FILE shows which)"),
+       group);
+    in(cmd.add_option("--pass", f.passes,
+                      "BUFFER=NAME: take BUFFER (color, variance, albedo, normal, position, depth, object_id, "
+                      "material_id, emission, motion) from the layer or channel NAME of a layered EXR (repeatable)"),
+       group);
+    in(cmd.add_option("--layer", f.layer, "View layer of a layered EXR with several (Blender: the ViewLayer name)"), group);
+    for (const FileFlag& ff : kFileFlags)
+        in(cmd.add_option(ff.names, f.file[int(ff.buffer)], ff.help), ff.buffer == io::Buffer::Color ? group : bufferGroup);
 }
 
 const char* bufferFlag(io::Buffer b) {

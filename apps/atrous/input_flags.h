@@ -21,9 +21,10 @@ struct InputFlags {
     bool any() const;                     // whether any input flag was given
 };
 
-// The per-buffer file flags (--color/--hdr, --variance, --albedo/--alb, --normal/--nrm,
-// --position, --depth, --ids, --emission), in their help group `group`, and --in, --pass, --layer.
-void addInputFlags(CLI::App& cmd, InputFlags& f, const std::string& group);
+// The input flags: --in/-i, --pass, --layer and --color/--hdr in the help group `group` ("": the
+// command's own options), the other buffers' files (--variance, --albedo/--alb, --normal/--nrm,
+// --position, --depth, --ids, --emission) in `bufferGroup`.
+void addInputFlags(CLI::App& cmd, InputFlags& f, const std::string& group, const std::string& bufferGroup);
 
 // The flag of buffer b's own file ("--color", ..., "--ids"); "" for one without (material_id, motion).
 const char* bufferFlag(io::Buffer b);
