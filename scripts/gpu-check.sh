@@ -4,7 +4,8 @@
 #   setup      unpack the binaries and the Debian libraries (dpkg -x into build-gpu/run/prefix,
 #              LD_LIBRARY_PATH), re-create the /tmp/atrous-gpu/{src,build} paths compiled into the tests
 #   info       nvidia-smi;  bandwidth  measured D2D copy bandwidth (gpu_bandwidth) against the peak
-#   tests      every CUDA test binary (tests/cuda/*_test.cu; GoogleTest JSON per binary)
+#   tests      every CUDA test binary (tests/cuda/*_test.cu, and tests/cuda/host_gpu_tests.txt's host
+#              binaries with GPU cases; GoogleTest JSON per binary)
 #   bench      atrous bench --device cuda --json (render, EAW, SURE, SVGF) at 512x512, 1280x720,
 #              1920x1080, 3840x2160, one call per size; bench_gpu_render at 1920x1080
 #   sanitizer  compute-sanitizer memcheck on a CUDA render (built-in and OBJ scenes), CUDA EAW, SURE,
@@ -174,7 +175,8 @@ check_pack() {
   [ "$total" -le "$limit" ] || { echo "pack over 64 MiB"; bad=1; }
   # the CUDA test binaries of this tree, against the pack's list
   local want have
-  want=$(for f in "$ROOT"/tests/cuda/*_test.cu; do basename "$f" .cu; done | sort | tr '\n' ' ')
+  want=$( (for f in "$ROOT"/tests/cuda/*_test.cu; do basename "$f" .cu; done; grep -v '^#' "$ROOT/tests/cuda/host_gpu_tests.txt") |
+         sort | tr '\n' ' ')
   have=$(sort "$PACK/tests.txt" | tr '\n' ' ')
   [ "$want" = "$have" ] || { echo "tests/cuda has '$want' but the pack '$have': run make gpu-pack"; bad=1; }
   for t in $(cat "$PACK/tests.txt"); do [ -x "$WORK/tests/$t" ] || { echo "missing binary tests/$t"; bad=1; }; done

@@ -3,7 +3,8 @@
 # lent GPU machine, and gather it into build-gpu/pack/ (ignored; the one folder a GPU session
 # carries). The GPU machine has the CUDA driver, nvcc, CMake and Python 3.12 but none of the
 # Debian libraries atrous links (Embree, TBB, OpenEXR, ...), so the pack holds:
-#   bin.tar.xz      atrous, the CUDA test binaries (tests/cuda/*_test.cu), bench_gpu_render, the
+#   bin.tar.xz      atrous, the CUDA test binaries (tests/cuda/*_test.cu, and the host test binaries
+#                   with GPU cases that tests/cuda/host_gpu_tests.txt names), bench_gpu_render, the
 #                   copy-bandwidth probe (scripts/gpu_bandwidth.cu), scenes/ (stripped; one solid
 #                   xz archive: the binaries share most of their bytes)
 #   debs/           the Debian packages of every shared library those binaries load that a bare
@@ -66,6 +67,7 @@ cmake -S "$LINK/src" -B "$LINK/build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CUDA_AR
 grep -q "CUDA backend ON" "$G/configure.log" || { echo "gpu-pack: CUDA backend is OFF (see $G/configure.log)" >&2; exit 1; }
 TESTS=()
 for f in "$SRC"/tests/cuda/*_test.cu; do TESTS+=("$(basename "$f" .cu)"); done
+TESTS+=($(grep -v '^#' "$SRC/tests/cuda/host_gpu_tests.txt"))  # host binaries with GPU cases
 say "building atrous, ${TESTS[*]}, bench_gpu_render (-j$JOBS; log in $G/build.log)"
 cmake --build "$LINK/build" -j "$JOBS" --target atrous "${TESTS[@]}" bench_gpu_render > "$G/build.log" 2>&1 \
   || { tail -40 "$G/build.log"; exit 1; }
