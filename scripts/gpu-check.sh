@@ -274,7 +274,7 @@ bench_render() {
 oidn() {  # WxH
   local w=${1%x*} h=${1#*x} dev=cuda n=20
   [ "$DRY" = 1 ] && { dev=cpu; w=64; h=64; n=1; }
-  LD_LIBRARY_PATH="$OIDN/lib" "$OIDN/bin/oidnBenchmark" -d $dev -r "RT.hdr_alb_nrm.${w}x${h}" -s "$w" "$h" -n $n -q high -v 1 \
+  LD_LIBRARY_PATH="$OIDN/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}" "$OIDN/bin/oidnBenchmark" -d $dev -r "RT.hdr_alb_nrm.${w}x${h}" -s "$w" "$h" -n $n -q high -v 1 \
     > "$LOGS/oidn-$1.out" 2>&1
   local rc=$?
   cat "$LOGS/oidn-$1.out"
@@ -282,7 +282,7 @@ oidn() {  # WxH
   $TOOL oidn-json "$LOGS/oidn-$1.out" > "$OUTDIR/oidn/oidn_${dev}_$1.json"
   grep -q msec_per_image "$OUTDIR/oidn/oidn_${dev}_$1.json" || { echo "no timing line in oidnBenchmark's output"; return 1; }
   if [ "$DRY" = 1 ]; then  # the CUDA device needs the driver: without one, a clean error
-    LD_LIBRARY_PATH="$OIDN/lib" "$OIDN/bin/oidnBenchmark" -d cuda -r RT.hdr_alb_nrm.64x64 -s 64 64 -n 1 2>&1 | tail -1
+    LD_LIBRARY_PATH="$OIDN/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}" "$OIDN/bin/oidnBenchmark" -d cuda -r RT.hdr_alb_nrm.64x64 -s 64 64 -n 1 2>&1 | tail -1
   fi
   return 0
 }

@@ -171,12 +171,15 @@ if [ "$WITH_OIDN" = 1 ]; then
     rm -rf "$G/oidn-stage" && mkdir -p "$G/oidn-stage/oidn/bin" "$G/oidn-stage/oidn/lib"
     cp "$OD/bin/oidnBenchmark" "$G/oidn-stage/oidn/bin/"
     # Only what the CUDA (and, for the dry run, CPU) devices load; SYCL/HIP and their runtimes stay behind.
+    # TBB too: the pack's debs bring Debian's libtbb12 (oneTBB 2021.8), which exports every TBB
+    # symbol OIDN 2.5.1's libraries use (18, checked with objdump -T on 2026-12-07), and the wheel's
+    # copy (1 MB compressed) no longer fits beside the tree (20 MB) in the 64 MiB a call sends.
     (cd "$OD/lib" && cp -L libOpenImageDenoise.so.2 libOpenImageDenoise_core.so.2.* libOpenImageDenoise_device_cuda.so.2.* \
-       libOpenImageDenoise_device_cpu.so.2.* libtbb.so.12 "$G/oidn-stage/oidn/lib/")
+       libOpenImageDenoise_device_cpu.so.2.* "$G/oidn-stage/oidn/lib/")
     rm -rf "$OPACK" && mkdir -p "$OPACK"
     tar -C "$G/oidn-stage" -cf - oidn | xz -9 -T"$JOBS" > "$OPACK/oidn.tar.xz"
     cp "$PACK/tests.txt" "$OPACK/" 2> /dev/null || true
-    OIDN_NOTE="OIDN $(ls "$OD"/lib/libOpenImageDenoise.so.2.* | sed 's/.*\.so\.//') (oidnBenchmark, core, CUDA + CPU devices, TBB) from pyoidn in $FROM"
+    OIDN_NOTE="OIDN $(ls "$OD"/lib/libOpenImageDenoise.so.2.* | sed 's/.*\.so\.//') (oidnBenchmark, core, CUDA + CPU devices; TBB from the debs) from pyoidn in $FROM"
   else
     OIDN_NOTE="pyoidn wheel not found (.venv or pip download): no OIDN comparison"
   fi
