@@ -22,6 +22,7 @@
 #include "atrous/io/exr_layers.h"
 #include "atrous/io/image_io.h"
 #include "atrous/io/pass_map.h"
+#include "atrous/param_set.h"
 #include "atrous/params.h"
 #include "atrous/srgb.h"
 #include "denoise_test_util.h"
@@ -237,7 +238,7 @@ TEST(NonFiniteColour, AColourWithNoFinitePixelIsOneLine) {
 }
 
 TEST(DidYouMean, UnknownNamesGetTheNearestOne) {
-    const std::vector<std::string> names = paramKeywords(denoiseParams());
+    const std::vector<std::string> names = paramKeywords(ParamSet(denoiseParams()));
     EXPECT_EQ(closestName("levles", names), "levels");
     EXPECT_EQ(closestName("sigma_norml", names), "sigma_normal");
     EXPECT_EQ(closestName("Sigma-Normal", names), "sigma_normal");

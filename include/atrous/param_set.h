@@ -147,4 +147,23 @@ inline bool ParamSet::same(const ParamSet& other) const {
     return mModel->same(*other.mModel);
 }
 
+// A negated switch's CLI name as a keyword (Python's): --no-firefly -> no_firefly.
+inline std::string negatedKeyword(const ParamRow& r) {
+    std::string k = r.flag.size() > 2 ? r.flag.substr(2) : r.flag;
+    for (char& c : k)
+        if (c == '-') c = '_';
+    return k;
+}
+
+// Every name a set's rows take in Python: each row's name, and a negated switch's negatedKeyword
+// (for "did you mean" after an unknown keyword, param_table.h's didYouMean).
+inline std::vector<std::string> paramKeywords(const ParamSet& set) {
+    std::vector<std::string> names;
+    for (const ParamRow& r : set.rows()) {
+        names.push_back(r.name);
+        if (r.negated && r.flag.size() > 2) names.push_back(negatedKeyword(r));
+    }
+    return names;
+}
+
 }  // namespace atrous

@@ -144,22 +144,6 @@ inline std::string didYouMean(const std::string& got, const std::vector<std::str
     return n.empty() ? "" : std::string(" (did you mean ") + quote + n + quote + "?)";
 }
 
-// Every name a table's rows take in Python: the row's name, and a negated switch's CLI name as a
-// keyword (--no-firefly: no_firefly).
-template <class S>
-std::vector<std::string> paramKeywords(const ParamTable<S>& t) {
-    std::vector<std::string> names;
-    for (const ParamField<S>& f : t) {
-        names.push_back(f.name);
-        if (!f.negated || t.flag(f).size() < 3) continue;
-        std::string k = t.flag(f).substr(2);
-        for (char& c : k)
-            if (c == '-') c = '_';
-        names.push_back(k);
-    }
-    return names;
-}
-
 // The shortest text that reads back as the same float: 1e-6, 0.9, 1048576.
 inline std::string formatParamNumber(double v) {
     if (!std::isfinite(v)) return std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf");

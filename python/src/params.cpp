@@ -22,14 +22,6 @@ T as(const nb::handle& v, const std::string& key) {
     }
 }
 
-// A negated switch's CLI name as a keyword: --no-firefly -> no_firefly.
-std::string pyAlias(const ParamRow& f) {
-    std::string k = f.flag.size() > 2 ? f.flag.substr(2) : f.flag;
-    for (char& c : k)
-        if (c == '-') c = '_';
-    return k;
-}
-
 nb::object paramValue(const ParamSet& set, size_t i) {
     const ParamRef r = set.at(i);
     if (int* const* n = std::get_if<int*>(&r)) return nb::cast(**n);
@@ -46,15 +38,8 @@ void applyParam(ParamSet& set, const std::string& k, const nb::handle& v, const 
     int row = set.find(k);
     bool negate = false;
     for (size_t i = 0; row < 0 && i < set.rows().size(); ++i)
-        if (set.rows()[i].negated && k == pyAlias(set.rows()[i])) row = int(i), negate = true;
-    if (row < 0) {
-        std::vector<std::string> names;  // every keyword the set takes, for a did-you-mean
-        for (const ParamRow& f : set.rows()) {
-            names.push_back(f.name);
-            if (f.negated) names.push_back(pyAlias(f));
-        }
-        throw InputError("unknown " + std::string(what) + " parameter '" + k + "'" + didYouMean(k, names));
-    }
+        if (set.rows()[i].negated && k == negatedKeyword(set.rows()[i])) row = int(i), negate = true;
+    if (row < 0) throw InputError("unknown " + std::string(what) + " parameter '" + k + "'" + didYouMean(k, paramKeywords(set)));
     const ParamRow& f = set.rows()[size_t(row)];
     const ParamRef r = set.at(size_t(row));
     if (int* const* n = std::get_if<int*>(&r)) **n = as<int>(v, k);
@@ -94,7 +79,7 @@ nb::list paramRows(const ParamSet& set) {
         d["doc"] = f.doc;
         d["group"] = f.group;
         d["flag"] = f.flag;
-        d["aliases"] = f.negated ? nb::cast(std::vector<std::string>{pyAlias(f)}) : nb::cast(std::vector<std::string>{});
+        d["aliases"] = f.negated ? nb::cast(std::vector<std::string>{negatedKeyword(f)}) : nb::cast(std::vector<std::string>{});
         rows.append(d);
     }
     return rows;

@@ -52,10 +52,6 @@ Image exrAlpha(const std::string& path, const std::vector<PassRequest>& passes, 
     return std::move(readExrChannelSets(info, {{channel}}, {"alpha channel '" + ch.fullName + "'"}, {1})[0]);
 }
 
-}  // namespace
-
-namespace {
-
 Image alphaOf(const std::string& path, const std::vector<PassRequest>& passes, const std::string& viewLayer, int width,
               int height, bool alone) {
     std::error_code ec;

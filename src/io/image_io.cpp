@@ -438,9 +438,9 @@ static Image readStb(const std::string& path, int* sourceChannels) {
 
 Image readStbAlpha(const std::string& path) {
     requireFile(path);
-    StbFile f = openStb(path);
     const std::string ext = extensionOf(path);
-    if (ext == ".jpg" || ext == ".jpeg" || ext == ".hdr") return {};  // no alpha in these formats
+    if (ext == ".jpg" || ext == ".jpeg" || ext == ".hdr") return {};  // no alpha in these formats: not read again
+    StbFile f = openStb(path);
     checkStb(path, f);
     if (f.n != 2 && f.n != 4) return {};
     Image a;

@@ -32,20 +32,8 @@ bool isLdrFormat(const std::string& path);
 
 // The alpha channel of a PNG, BMP or TGA with one (grey + alpha, RGBA), as a 1-channel host
 // image of code / 255 (or / 65535); empty when the file has none (and for JPEG and .hdr, which
-// have none). Throws InputError as readImage does. (alpha.h's readAlpha reads any format's.)
-Image readStbAlpha(const std::string& path);
-
-// Throws InputError "<what>: color buffer has no finite pixel ..." when no pixel of the host image
-// `color` has three finite channels (an all-NaN render would otherwise come out black).
-void requireFinitePixel(const Image& color, const std::string& what);
-
-// Whether `path` names an 8- or 16-bit display-referred format (PNG, JPEG, BMP, TGA: LDR, values
-// in [0, 1] once read), by its extension; not EXR, PFM or Radiance .hdr.
-bool isLdrFormat(const std::string& path);
-
-// The alpha channel of a PNG, BMP or TGA with one (grey + alpha, RGBA), as a 1-channel host
-// image of code / 255 (or / 65535); empty when the file has none (and for JPEG and .hdr, which
-// have none). Throws InputError as readImage does. (alpha.h's readAlpha reads any format's.)
+// have none: those files are not read). Throws InputError as readImage does. (alpha.h's readAlpha
+// reads any format's.)
 Image readStbAlpha(const std::string& path);
 
 // Throws InputError "<what>: color buffer has no finite pixel ..." when no pixel of the host image
