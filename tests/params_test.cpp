@@ -188,7 +188,7 @@ TEST(ParamTables, NegatedSwitchesKeepTheirFlags) {
     std::vector<std::string> negated;
     for (const auto& f : denoiseParams())
         if (f.negated) negated.push_back(denoiseParams().flag(f));
-    EXPECT_EQ(negated, (std::vector<std::string>{"--no-ids", "--no-correlated-variance", "--no-firefly", "--no-demodulate"}));
+    EXPECT_EQ(negated, (std::vector<std::string>{"--no-ids", "--no-correlated-variance", "--no-firefly", "--no-firefly-restore", "--no-demodulate"}));
     EXPECT_EQ(svgfParams().flag(*svgfParams().find("depth_tolerance")), "--svgf-depth-tolerance");
     EXPECT_EQ(svgfParams().flag(*svgfParams().find("taa_alpha")), "--taa-alpha");
     EXPECT_EQ(denoiseParams().flag(*denoiseParams().find("sure_window")), "--sure-window");

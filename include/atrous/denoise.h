@@ -87,6 +87,10 @@ struct SureParams {
 struct FireflyParams {
     bool enabled = true;
     float k = 4.0f;  // > 0
+    // Put what the pass removed back, spread over the smallest window around each clamped pixel
+    // that holds 8 clamped pixels (radius <= 16; a lone firefly's excess is dropped):
+    // src/filters/firefly_restore.h.
+    bool restore = true;
 };
 
 // The safety net after either filter (docs/algorithms.md, "The safety net"), off by default: per

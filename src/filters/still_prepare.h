@@ -4,6 +4,7 @@
 // estimate. Written once as templates on the executor (CpuExec, CudaExec).
 #pragma once
 #include "filters/emission_filter.h"
+#include "filters/firefly_restore.h"
 #include "filters/noise_estimate.h"
 #include "filters/prepass.h"
 #include "filters/still_state.h"
@@ -117,6 +118,11 @@ void clampFireflies(const Exec& exec, const StillConfig& cfg, PlanePool& pool, c
             runFireflyDense(exec, pass, tmp.view(), sums.view());
         }
         if (out.report) reportFireflies(exec, flag, *out.report);
+        if (o.firefly.restore) {
+            Image share = pool.take(3), diff = pool.take(3), radius = pool.take(1);
+            runFireflyRestore(exec, FireflyRestore{c0.view(), p.color.view(), flag, share.view(), diff.view(), radius.view(), {}});
+            pool.give(std::move(share)), pool.give(std::move(diff)), pool.give(std::move(radius));
+        }
         pool.give(std::move(c0));
         pool.give(std::move(v0));
     }

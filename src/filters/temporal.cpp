@@ -11,6 +11,7 @@
 #include "atrous/params.h"
 #include "core/parallel.h"
 #include "atrous/timer.h"
+#include "filters/firefly_restore.h"
 #include "filters/prepass.h"
 #include "filters/svgf_gbuffer.h"
 #include "filters/temporal_window.h"
@@ -91,9 +92,9 @@ void prepare(const CpuExec& exec, const Frame& f, bool stats, float fireflyK, Pr
         // that a neighbour's firefly, spread over 2x2 pixels by the bilinear taps, does not reach
         // the average as a blob their own firefly pass keeps.
         p.color = Image::uninitialized(w, h, 3);
-        Image zero(w, h, 3), scratch = Image::uninitialized(w, h, 3);
+        Image zero(w, h, 3), scratch = Image::uninitialized(w, h, 3), flag = Image::uninitialized(w, h, 1);
         filters::runFireflyClamp(exec, filters::FireflyClamp{fireflyK, 0, v.color, zero.view(), p.color.view(),
-                                                             scratch.view(), ImageView{}});
+                                                             scratch.view(), flag.view()});
         // The emission is scaled with its colour: a firefly on a light (the sun seen through the
         // sky, where colour = emission) clamped in the colour alone would leave colour - emission,
         // which the still method filters, hugely negative in the average.
@@ -101,6 +102,22 @@ void prepare(const CpuExec& exec, const Frame& f, bool stats, float fireflyK, Pr
             p.emission = Image::uninitialized(w, h, 3);
             exec.forEachPixel(w, h, temporal::ScaleLikeColour{v.color, p.color.view(), viewOf(f.emission), p.emission.view()});
         }
+        // What the clamp took, put back where clamped pixels are dense (as the still path does;
+        // after the emission's scale, which reads the clamp's own factor). Of the reflected light
+        // only, as in the still path (there the emission is split off before the pass): a clamped
+        // sun's excess spread around it would be a glow of reflected light.
+        Image radius = Image::uninitialized(w, h, 1);
+        filters::FireflyRestore r{v.color, p.color.view(), flag.view(), scratch.view(), zero.view(), radius.view(), {}};
+        Image before, after;
+        if (f.emission) {
+            before = Image::uninitialized(w, h, 3), after = Image::uninitialized(w, h, 3);
+            exec.forEachPixel(w, h, filters::Copy3{v.color, before.view()});
+            exec.forEachPixel(w, h, filters::SubtractEmission{viewOf(f.emission), before.view()});
+            exec.forEachPixel(w, h, filters::Copy3{p.color.view(), after.view()});
+            exec.forEachPixel(w, h, filters::SubtractEmission{p.emission.view(), after.view()});
+            r.cIn = before.view(), r.cOut = after.view(), r.addTo = p.color.view();
+        }
+        filters::runFireflyRestore(exec, r);
         v.color = p.color.view();
     }
     v.emission = p.emission.empty() ? viewOf(f.emission) : p.emission.view();
