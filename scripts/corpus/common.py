@@ -11,7 +11,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 
 # Seeds: noisy renders use one seed per spp, the references an independent one.
-SEED_NOISY = {4: 1, 16: 2}
+SEED_NOISY = {1: 5, 4: 1, 16: 2}
 SEED_REF = 1000003
 SEED_SEQ = 1          # frame f of a 1-spp sequence uses SEED_SEQ + f
 SEED_SEQ_REF = 2000003  # its reference uses SEED_SEQ_REF + f
@@ -27,6 +27,8 @@ MODES = {
     "quick": dict(res=64, spp=[4, 16], ref_spp=256, seq_res=48, seq_frames=4, seq_ref_spp=64, seq_spp=[1]),
     # The corpus proper.
     "full": dict(res=256, spp=[4, 16], ref_spp=2048, seq_res=128, seq_frames=20, seq_ref_spp=2048, seq_spp=[1, 4, 16]),
+    # Stills at 1, 4 and 16 spp (issue 47's window-lit rooms): 128x128, 2048-spp references, no sequences.
+    "lowspp": dict(res=128, spp=[1, 4, 16], ref_spp=2048, seq_res=0, seq_frames=0, seq_ref_spp=0, seq_spp=[]),
 }
 
 

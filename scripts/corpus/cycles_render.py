@@ -528,7 +528,7 @@ def main():
                        "sensor_width_mm": cam.data.sensor_width},
         })
 
-    seqs = QUICK_SEQUENCES if a.mode == "quick" else list(SEQUENCES)
+    seqs = QUICK_SEQUENCES if a.mode == "quick" else list(SEQUENCES) if mode["seq_frames"] else []
     for seq in seqs:
         if not a.scenes or seq in a.scenes.split(","):
             render_sequence(seq, mode, root, version)

@@ -31,7 +31,7 @@ import pyluxcore
 pyluxcore.Init(lambda s: None)
 
 SIZE = 256
-SPPS = ((4, 1), (16, 2))  # spp, seed
+SEEDS = {1: 5, 4: 1, 16: 2}  # the noisy seeds by spp (common.SEED_NOISY)
 REF_SPP, REF_SEED = 2048, 1000003
 OUTPUTS = ("RGB", "ALBEDO", "AVG_SHADING_NORMAL", "POSITION", "DEPTH")
 
@@ -174,6 +174,7 @@ def main():
     ap.add_argument("--scenes", default=",".join(SCENES))
     ap.add_argument("--size", type=int, default=SIZE)
     ap.add_argument("--ref-spp", type=int, default=REF_SPP)
+    ap.add_argument("--spp", default="4,16", help="the noisy sample counts (1, 4, 16; issue 47's low-spp set: 1,4,16)")
     a = ap.parse_args()
     for name in a.scenes.split(","):
         build, desc = SCENES[name]
@@ -181,7 +182,7 @@ def main():
         os.makedirs(sd, exist_ok=True)
         ref = f"ref{a.ref_spp:04d}"
         files, times = {}, {}
-        for spp, seed, stem in [(s, sd_, f"spp{s:04d}") for s, sd_ in SPPS] + [(a.ref_spp, REF_SEED, ref)]:
+        for spp, seed, stem in [(s, SEEDS[s], f"spp{s:04d}") for s in map(int, a.spp.split(","))] + [(a.ref_spp, REF_SEED, ref)]:
             files[stem] = {"spp": spp, "seed": seed, "folder": stem, "files": [t + ".exr" for t in OUTPUTS]}
             if not os.path.exists(os.path.join(sd, stem, "RGB.exr")):
                 times[stem] = round(render(build, os.path.join(sd, stem), spp, seed, a.size), 1)

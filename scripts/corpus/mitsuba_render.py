@@ -388,7 +388,7 @@ def main():
         })
 
     # ------------------------------------------------ sequence
-    if a.scenes and SEQ_NAME not in a.scenes.split(","):
+    if (a.scenes and SEQ_NAME not in a.scenes.split(",")) or not mode["seq_frames"]:
         return
     objects, what, bg = scene_orbit_objects()
     n, sres, rspp = mode["seq_frames"], mode["seq_res"], mode["seq_ref_spp"]
