@@ -57,8 +57,8 @@ struct Clamped {
         for (size_t i = 0; i < out.size(); ++i) out.data()[i] -= after.data()[i];
         return out;
     }
-    // The same by brute force: each clamped pixel's smallest window (radius 1, 2, 4, 8, 16) with
-    // 8 clamped pixels gets its excess over the window's in-image pixels, in double.
+    // The same by brute force: each clamped pixel's smallest window (radius 1, 2, 4, ..., 32) with
+    // 32 clamped pixels gets its excess over the window's in-image pixels, in double.
     std::vector<double> scattered(double* total) const {
         const int w = before.width(), h = before.height();
         std::vector<double> s(size_t(w) * h * 3, 0.0);
@@ -66,13 +66,13 @@ struct Clamped {
         for (int qy = 0; qy < h; ++qy)
             for (int qx = 0; qx < w; ++qx) {
                 if (flag(qx, qy, 0) < 0.5f) continue;
-                for (int r = 1; r <= 16; r *= 2) {
+                for (int r = 1; r <= 32; r *= 2) {
                     const int x0 = std::max(qx - r, 0), x1 = std::min(qx + r, w - 1);
                     const int y0 = std::max(qy - r, 0), y1 = std::min(qy + r, h - 1);
                     int n = 0;
                     for (int y = y0; y <= y1; ++y)
                         for (int x = x0; x <= x1; ++x) n += flag(x, y, 0) > 0.5f;
-                    if (n < 8) continue;
+                    if (n < 32) continue;
                     const double taps = double(x1 - x0 + 1) * (y1 - y0 + 1);
                     for (int c = 0; c < 3; ++c) {
                         const double e = double(before(qx, qy, c)) - after(qx, qy, c);
@@ -96,10 +96,10 @@ double sum(const Image& img) {
 }  // namespace
 
 // The gathered corners and prefix sums equal a plain scatter, at every density (windows of every
-// radius, and windows clipped at all four borders: 41 x 29 pixels).
+// radius, and windows clipped at all four borders: 97 x 61 pixels).
 TEST(FireflyRestore, EqualsBruteForceScatter) {
     for (double density : {0.004, 0.02, 0.08, 0.3}) {
-        Clamped c(41, 29, density, unsigned(density * 1000));
+        Clamped c(97, 61, density, unsigned(density * 1000));
         double total = 0.0;
         const std::vector<double> want = c.scattered(&total);
         const Image got = c.restored(CpuExec{});
@@ -116,8 +116,8 @@ TEST(FireflyRestore, EqualsBruteForceScatter) {
     }
 }
 
-// The CPU's prefix sums (bands of rows) give the functors' values bit for bit.
-TEST(FireflyRestore, CpuPrefixEqualsFunctors) {
+// The CPU path (window counts from a table, rows of marks, bands of columns) gives the functors' values bit for bit.
+TEST(FireflyRestore, CpuPathEqualsFunctors) {
     Clamped c(300, 70, 0.05, 7);
     const Image cpu = c.restored(CpuExec{});
     const Image generic = c.restored(SerialExec{});
@@ -125,7 +125,7 @@ TEST(FireflyRestore, CpuPrefixEqualsFunctors) {
     for (size_t i = 0; i < cpu.size(); ++i) ASSERT_EQ(cpu.data()[i], generic.data()[i]) << i;
 }
 
-// A lone firefly has no window of 8 clamped pixels: its excess is dropped, nothing is added.
+// A lone firefly has no window of 32 clamped pixels: its excess is dropped, nothing is added.
 TEST(FireflyRestore, LoneFireflyIsDropped) {
     Clamped c(64, 64, 0.0, 1);
     c.flag(30, 30, 0) = 1.0f;

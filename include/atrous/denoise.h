@@ -88,7 +88,7 @@ struct FireflyParams {
     bool enabled = true;
     float k = 4.0f;  // > 0
     // Put what the pass removed back, spread over the smallest window around each clamped pixel
-    // that holds 8 clamped pixels (radius <= 16; a lone firefly's excess is dropped):
+    // that holds 32 clamped pixels (radius <= 32; a lone firefly's excess is dropped):
     // src/filters/firefly_restore.h.
     bool restore = true;
 };

@@ -4,16 +4,16 @@
 // finds the sun patch), and dropping them darkened the room by a fifth at 1 spp and a tenth at 4
 // (docs/quality.md, "Firefly energy loss"). A clamped sample is not wrong, only too concentrated:
 // its excess is an unbiased part of the neighbourhood's light. So the excess E(q) of each clamped
-// pixel q is spread evenly over the smallest window around q (radius 1, 2, 4, 8 or 16 pixels)
+// pixel q is spread evenly over the smallest window around q (radius 1, 2, 4, ..., 32 pixels)
 // that holds at least kRestoreCount clamped pixels, the way a photon map's density estimate takes
 // its k nearest photons: where clamped samples are dense (the room's walls at 1 spp, a caustic)
 // the window is small and the light stays where it fell; a lone firefly, with no such window
-// within kRestoreMaxRadius, is dropped as before (a sun glint that no neighbour confirms, spread
-// over 33×33 pixels, is a haze on dark ground: docs/quality.md). The spread is a scatter (each
+// within kRestoreMaxRadius, is dropped as before (sun glints that no neighbour confirms, spread up
+// to radius 64, were a haze on dark ground: docs/quality.md). The spread is a scatter (each
 // source's in-image window gets E / taps, so the energy put back equals the energy taken, to
 // float rounding), computed in O(1) a pixel as a difference image and two prefix sums: the
 // difference image is gathered per pixel (each window adds +-E/taps at its four corners; a pixel
-// reads the corners that fall on it, at most 20 taps inside the image) and is then summed along
+// reads the corners that fall on it, at most 24 taps inside the image) and is then summed along
 // rows and along columns.
 #pragma once
 #include "atrous/image.h"
@@ -25,9 +25,9 @@ struct CpuExec;
 
 namespace atrous::filters {
 
-constexpr int kRestoreCount = 8;       // clamped pixels a window must hold (docs/decisions.md, "Fireflies put back")
-constexpr int kRestoreLevels = 5;      // windows of radius 1, 2, 4, 8, 16
-constexpr int kRestoreMaxRadius = 16;  // 1 << (kRestoreLevels - 1)
+constexpr int kRestoreCount = 32;      // clamped pixels a window must hold (docs/decisions.md, "Fireflies put back")
+constexpr int kRestoreLevels = 6;      // windows of radius 1, 2, 4, 8, 16, 32
+constexpr int kRestoreMaxRadius = 32;  // 1 << (kRestoreLevels - 1)
 ATROUS_INLINE int restoreRadius(int level) { return 1 << level; }
 
 // 1. Per pixel: 0 where not clamped or no window holds kRestoreCount clamped pixels; else its excess
@@ -37,14 +37,18 @@ ATROUS_INLINE int restoreRadius(int level) { return 1 << level; }
 struct RestoreSource {
     ImageView cIn, cOut, flag, share, radius;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        int r = 0;
-        if (flag(x, y, 0) > 0.5f) r = windowRadius(x, y);
+        write(x, y, flag(x, y, 0) > 0.5f ? windowRadius(x, y) : 0);
+    }
+    // Pixel (x, y)'s outputs for window radius r (0: none).
+    ATROUS_HOST_DEVICE void write(int x, int y, int r) const {
         radius(x, y, 0) = float(r);
         const float inv = r > 0 ? 1.0f / boxTaps(r, x, y, cIn.width, cIn.height) : 0.0f;
-        for (int c = 0; c < 3; ++c) {
-            const float e = cIn(x, y, c) - cOut(x, y, c);
-            share(x, y, c) = e > 0.0f ? e * inv : 0.0f;
-        }
+        for (int c = 0; c < 3; ++c) share(x, y, c) = shareOf(cIn(x, y, c), cOut(x, y, c), inv);
+    }
+    // A channel's share: its excess over the pass's output (never negative) over the window's taps.
+    ATROUS_HOST_DEVICE static float shareOf(float in, float out, float invTaps) {
+        const float e = in - out;
+        return e > 0.0f ? e * invTaps : 0.0f;
     }
     // The smallest radius whose window holds kRestoreCount clamped pixels (0: none does). Counts
     // ring by ring, each window's count the previous one's plus its new ring.
@@ -150,7 +154,9 @@ struct RestoreAdd {
 
 struct FireflyRestore {
     ImageView cIn, cOut, flag;  // the pass's input, its output (added to in place) and its flags
-    ImageView share, diff;      // 3-channel scratch planes of the image's size
+    // 3-channel scratch planes of the image's size; diff may be cIn's planes (cIn is not read
+    // once the sources are found).
+    ImageView share, diff;
     ImageView radius;           // a 1-channel scratch plane
     ImageView addTo;            // where the spread is added (invalid: cOut)
 };
@@ -173,5 +179,9 @@ void runFireflyRestore(const Exec& exec, const FireflyRestore& r) {
     runRestorePrefix(exec, r.diff);
     exec.forEachPixel(w, h, RestoreAdd{r.diff, r.addTo.valid() ? r.addTo : r.cOut});
 }
+// The CPU's: the same functors in plain row loops (the generic loop's `omp simd` ran every lane's
+// window count and corner spans masked: 4x slower at 1080p), the window count only at clamped
+// pixels, and runRestorePrefix's CPU overload; the same values.
+void runFireflyRestore(const CpuExec& exec, const FireflyRestore& r);
 
 }  // namespace atrous::filters

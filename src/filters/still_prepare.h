@@ -116,15 +116,18 @@ void clampFireflies(const Exec& exec, const StillConfig& cfg, PlanePool& pool, c
         {
             Image tmp = pool.take(1), sums = pool.take(1);
             runFireflyDense(exec, pass, tmp.view(), sums.view());
+            pool.give(std::move(tmp)), pool.give(std::move(sums));
         }
         if (out.report) reportFireflies(exec, flag, *out.report);
+        pool.give(std::move(v0));
         if (o.firefly.restore) {
-            Image share = pool.take(3), diff = pool.take(3), radius = pool.take(1);
-            runFireflyRestore(exec, FireflyRestore{c0.view(), p.color.view(), flag, share.view(), diff.view(), radius.view(), {}});
-            pool.give(std::move(share)), pool.give(std::move(diff)), pool.give(std::move(radius));
+            // What the pass took, put back (firefly_restore.h); its difference image in c_0's
+            // planes, which it no longer reads then (planes already touched: no page faults).
+            Image share = pool.take(3), radius = pool.take(1);
+            runFireflyRestore(exec, FireflyRestore{c0.view(), p.color.view(), flag, share.view(), c0.view(), radius.view(), {}});
+            pool.give(std::move(share)), pool.give(std::move(radius));
         }
         pool.give(std::move(c0));
-        pool.give(std::move(v0));
     }
     if (out.afterFirefly.valid()) exec.forEachPixel(p.color.width(), p.color.height(), Copy3{p.color.view(), out.afterFirefly});
     if (out.report) reportLuminance(exec, p.color.view(), *out.report);
