@@ -97,10 +97,11 @@ def log(*a):
     print(time.strftime("%H:%M:%S"), *a, flush=True)
 
 
-def parse_render_args(renderer, quick, stills):
+def parse_render_args(renderer, quick, stills, named_only=()):
     """The command line both renderers take: (args, mode dict, output root, still names to render).
 
-    --scenes keeps only names of `stills` (the sequence's name is checked by the caller)."""
+    --scenes keeps only names of `stills` or `named_only` (stills rendered only when named, kept out
+    of --full; the sequence's name is checked by the caller)."""
     ap = argparse.ArgumentParser()
     ap.add_argument("--mode", choices=list(MODES), default="quick")
     ap.add_argument("--out", required=True)
@@ -108,7 +109,7 @@ def parse_render_args(renderer, quick, stills):
     a = ap.parse_args()
     names = quick if a.mode == "quick" else list(stills)
     if a.scenes:
-        names = [n for n in a.scenes.split(",") if n in stills]
+        names = [n for n in a.scenes.split(",") if n in stills or n in named_only]
     return a, MODES[a.mode], Path(a.out) / renderer, names
 
 

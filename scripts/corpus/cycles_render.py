@@ -355,6 +355,29 @@ def scene_turntable(sc, nframes):
         "world constant (0.03, 0.03, 0.035)"
 
 
+def scene_studio(sc):
+    """Issue 47's highlights: a glossy red ball and a chrome ball under a small key light out of
+    view (their highlights a few pixels across, far brighter than anything around) and a visible
+    emissive panel, on a grey floor and backdrop."""
+    world_constant(sc, (0.02, 0.02, 0.025))
+    floor = material("floor", "diffuse", (0.5, 0.5, 0.5), 0.6)
+    add("plane", floor, loc=(0, 0, 0), scale=(6, 6, 1))
+    add("plane", floor, loc=(0, 3, 2), rot=(math.radians(90), 0, 0), scale=(6, 3, 1))
+    add("sphere", material("red", "diffuse", (0.6, 0.08, 0.05), 0.08, index=2), loc=(-0.7, 0, 0.6), radius=0.6)
+    add("sphere", material("chrome", "metal", (0.9, 0.9, 0.9), 0.06, index=3), loc=(0.8, -0.4, 0.5), radius=0.5)
+    add("plane", material("panel", "emission", (1, 0.95, 0.9), strength=25.0, index=4), loc=(0, 1.5, 2.6),
+        rot=(math.radians(70), 0, 0), scale=(0.6, 0.25, 1))
+    bpy.ops.object.light_add(type="AREA", location=(-2.5, -2, 3.5))
+    key = bpy.context.active_object
+    key.data.energy, key.data.size = 300, 0.3
+    key.rotation_mode = "QUATERNION"
+    key.rotation_quaternion = (Vector((0, 0, 0.5)) - key.location).to_track_quat("-Z", "Y")
+    camera(sc, (0, -5.5, 1.6), (0, 0, 0.8), lens=40)
+    return ("glossy red ball (roughness 0.08) and chrome ball (0.06) under a small key light out of view: "
+            "specular highlights of a few pixels; visible emissive panel (strength 25)"), \
+        "world constant (0.02, 0.02, 0.025)"
+
+
 STILLS = {
     "cy_glass_mirror": scene_glass_mirror,
     "cy_sunsky_thin": scene_sunsky_thin,
@@ -362,6 +385,8 @@ STILLS = {
     "cy_textures_box": scene_textures_box,
 }
 QUICK = ["cy_glass_mirror", "cy_sunsky_thin"]
+# Stills rendered only when named (--scenes; kept out of --full, whose figures they would change).
+NAMED_ONLY = {"cy_studio": scene_studio}
 # The sequences: cy_orbit in every mode (the CI subset renders it at 48x48), cy_turntable in --full.
 SEQUENCES = {"cy_orbit": scene_orbit, "cy_turntable": scene_turntable}
 QUICK_SEQUENCES = ["cy_orbit"]
@@ -492,7 +517,7 @@ def vector_check(path, sc, frame_prev):
 
 
 def main():
-    a, mode, root, names = parse_render_args("cycles", QUICK, STILLS)
+    a, mode, root, names = parse_render_args("cycles", QUICK, STILLS, NAMED_ONLY)
     res = mode["res"]
     version = bpy.app.version_string
     for name in names:
@@ -503,7 +528,7 @@ def main():
         for spp, seed, stem in still_jobs(mode):
             _obj_index[0] = 0
             sc = reset()
-            what, bg = STILLS[name](sc)
+            what, bg = {**STILLS, **NAMED_ONLY}[name](sc)
             configure(sc, res, spp, seed)
             if name == "cy_textures_box":
                 sc.cycles.pixel_filter_type = "BOX"

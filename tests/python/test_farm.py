@@ -313,6 +313,28 @@ def test_evaluate_sweep_dataset_and_denoise_jobs(cluster, tmp_path):
                                                          seed=9 + i)["color"])
     assert random_scene(9, 0) != random_scene(9, 1)
 
+    # Training targets without a reference render (issue 47): OIDN high on a 64-spp render, a true
+    # reference for every second scene only; the target is far closer to it than the 1-spp input.
+    tg, tspec = tmp_path / "tg", tmp_path / "tspec.json"
+    tspec.write_text(json.dumps({"count": 2, "seed": 9, "width": 32, "height": 32, "spp": [1],
+                                 "reference_spp": 256, "target": "oidn", "target_spp": 64, "reference_every": 2}))
+    r = farm(["render", "--dataset", str(tspec), "--address", cluster.address, "--out", str(tg), "--quiet"], env=env)
+    assert r.returncode == 0, r.stderr
+    assert sorted(p.name for p in (tg / "scene_000000").iterdir()) == ["reference.exr", "scene.json", "spp_1",
+                                                                       "target.exr", "target.json"]
+    assert sorted(p.name for p in (tg / "scene_000001").iterdir()) == ["scene.json", "spp_1", "target.exr",
+                                                                       "target.json"]
+    meta = json.loads((tg / "scene_000001" / "target.json").read_text())
+    assert meta["kind"] == "oidn-high" and meta["spp"] == 64
+    from atrous.farm.target_error import target_error
+    err = target_error(tg)
+    assert [x["scene"] for x in err["scenes"]] == ["scene_000000"]
+    assert err["geomean_relmse"]["target"] < 0.25 * err["geomean_relmse"]["spp_1"]
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps({"count": 1, "target": "oidn-high"}))
+    r = farm(["render", "--dataset", str(bad), "--out", str(tmp_path / "y")], env=env)
+    assert r.returncode == 2 and "target must be one of reference, oidn" in r.stderr
+
     dn = tmp_path / "dn"
     r = farm(["denoise", "--in", str(ds), "--method", "eaw", "--param", "levels=3",
               "--address", cluster.address, "--out", str(dn), "--quiet"], env=env)

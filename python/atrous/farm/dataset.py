@@ -5,6 +5,16 @@ A spec is a JSON object (a file for the CLI, a dict for the Python API):
     {"count": 100, "seed": 7, "width": 128, "height": 128, "spp": [1, 4, 16],
      "reference_spp": 1024, "max_depth": 8}
 
+or, with training targets that need no reference render (issue 47):
+
+    {"count": 1000, "spp": [1, 4, 16], "target": "oidn", "target_spp": 256, "reference_every": 20}
+
+"target": "reference" (the default) writes reference.exr, a reference_spp render; "oidn" writes
+target.exr instead: a target_spp render (a third seed) denoised by OIDN at quality high (pyoidn,
+colour + albedo + normal, HDR), with target.json saying so, at a small part of a reference's cost;
+with reference_every N > 0, every Nth scene (index 0, N, 2N, ...) also gets reference.exr, so that
+the targets' own error can be measured (python -m atrous.farm.target_error DIR).
+
 Scene i is drawn from random.Random(f"{seed}:{i}") (Python's documented, version-stable seeding
 of a string), so the same spec gives the same scenes on every machine and any subset of them can
 be re-rendered alone. A scene is a room (floor, back and side walls of random colours) with 2-6
@@ -24,7 +34,9 @@ from .items import FarmInputError, int_list, positive_int
 __all__ = ["DEFAULT_SPEC", "check_spec", "load_spec", "random_scene"]
 
 DEFAULT_SPEC: Dict[str, Any] = {"count": 16, "seed": 1, "width": 128, "height": 128, "spp": [4],
-                                "reference_spp": 1024, "max_depth": 8}
+                                "reference_spp": 1024, "max_depth": 8, "target": "reference", "target_spp": 256,
+                                "reference_every": 0}
+TARGETS = ("reference", "oidn")
 _KEYS = set(DEFAULT_SPEC)
 
 
@@ -43,7 +55,12 @@ def check_spec(spec: Dict[str, Any], where: str = "dataset spec") -> Dict[str, A
         "spp": int_list(s["spp"], f"{where}: spp", 1, 1 << 20),
         "reference_spp": positive_int(s["reference_spp"], f"{where}: reference_spp", 1, 1 << 20),
         "max_depth": positive_int(s["max_depth"], f"{where}: max_depth", 1, 1000),
+        "target_spp": positive_int(s["target_spp"], f"{where}: target_spp", 1, 1 << 20),
+        "reference_every": positive_int(s["reference_every"], f"{where}: reference_every", 0, 1_000_000),
     }
+    if s["target"] not in TARGETS:
+        raise FarmInputError(f"{where}: target must be one of {', '.join(TARGETS)}, got {s['target']!r}")
+    out["target"] = s["target"]
     return out
 
 

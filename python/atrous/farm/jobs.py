@@ -67,7 +67,8 @@ def render(out: PathLike, scenes: Any, spp: Any = (16,), *, width: int = 512, he
 
 def render_dataset(out: PathLike, spec: Union[Dict[str, Any], PathLike], **run: Any) -> JobResult:
     """A training set of spec["count"] randomised scenes (dataset.py): OUT/scene_NNNNNN/ with
-    scene.json, spp_<N>/ per input spp and reference.exr."""
+    scene.json, spp_<N>/ per input spp and reference.exr, or target.exr + target.json (an OIDN-high
+    denoise of a target_spp render) with reference.exr for every reference_every-th scene."""
     s = _dataset.check_spec(spec) if isinstance(spec, dict) else _dataset.load_spec(spec)
     ref_seed = (s["seed"] * 7919 + 1000003) % (_SEED_MAX + 1)  # never an input's seed stream
     items = []
@@ -75,7 +76,11 @@ def render_dataset(out: PathLike, spec: Union[Dict[str, Any], PathLike], **run: 
         iid = f"scene_{i:06d}"
         p = {"scene": _dataset.random_scene(s["seed"], i), "index": i, "width": s["width"], "height": s["height"],
              "spp": s["spp"], "seed": (s["seed"] + i) % (_SEED_MAX + 1), "reference_spp": s["reference_spp"],
-             "reference_seed": (ref_seed + i) % (_SEED_MAX + 1), "max_depth": s["max_depth"]}
+             "reference_seed": (ref_seed + i) % (_SEED_MAX + 1), "max_depth": s["max_depth"],
+             "target": s["target"], "reference": s["target"] == "reference" or
+             (s["reference_every"] > 0 and i % s["reference_every"] == 0)}
+        if s["target"] == "oidn":  # a third seed stream, neither an input's nor a reference's
+            p.update(target_spp=s["target_spp"], target_seed=(ref_seed + 0x5BD1E995 + i) % (_SEED_MAX + 1))
         items.append(Item(iid, "dataset", p, [iid]))
     return run_job("render", {"dataset": s}, items, Path(out), **run)
 

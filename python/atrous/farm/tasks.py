@@ -16,7 +16,7 @@ import time
 import uuid
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, Dict, Iterator, List, Optional
+from typing import Any, Dict, Iterator, List, Optional, Tuple
 
 import numpy as np
 
@@ -156,9 +156,23 @@ def run_frame(item: Dict[str, Any], out: Path, threads: int, device: str) -> Dic
     return {}
 
 
+def oidn_target(bufs: Dict[str, np.ndarray]) -> Tuple[np.ndarray, str]:
+    """OIDN at quality high on a render (colour + albedo + normal, HDR, as atrous.eval runs it):
+    a training target (docs/farm.md, "Training targets"), and pyoidn's version."""
+    try:
+        import pyoidn
+    except Exception as e:  # ImportError, or a broken native library
+        raise RuntimeError(f"target 'oidn' needs pyoidn ({type(e).__name__}: {e})") from None
+    from atrous.eval import oidn_inputs
+
+    img = np.asarray(pyoidn.denoise(*oidn_inputs(bufs), hdr=True, quality="high"), np.float32)
+    return img, str(getattr(getattr(pyoidn, "version", None), "__version__", ""))
+
+
 def run_dataset(item: Dict[str, Any], out: Path, threads: int, device: str) -> Dict[str, Any]:
     """One scene of a training set: scene.json, spp_<N>/ per input spp (the `atrous render --out`
-    layout) and reference.exr (reference_spp samples, another seed)."""
+    layout) and reference.exr (reference_spp samples, another seed), or target.exr (OIDN high on a
+    target_spp render, a third seed) with target.json, and reference.exr where params["reference"]."""
     p = item["params"]
     with staged(out, item["id"]) as stage:
         scene = stage / "scene.json"
@@ -167,8 +181,15 @@ def run_dataset(item: Dict[str, Any], out: Path, threads: int, device: str) -> D
             d = stage / f"spp_{spp}"
             d.mkdir()
             write_buffers(d, _render(p, threads, spp=spp, scene=str(scene)))
-        ref = _render(p, threads, spp=p["reference_spp"], seed=p["reference_seed"], scene=str(scene))
-        atrous.write_image(stage / "reference.exr", ref["color"])
+        if p.get("target") == "oidn":
+            img, version = oidn_target(_render(p, threads, spp=p["target_spp"], seed=p["target_seed"],
+                                               scene=str(scene)))
+            atrous.write_image(stage / "target.exr", img)
+            (stage / "target.json").write_text(json.dumps({"kind": "oidn-high", "spp": p["target_spp"],
+                                                           "seed": p["target_seed"], "pyoidn": version}))
+        if p.get("reference", True):
+            ref = _render(p, threads, spp=p["reference_spp"], seed=p["reference_seed"], scene=str(scene))
+            atrous.write_image(stage / "reference.exr", ref["color"])
         # The scene file names no other file, so it is as valid in its final place.
         publish_dir(stage, out / item["outputs"][0])
     return {}
