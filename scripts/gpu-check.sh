@@ -138,7 +138,7 @@ setup() {
   done
   LIBDIRS="$PREFIX/usr/lib/x86_64-linux-gnu:$PREFIX/lib/x86_64-linux-gnu"
   export LD_LIBRARY_PATH="$LIBDIRS${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
-  if ldd "$WORK/atrous" 2>&1 | grep -q "version .* not found"; then
+  if grep -q "version .* not found" <<< "$(ldd "$WORK/atrous" 2>&1)"; then  # (no pipe: pipefail and grep -q)
     echo "the system's libstdc++/libgcc are too old: using the carried ones"
     for d in "$PACK"/debs/fallback/*.deb; do
       if command -v dpkg > /dev/null; then dpkg -x "$d" "$PREFIX/fallback"; else $TOOL deb-extract "$d" "$PREFIX/fallback"; fi
@@ -185,7 +185,7 @@ check_pack() {
   local bins=("$WORK/atrous" "$WORK/gpu_bandwidth" "$WORK/bench/bench_gpu_render" "$WORK"/tests/*)
   for b in "${bins[@]}"; do
     if command -v cuobjdump > /dev/null; then
-      cuobjdump --list-elf "$b" | grep -q sm_90 || { echo "$b: no sm_90 ELF (cuobjdump)"; bad=1; }
+      grep -q sm_90 <<< "$(cuobjdump --list-elf "$b")" || { echo "$b: no sm_90 ELF (cuobjdump)"; bad=1; }
     fi
   done
   $TOOL fatbin-arch "${bins[@]}" > "$OUTDIR/fatbin.json" || bad=1
