@@ -14,8 +14,8 @@ OIDN-high targets (no reference renders)?
   .venv-train/bin/python scripts/train/probe_residual.py train out/probe/residual/train.npz out/probe/residual --minutes 12
   .venv-train/bin/python scripts/train/probe_residual.py eval out/probe/residual/test.npz out/probe/residual
 
-The network: 12 inputs (log1p of the default's output and of the noisy colour, the albedo, the
-normal), a 3-level U-Net (16 / 24 / 32 channels, two 3x3 convolutions a level, about 16 000
+The network: 15 inputs (log1p of the default's output and of the noisy colour, the albedo, the
+normal, and a noise level: the 7x7 mean of |log1p(noisy) - log1p(default)|), a 3-level U-Net (16 / 24 / 32 channels, two 3x3 convolutions a level, about 16 000
 multiply-adds a pixel), 3 outputs r; the result is expm1(log1p(default) + r). Loss: relMSE against
 the target (the metric the corpus tables use). No C++ reads these weights.
 """
@@ -31,13 +31,24 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[2]
 C1, C2, C3 = 16, 24, 32
-NIN = 12
+NIN = 15
+
+
+def noise_level(base, color, radius=3):
+    """A noise input: the 7x7 mean of |log1p(noisy) - log1p(default)| per channel (what the default
+    took away, large where the input is noisy, small where it is clean)."""
+    d = np.abs(np.log1p(np.maximum(color, 0)) - np.log1p(np.maximum(base, 0)))
+    s = np.pad(d, ((radius, radius), (radius, radius), (0, 0)), mode="edge").cumsum(0).cumsum(1)
+    s = np.pad(s, ((1, 0), (1, 0), (0, 0)))
+    k = 2 * radius + 1
+    return (s[k:, k:] - s[:-k, k:] - s[k:, :-k] + s[:-k, :-k]) / (k * k)
 
 
 def features(base, color, albedo, normal):
-    """The network's inputs, H x W x 12 float32."""
+    """The network's inputs, H x W x NIN float32."""
     f = [np.log1p(np.maximum(base, 0)), np.log1p(np.maximum(color, 0)),
-         np.clip(np.nan_to_num(albedo), 0, 1), np.clip(np.nan_to_num(normal), -1, 1)]
+         np.clip(np.nan_to_num(albedo), 0, 1), np.clip(np.nan_to_num(normal), -1, 1),
+         noise_level(base, color)]
     return np.concatenate(f, axis=-1).astype(np.float32)
 
 
