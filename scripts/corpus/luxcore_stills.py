@@ -28,11 +28,12 @@ import time
 
 import pyluxcore
 
+from common import SEED_NOISY, SEED_REF  # the seeds of the other renderers' stills (scripts/corpus/common.py)
+
 pyluxcore.Init(lambda s: None)
 
 SIZE = 256
-SEEDS = {1: 5, 4: 1, 16: 2}  # the noisy seeds by spp (common.SEED_NOISY)
-REF_SPP, REF_SEED = 2048, 1000003
+REF_SPP = 2048
 OUTPUTS = ("RGB", "ALBEDO", "AVG_SHADING_NORMAL", "POSITION", "DEPTH")
 
 
@@ -182,7 +183,7 @@ def main():
         os.makedirs(sd, exist_ok=True)
         ref = f"ref{a.ref_spp:04d}"
         files, times = {}, {}
-        for spp, seed, stem in [(s, SEEDS[s], f"spp{s:04d}") for s in map(int, a.spp.split(","))] + [(a.ref_spp, REF_SEED, ref)]:
+        for spp, seed, stem in [(s, SEED_NOISY[s], f"spp{s:04d}") for s in map(int, a.spp.split(","))] + [(a.ref_spp, SEED_REF, ref)]:
             files[stem] = {"spp": spp, "seed": seed, "folder": stem, "files": [t + ".exr" for t in OUTPUTS]}
             if not os.path.exists(os.path.join(sd, stem, "RGB.exr")):
                 times[stem] = round(render(build, os.path.join(sd, stem), spp, seed, a.size), 1)

@@ -1,14 +1,11 @@
-// CPU paths of the firefly restore (src/filters/firefly_restore.h), the same values as the
-// functors (tests/firefly_restore_test.cpp holds them bit for bit):
-// - runRestorePrefix: the prefix sums of a difference image, rows on TBB threads as in the
-//   functor, columns in bands of columns added a row at a time into double accumulators (the
-//   functor walks one column at a time, serial and strided here).
-// - runFireflyRestore: the window counts from a summed-area table of the flags (integers: exact)
-//   at the clamped pixels only; the difference image built a row at a time from lists of each
-//   row's sources (the functor gathers 20 taps at every pixel), its row sums taken while the row is
-//   in cache, and the column sums added to the output in the same pass. Nothing to do without a
-//   source. The generic per-pixel loop vectorised the window counts and corner spans as masked
-//   lanes: 4x slower at 1080p.
+// The CPU path of the firefly restore (src/filters/firefly_restore.h), the same values as the
+// functors (tests/firefly_restore_test.cpp holds them bit for bit): the window counts from a
+// summed-area table of the flags (integers: exact) at the clamped pixels only; the difference image
+// built a row at a time from lists of each row's sources (the functor gathers 24 taps at every
+// pixel), its row sums taken while the row is in cache; the column sums in bands of columns added a
+// row at a time into double accumulators (the functor walks one column at a time, serial and
+// strided here), added to the output in the same pass. Nothing to do without a source. The generic
+// per-pixel loop vectorised the window counts and corner spans as masked lanes: 4x slower at 1080p.
 #include <algorithm>
 #include <memory>
 #include <vector>
@@ -78,12 +75,6 @@ struct FlagTable {
 };
 
 }  // namespace
-
-void runRestorePrefix(const CpuExec&, const ImageView& plane) {
-    const RestoreRowSum rows{plane};
-    parallelForRowsCpu(plane.height, [&](int y) { rows(0, y); });
-    columnSums(plane, [&](int c, int x, int y, float s) { plane(x, y, c) = s; });
-}
 
 void runFireflyRestore(const CpuExec&, const FireflyRestore& r) {
     const int w = r.cIn.width, h = r.cIn.height;

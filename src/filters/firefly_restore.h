@@ -8,7 +8,7 @@
 // that holds at least kRestoreCount clamped pixels, the way a photon map's density estimate takes
 // its k nearest photons: where clamped samples are dense (the room's walls at 1 spp, a caustic)
 // the window is small and the light stays where it fell; a lone firefly, with no such window
-// within kRestoreMaxRadius, is dropped as before (sun glints that no neighbour confirms, spread up
+// up to the largest radius, is dropped as before (sun glints that no neighbour confirms, spread up
 // to radius 64, were a haze on dark ground: docs/quality.md). The spread is a scatter (each
 // source's in-image window gets E / taps, so the energy put back equals the energy taken, to
 // float rounding), computed in O(1) a pixel as a difference image and two prefix sums: the
@@ -25,9 +25,8 @@ struct CpuExec;
 
 namespace atrous::filters {
 
-constexpr int kRestoreCount = 32;      // clamped pixels a window must hold (docs/decisions.md, "Fireflies put back")
-constexpr int kRestoreLevels = 6;      // windows of radius 1, 2, 4, 8, 16, 32
-constexpr int kRestoreMaxRadius = 32;  // 1 << (kRestoreLevels - 1)
+constexpr int kRestoreCount = 32;  // clamped pixels a window must hold (docs/decisions.md, "Fireflies put back")
+constexpr int kRestoreLevels = 6;  // windows of radius 1, 2, 4, 8, 16, 32
 ATROUS_INLINE int restoreRadius(int level) { return 1 << level; }
 
 // 1. Per pixel: 0 where not clamped or no window holds kRestoreCount clamped pixels; else its excess
@@ -161,27 +160,19 @@ struct FireflyRestore {
     ImageView addTo;            // where the spread is added (invalid: cOut)
 };
 
-template <class Exec>
-void runRestorePrefix(const Exec& exec, const ImageView& plane) {
-    exec.forEachPixel(1, plane.height, RestoreRowSum{plane});
-    exec.forEachPixel(plane.width, 1, RestoreColumnSum{plane});
-}
-// The CPU's: rows on TBB threads, columns as rows added in order in bands of columns (the
-// functor's column walk is serial and strided there); the same sums in double.
-void runRestorePrefix(const CpuExec& exec, const ImageView& plane);
-
 // Adds what the firefly pass removed back into r.cOut (the steps above).
 template <class Exec>
 void runFireflyRestore(const Exec& exec, const FireflyRestore& r) {
     const int w = r.cIn.width, h = r.cIn.height;
     exec.forEachPixel(w, h, RestoreSource{r.cIn, r.cOut, r.flag, r.share, r.radius});
     exec.forEachPixel(w, h, RestoreCorners{r.share, r.radius, r.diff});
-    runRestorePrefix(exec, r.diff);
+    exec.forEachPixel(1, h, RestoreRowSum{r.diff});
+    exec.forEachPixel(w, 1, RestoreColumnSum{r.diff});
     exec.forEachPixel(w, h, RestoreAdd{r.diff, r.addTo.valid() ? r.addTo : r.cOut});
 }
-// The CPU's: the same functors in plain row loops (the generic loop's `omp simd` ran every lane's
-// window count and corner spans masked: 4x slower at 1080p), the window count only at clamped
-// pixels, and runRestorePrefix's CPU overload; the same values.
+// The CPU's (src/cpu/restore_cpu.cpp): the same values from row loops, without the share and
+// radius planes (the generic loop's `omp simd` ran every lane's window count and corner spans
+// masked: 4x slower at 1080p).
 void runFireflyRestore(const CpuExec& exec, const FireflyRestore& r);
 
 }  // namespace atrous::filters

@@ -19,6 +19,12 @@ void refuseScene(const std::string& flag, const std::string& path) {
         throw InputError(path + ": a JSON scene, not a render (" + flag + " opens renders): open it with --scene " + path);
 }
 
+// A buffer's name among a sequence frame's files (kSequenceBuffers, SequenceFrame::fileOf): the
+// library's name, "ids" for the object ids.
+std::string frameBufferName(int b) {
+    return b == int(io::Buffer::ObjectId) ? "ids" : io::bufferName(io::Buffer(b));
+}
+
 }  // namespace
 
 FileSource::FileSource(const cli::InputFlags& input, const std::string& sequence, const io::FrameRange& range)
@@ -73,7 +79,7 @@ io::BufferSet FileSource::load(int k) {
         for (auto& [b, img] : slots) set.image[int(b)] = std::move(*img);
         for (int i = 0; i < 10; ++i) mFiles[i] = f.files[i];
         for (int b = 0; b < io::kBufferCount; ++b)
-            if (!set.image[b].empty()) set.from[b] = f.fileOf(b == int(io::Buffer::ObjectId) ? "ids" : io::bufferName(io::Buffer(b)));
+            if (!set.image[b].empty()) set.from[b] = f.fileOf(frameBufferName(b));
         set.layered = f.layered;
     }
     mCurrent = k;
@@ -92,8 +98,7 @@ std::string FileSource::denoiseInput() const {
         // Numbered files per buffer in one folder: each buffer's file by its own flag.
         for (int i = 0; i < 10; ++i)
             for (int b = 0; b < io::kBufferCount && !mFiles[i].empty(); ++b) {
-                const std::string name = b == int(io::Buffer::ObjectId) ? "ids" : io::bufferName(io::Buffer(b));
-                if (name == io::kSequenceBuffers[i] && *cli::bufferFlag(io::Buffer(b))) f.file[b] = mFiles[i];
+                if (frameBufferName(b) == io::kSequenceBuffers[i] && *cli::bufferFlag(io::Buffer(b))) f.file[b] = mFiles[i];
             }
     }
     return cli::inputCommandLine(f);

@@ -157,16 +157,14 @@ def run_frame(item: Dict[str, Any], out: Path, threads: int, device: str) -> Dic
 
 
 def oidn_target(bufs: Dict[str, np.ndarray]) -> Tuple[np.ndarray, str]:
-    """OIDN at quality high on a render (colour + albedo + normal, HDR, as atrous.eval runs it):
-    a training target (docs/farm.md, "Training targets"), and pyoidn's version."""
-    try:
-        import pyoidn
-    except Exception as e:  # ImportError, or a broken native library
-        raise RuntimeError(f"target 'oidn' needs pyoidn ({type(e).__name__}: {e})") from None
-    from atrous.eval import oidn_inputs
+    """OIDN at quality high on a render, as atrous.eval runs it (load_oidn): a training target
+    (docs/farm.md, "Training targets"), and which pyoidn made it."""
+    from atrous.eval import load_oidn
 
-    img = np.asarray(pyoidn.denoise(*oidn_inputs(bufs), hdr=True, quality="high"), np.float32)
-    return img, str(getattr(getattr(pyoidn, "version", None), "__version__", ""))
+    run, version = load_oidn()
+    if run is None:
+        raise RuntimeError(f"target 'oidn': {version}")
+    return np.asarray(run(bufs), np.float32), version
 
 
 def run_dataset(item: Dict[str, Any], out: Path, threads: int, device: str) -> Dict[str, Any]:
