@@ -13,6 +13,7 @@
 #include "atrous/device.h"
 #include "atrous/image.h"
 #include "atrous/learned.h"
+#include "atrous/refine.h"
 #include "atrous/stage_time.h"
 
 namespace atrous {
@@ -127,6 +128,11 @@ struct DenoiseOptions {
     // (LearnedWeights::load for a weight file, version 4 or 3; docs/learned.md) and shared between
     // calls, so a sequence or a batch reads its file once. Empty = the built-in weights.
     LearnedWeights weights;
+    // The refine stage after the method (docs/learned.md, "Refine"; src/filters/refine.h): a small
+    // U-Net predicts a correction of the finished image, a residual in log space. It reads the
+    // noisy colour, the albedo and the normal; without an albedo and a normal it is skipped.
+    bool refine = false;
+    RefineWeights refineWeights;  // empty = the built-in weights
 };
 
 // What a denoise() call did, for the CLI and for measurements.

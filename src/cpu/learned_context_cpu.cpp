@@ -1,22 +1,7 @@
 // The learned filter v4's context branch on the CPU (filters/learned_context.h): the cell inputs
 // row-wise (the quantities of a pixel row in vector loops, summed per column, then per cell), the
 // 2x2 pooling and the x2 upsampling through the functors, the four 3x3 convolutions and the 1x1
-// layer through oneDNN (Debian's libdnnl-dev) on the channels-last tensors (nhwc; the kernels in
-// the weight file's HWIO order, reordered to oneDNN's choice). Primitives are made per call:
-// oneDNN's own primitive cache returns them for a size it has seen.
-//
-// Threads: Debian's oneDNN runs on OpenMP, the rest of atrous on TBB. On this 2-core machine
-// OpenMP's team woken beside TBB's spinning workers cost 5-10 ms per primitive (a 16x13x3x3 weight
-// reorder took 10 ms); each convolution here is a few ms on one core. So oneDNN runs on the calling
-// thread alone (omp_set_num_threads(1), which sets that thread's team size only), and the
-// convolutions over the image's halves run as two TBB tasks, each a oneDNN call on its rows.
-#if ATROUS_HAVE_ONEDNN
-#include <dnnl.hpp>
-#include <omp.h>
-#endif
-
-#include <tbb/parallel_for.h>
-
+// layer through oneDNN (src/cpu/dnnl_conv.cpp).
 #include <algorithm>
 #include <string>
 #include <vector>
@@ -24,6 +9,7 @@
 #include "atrous/error.h"
 #include "core/parallel.h"
 #include "core/isa_dispatch.h"
+#include "cpu/dnnl_conv.h"
 #include "filters/learned.h"
 
 namespace atrous::filters {
@@ -110,86 +96,20 @@ struct CellRows {
     }
 };
 
-#if ATROUS_HAVE_ONEDNN
-dnnl::engine& cpuEngine() {
-    static dnnl::engine e(dnnl::engine::kind::cpu, 0);
-    return e;
-}
-
-// The convolution's output rows [y0, y1) from the input rows they read (one above and below where
-// the image has them; zero padding only at the image's edges): channels-last bands are dense.
-void dnnlConvRows(const LearnedTensor& in, const LearnedTensor& out, const float* k, const float* b, int ks, bool relu,
-                  int y0, int y1) {
-    const int pad = ks / 2, i0 = std::max(0, y0 - pad), i1 = std::min(in.height, y1 + pad);
-    using namespace dnnl;
-    using dt = memory::data_type;
-    using tag = memory::format_tag;
-    const memory::dim ic = in.channels, oc = out.channels, w = in.width;
-    const memory::desc srcMd({1, ic, i1 - i0, w}, dt::f32, tag::nhwc), dstMd({1, oc, y1 - y0, w}, dt::f32, tag::nhwc);
-    const memory::desc wMd({oc, ic, ks, ks}, dt::f32, tag::hwio), bMd({oc}, dt::f32, tag::x);
-    const memory::dim padTop = pad - (y0 - i0), padBottom = pad - (i1 - y1);
-    const convolution_forward::desc d(prop_kind::forward_inference, algorithm::convolution_direct, srcMd,
-                                      memory::desc({oc, ic, ks, ks}, dt::f32, tag::any), bMd, dstMd, {1, 1},
-                                      {padTop, pad}, {padBottom, pad});
-    primitive_attr attr;
-    if (relu) {
-        post_ops ops;
-        ops.append_eltwise(1.0f, algorithm::eltwise_relu, 0.0f, 0.0f);
-        attr.set_post_ops(ops);
-    }
-    omp_set_num_threads(1);
-    stream s(cpuEngine());
-    const convolution_forward::primitive_desc pd(d, attr, cpuEngine());
-    memory wUser(wMd, cpuEngine(), const_cast<float*>(k));
-    memory wPrim = wUser;
-    if (pd.weights_desc() != wMd) {  // oneDNN's blocked layout for the kernel (9 K floats at most)
-        wPrim = memory(pd.weights_desc(), cpuEngine());
-        reorder(wUser, wPrim).execute(s, wUser, wPrim);
-    }
-    memory src(srcMd, cpuEngine(), in.data + size_t(i0) * size_t(w) * size_t(ic));
-    memory dst(dstMd, cpuEngine(), out.data + size_t(y0) * size_t(w) * size_t(oc));
-    memory bias(bMd, cpuEngine(), const_cast<float*>(b));
-    convolution_forward(pd).execute(
-        s, {{DNNL_ARG_SRC, src}, {DNNL_ARG_WEIGHTS, wPrim}, {DNNL_ARG_BIAS, bias}, {DNNL_ARG_DST, dst}});
-    s.wait();
-}
-
-// The convolution in two halves of rows on TBB's threads (one piece below 64 rows).
-void conv(const LearnedTensor& in, const LearnedTensor& out, const float* k, const float* b, int ks, bool relu) {
-    const int h = out.height, parts = h >= 64 ? 2 : 1;
-    tbb::parallel_for(0, parts,
-                      [&](int i) { dnnlConvRows(in, out, k, b, ks, relu, h * i / parts, h * (i + 1) / parts); });
-}
-#else
-// Built without oneDNN (ATROUS_ONEDNN=OFF: the GPU check's pack): the direct-convolution functor.
-void conv(const LearnedTensor& in, const LearnedTensor& out, const float* k, const float* b, int ks, bool relu) {
-    CpuExec{}.forEachPixel(out.width, out.height, LearnedConv{in, out, k, b, ks, relu});
-}
-#endif
-
 }  // namespace
+
+constexpr const char* kWho = "learned filter";
 
 void runLearnedContextCpu(const CpuExec& exec, const LearnedCtxNet& net, const PreparedView& P,
                           const LearnedCtxPlanes& C) {
     cpu::parallelForIsa(cpu::activeIsa(), 0, C.cells.height, 1, CellRows{P.color, P.variance, P.albedo, P.normal, P.depth, C.cells});
-    auto convolutions = [&] {
-        conv(C.cells, C.c1, net.k1, net.kb1, 3, true);
-        exec.forEachPixel(C.pool.width, C.pool.height, LearnedPool2{C.c1, C.pool});
-        conv(C.pool, C.c2, net.k2, net.kb2, 3, true);
-        conv(C.c2, C.c3, net.k3, net.kb3, 3, true);
-        exec.forEachPixel(C.cat.width, C.cat.height, LearnedUp2Cat{C.c1, C.c3, C.cat});
-        conv(C.cat, C.c4, net.k4, net.kb4, 3, true);
-        conv(C.c4, C.z, net.kz, net.kbz, 1, false);
-    };
-#if ATROUS_HAVE_ONEDNN
-    try {
-        convolutions();
-    } catch (const dnnl::error& e) {
-        throw RuntimeError(std::string("learned filter: oneDNN: ") + e.what());
-    }
-#else
-    convolutions();
-#endif
+    learnedConvCpu(C.cells, C.c1, net.k1, net.kb1, 3, true, kWho);
+    exec.forEachPixel(C.pool.width, C.pool.height, LearnedPool2{C.c1, C.pool});
+    learnedConvCpu(C.pool, C.c2, net.k2, net.kb2, 3, true, kWho);
+    learnedConvCpu(C.c2, C.c3, net.k3, net.kb3, 3, true, kWho);
+    exec.forEachPixel(C.cat.width, C.cat.height, LearnedUp2Cat{C.c1, C.c3, C.cat});
+    learnedConvCpu(C.cat, C.c4, net.k4, net.kb4, 3, true, kWho);
+    learnedConvCpu(C.c4, C.z, net.kz, net.kbz, 1, false, kWho);
 }
 
 }  // namespace atrous::filters

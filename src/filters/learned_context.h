@@ -24,6 +24,8 @@
 namespace atrous::filters {
 
 ATROUS_INLINE int learnedCeilDiv(int n, int f) { return (n + f - 1) / f; }
+// The most output channels LearnedConv computes (its accumulators; the refine stage's 32).
+constexpr int kLearnedConvMaxOut = 32;
 
 // A channels-last tensor (HWC: sample (x, y)'s channels are adjacent): the branch's layout, so that
 // a band of rows is one dense block (oneDNN's nhwc; the CPU convolves the image's halves apart).
@@ -163,7 +165,7 @@ struct LearnedConv {
     bool relu;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         const int cin = in.channels, cout = out.channels, p = ks / 2;
-        float acc[kLearnedHidden];
+        float acc[kLearnedConvMaxOut];
         for (int o = 0; o < cout; ++o) acc[o] = b[o];
         for (int ky = 0; ky < ks; ++ky) {
             const int yy = y + ky - p;

@@ -135,7 +135,7 @@ DenoiseMethod resolveDenoiseMethod(DenoiseMethod m, const Frame& in) {
 // ---- What a call reads ------------------------------------------------------------------------
 
 const std::vector<std::string>& stillStageGroups() {
-    static const std::vector<std::string> g = {"", "firefly", "emission", "safety"};
+    static const std::vector<std::string> g = {"", "firefly", "emission", "safety", "refine"};
     return g;
 }
 
@@ -210,6 +210,7 @@ BufferMask methodReads(const DenoiseMethodInfo& m, const DenoiseOptions& o) {
 BufferMask denoiseReads(const DenoiseOptions& o, DenoiseMethod resolved) {
     BufferMask r{Buffer::Color, Buffer::Variance, Buffer::Emission, Buffer::Normal, Buffer::Depth};
     if (o.demodulate) r = r.with(Buffer::Albedo);
+    if (o.refine) r = r.with(Buffer::Albedo);  // the refine stage's inputs (the normal is read above)
     r = r | methodReads(denoiseMethodInfo(resolved), o);
     // The ids are one image: the material id comes with the object id.
     if (r.has(Buffer::ObjectId)) r = r.with(Buffer::MaterialId);
@@ -219,7 +220,7 @@ BufferMask denoiseReads(const DenoiseOptions& o, DenoiseMethod resolved) {
 std::string unusedReason(Buffer b, const DenoiseOptions& o, DenoiseMethod resolved, bool noiseEstimated) {
     const DenoiseMethodInfo& m = denoiseMethodInfo(resolved);
     const bool preparation = b == Buffer::Color || b == Buffer::Variance || b == Buffer::Emission ||
-                             (b == Buffer::Albedo && o.demodulate) ||
+                             (b == Buffer::Albedo && (o.demodulate || o.refine)) || (b == Buffer::Normal && o.refine) ||
                              ((b == Buffer::Normal || b == Buffer::Depth) && noiseEstimated);
     if (preparation || methodReads(m, o).has(b)) return "";
     // A switch of the row or of a row it combines that reads b.

@@ -8,6 +8,7 @@
 #include "filters/still_finish.h"
 #include "filters/still_prepare.h"
 #include "filters/still_state.h"
+#include "filters/refine.h"
 
 namespace atrous::filters {
 
@@ -58,13 +59,31 @@ Filtered runCascade(const Exec& exec, const StillConfig& cfg, Prepared& p, Plane
     throw InputError("the still path was given auto unresolved");
 }
 
+// The refine stage (filters/refine.h) on the finished output, when asked for and the albedo and
+// the normal are there: lc, log1p of the noisy colour, is taken before the preparation (which may
+// sanitise the colour in place).
 template <class Exec>
 void runStill(const Exec& exec, const StillInputs& in, const StillConfig& cfg, const StillOutputs& out) {
-    PlanePool pool(in.color.width, in.color.height, exec.device());
+    const int w = in.color.width, h = in.color.height;
+    PlanePool pool(w, h, exec.device());
+    const bool refine = cfg.opts.refine && in.albedo.valid() && in.normal.valid();
+    Image lc;
+    if (refine) {
+        lc = pool.take(3);
+        exec.forEachPixel(w, h, RefineLogColour{in.color, lc.view()});
+    }
     Prepared p = prepare(exec, in, cfg, preparedFeatures(cfg), pool, out);
     KeptInput kept;
     Filtered F = runCascade(exec, cfg, p, pool, kept, out);
     finish(exec, cfg, p, kept, pool, F, out);
+    if (refine) {
+        p = Prepared{};
+        kept = KeptInput{};
+        Image t = pool.take(3);
+        runRefine(exec, cfg.opts.refineWeights, RefineViews{lc.view(), t.view(), in.albedo, in.normal,
+                                                            out.out.valid() ? out.out : out.result->view()});
+        markStage(out.clock, "refine");
+    }
 }
 
 }  // namespace atrous::filters

@@ -321,9 +321,10 @@ def test_evaluate_sweep_dataset_and_denoise_jobs(cluster, tmp_path):
     r = farm(["render", "--dataset", str(tspec), "--address", cluster.address, "--out", str(tg), "--quiet"], env=env)
     assert r.returncode == 0, r.stderr
     assert sorted(p.name for p in (tg / "scene_000000").iterdir()) == ["reference.exr", "scene.json", "spp_1",
-                                                                       "target.exr", "target.json"]
+                                                                       "target.exr", "target.json",
+                                                                       "target_input.exr"]
     assert sorted(p.name for p in (tg / "scene_000001").iterdir()) == ["scene.json", "spp_1", "target.exr",
-                                                                       "target.json"]
+                                                                       "target.json", "target_input.exr"]
     meta = json.loads((tg / "scene_000001" / "target.json").read_text())
     assert meta["kind"] == "oidn-high" and meta["spp"] == 64
     from atrous.farm.target_error import target_error

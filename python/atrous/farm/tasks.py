@@ -170,7 +170,8 @@ def oidn_target(bufs: Dict[str, np.ndarray]) -> Tuple[np.ndarray, str]:
 def run_dataset(item: Dict[str, Any], out: Path, threads: int, device: str) -> Dict[str, Any]:
     """One scene of a training set: scene.json, spp_<N>/ per input spp (the `atrous render --out`
     layout) and reference.exr (reference_spp samples, another seed), or target.exr (OIDN high on a
-    target_spp render, a third seed) with target.json, and reference.exr where params["reference"]."""
+    target_spp render, a third seed) with target.json and that render's colour (target_input.exr),
+    and reference.exr where params["reference"]."""
     p = item["params"]
     with staged(out, item["id"]) as stage:
         scene = stage / "scene.json"
@@ -180,9 +181,11 @@ def run_dataset(item: Dict[str, Any], out: Path, threads: int, device: str) -> D
             d.mkdir()
             write_buffers(d, _render(p, threads, spp=spp, scene=str(scene)))
         if p.get("target") == "oidn":
-            img, version = oidn_target(_render(p, threads, spp=p["target_spp"], seed=p["target_seed"],
-                                               scene=str(scene)))
+            raw = _render(p, threads, spp=p["target_spp"], seed=p["target_seed"], scene=str(scene))
+            img, version = oidn_target(raw)
             atrous.write_image(stage / "target.exr", img)
+            # The render OIDN denoised: unbiased where OIDN's output may not be (an energy term's anchor).
+            atrous.write_image(stage / "target_input.exr", raw["color"])
             (stage / "target.json").write_text(json.dumps({"kind": "oidn-high", "spp": p["target_spp"],
                                                            "seed": p["target_seed"], "pyoidn": version}))
         if p.get("reference", True):
