@@ -255,6 +255,8 @@ bench_size() {  # WxH
     # flags and JSON through the CPU path, then the CUDA path must refuse cleanly (exit 2) without a GPU
     "$WORK/atrous" bench --device cpu --json --sizes 64x64 --what render,eaw,sure,svgf,learned --runs 1 --warmup 0 \
       > "$OUTDIR/bench/atrous_bench_cpu_dry.json" || return 1
+    "$WORK/atrous" bench --device cpu --json --sizes 64x64 --what refine --runs 1 --warmup 0 \
+      > "$OUTDIR/bench/atrous_bench_cpu_refine_dry.json" || return 1
     python3 -m json.tool "$OUTDIR/bench/atrous_bench_cpu_dry.json" > /dev/null || return 1
     "$WORK/atrous" bench --device cuda --json --sizes "$1" --what render,eaw,sure,svgf,learned > /dev/null 2> "$LOGS/bench-cuda-dry.err"
     local rc=$?
@@ -263,7 +265,10 @@ bench_size() {  # WxH
     return 0
   fi
   "$WORK/atrous" bench --device cuda --json --sizes "$1" --what render,eaw,sure,svgf,learned > "$OUTDIR/bench/atrous_bench_cuda_$1.json" \
-    && python3 -m json.tool "$OUTDIR/bench/atrous_bench_cuda_$1.json" > /dev/null
+    && python3 -m json.tool "$OUTDIR/bench/atrous_bench_cuda_$1.json" > /dev/null || return 1
+  # the refine method (SURE and the refine stage; issue 47, docs/refine.md)
+  "$WORK/atrous" bench --device cuda --json --sizes "$1" --what refine > "$OUTDIR/bench/atrous_bench_cuda_refine_$1.json" \
+    && python3 -m json.tool "$OUTDIR/bench/atrous_bench_cuda_refine_$1.json" > /dev/null
 }
 bench_render() {
   local args=(--scene cornell --width 1920 --height 1080 --spp 1 --runs 5)

@@ -26,8 +26,11 @@ namespace atrous {
 // SURE outputs, both from the same prepared planes (one preparation, the two cascades): their
 // errors are partly independent (docs/decisions.md; docs/quality.md, "The default method"). Auto (the default): resolved by denoise() to Blend when
 // an albedo and a normal buffer are given, else Sure (DenoiseReport::methodUsed says which).
-// Registered methods (registerDenoiseMethod, below) take the values after Blend.
-enum class DenoiseMethod : int { Eaw, Sure, Learned, Auto, Blend };
+// Refine: SURE, then the refine stage (src/filters/refine.h, docs/refine.md): a small U-Net on the
+// finished image, the noisy colour, the albedo and the normal predicts a correction, a residual
+// in log space, and a smooth gain keeps SURE's light per 64-pixel block; it needs an albedo and a
+// normal. Registered methods (registerDenoiseMethod, below) take the values after Refine.
+enum class DenoiseMethod : int { Eaw, Sure, Learned, Auto, Blend, Refine };
 
 // The buffers of a denoise() call are one Frame (atrous/buffers.h, where each buffer's channels
 // and conventions are stated). Only `color` is required; a missing feature simply removes its edge
@@ -128,11 +131,8 @@ struct DenoiseOptions {
     // (LearnedWeights::load for a weight file, version 4 or 3; docs/learned.md) and shared between
     // calls, so a sequence or a batch reads its file once. Empty = the built-in weights.
     LearnedWeights weights;
-    // The refine stage after the method (docs/learned.md, "Refine"; src/filters/refine.h): a small
-    // U-Net predicts a correction of the finished image, a residual in log space. It reads the
-    // noisy colour, the albedo and the normal; without an albedo and a normal it is skipped.
-    bool refine = false;
-    RefineWeights refineWeights;  // empty = the built-in weights
+    // The refine method's network (RefineWeights::load for a weight file); empty = the built-in weights.
+    RefineWeights refineWeights;
 };
 
 // What a denoise() call did, for the CLI and for measurements.

@@ -74,10 +74,6 @@ inline const ParamField<D> kDenoise[] = {
      "radius of the safety net's SURE window", "safety"},
     {"safety_trigger", &at2<&D::safety, &SafetyNetParams::trigger>, paramIn(0, 1e6),
      "the safety net acts where the residual's energy exceeds this many times the input's variance", "safety"},
-    {"refine", &at<&D::refine>, {},
-     "after the method, a small U-Net predicts a correction of the image (needs an albedo and a normal; "
-     "docs/learned.md, \"Refine\")",
-     "refine"},
     {"demodulate", &at<&D::demodulate>, {}, "divide by the albedo before filtering, multiply after", "", nullptr, true},
     {"albedo_epsilon", &at<&D::albedoEpsilon>, paramAtLeast(1e-6), "smallest albedo divided by"},
     {"albedo_floor", &at<&D::albedoFloor>, paramIn(0, 1),
@@ -147,8 +143,7 @@ inline const ParamTable<DenoiseOptions>& denoiseParams() {
 inline const char* denoiseGroupTitle(const std::string& group) {
     static const std::pair<const char*, const char*> kTitles[] = {
         {"", "Albedo demodulation"}, {"firefly", "Fireflies"}, {"emission", "Emission"},
-        {"safety", "Safety net"},    {"eaw", "EAW's edge stops"},  {"sure", "SURE's choice of details"},
-        {"refine", "Refine stage"}};
+        {"safety", "Safety net"},    {"eaw", "EAW's edge stops"},  {"sure", "SURE's choice of details"}};
     for (const auto& t : kTitles)
         if (group == t.first) return t.second;
     return "";

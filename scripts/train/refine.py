@@ -7,9 +7,10 @@ a still method (--method, default sure), trained on farm items with OIDN-high ta
   .venv/bin/python -m atrous.farm render --dataset SPEC.json --out out/refine/data
   # inputs: the method's output and the buffers, per scene and spp, into one npz (the project venv)
   .venv/bin/python scripts/train/refine.py prepare out/refine/data out/refine/train.npz
+  .venv/bin/python scripts/train/refine.py prepare-train-corpus out/refine/corpus_train.npz out/corpus/train/*/tr_*
   .venv/bin/python scripts/train/refine.py prepare-corpus out/refine/test.npz DIR...
   # train (.venv-train: jax, optax), resumable from OUT/ckpt.npz; a JSON line per 50 steps in OUT/log.jsonl
-  .venv-train/bin/python scripts/train/refine.py train out/refine/train.npz out/refine/run --minutes 20
+  .venv-train/bin/python scripts/train/refine.py train out/refine/train.npz[,out/refine/corpus_train.npz] out/refine/run --minutes 20
   .venv-train/bin/python scripts/train/refine.py eval out/refine/test.npz out/refine/run
   # the weight file the library compiles in (src/filters/refine_default.atrf), naming the run
   .venv-train/bin/python scripts/train/refine.py export out/refine/run src/filters/refine_default.atrf --run NAME
@@ -67,6 +68,28 @@ def prepare(data_dir, out, method):
     print(f"{len(names)} images ({method}) -> {out}")
 
 
+def prepare_train_corpus(out, dirs, method):
+    """The corpus's training split (docs/corpus.md, "Training split": other renderers' scenes, none
+    of them a test scene), in the renderers' own files: each noisy still with its true reference as
+    both target and anchor, in prepare's format (the same size as the farm's views: 128^2)."""
+    from atrous.eval.corpus import load_still
+    xs, bases, targets, names = [], [], [], []
+    for sd in map(Path, dirs):
+        man = json.loads((sd / "manifest.json").read_text())
+        ref = load_still(sd, man, man["reference"])["color"][..., :3]
+        for stem, e in man["files"].items():
+            if stem == man["reference"]:
+                continue
+            b = load_still(sd, man, stem)
+            base = _method_output(b, method)
+            xs.append(R.features(base, b["color"], b["albedo"], b["normal"]))
+            bases.append(base), targets.append(ref)
+            names.append(f"{sd.name}/{e['spp']}")
+    np.savez(out, x=np.stack(xs), base=np.stack(bases), target=np.stack(targets), anchor=np.stack(targets),
+             names=np.array(names), method=method)
+    print(f"{len(names)} images ({method}) -> {out}")
+
+
 def prepare_corpus(out, dirs, method):
     """Corpus scene folders (manifest.json; atrous.eval.corpus's loaders): every noisy still with
     its reference, the method's output and OIDN fast's (to compare), any size (kept as a list)."""
@@ -100,6 +123,13 @@ def conv_jax(a, k, b):
 
 
 def apply(p, x, base):
+    """The stage on crops of one energy block (training) or, for eval, whole images through
+    energy_gain afterwards (apply_full)."""
+    import jax.numpy as jnp
+    return R.energy_gain_crop(base, R.apply_residual(base, R.forward(p, x, conv_jax, jnp), jnp), jnp)
+
+
+def refined_only(p, x, base):
     import jax.numpy as jnp
     return R.apply_residual(base, R.forward(p, x, conv_jax, jnp), jnp)
 
@@ -127,8 +157,11 @@ def train(data, out_dir, minutes, steps, lr, crop, batch, seed, energy_weight):
     import optax
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    z = np.load(data)
-    x, base, target, anchor = z["x"], z["base"], z["target"], z["anchor"]
+    # "a.npz,b.npz:4": b's images four times over (drawn four times as often)
+    parts = [(d.rsplit(":", 1)[0], int(d.rsplit(":", 1)[1])) if ":" in d else (d, 1) for d in str(data).split(",")]
+    zs = [(np.load(d), n) for d, n in parts]
+    x, base, target, anchor = (np.concatenate([z[k] for z, n in zs for _ in range(n)])
+                               for k in ("x", "base", "target", "anchor"))
     ckpt = out_dir / "ckpt.npz"
     opt = optax.adam(lr)
     if ckpt.exists():
@@ -156,6 +189,7 @@ def train(data, out_dir, minutes, steps, lr, crop, batch, seed, energy_weight):
     def save():
         np.savez(ckpt, step=step, **{f"p/{k}": np.asarray(v) for k, v in params.items()})
 
+    assert crop <= R.ENERGY_BLOCK, "training crops are one energy block (energy_gain_crop)"
     while step < steps and time.time() - t0 < minutes * 60:
         idx = rng.integers(0, n, batch)
         ys = rng.integers(0, (h - crop) // BLOCK + 1, batch) * BLOCK
@@ -189,7 +223,7 @@ def evaluate(test, out_dir):
     params, step = load_ckpt(Path(out_dir) / "ckpt.npz")
     z = np.load(test)
     keys = sorted({k.rsplit("/", 1)[0] for k in z.files if "/" in k})
-    f = jax.jit(apply)
+    f = jax.jit(refined_only)
     rows = {}
 
     def rel(a, ref):
@@ -198,7 +232,7 @@ def evaluate(test, out_dir):
     for k in keys:
         x, base, ref, oidn = z[k + "/x"], z[k + "/base"], z[k + "/ref"], z[k + "/oidn_fast"]
         h, w = x.shape[:2]
-        out = np.asarray(f(params, R.pad4(x)[None], R.pad4(base)[None]))[0, :h, :w]
+        out = R.energy_gain(base, np.asarray(f(params, R.pad4(x)[None], R.pad4(base)[None]))[0, :h, :w])
         rows[k] = {"base": rel(base, ref), "refined": rel(out, ref), "oidn_fast": rel(oidn, ref),
                    "mse_base": float(np.mean((base - ref) ** 2)), "mse_refined": float(np.mean((out - ref) ** 2)),
                    "mean_base": float(base.mean() / ref.mean()), "mean_refined": float(out.mean() / ref.mean())}
@@ -230,8 +264,13 @@ def main(argv):
     a.add_argument("out")
     a.add_argument("dirs", nargs="+")
     a.add_argument("--method", default="sure")
+    a = sub.add_parser("prepare-train-corpus")
+    a.add_argument("out")
+    a.add_argument("dirs", nargs="+")
+    a.add_argument("--method", default="sure")
     a = sub.add_parser("train")
-    a.add_argument("data")
+    a.add_argument("data", help="one npz of prepare's, or several joined by commas (the same image size), "
+                                "each optionally :N (its images N times over)")
     a.add_argument("out")
     a.add_argument("--minutes", type=float, default=10)
     a.add_argument("--steps", type=int, default=1000000)
@@ -252,6 +291,8 @@ def main(argv):
         prepare(a.data, a.out, a.method)
     elif a.cmd == "prepare-corpus":
         prepare_corpus(a.out, a.dirs, a.method)
+    elif a.cmd == "prepare-train-corpus":
+        prepare_train_corpus(a.out, a.dirs, a.method)
     elif a.cmd == "train":
         train(a.data, a.out, a.minutes, a.steps, a.lr, a.crop, a.batch, a.seed, a.energy)
     elif a.cmd == "eval":

@@ -7,14 +7,12 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <vector>
 
 #include "atrous/error.h"
 #include "atrous/learned.h"
 #include "filters/learned.h"
+#include "filters/weight_file.h"
 
 namespace atrous::filters {
 extern const std::uint8_t kLearnedDefaultWeights[];
@@ -27,15 +25,8 @@ namespace {
 
 constexpr size_t kHeaderBytesV3 = 28, kHeaderBytesV4 = 36;
 
-std::uint32_t fnv1a(const std::uint8_t* p, size_t n) {
-    std::uint32_t h = 0x811C9DC5u;
-    for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 0x01000193u;
-    return h;
-}
-
-std::uint32_t u32(const std::uint8_t* p) {
-    return std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 | std::uint32_t(p[3]) << 24;
-}
+using filters::weightFnv1a;
+using filters::weightU32;
 
 std::string shapeText(std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d, bool ctx, std::uint32_t e,
                       std::uint32_t f, std::uint32_t n) {
@@ -51,7 +42,7 @@ LearnedWeights LearnedWeights::parse(const void* data, size_t size, const std::s
     const auto* p = static_cast<const std::uint8_t*>(data);
     if (size < 8 || std::memcmp(p, "ATRL", 4) != 0)
         throw InputError(name + ": not an atrous learned-filter weight file (no ATRL header)");
-    const std::uint32_t version = u32(p + 4);
+    const std::uint32_t version = weightU32(p + 4);
     // The retired versions, named as python/atrous/learn/weights.py names them.
     if (version == 1) throw InputError(name + ": version 1 (the first network, retired); retrain with make train");
     if (version == 2)
@@ -63,8 +54,8 @@ LearnedWeights LearnedWeights::parse(const void* data, size_t size, const std::s
     const bool v4 = version == 4;
     const size_t head = v4 ? kHeaderBytesV4 : kHeaderBytesV3;
     if (size < head + 4) throw InputError(name + ": truncated weight file (" + std::to_string(size) + " bytes)");
-    const std::uint32_t nIn = u32(p + 8), nHid = u32(p + 12), nFeat = u32(p + 16), nLev = u32(p + 20);
-    const std::uint32_t nCtxIn = v4 ? u32(p + 24) : 0, nCtx = v4 ? u32(p + 28) : 0, n = u32(p + head - 4);
+    const std::uint32_t nIn = weightU32(p + 8), nHid = weightU32(p + 12), nFeat = weightU32(p + 16), nLev = weightU32(p + 20);
+    const std::uint32_t nCtxIn = v4 ? weightU32(p + 24) : 0, nCtx = v4 ? weightU32(p + 28) : 0, n = weightU32(p + head - 4);
     const std::uint32_t want = v4 ? std::uint32_t(kLearnedParams) : std::uint32_t(kLearnedMlpParams);
     if (nIn != kLearnedIn || nHid != kLearnedHidden || nFeat != kLearnedFeat || nLev != kLearnedLevels || n != want ||
         (v4 && (nCtxIn != kLearnedCtxIn || nCtx != kLearnedCtx)))
@@ -79,13 +70,13 @@ LearnedWeights LearnedWeights::parse(const void* data, size_t size, const std::s
     if (size > expect)
         throw InputError(name + ": over-long weight file (" + std::to_string(size) + " bytes, " +
                          std::to_string(expect) + " expected)");
-    if (fnv1a(p, size - 4) != u32(p + size - 4)) throw InputError(name + ": weight file checksum mismatch (corrupt)");
+    if (weightFnv1a(p, size - 4) != weightU32(p + size - 4)) throw InputError(name + ": weight file checksum mismatch (corrupt)");
     auto impl = std::make_shared<Impl>();
     std::memset(&impl->net, 0, sizeof(impl->net));
     // The floats in the file's order: the MLP's, then (version 4) the context's, as LearnedNet lays them out.
     float* w = reinterpret_cast<float*>(&impl->net);
     for (std::uint32_t i = 0; i < n; ++i) {
-        const std::uint32_t b = u32(p + head + 4 * size_t(i));
+        const std::uint32_t b = weightU32(p + head + 4 * size_t(i));
         std::memcpy(&w[i], &b, 4);
         if (!std::isfinite(w[i])) throw InputError(name + ": weight " + std::to_string(i) + " is not finite");
     }
@@ -100,22 +91,7 @@ LearnedWeights LearnedWeights::parse(const void* data, size_t size, const std::s
 }
 
 LearnedWeights LearnedWeights::load(const std::string& path) {
-    namespace fs = std::filesystem;
-    std::error_code ec;
-    if (!fs::exists(path, ec)) throw InputError(path + ": cannot open the learned-filter weight file (not found)");
-    if (fs::is_directory(path, ec)) throw InputError(path + ": is a directory, not a learned-filter weight file");
-    // A FIFO or a device (/dev/zero) would be read for ever: only regular files, and only as many
-    // bytes as a weight file can have (it is a few KB; parse() checks the exact size).
-    if (!fs::is_regular_file(path, ec)) throw InputError(path + ": not a regular file (a learned-filter weight file)");
-    const uintmax_t size = fs::file_size(path, ec);
-    constexpr uintmax_t kMaxBytes = 1u << 20;
-    if (ec || size > kMaxBytes)
-        throw InputError(path + ": over-long weight file (" + std::to_string(size) + " bytes; a weight file has a few KB)");
-    std::ifstream f(path, std::ios::binary);
-    if (!f) throw InputError(path + ": cannot open the learned-filter weight file");
-    std::vector<std::uint8_t> bytes(static_cast<size_t>(size));
-    f.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(size));
-    if (size_t(f.gcount()) != bytes.size()) throw InputError(path + ": cannot read the learned-filter weight file");
+    const std::vector<std::uint8_t> bytes = filters::readWeightFile(path, "learned-filter weight file");
     return parse(bytes.data(), bytes.size(), path);
 }
 

@@ -41,6 +41,10 @@ struct MethodRegistry {
         builtin(DenoiseMethod::Auto, "auto",
                 "blend with an albedo and a normal, else sure: the method measured best for the buffers given",
                 {{}, {}, false, {DenoiseMethod::Blend, DenoiseMethod::Sure}}, CascadeKind::Auto),
+        builtin(DenoiseMethod::Refine, "refine",
+                "SURE, then a small U-Net that predicts a correction of the image, keeping its light per 64-pixel "
+                "block (docs/refine.md; needs an albedo and a normal)",
+                {kEawReads, {"eaw", "sure"}, false, {}}, CascadeKind::Sure),
     };
     std::deque<std::string> strings;
 };
@@ -85,7 +89,7 @@ DenoiseMethod registerDenoiseMethod(DenoiseMethodInfo info) {
             throw InputError("registerDenoiseMethod: method '" + name + "': reads the parameter group '" + g +
                              "', which denoiseParams() does not have");
     MethodRegistry& r = registry();
-    info.method = static_cast<DenoiseMethod>(r.rows.size());  // the built-ins are 0..4
+    info.method = static_cast<DenoiseMethod>(r.rows.size());  // the built-ins are 0..5
     info.kind = CascadeKind::Registered;
     r.strings.push_back(name);
     info.name = r.strings.back().c_str();
@@ -135,7 +139,7 @@ DenoiseMethod resolveDenoiseMethod(DenoiseMethod m, const Frame& in) {
 // ---- What a call reads ------------------------------------------------------------------------
 
 const std::vector<std::string>& stillStageGroups() {
-    static const std::vector<std::string> g = {"", "firefly", "emission", "safety", "refine"};
+    static const std::vector<std::string> g = {"", "firefly", "emission", "safety"};
     return g;
 }
 
@@ -210,7 +214,7 @@ BufferMask methodReads(const DenoiseMethodInfo& m, const DenoiseOptions& o) {
 BufferMask denoiseReads(const DenoiseOptions& o, DenoiseMethod resolved) {
     BufferMask r{Buffer::Color, Buffer::Variance, Buffer::Emission, Buffer::Normal, Buffer::Depth};
     if (o.demodulate) r = r.with(Buffer::Albedo);
-    if (o.refine) r = r.with(Buffer::Albedo);  // the refine stage's inputs (the normal is read above)
+    if (resolved == DenoiseMethod::Refine) r = r.with(Buffer::Albedo);  // the network's input, demodulating or not
     r = r | methodReads(denoiseMethodInfo(resolved), o);
     // The ids are one image: the material id comes with the object id.
     if (r.has(Buffer::ObjectId)) r = r.with(Buffer::MaterialId);
@@ -220,7 +224,7 @@ BufferMask denoiseReads(const DenoiseOptions& o, DenoiseMethod resolved) {
 std::string unusedReason(Buffer b, const DenoiseOptions& o, DenoiseMethod resolved, bool noiseEstimated) {
     const DenoiseMethodInfo& m = denoiseMethodInfo(resolved);
     const bool preparation = b == Buffer::Color || b == Buffer::Variance || b == Buffer::Emission ||
-                             (b == Buffer::Albedo && (o.demodulate || o.refine)) || (b == Buffer::Normal && o.refine) ||
+                             (b == Buffer::Albedo && (o.demodulate || resolved == DenoiseMethod::Refine)) ||
                              ((b == Buffer::Normal || b == Buffer::Depth) && noiseEstimated);
     if (preparation || methodReads(m, o).has(b)) return "";
     // A switch of the row or of a row it combines that reads b.

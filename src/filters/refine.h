@@ -1,7 +1,9 @@
 // The refine stage (docs/learned.md, "Refine"; issue 47): after a still method, a small U-Net
 // predicts a correction of the image, a residual r in log space, so that an output pixel is no
 // longer a convex combination of its neighbourhood (a stripe can get its contrast back, a highlight
-// its energy): out = expm1(log1p(max(base, 0)) + clamp(r, +-kRefineMaxResidual)).
+// its energy): refined = max(expm1(log1p(max(base, 0)) + clamp(r, +-kRefineMaxResidual)), 0), then scaled
+// by the energy gain (per 64-pixel block, smooth, so that the stage moves light within a block
+// but keeps the method's light at that scale).
 // python/atrous/learn/refine.py is the same math in NumPy/JAX (training, export, the reference).
 //
 // Inputs, 15 per pixel (RefineFeatures): log1p of the method's output (3) and of the noisy colour
@@ -39,6 +41,9 @@ namespace atrous::filters {
 constexpr int kRefineIn = 15, kRefineC1 = 16, kRefineC2 = 24, kRefineC3 = 32, kRefineOut = 3;
 constexpr int kRefineNoiseRadius = 3;      // the noise level's window: 7 x 7
 constexpr float kRefineMaxResidual = 3.0f;  // |r| in log space (a factor of e^3 either way)
+// The energy gain (RefineGainRows below): blocks, fixed-point steps, eps, the largest factor.
+constexpr int kRefineEnergyBlock = 64, kRefineGainIterations = 3;
+constexpr float kRefineGainEps = 1e-4f, kRefineGainMax = 4.0f;
 static_assert(kRefineC3 <= kLearnedConvMaxOut && kRefineC2 <= kLearnedConvMaxOut, "LearnedConv's accumulators");
 
 // The network's parameters, the weight file's order (kernels HWIO: k[((ky 3 + kx) cin + i) cout + o]).
@@ -63,14 +68,18 @@ struct RefinePlanes {
     LearnedTensor x, e1a, e1, cat1, d1, r;        // full
     LearnedTensor p1, e2a, e2, cat2, d2;          // 1/2
     LearnedTensor p2, e3a, e3;                    // 1/4
+    LearnedTensor gain;                           // 3: a sample per energy block
+    LearnedTensor gainRows;                       // 6: block columns x the image's rows
     bool valid() const { return x.valid(); }
 };
 inline int refinePadded(int n) { return (n + 3) / 4 * 4; }
 inline size_t refineFloats(int w, int h) {
     const size_t W = size_t(refinePadded(w)), H = size_t(refinePadded(h));
     const size_t full = W * H, half = full / 4, quarter = full / 16;
+    const size_t blocks = size_t(learnedCeilDiv(w, kRefineEnergyBlock)) * size_t(learnedCeilDiv(h, kRefineEnergyBlock));
     return full * (kRefineC2 + 3 * kRefineC1) + half * (kRefineC1 + 2 * kRefineC2 + kRefineC3 + kRefineC2 + kRefineC2) +
-           quarter * (kRefineC2 + 2 * kRefineC3);
+           quarter * (kRefineC2 + 2 * kRefineC3) + blocks * 3 +
+           size_t(learnedCeilDiv(w, kRefineEnergyBlock)) * size_t(h) * 6;
 }
 inline RefinePlanes refinePlanes(float* base, int w, int h) {
     const int W = refinePadded(w), H = refinePadded(h);
@@ -88,6 +97,8 @@ inline RefinePlanes refinePlanes(float* base, int w, int h) {
     p.p1 = take(W / 2, H / 2, kRefineC1), p.e2a = take(W / 2, H / 2, kRefineC2), p.e2 = take(W / 2, H / 2, kRefineC2);
     p.cat2 = take(W / 2, H / 2, kRefineC3 + kRefineC2), p.d2 = take(W / 2, H / 2, kRefineC2);
     p.p2 = take(W / 4, H / 4, kRefineC2), p.e3a = take(W / 4, H / 4, kRefineC3), p.e3 = take(W / 4, H / 4, kRefineC3);
+    p.gain = take(learnedCeilDiv(w, kRefineEnergyBlock), learnedCeilDiv(h, kRefineEnergyBlock), 3);
+    p.gainRows = take(p.gain.width, h, 6);
     return p;
 }
 
@@ -158,17 +169,93 @@ struct RefineUp2Cat {
     }
 };
 
-// out = expm1(log1p(max(out, 0)) + clamp(r)), in place (a non-finite result keeps the method's
-// output, which is finite).
-struct RefineApply {
+// r := the refined value max(expm1(log1p(max(out, 0)) + clamp(r)), 0) at the image's pixels (a
+// non-finite one: the method's output, which is finite).
+struct RefineResidual {
     LearnedTensor r;
     ImageView out;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         for (int k = 0; k < 3; ++k) {
             const float b = out(x, y, k);
             const float v = expm1f(refineLog(b) + refineClamp(r(x, y, k), -kRefineMaxResidual, kRefineMaxResidual));
-            out(x, y, k) = finite(v) ? v : b;
+            r(x, y, k) = finite(v) ? (v > 0.0f ? v : 0.0f) : b;
         }
+    }
+};
+
+// The energy gain (docs/refine.md, "Energy"): a gain g_b per block of kRefineEnergyBlock pixels a
+// side and channel, upsampled bilinearly (half-pixel centres, clamped: weights w_b(p), a partition
+// of unity), out = refined G with G(p) = sum_b w_b(p) g_b, chosen so that for every block
+// sum_p w_b(p) out(p) = sum_p w_b(p) base(p): the refined image keeps the method's light at that
+// scale (which the firefly restore keeps within a few percent of the reference's; summed over b,
+// the whole image's light exactly) and the network decides only how it is laid out. Solved by
+// kRefineGainIterations fixed-point steps from g = 1, g_b *= (sum w_b base + eps) / (sum w_b out + eps),
+// clamped to [1/4, 4]. Separable: per row the weighted sums of each block column, then per block.
+// w_b(x) along one axis: the weight output x's bilinear taps give block b.
+ATROUS_FORCE_INLINE ATROUS_INLINE float refineHat(int x, int b, int nBlocks) {
+    const LearnedUpTap t = learnedUpTap(x, kRefineEnergyBlock, nBlocks);
+    return (t.i0 == b ? 1.0f - t.t : 0.0f) + (t.i1 == b ? t.t : 0.0f);
+}
+// G(x, y), channel k.
+ATROUS_FORCE_INLINE ATROUS_INLINE float refineGainAt(const LearnedTensor& gain, int x, int y, int k) {
+    const LearnedUpTap ty = learnedUpTap(y, kRefineEnergyBlock, gain.height), tx = learnedUpTap(x, kRefineEnergyBlock, gain.width);
+    const float a = gain(tx.i0, ty.i0, k) * (1.0f - ty.t) + gain(tx.i0, ty.i1, k) * ty.t;
+    const float b = gain(tx.i1, ty.i0, k) * (1.0f - ty.t) + gain(tx.i1, ty.i1, k) * ty.t;
+    return a * (1.0f - tx.t) + b * tx.t;
+}
+
+// rows(b, y) = sum_x w_b(x) base(x, y) (channels 0-2) and sum_x w_b(x) refined(x, y) G(x, y) (3-5)
+// over the columns block b's weights reach.
+struct RefineGainRows {
+    LearnedTensor refined, gain, rows;
+    ImageView base;
+    ATROUS_HOST_DEVICE void operator()(int b, int y) const {
+        constexpr int B = kRefineEnergyBlock;
+        const int x0 = b * B - B / 2 > 0 ? b * B - B / 2 : 0, x1 = (b + 1) * B + B / 2 < base.width ? (b + 1) * B + B / 2 : base.width;
+        double sb[3] = {0, 0, 0}, sr[3] = {0, 0, 0};
+        for (int x = b == 0 ? 0 : x0; x < (b == gain.width - 1 ? base.width : x1); ++x) {
+            const float w = refineHat(x, b, gain.width);
+            for (int k = 0; k < 3; ++k) {
+                sb[k] += double(w * base(x, y, k));
+                sr[k] += double(w * refined(x, y, k) * refineGainAt(gain, x, y, k));
+            }
+        }
+        for (int k = 0; k < 3; ++k) rows(b, y, k) = float(sb[k]), rows(b, y, 3 + k) = float(sr[k]);
+    }
+};
+
+// g_b *= the ratio of the column sums of rows over the rows block b's weights reach.
+struct RefineGainStep {
+    LearnedTensor rows, gain;
+    ATROUS_HOST_DEVICE void operator()(int bx, int by) const {
+        constexpr int B = kRefineEnergyBlock;
+        const int h = rows.height;
+        const int y0 = by == 0 ? 0 : by * B - B / 2, y1 = by == gain.height - 1 ? h : ((by + 1) * B + B / 2 < h ? (by + 1) * B + B / 2 : h);
+        double sb[3] = {0, 0, 0}, sr[3] = {0, 0, 0};
+        for (int y = y0; y < y1; ++y) {
+            const float w = refineHat(y, by, gain.height);
+            for (int k = 0; k < 3; ++k) sb[k] += double(w) * double(rows(bx, y, k)), sr[k] += double(w) * double(rows(bx, y, 3 + k));
+        }
+        for (int k = 0; k < 3; ++k) {
+            const float g = gain(bx, by, k) * float((sb[k] + kRefineGainEps) / (sr[k] + kRefineGainEps));
+            gain(bx, by, k) = refineClamp(g, 1.0f / kRefineGainMax, kRefineGainMax);
+        }
+    }
+};
+
+struct RefineGainInit {
+    LearnedTensor gain;
+    ATROUS_HOST_DEVICE void operator()(int bx, int by) const {
+        for (int k = 0; k < 3; ++k) gain(bx, by, k) = 1.0f;
+    }
+};
+
+// out = refined G.
+struct RefineApply {
+    LearnedTensor refined, gain;
+    ImageView out;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        for (int k = 0; k < 3; ++k) out(x, y, k) = refined(x, y, k) * refineGainAt(gain, x, y, k);
     }
 };
 
@@ -199,7 +286,13 @@ void runRefinePasses(const Exec& exec, const RefineNet* net, const RefineViews& 
     exec.forEachPixel(P.cat1.width, P.cat1.height, RefineUp2Cat{P.d2, P.e1, P.cat1});
     conv(P.cat1, P.d1, net->ku1, net->bu1, 3, true);
     conv(P.d1, P.r, net->ko, net->bo, 1, false);
-    exec.forEachPixel(w, h, RefineApply{P.r, v.out});
+    exec.forEachPixel(w, h, RefineResidual{P.r, v.out});
+    exec.forEachPixel(P.gain.width, P.gain.height, RefineGainInit{P.gain});
+    for (int i = 0; i < kRefineGainIterations; ++i) {
+        exec.forEachPixel(P.gainRows.width, P.gainRows.height, RefineGainRows{P.r, P.gain, P.gainRows, v.out});
+        exec.forEachPixel(P.gain.width, P.gain.height, RefineGainStep{P.gainRows, P.gain});
+    }
+    exec.forEachPixel(w, h, RefineApply{P.r, P.gain, v.out});
 }
 
 // The whole stage through the functors (the GPU; the CPU's reference).

@@ -296,6 +296,9 @@ CheckedInputs checkInputs(const Frame& given, const DenoiseOptions& o, DenoiseRe
     Frame in = given;
     checkSizes(in);
     validateDenoiseOptions(o);
+    if (o.method == DenoiseMethod::Refine && (!in.albedo || in.albedo->empty() || !in.normal || in.normal->empty()))
+        throw InputError("method 'refine' needs an albedo and a normal buffer (its network reads them); without "
+                         "them, sure is the same filter without the network");
     CheckedInputs p;
     scanHost(in, p, rep, varianceDropped);
     rep.noiseEstimated = !in.variance;

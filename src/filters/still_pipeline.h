@@ -59,14 +59,14 @@ Filtered runCascade(const Exec& exec, const StillConfig& cfg, Prepared& p, Plane
     throw InputError("the still path was given auto unresolved");
 }
 
-// The refine stage (filters/refine.h) on the finished output, when asked for and the albedo and
-// the normal are there: lc, log1p of the noisy colour, is taken before the preparation (which may
-// sanitise the colour in place).
+// The refine method's stage (filters/refine.h) on the finished output (the inputs were checked to
+// have an albedo and a normal): lc, log1p of the noisy colour, is taken before the preparation
+// (which may sanitise the colour in place).
 template <class Exec>
 void runStill(const Exec& exec, const StillInputs& in, const StillConfig& cfg, const StillOutputs& out) {
     const int w = in.color.width, h = in.color.height;
     PlanePool pool(w, h, exec.device());
-    const bool refine = cfg.opts.refine && in.albedo.valid() && in.normal.valid();
+    const bool refine = cfg.opts.method == DenoiseMethod::Refine && in.albedo.valid() && in.normal.valid();
     Image lc;
     if (refine) {
         lc = pool.take(3);

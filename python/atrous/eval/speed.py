@@ -12,9 +12,10 @@ same inputs (the scene at 2 spp, seed 7, as `atrous bench` renders them, through
   and commits the filter in every call);
 * ``oidn_filter``: pyoidn's object API, a ``pyoidn.Filter`` ("RT", hdr, quality high) created,
   bound and committed once, then only ``execute()`` timed: OIDN's own cost.
-* ``alt_*``: the default method (``atrous.denoise`` with no ``method``: auto, blend with these
-  buffers, through Python) and OIDN fast, balanced and high (``Filter.execute``), one call of each
-  in turn per round, in this process: the issue-27 speed bar (default at most OIDN fast).
+* ``alt_*``: the default method (``atrous.denoise`` with no ``method``: auto), ``blend``, ``refine``
+  (SURE and the refine stage), through Python, and OIDN fast, balanced and high
+  (``Filter.execute``), one call of each in turn per round, in this process: the speed bar of
+  issues 27 and 47 (default at most OIDN fast).
 
 Both are --warmup untimed calls (at least one), then the median of --runs calls (atrous.eval's
 time_call), the same counts as the atrous rows. The result
@@ -108,8 +109,10 @@ def time_default_alternating(b, runs: int, warmup: int) -> dict:
     fast, fast_out = _oidn_filter(pyoidn, dev, color, albedo, normal, pyoidn.OIDN_QUALITY_FAST)
     bal, bal_out = _oidn_filter(pyoidn, dev, color, albedo, normal, pyoidn.OIDN_QUALITY_BALANCED)
     high, high_out = _oidn_filter(pyoidn, dev, color, albedo, normal, pyoidn.OIDN_QUALITY_HIGH)
-    calls = {"default": lambda: atrous.denoise(b["color"], **feats), "oidn_fast": fast.execute,
-             "oidn_balanced": bal.execute, "oidn_high": high.execute}
+    calls = {"default": lambda: atrous.denoise(b["color"], **feats),
+             "blend": lambda: atrous.denoise(b["color"], method="blend", **feats),
+             "refine": lambda: atrous.denoise(b["color"], method="refine", **feats),
+             "oidn_fast": fast.execute, "oidn_balanced": bal.execute, "oidn_high": high.execute}
     times = {k: [] for k in calls}
     for r in range(warmup + runs):
         for k, f in calls.items():
@@ -127,6 +130,7 @@ def time_default_alternating(b, runs: int, warmup: int) -> dict:
     del fast_out, bal_out, high_out
     out = {f"alt_{k}_ms": float(np.median(v)) for k, v in times.items()}
     out["alt_default_over_oidn_fast"] = out["alt_default_ms"] / out["alt_oidn_fast_ms"]
+    out["alt_refine_over_oidn_fast"] = out["alt_refine_ms"] / out["alt_oidn_fast_ms"]
     return out
 
 

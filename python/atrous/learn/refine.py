@@ -1,6 +1,7 @@
 """The refine stage (docs/learned.md, "Refine"; src/filters/refine.h is the same math in C++/CUDA):
-a U-Net that predicts a residual r in log space after a still method, out = expm1(log1p(max(base, 0))
-+ clip(r, +-3)). Its inputs, the network, its weight file. NumPy only, except `forward`, which takes
+a U-Net that predicts a residual r in log space after a still method, refined = max(expm1(log1p(
+max(base, 0)) + clip(r, +-3)), 0), then scaled by a smooth gain that gives it the method's light at
+the scale of 64-pixel blocks (the energy gain). Its inputs, the network, its weight file. NumPy only, except `forward`, which takes
 the array module and a convolution (NumPy here for the reference, JAX in scripts/train/refine.py).
 
 Weight file, version 1 (read by src/filters/refine_weights.cpp): little-endian
@@ -17,6 +18,7 @@ import numpy as np
 N_IN, C1, C2, C3, N_OUT = 15, 16, 24, 32, 3
 NOISE_RADIUS = 3
 MAX_RESIDUAL = 3.0
+ENERGY_BLOCK, GAIN_EPS, GAIN_MAX, GAIN_ITERATIONS = 64, 1e-4, 4.0, 3
 MAGIC, VERSION, RUN_BYTES = b"ATRF", 1, 48
 
 SHAPES = (("k1", (3, 3, N_IN, C1)), ("b1", (C1,)), ("k1b", (3, 3, C1, C1)), ("b1b", (C1,)),
@@ -90,8 +92,44 @@ def forward(p, x, conv, xp=np):
 
 
 def apply_residual(base, r, xp=np):
-    """out = expm1(log1p(max(base, 0)) + clip(r, +-MAX_RESIDUAL))."""
-    return xp.expm1(xp.log1p(xp.maximum(base, 0.0)) + xp.clip(r, -MAX_RESIDUAL, MAX_RESIDUAL))
+    """refined = max(expm1(log1p(max(base, 0)) + clip(r, +-MAX_RESIDUAL)), 0)."""
+    return xp.maximum(xp.expm1(xp.log1p(xp.maximum(base, 0.0)) + xp.clip(r, -MAX_RESIDUAL, MAX_RESIDUAL)), 0.0)
+
+
+def energy_gain_crop(base, refined, xp=np):
+    """The energy gain on crops of one block (training's 64^2 crops): the hat weights are then 1
+    everywhere and the fixed point is the crop's mean of the base over the refined's, per image
+    and channel (N x H x W x 3)."""
+    mb, mr = base.mean(axis=(1, 2), keepdims=True), refined.mean(axis=(1, 2), keepdims=True)
+    return refined * xp.clip((mb + GAIN_EPS) / (mr + GAIN_EPS), 1 / GAIN_MAX, GAIN_MAX)
+
+
+def _hat(n):
+    """n x blocks: the weight output i's bilinear taps (half-pixel centres, clamped) give block b."""
+    nb = -(-n // ENERGY_BLOCK)
+    s = (np.arange(n) + 0.5) / ENERGY_BLOCK - 0.5
+    fl = np.floor(s)
+    t = (s - fl).astype(np.float32)
+    i0, i1 = np.clip(fl.astype(int), 0, nb - 1), np.clip(fl.astype(int) + 1, 0, nb - 1)
+    m = np.zeros((n, nb), np.float32)
+    np.add.at(m, (np.arange(n), i0), 1 - t)
+    np.add.at(m, (np.arange(n), i1), t)
+    return m
+
+
+def energy_gain(base, refined):
+    """The energy gain on one image (H x W x 3, NumPy; src/filters/refine.h RefineGainRows,
+    RefineGainStep, RefineApply): G = Wy g Wx^T per channel with the hat weights W, g from
+    GAIN_ITERATIONS steps g *= (Wy^T base Wx + eps) / (Wy^T (refined G) Wx + eps) from 1, clamped."""
+    h, w = base.shape[:2]
+    wy, wx = _hat(h).astype(np.float64), _hat(w).astype(np.float64)
+    g = np.ones((wy.shape[1], wx.shape[1], 3))
+    sb = np.einsum("yb,yxk,xc->bck", wy, base.astype(np.float64), wx)
+    for _ in range(GAIN_ITERATIONS):
+        G = np.einsum("yb,bck,xc->yxk", wy, g, wx)
+        sr = np.einsum("yb,yxk,xc->bck", wy, refined.astype(np.float64) * G, wx)
+        g = np.clip(g * (sb + GAIN_EPS) / (sr + GAIN_EPS), 1 / GAIN_MAX, GAIN_MAX)
+    return (refined * np.einsum("yb,bck,xc->yxk", wy, g, wx)).astype(np.float32)
 
 
 def conv_numpy(a, k, b):
@@ -111,8 +149,8 @@ def refine_numpy(p, base, color, albedo, normal):
     h, w = base.shape[:2]
     x = pad4(features(base, color, albedo, normal))[None]
     r = forward(p, x, conv_numpy)[0, :h, :w]
-    b = np.where(np.isfinite(base[..., :3]), base[..., :3], 0)
-    return apply_residual(b, r).astype(np.float32)
+    b = np.where(np.isfinite(base[..., :3]), base[..., :3], 0).astype(np.float32)
+    return energy_gain(b, apply_residual(b, r).astype(np.float32)).astype(np.float32)
 
 
 def fnv1a(data: bytes) -> int:
