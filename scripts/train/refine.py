@@ -17,7 +17,8 @@ a still method (--method, default sure), trained on farm items with OIDN-high ta
 
 Loss: relMSE against the OIDN target (the corpus tables' metric) plus an energy term: the 8x8
 block means of the output against those of the render OIDN was given (target_input.exr, 256 spp,
-unbiased where OIDN's output can be a few percent dark), relative, weighted --energy.
+unbiased where OIDN's output can be a few percent dark), relative, weighted --energy; and a
+plain-MSE term per crop (weighted --mse), which the brightest pixels dominate.
 """
 from __future__ import annotations
 
@@ -140,11 +141,15 @@ def blocks(a):
 
 
 def loss_terms(out, target, anchor):
+    """relMSE; the energy term (8x8 block means against the anchor's, relative); and the plain
+    MSE per crop over the crop's mean square target (the brightest pixels dominate it: highlights,
+    visible lights)."""
     import jax.numpy as jnp
     rel = jnp.mean((out - target) ** 2 / (target ** 2 + 0.01))
     bo, ba = blocks(out), blocks(anchor)
     energy = jnp.mean((bo - ba) ** 2 / (ba ** 2 + 0.01))
-    return rel, energy
+    mse = jnp.mean(jnp.mean((out - target) ** 2, axis=(1, 2, 3)) / (jnp.mean(target ** 2, axis=(1, 2, 3)) + 0.01))
+    return rel, energy, mse
 
 
 def load_ckpt(path):
@@ -152,7 +157,7 @@ def load_ckpt(path):
     return {k[2:]: c[k] for k in c.files if k.startswith("p/")}, int(c["step"])
 
 
-def train(data, out_dir, minutes, steps, lr, crop, batch, seed, energy_weight):
+def train(data, out_dir, minutes, steps, lr, crop, batch, seed, energy_weight, mse_weight):
     import jax
     import optax
     out_dir = Path(out_dir)
@@ -172,8 +177,8 @@ def train(data, out_dir, minutes, steps, lr, crop, batch, seed, energy_weight):
     state = opt.init(params)
 
     def loss_fn(p, xb, bb, tb, ab):
-        rel, en = loss_terms(apply(p, xb, bb), tb, ab)
-        return rel + energy_weight * en, (rel, en)
+        rel, en, mse = loss_terms(apply(p, xb, bb), tb, ab)
+        return rel + energy_weight * en + mse_weight * mse, (rel, en, mse)
 
     @jax.jit
     def step_fn(p, s, xb, bb, tb, ab):
@@ -200,14 +205,14 @@ def train(data, out_dir, minutes, steps, lr, crop, batch, seed, energy_weight):
         def crops(arr):
             return np.stack([arr[i][a, b][:, ::-1] if f else arr[i][a, b] for (i, a, b), f in zip(sl, flip)])
 
-        params, state, l, (rel, en) = step_fn(params, state, crops(x), crops(base), crops(target), crops(anchor))
-        losses.append((float(l), float(rel), float(en)))
+        params, state, l, (rel, en, mse) = step_fn(params, state, crops(x), crops(base), crops(target), crops(anchor))
+        losses.append((float(l), float(rel), float(en), float(mse)))
         step += 1
         if step % 50 == 0:
             m = np.median(np.array(losses), axis=0)
-            rec = {"step": step, "loss": float(m[0]), "relmse": float(m[1]), "energy": float(m[2]),
+            rec = {"step": step, "loss": float(m[0]), "relmse": float(m[1]), "energy": float(m[2]), "mse": float(m[3]),
                    "seconds": round(time.time() - t0, 1), "data": str(data), "images": int(n), "lr": lr, "crop": crop,
-                   "batch": batch, "energy_weight": energy_weight}
+                   "batch": batch, "energy_weight": energy_weight, "mse_weight": mse_weight}
             log.write(json.dumps(rec) + "\n")
             log.flush()
             print(rec, flush=True)
@@ -279,6 +284,7 @@ def main(argv):
     a.add_argument("--batch", type=int, default=8)
     a.add_argument("--seed", type=int, default=1)
     a.add_argument("--energy", type=float, default=2.0, help="weight of the block-mean energy term")
+    a.add_argument("--mse", type=float, default=0.0, help="weight of the plain-MSE term (runs A, B: 0)")
     a = sub.add_parser("eval")
     a.add_argument("test")
     a.add_argument("out")
@@ -294,7 +300,7 @@ def main(argv):
     elif a.cmd == "prepare-train-corpus":
         prepare_train_corpus(a.out, a.dirs, a.method)
     elif a.cmd == "train":
-        train(a.data, a.out, a.minutes, a.steps, a.lr, a.crop, a.batch, a.seed, a.energy)
+        train(a.data, a.out, a.minutes, a.steps, a.lr, a.crop, a.batch, a.seed, a.energy, a.mse)
     elif a.cmd == "eval":
         evaluate(a.test, a.out)
     else:

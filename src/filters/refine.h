@@ -25,6 +25,7 @@
 #pragma once
 #include <cmath>
 #include <cstddef>
+#include <cstring>
 
 #include "atrous/image.h"
 #include "filters/atrous_math.h"
@@ -115,18 +116,22 @@ struct RefineLogColour {
     }
 };
 
-// The noise level's first step: t(x, y) = the sum over |dx| <= R (columns clamped to the image) of
-// |lc - log1p(base)|.
-struct RefineNoiseRows {
-    ImageView lc, base, t;
+// The noise level's first steps: d = |lc - log1p(base)| per pixel, then t(x, y) = the sum of d over
+// |dx| <= R (columns clamped to the image).
+struct RefineNoiseDiff {
+    ImageView lc, base, d;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        const int w = lc.width;
+        for (int k = 0; k < 3; ++k) d(x, y, k) = fabsf(lc(x, y, k) - refineLog(base(x, y, k)));
+    }
+};
+struct RefineNoiseRows {
+    ImageView d, t;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        const int w = d.width;
         for (int k = 0; k < 3; ++k) {
             float s = 0.0f;
-            for (int dx = -kRefineNoiseRadius; dx <= kRefineNoiseRadius; ++dx) {
-                const int xx = x + dx < 0 ? 0 : (x + dx >= w ? w - 1 : x + dx);
-                s += fabsf(lc(xx, y, k) - refineLog(base(xx, y, k)));
-            }
+            for (int dx = -kRefineNoiseRadius; dx <= kRefineNoiseRadius; ++dx)
+                s += d(x + dx < 0 ? 0 : (x + dx >= w ? w - 1 : x + dx), y, k);
             t(x, y, k) = s;
         }
     }
@@ -161,11 +166,9 @@ struct RefineFeatures {
 struct RefineUp2Cat {
     LearnedTensor lo, skip, cat;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        const float* a = lo.at(x / 2, y / 2);
-        const float* b = skip.at(x, y);
         float* o = &cat(x, y, 0);
-        for (int c = 0; c < lo.channels; ++c) o[c] = a[c];
-        for (int c = 0; c < skip.channels; ++c) o[lo.channels + c] = b[c];
+        memcpy(o, lo.at(x / 2, y / 2), sizeof(float) * size_t(lo.channels));
+        memcpy(o + lo.channels, skip.at(x, y), sizeof(float) * size_t(skip.channels));
     }
 };
 
@@ -271,7 +274,9 @@ struct RefineViews {
 template <class Exec, class Conv>
 void runRefinePasses(const Exec& exec, const RefineNet* net, const RefineViews& v, const RefinePlanes& P, Conv conv) {
     const int w = v.out.width, h = v.out.height;
-    exec.forEachPixel(w, h, RefineNoiseRows{v.lc, v.out, v.t});
+    const ImageView d{P.e1a.data, w, h, 3};  // e1a's storage, free until the first convolution
+    exec.forEachPixel(w, h, RefineNoiseDiff{v.lc, v.out, d});
+    exec.forEachPixel(w, h, RefineNoiseRows{d, v.t});
     exec.forEachPixel(P.x.width, P.x.height, RefineFeatures{v.out, v.lc, v.albedo, v.normal, v.t, P.x});
     conv(P.x, P.e1a, net->k1, net->b1, 3, true);
     conv(P.e1a, P.e1, net->k1b, net->b1b, 3, true);
