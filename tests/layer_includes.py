@@ -53,6 +53,7 @@ LAYERS = {
     "include/atrous/svgf.h": "filters",
     "include/atrous/temporal.h": "filters",
     "include/atrous/learned.h": "filters",
+    "include/atrous/refine.h": "filters",
     "include/atrous/params.h": "filters",
     "include/atrous/metrics.h": "filters",
     "include/atrous/param_set.h": "filters",

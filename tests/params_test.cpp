@@ -55,9 +55,10 @@ TEST(ParamTables, EveryStructFieldHasARow) {
     EXPECT_EQ(rowsOf(d, "sure"), fieldCount<SureParams>());
     EXPECT_EQ(rowsOf(d, "firefly"), fieldCount<FireflyParams>());
     EXPECT_EQ(rowsOf(d, "safety"), fieldCount<SafetyNetParams>());
-    // DenoiseOptions' own rows; method, device, the four structs and weights (the loaded network:
-    // --learned-weights and learned_weights= name its file) are not parameters.
-    EXPECT_EQ(rowsOf(d, "") + 7, fieldCount<DenoiseOptions>());
+    // DenoiseOptions' own rows; method, device, the four structs, weights and refineWeights (the
+    // loaded networks: --learned-weights and learned_weights= name the learned filter's file) are
+    // not parameters.
+    EXPECT_EQ(rowsOf(d, "") + 8, fieldCount<DenoiseOptions>());
     EXPECT_EQ(d.count, rowsOf(d, "eaw") + rowsOf(d, "emission") + rowsOf(d, "sure") + rowsOf(d, "firefly") +
                            rowsOf(d, "safety") + rowsOf(d, ""));
     EXPECT_EQ(svgfParams().count, fieldCount<SvgfParams>());
