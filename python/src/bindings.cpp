@@ -288,6 +288,7 @@ NB_MODULE(_core, m) {
     m.attr("SURE_METHOD") = denoiseMethodName(DenoiseMethod::Sure);
     m.attr("LEARNED_METHOD") = denoiseMethodName(DenoiseMethod::Learned);
     m.attr("BLEND_METHOD") = denoiseMethodName(DenoiseMethod::Blend);
+    m.attr("REFINE_METHOD") = denoiseMethodName(DenoiseMethod::Refine);
     m.attr("DEFAULT_METHOD") = denoiseMethodName(DenoiseOptions{}.method);
     m.def("svgf_params", [] { return paramRows(svgfParams()); });
     m.def("temporal_params", [] { return paramRows(temporalParams()); });

@@ -98,6 +98,7 @@ def time_default_alternating(b, runs: int, warmup: int) -> dict:
     round: the same load on every figure. Medians of `runs` rounds after `warmup` rounds."""
     import atrous
     import pyoidn
+    from atrous import names
     from atrous.eval import oidn_inputs
 
     color, albedo, normal = oidn_inputs(b)
@@ -110,8 +111,8 @@ def time_default_alternating(b, runs: int, warmup: int) -> dict:
     bal, bal_out = _oidn_filter(pyoidn, dev, color, albedo, normal, pyoidn.OIDN_QUALITY_BALANCED)
     high, high_out = _oidn_filter(pyoidn, dev, color, albedo, normal, pyoidn.OIDN_QUALITY_HIGH)
     calls = {"default": lambda: atrous.denoise(b["color"], **feats),
-             "blend": lambda: atrous.denoise(b["color"], method="blend", **feats),
-             "refine": lambda: atrous.denoise(b["color"], method="refine", **feats),
+             names.BLEND: lambda: atrous.denoise(b["color"], method=names.BLEND, **feats),
+             names.REFINE: lambda: atrous.denoise(b["color"], method=names.REFINE, **feats),
              "oidn_fast": fast.execute, "oidn_balanced": bal.execute, "oidn_high": high.execute}
     times = {k: [] for k in calls}
     for r in range(warmup + runs):
@@ -130,7 +131,7 @@ def time_default_alternating(b, runs: int, warmup: int) -> dict:
     del fast_out, bal_out, high_out
     out = {f"alt_{k}_ms": float(np.median(v)) for k, v in times.items()}
     out["alt_default_over_oidn_fast"] = out["alt_default_ms"] / out["alt_oidn_fast_ms"]
-    out["alt_refine_over_oidn_fast"] = out["alt_refine_ms"] / out["alt_oidn_fast_ms"]
+    out[f"alt_{names.REFINE}_over_oidn_fast"] = out[f"alt_{names.REFINE}_ms"] / out["alt_oidn_fast_ms"]
     return out
 
 
