@@ -10,8 +10,6 @@
 
 namespace atrous::filters {
 
-const RefineNet& refineNet(const RefineWeights& w);  // refine_weights.cpp
-
 void runRefine(const CpuExec& exec, const RefineWeights& weights, const RefineViews& v, bool functors) {
     const int w = v.out.width, h = v.out.height;
     // Not zero-filled: every tensor is written whole before it is read.

@@ -8,8 +8,6 @@
 
 namespace atrous::filters {
 
-const RefineNet& refineNet(const RefineWeights& w);  // refine_weights.cpp
-
 void runRefine(const CudaExec& exec, const RefineWeights& weights, const RefineViews& v) {
     const int w = v.out.width, h = v.out.height;
     cuda::DeviceBuffer<RefineNet> net(1);

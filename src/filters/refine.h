@@ -216,7 +216,7 @@ struct RefineGainRows {
         constexpr int B = kRefineEnergyBlock;
         const int x0 = b * B - B / 2 > 0 ? b * B - B / 2 : 0, x1 = (b + 1) * B + B / 2 < base.width ? (b + 1) * B + B / 2 : base.width;
         double sb[3] = {0, 0, 0}, sr[3] = {0, 0, 0};
-        for (int x = b == 0 ? 0 : x0; x < (b == gain.width - 1 ? base.width : x1); ++x) {
+        for (int x = x0; x < x1; ++x) {
             const float w = refineHat(x, b, gain.width);
             for (int k = 0; k < 3; ++k) {
                 sb[k] += double(w * base(x, y, k));
@@ -233,7 +233,7 @@ struct RefineGainStep {
     ATROUS_HOST_DEVICE void operator()(int bx, int by) const {
         constexpr int B = kRefineEnergyBlock;
         const int h = rows.height;
-        const int y0 = by == 0 ? 0 : by * B - B / 2, y1 = by == gain.height - 1 ? h : ((by + 1) * B + B / 2 < h ? (by + 1) * B + B / 2 : h);
+        const int y0 = by * B - B / 2 > 0 ? by * B - B / 2 : 0, y1 = (by + 1) * B + B / 2 < h ? (by + 1) * B + B / 2 : h;
         double sb[3] = {0, 0, 0}, sr[3] = {0, 0, 0};
         for (int y = y0; y < y1; ++y) {
             const float w = refineHat(y, by, gain.height);
@@ -308,6 +308,9 @@ void runRefineFunctors(const Exec& exec, const RefineNet* net, const RefineViews
                         exec.forEachPixel(out.width, out.height, LearnedConv{in, out, k, b, ks, relu});
                     });
 }
+
+// The network's parameters of `w` (the built-in ones when it is empty; refine_weights.cpp).
+const RefineNet& refineNet(const RefineWeights& w);
 
 // The stage on each executor (src/cpu/refine_cpu.cpp, src/cuda/refine.cu). functors: the CPU's
 // reference path (direct convolutions) instead of oneDNN.
