@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <string>
+#include <vector>
 
 #include "atrous/error.h"
 #include "core/parallel.h"
@@ -35,7 +36,7 @@ dnnl::engine& cpuEngine() {
 // The convolution's output rows [y0, y1) from the input rows they read (one above and below where
 // the image has them; zero padding only at the image's edges): channels-last bands are dense.
 void dnnlConvRows(const LearnedTensor& in, const LearnedTensor& out, const float* k, const float* b, int ks, bool relu,
-                  int y0, int y1) {
+                  bool accumulate, int y0, int y1) {
     const int pad = ks / 2, i0 = std::max(0, y0 - pad), i1 = std::min(in.height, y1 + pad);
     using namespace dnnl;
     using dt = memory::data_type;
@@ -48,11 +49,10 @@ void dnnlConvRows(const LearnedTensor& in, const LearnedTensor& out, const float
                                       memory::desc({oc, ic, ks, ks}, dt::f32, tag::any), bMd, dstMd, {1, 1},
                                       {padTop, pad}, {padBottom, pad});
     primitive_attr attr;
-    if (relu) {
-        post_ops ops;
-        ops.append_eltwise(1.0f, algorithm::eltwise_relu, 0.0f, 0.0f);
-        attr.set_post_ops(ops);
-    }
+    post_ops ops;
+    if (accumulate) ops.append_sum(1.0f);
+    if (relu) ops.append_eltwise(1.0f, algorithm::eltwise_relu, 0.0f, 0.0f);
+    attr.set_post_ops(ops);
     omp_set_num_threads(1);
     stream s(cpuEngine());
     const convolution_forward::primitive_desc pd(d, attr, cpuEngine());
@@ -75,11 +75,12 @@ void dnnlConvRows(const LearnedTensor& in, const LearnedTensor& out, const float
 // The convolution in bands of rows on TBB's threads, one band per thread and at least 32 rows a
 // band (two halves on a 2-core machine; one piece below 64 rows).
 void learnedConvCpu(const LearnedTensor& in, const LearnedTensor& out, const float* k, const float* b, int ks, bool relu,
-                    const char* who) {
+                    const char* who, bool accumulate) {
     const int h = out.height, parts = std::max(1, std::min(tbb::this_task_arena::max_concurrency(), h / 32));
     try {
-        tbb::parallel_for(0, parts,
-                          [&](int i) { dnnlConvRows(in, out, k, b, ks, relu, h * i / parts, h * (i + 1) / parts); });
+        tbb::parallel_for(0, parts, [&](int i) {
+            dnnlConvRows(in, out, k, b, ks, relu, accumulate, h * i / parts, h * (i + 1) / parts);
+        });
     } catch (const dnnl::error& e) {
         throw RuntimeError(std::string(who) + ": oneDNN: " + e.what());
     }
@@ -87,8 +88,18 @@ void learnedConvCpu(const LearnedTensor& in, const LearnedTensor& out, const flo
 #else
 // Built without oneDNN (ATROUS_ONEDNN=OFF: the GPU check's pack): the direct-convolution functor.
 void learnedConvCpu(const LearnedTensor& in, const LearnedTensor& out, const float* k, const float* b, int ks, bool relu,
-                    const char*) {
-    CpuExec{}.forEachPixel(out.width, out.height, LearnedConv{in, out, k, b, ks, relu});
+                    const char*, bool accumulate) {
+    if (!accumulate) {
+        CpuExec{}.forEachPixel(out.width, out.height, LearnedConv{in, out, k, b, ks, relu});
+        return;
+    }
+    std::vector<float> part(size_t(out.width) * size_t(out.height) * size_t(out.channels));
+    const LearnedTensor p{part.data(), out.width, out.height, out.channels};
+    CpuExec{}.forEachPixel(out.width, out.height, LearnedConv{in, p, k, b, ks, false});
+    for (size_t i = 0; i < part.size(); ++i) {
+        const float v = out.data[i] + part[i];
+        out.data[i] = relu && v < 0.0f ? 0.0f : v;
+    }
 }
 #endif
 

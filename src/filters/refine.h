@@ -172,6 +172,15 @@ struct RefineUp2Cat {
     }
 };
 
+// up = up2 lo (nearest), lo's channels only: the CPU's concatenation-free form of the decoder
+// (src/cpu/refine_cpu.cpp convolves up and the skip tensor apart and sums).
+struct RefineUp2 {
+    LearnedTensor lo, up;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        memcpy(&up(x, y, 0), lo.at(x / 2, y / 2), sizeof(float) * size_t(lo.channels));
+    }
+};
+
 // r := the refined value max(expm1(log1p(max(out, 0)) + clamp(r)), 0) at the image's pixels (a
 // non-finite one: the method's output, which is finite).
 struct RefineResidual {
@@ -269,10 +278,26 @@ struct RefineViews {
     ImageView lc, t, albedo, normal, out;
 };
 
-// Everything before the network and the convolutions' order, through the functors (conv: the
-// executor's convolution, LearnedConv's signature).
+// A decoder convolution, out = relu conv3(cat(up2 lo, skip)) with the kernel k over the
+// concatenation's channels, through the functors: Up2Cat into `cat`, then conv (the GPU's form and
+// the CPU's reference).
 template <class Exec, class Conv>
-void runRefinePasses(const Exec& exec, const RefineNet* net, const RefineViews& v, const RefinePlanes& P, Conv conv) {
+struct RefineCatConv {
+    const Exec& exec;
+    Conv& conv;
+    void operator()(const LearnedTensor& lo, const LearnedTensor& skip, const LearnedTensor& cat, const LearnedTensor& out,
+                    const float* k, const float* b) const {
+        exec.forEachPixel(cat.width, cat.height, RefineUp2Cat{lo, skip, cat});
+        conv(cat, out, k, b, 3, true);
+    }
+};
+
+// Everything before the network and the convolutions' order, through the functors (conv: the
+// executor's convolution, LearnedConv's signature; catConv: a decoder convolution, RefineCatConv's
+// signature).
+template <class Exec, class Conv, class CatConv>
+void runRefinePasses(const Exec& exec, const RefineNet* net, const RefineViews& v, const RefinePlanes& P, Conv conv,
+                     CatConv catConv) {
     const int w = v.out.width, h = v.out.height;
     const ImageView d{P.e1a.data, w, h, 3};  // e1a's storage, free until the first convolution
     exec.forEachPixel(w, h, RefineNoiseDiff{v.lc, v.out, d});
@@ -286,10 +311,8 @@ void runRefinePasses(const Exec& exec, const RefineNet* net, const RefineViews& 
     exec.forEachPixel(P.p2.width, P.p2.height, LearnedPool2{P.e2, P.p2});
     conv(P.p2, P.e3a, net->k3, net->b3, 3, true);
     conv(P.e3a, P.e3, net->k3b, net->b3b, 3, true);
-    exec.forEachPixel(P.cat2.width, P.cat2.height, RefineUp2Cat{P.e3, P.e2, P.cat2});
-    conv(P.cat2, P.d2, net->ku2, net->bu2, 3, true);
-    exec.forEachPixel(P.cat1.width, P.cat1.height, RefineUp2Cat{P.d2, P.e1, P.cat1});
-    conv(P.cat1, P.d1, net->ku1, net->bu1, 3, true);
+    catConv(P.e3, P.e2, P.cat2, P.d2, net->ku2, net->bu2);
+    catConv(P.d2, P.e1, P.cat1, P.d1, net->ku1, net->bu1);
     conv(P.d1, P.r, net->ko, net->bo, 1, false);
     exec.forEachPixel(w, h, RefineResidual{P.r, v.out});
     exec.forEachPixel(P.gain.width, P.gain.height, RefineGainInit{P.gain});
@@ -303,10 +326,10 @@ void runRefinePasses(const Exec& exec, const RefineNet* net, const RefineViews& 
 // The whole stage through the functors (the GPU; the CPU's reference).
 template <class Exec>
 void runRefineFunctors(const Exec& exec, const RefineNet* net, const RefineViews& v, const RefinePlanes& P) {
-    runRefinePasses(exec, net, v, P,
-                    [&](const LearnedTensor& in, const LearnedTensor& out, const float* k, const float* b, int ks, bool relu) {
-                        exec.forEachPixel(out.width, out.height, LearnedConv{in, out, k, b, ks, relu});
-                    });
+    auto conv = [&](const LearnedTensor& in, const LearnedTensor& out, const float* k, const float* b, int ks, bool relu) {
+        exec.forEachPixel(out.width, out.height, LearnedConv{in, out, k, b, ks, relu});
+    };
+    runRefinePasses(exec, net, v, P, conv, RefineCatConv<Exec, decltype(conv)>{exec, conv});
 }
 
 // The network's parameters of `w` (the built-in ones when it is empty; refine_weights.cpp).
