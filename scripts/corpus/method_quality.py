@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """relMSE of atrous CLI runs (any flags) beside OIDN fast and high on the third-party corpus's
-stills, per case and as geometric means per renderer and spp over OIDN fast and over SURE
+stills (and plain MSE and the mean over the reference's), per case and as geometric means per renderer and
+spp over OIDN fast and over SURE
 (docs/quality.md, "The default method").
 
     .venv/bin/python scripts/corpus/method_quality.py --corpus out/corpus/full --json out/corpus/full/methods.json \\
@@ -41,6 +42,27 @@ def oidn_output(cache: Path, key: str, b, quality: str):
     return np.load(f)
 
 
+def parse_variants(ap, items):
+    """NAME=FLAGS arguments -> [(name, [flags])]; a malformed one is the parser's error."""
+    variants = []
+    for v in items:
+        if "=" not in v:
+            ap.error(f"'{v}': expected NAME=FLAGS")
+        name, flags = v.split("=", 1)
+        variants.append((name, flags.split()))
+    return variants
+
+
+def run_variant(atrous, inp, out, flags, what):
+    """`atrous denoise --in INP --out OUT FLAGS`, the output's RGB; None (after one line on stderr)
+    where the CLI failed."""
+    r = subprocess.run([atrous, "denoise", "--in", str(inp), "--out", out] + flags, capture_output=True, text=True)
+    if r.returncode:
+        print(f"{what} failed: {r.stdout}{r.stderr}", file=sys.stderr)
+        return None
+    return Q._stack(Q.read_exr(out), ["R", "G", "B"])
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--corpus", default="out/corpus/full")
@@ -53,12 +75,7 @@ def main() -> int:
     ap.add_argument("--crop-size", type=int, default=96)
     ap.add_argument("variants", nargs="+", metavar="NAME=FLAGS")
     a = ap.parse_args()
-    variants = []
-    for v in a.variants:
-        if "=" not in v:
-            ap.error(f"'{v}': expected NAME=FLAGS")
-        name, flags = v.split("=", 1)
-        variants.append((name, flags.split()))
+    variants = parse_variants(ap, a.variants)
     only = set(a.scenes.split(",")) if a.scenes else None
     crops = set(a.crop_cases.split(",")) if a.crop_cases else set()
     corpus = Path(a.corpus)
@@ -74,20 +91,24 @@ def main() -> int:
                 continue
             b = Q.load_still(sd, man, stem)
             row = {"scene": man["scene"], "renderer": man["renderer"], "spp": e["spp"],
-                   "pixel_filter": man.get("pixel_filter", "?"), "relmse": {"noisy": Q.relmse(b["color"], ref)}}
+                   "pixel_filter": man.get("pixel_filter", "?"), "relmse": {}, "mse": {}, "mean_over_ref": {}}
+
+            def score(name, img):
+                row["relmse"][name] = Q.relmse(img, ref)
+                row["mse"][name] = float(np.mean((img.astype(np.float64) - ref) ** 2))
+                row["mean_over_ref"][name] = float(img.mean(dtype=np.float64) / ref.mean(dtype=np.float64))
+
+            score("noisy", b["color"])
             for q in ("fast", "balanced", "high"):
-                row["relmse"]["oidn_" + q] = Q.relmse(oidn_output(corpus / "oidn_cache", f"{man['scene']}_{stem}", b, q), ref)
+                score("oidn_" + q, oidn_output(corpus / "oidn_cache", f"{man['scene']}_{stem}", b, q))
             inp = sd / (e["file"] if "file" in e else e["folder"])
             with tempfile.TemporaryDirectory() as t:
                 for name, flags in variants:
                     out = os.path.join(t, name + ".exr")
-                    r = subprocess.run([a.atrous, "denoise", "--in", str(inp), "--out", out] + flags,
-                                       capture_output=True, text=True)
-                    if r.returncode:
-                        print(f"{man['scene']} {stem}: {name} failed: {r.stdout}{r.stderr}", file=sys.stderr)
+                    img = run_variant(a.atrous, inp, out, flags, f"{man['scene']} {stem}: {name}")
+                    if img is None:
                         return 2
-                    img = Q._stack(Q.read_exr(out), ["R", "G", "B"])
-                    row["relmse"][name] = Q.relmse(img, ref)
+                    score(name, img)
                     if a.crops and name == a.crop_variant and f"{man['scene']}/{e['spp']}" in crops:
                         key = f"{man['scene']}_{stem}"
                         strip = Q.crop_strip([b["color"], img, oidn_output(corpus / "oidn_cache", key, b, "fast"),
@@ -106,6 +127,11 @@ def main() -> int:
         s = {"cases": len(rs), "geomean_over_oidn_fast": g}
         if "sure" in names:
             s["worst_over_sure"] = {n: max(r["relmse"][n] / r["relmse"]["sure"] for r in rs) for n in names}
+        s["worst_over_oidn_high"] = {n: max(r["relmse"][n] / r["relmse"]["oidn_high"] for r in rs) for n in names}
+        s["worst_over_noisy"] = {n: max(r["relmse"][n] / r["relmse"]["noisy"] for r in rs) for n in names}
+        # the issue's bright-pixel bar: plain MSE at most the larger of the input's and OIDN high's
+        s["mse_above_noisy_and_oidn_high"] = {n: sum(r["mse"][n] > max(r["mse"]["noisy"], r["mse"]["oidn_high"])
+                                                     for r in rs) for n in names}
         summary[f"{renderer} {spp}spp"] = s
         print(f"{renderer} {spp} spp ({len(rs)} cases), geomean / OIDN fast: " +
               " ".join(f"{n}={v:.3f}" for n, v in g.items()))

@@ -123,16 +123,58 @@ def conv_jax(a, k, b):
     return jax.lax.conv_general_dilated(a, k, (1, 1), "SAME", dimension_numbers=("NHWC", "HWIO", "NHWC")) + b
 
 
+# The output head (issue 47: "a residual ..., signed per-pixel kernels ..., or a direct prediction;
+# measure which"); only `residual` is built into the library (docs/learned.md, "Heads").
+#   residual: expm1(log1p(base) + clip(r, +-3)), r 3 channels (the shipped stage)
+#   kernel:   a signed, unnormalised per-pixel kernel shared by the channels: 5x5 taps over the
+#             base and 3x3 over the noisy colour (34 outputs; the centre base tap starts at 1)
+#   direct:   expm1(clip(r, -10, 12)): the image in log space from the features alone
+HEADS = {"residual": 3, "kernel": 34, "direct": 3}
+HEAD = "residual"
+
+
+def init_params(seed, head):
+    p = R.init(seed)
+    n = HEADS[head]
+    if n != p["bo"].shape[0]:
+        rng = np.random.default_rng(seed + 7)
+        p["ko"] = (rng.standard_normal((1, 1, R.C1, n)) * 0.01 * math.sqrt(2.0 / R.C1)).astype(np.float32)
+        p["bo"] = np.zeros((n,), np.float32)
+    if head == "kernel":
+        p["bo"][12] = 1.0  # the 5x5 base kernel's centre
+    return p
+
+
+def _taps(img, r, jnp):
+    """The (2r+1)^2 shifted copies of img (N x H x W x C, edges replicated), row-major."""
+    n, h, w, _ = img.shape
+    q = jnp.pad(img, ((0, 0), (r, r), (r, r), (0, 0)), mode="edge")
+    return [q[:, r + dy:r + dy + h, r + dx:r + dx + w] for dy in range(-r, r + 1) for dx in range(-r, r + 1)]
+
+
+def head_output(r, x, base, head=None):
+    import jax.numpy as jnp
+    head = head or HEAD
+    if head == "residual":
+        return R.apply_residual(base, r, jnp)
+    if head == "direct":
+        return jnp.maximum(jnp.expm1(jnp.clip(r, -10.0, 12.0)), 0.0)
+    color = jnp.expm1(x[..., 3:6])
+    out = sum(r[..., k:k + 1] * t for k, t in enumerate(_taps(base, 2, jnp)))
+    out = out + sum(r[..., 25 + k:26 + k] * t for k, t in enumerate(_taps(color, 1, jnp)))
+    return jnp.maximum(out, 0.0)
+
+
 def apply(p, x, base):
     """The stage on crops of one energy block (training) or, for eval, whole images through
     energy_gain afterwards (apply_full)."""
     import jax.numpy as jnp
-    return R.energy_gain_crop(base, R.apply_residual(base, R.forward(p, x, conv_jax, jnp), jnp), jnp)
+    return R.energy_gain_crop(base, refined_only(p, x, base), jnp)
 
 
 def refined_only(p, x, base):
     import jax.numpy as jnp
-    return R.apply_residual(base, R.forward(p, x, conv_jax, jnp), jnp)
+    return head_output(R.forward(p, x, conv_jax, jnp), x, base)
 
 
 def blocks(a):
@@ -153,11 +195,14 @@ def loss_terms(out, target, anchor):
 
 
 def load_ckpt(path):
+    global HEAD
     c = np.load(path, allow_pickle=True)
+    HEAD = str(c["head"]) if "head" in c.files else "residual"
     return {k[2:]: c[k] for k in c.files if k.startswith("p/")}, int(c["step"])
 
 
-def train(data, out_dir, minutes, steps, lr, crop, batch, seed, energy_weight, mse_weight):
+def train(data, out_dir, minutes, steps, lr, crop, batch, seed, energy_weight, mse_weight, head="residual"):
+    global HEAD
     import jax
     import optax
     out_dir = Path(out_dir)
@@ -171,9 +216,12 @@ def train(data, out_dir, minutes, steps, lr, crop, batch, seed, energy_weight, m
     opt = optax.adam(lr)
     if ckpt.exists():
         params, step0 = load_ckpt(ckpt)
+        if HEAD != head:
+            raise SystemExit(f"{ckpt}: a {HEAD} head's checkpoint, asked for --head {head}")
         print(f"resumed at step {step0} (the optimiser's moments start again)")
     else:
-        params, step0 = R.init(seed), 0
+        HEAD = head
+        params, step0 = init_params(seed, head), 0
     state = opt.init(params)
 
     def loss_fn(p, xb, bb, tb, ab):
@@ -192,7 +240,7 @@ def train(data, out_dir, minutes, steps, lr, crop, batch, seed, energy_weight, m
     log = open(out_dir / "log.jsonl", "a")
 
     def save():
-        np.savez(ckpt, step=step, **{f"p/{k}": np.asarray(v) for k, v in params.items()})
+        np.savez(ckpt, step=step, head=HEAD, **{f"p/{k}": np.asarray(v) for k, v in params.items()})
 
     assert crop <= R.ENERGY_BLOCK, "training crops are one energy block (energy_gain_crop)"
     while step < steps and time.time() - t0 < minutes * 60:
@@ -212,7 +260,7 @@ def train(data, out_dir, minutes, steps, lr, crop, batch, seed, energy_weight, m
             m = np.median(np.array(losses), axis=0)
             rec = {"step": step, "loss": float(m[0]), "relmse": float(m[1]), "energy": float(m[2]), "mse": float(m[3]),
                    "seconds": round(time.time() - t0, 1), "data": str(data), "images": int(n), "lr": lr, "crop": crop,
-                   "batch": batch, "energy_weight": energy_weight, "mse_weight": mse_weight}
+                   "batch": batch, "energy_weight": energy_weight, "mse_weight": mse_weight, "head": HEAD}
             log.write(json.dumps(rec) + "\n")
             log.flush()
             print(rec, flush=True)
@@ -247,12 +295,14 @@ def evaluate(test, out_dir):
     g = {m: math.exp(np.mean([math.log(v[m]) for v in rows.values()])) for m in ("base", "refined", "oidn_fast")}
     print("geometric mean", {m: round(v, 5) for m, v in g.items()}, "refined/base", round(g["refined"] / g["base"], 3),
           "refined/oidn_fast", round(g["refined"] / g["oidn_fast"], 3))
-    (Path(out_dir) / "eval.json").write_text(json.dumps({"step": step, "method": str(z["method"]), "rows": rows,
+    (Path(out_dir) / "eval.json").write_text(json.dumps({"step": step, "head": HEAD, "method": str(z["method"]), "rows": rows,
                                                          "geomean": g}, indent=1))
 
 
 def export(out_dir, path, run):
     params, step = load_ckpt(Path(out_dir) / "ckpt.npz")
+    if HEAD != "residual":
+        raise SystemExit(f"{out_dir}: a {HEAD} head; the library's weight file holds the residual head only")
     Path(path).write_bytes(R.to_bytes(params, run, step))
     print(f"{run} step {step} -> {path}")
 
@@ -285,6 +335,7 @@ def main(argv):
     a.add_argument("--seed", type=int, default=1)
     a.add_argument("--energy", type=float, default=2.0, help="weight of the block-mean energy term")
     a.add_argument("--mse", type=float, default=0.0, help="weight of the plain-MSE term (runs A, B: 0)")
+    a.add_argument("--head", choices=sorted(HEADS), default="residual", help="the output head (HEADS above)")
     a = sub.add_parser("eval")
     a.add_argument("test")
     a.add_argument("out")
@@ -300,7 +351,7 @@ def main(argv):
     elif a.cmd == "prepare-train-corpus":
         prepare_train_corpus(a.out, a.dirs, a.method)
     elif a.cmd == "train":
-        train(a.data, a.out, a.minutes, a.steps, a.lr, a.crop, a.batch, a.seed, a.energy, a.mse)
+        train(a.data, a.out, a.minutes, a.steps, a.lr, a.crop, a.batch, a.seed, a.energy, a.mse, a.head)
     elif a.cmd == "eval":
         evaluate(a.test, a.out)
     else:
