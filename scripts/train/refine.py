@@ -22,6 +22,7 @@ plain-MSE term per crop (weighted --mse), which the brightest pixels dominate.
 """
 from __future__ import annotations
 
+import functools
 import importlib.util
 import json
 import math
@@ -130,7 +131,6 @@ def conv_jax(a, k, b):
 #             base and 3x3 over the noisy colour (34 outputs; the centre base tap starts at 1)
 #   direct:   expm1(clip(r, -10, 12)): the image in log space from the features alone
 HEADS = {"residual": 3, "kernel": 34, "direct": 3}
-HEAD = "residual"
 
 
 def init_params(seed, head):
@@ -152,9 +152,8 @@ def _taps(img, r, jnp):
     return [q[:, r + dy:r + dy + h, r + dx:r + dx + w] for dy in range(-r, r + 1) for dx in range(-r, r + 1)]
 
 
-def head_output(r, x, base, head=None):
+def head_output(r, x, base, head):
     import jax.numpy as jnp
-    head = head or HEAD
     if head == "residual":
         return R.apply_residual(base, r, jnp)
     if head == "direct":
@@ -165,16 +164,16 @@ def head_output(r, x, base, head=None):
     return jnp.maximum(out, 0.0)
 
 
-def apply(p, x, base):
+def apply(p, x, base, head):
     """The stage on crops of one energy block (training) or, for eval, whole images through
     energy_gain afterwards (apply_full)."""
     import jax.numpy as jnp
-    return R.energy_gain_crop(base, refined_only(p, x, base), jnp)
+    return R.energy_gain_crop(base, refined_only(p, x, base, head), jnp)
 
 
-def refined_only(p, x, base):
+def refined_only(p, x, base, head):
     import jax.numpy as jnp
-    return head_output(R.forward(p, x, conv_jax, jnp), x, base)
+    return head_output(R.forward(p, x, conv_jax, jnp), x, base, head)
 
 
 def blocks(a):
@@ -195,14 +194,13 @@ def loss_terms(out, target, anchor):
 
 
 def load_ckpt(path):
-    global HEAD
+    """(params, step, head); checkpoints from before --head are the residual's."""
     c = np.load(path, allow_pickle=True)
-    HEAD = str(c["head"]) if "head" in c.files else "residual"
-    return {k[2:]: c[k] for k in c.files if k.startswith("p/")}, int(c["step"])
+    head = str(c["head"]) if "head" in c.files else "residual"
+    return {k[2:]: c[k] for k in c.files if k.startswith("p/")}, int(c["step"]), head
 
 
 def train(data, out_dir, minutes, steps, lr, crop, batch, seed, energy_weight, mse_weight, head="residual"):
-    global HEAD
     import jax
     import optax
     out_dir = Path(out_dir)
@@ -215,17 +213,16 @@ def train(data, out_dir, minutes, steps, lr, crop, batch, seed, energy_weight, m
     ckpt = out_dir / "ckpt.npz"
     opt = optax.adam(lr)
     if ckpt.exists():
-        params, step0 = load_ckpt(ckpt)
-        if HEAD != head:
-            raise SystemExit(f"{ckpt}: a {HEAD} head's checkpoint, asked for --head {head}")
+        params, step0, saved = load_ckpt(ckpt)
+        if saved != head:
+            raise SystemExit(f"{ckpt}: a {saved} head's checkpoint, asked for --head {head}")
         print(f"resumed at step {step0} (the optimiser's moments start again)")
     else:
-        HEAD = head
         params, step0 = init_params(seed, head), 0
     state = opt.init(params)
 
     def loss_fn(p, xb, bb, tb, ab):
-        rel, en, mse = loss_terms(apply(p, xb, bb), tb, ab)
+        rel, en, mse = loss_terms(apply(p, xb, bb, head), tb, ab)
         return rel + energy_weight * en + mse_weight * mse, (rel, en, mse)
 
     @jax.jit
@@ -240,7 +237,7 @@ def train(data, out_dir, minutes, steps, lr, crop, batch, seed, energy_weight, m
     log = open(out_dir / "log.jsonl", "a")
 
     def save():
-        np.savez(ckpt, step=step, head=HEAD, **{f"p/{k}": np.asarray(v) for k, v in params.items()})
+        np.savez(ckpt, step=step, head=head, **{f"p/{k}": np.asarray(v) for k, v in params.items()})
 
     assert crop <= R.ENERGY_BLOCK, "training crops are one energy block (energy_gain_crop)"
     while step < steps and time.time() - t0 < minutes * 60:
@@ -260,7 +257,7 @@ def train(data, out_dir, minutes, steps, lr, crop, batch, seed, energy_weight, m
             m = np.median(np.array(losses), axis=0)
             rec = {"step": step, "loss": float(m[0]), "relmse": float(m[1]), "energy": float(m[2]), "mse": float(m[3]),
                    "seconds": round(time.time() - t0, 1), "data": str(data), "images": int(n), "lr": lr, "crop": crop,
-                   "batch": batch, "energy_weight": energy_weight, "mse_weight": mse_weight, "head": HEAD}
+                   "batch": batch, "energy_weight": energy_weight, "mse_weight": mse_weight, "head": head}
             log.write(json.dumps(rec) + "\n")
             log.flush()
             print(rec, flush=True)
@@ -273,10 +270,10 @@ def train(data, out_dir, minutes, steps, lr, crop, batch, seed, energy_weight, m
 
 def evaluate(test, out_dir):
     import jax
-    params, step = load_ckpt(Path(out_dir) / "ckpt.npz")
+    params, step, head = load_ckpt(Path(out_dir) / "ckpt.npz")
     z = np.load(test)
     keys = sorted({k.rsplit("/", 1)[0] for k in z.files if "/" in k})
-    f = jax.jit(refined_only)
+    f = jax.jit(functools.partial(refined_only, head=head))
     rows = {}
 
     def rel(a, ref):
@@ -295,14 +292,14 @@ def evaluate(test, out_dir):
     g = {m: math.exp(np.mean([math.log(v[m]) for v in rows.values()])) for m in ("base", "refined", "oidn_fast")}
     print("geometric mean", {m: round(v, 5) for m, v in g.items()}, "refined/base", round(g["refined"] / g["base"], 3),
           "refined/oidn_fast", round(g["refined"] / g["oidn_fast"], 3))
-    (Path(out_dir) / "eval.json").write_text(json.dumps({"step": step, "head": HEAD, "method": str(z["method"]), "rows": rows,
+    (Path(out_dir) / "eval.json").write_text(json.dumps({"step": step, "head": head, "method": str(z["method"]), "rows": rows,
                                                          "geomean": g}, indent=1))
 
 
 def export(out_dir, path, run):
-    params, step = load_ckpt(Path(out_dir) / "ckpt.npz")
-    if HEAD != "residual":
-        raise SystemExit(f"{out_dir}: a {HEAD} head; the library's weight file holds the residual head only")
+    params, step, head = load_ckpt(Path(out_dir) / "ckpt.npz")
+    if head != "residual":
+        raise SystemExit(f"{out_dir}: a {head} head; the library's weight file holds the residual head only")
     Path(path).write_bytes(R.to_bytes(params, run, step))
     print(f"{run} step {step} -> {path}")
 

@@ -162,22 +162,22 @@ struct RefineFeatures {
     }
 };
 
-// cat = (up2 lo, skip): lo's channels at (x / 2, y / 2) (nearest), then skip's at (x, y).
-struct RefineUp2Cat {
-    LearnedTensor lo, skip, cat;
-    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
-        float* o = &cat(x, y, 0);
-        memcpy(o, lo.at(x / 2, y / 2), sizeof(float) * size_t(lo.channels));
-        memcpy(o + lo.channels, skip.at(x, y), sizeof(float) * size_t(skip.channels));
-    }
-};
-
-// up = up2 lo (nearest), lo's channels only: the CPU's concatenation-free form of the decoder
-// (src/cpu/refine_cpu.cpp convolves up and the skip tensor apart and sums).
+// up = up2 lo (nearest): lo's channels at (x / 2, y / 2) into the first of up's. Alone, the CPU's
+// concatenation-free decoder (src/cpu/refine_cpu.cpp convolves up and the skip tensor apart and
+// sums); in RefineUp2Cat, the concatenation's first part.
 struct RefineUp2 {
     LearnedTensor lo, up;
     ATROUS_HOST_DEVICE void operator()(int x, int y) const {
         memcpy(&up(x, y, 0), lo.at(x / 2, y / 2), sizeof(float) * size_t(lo.channels));
+    }
+};
+
+// cat = (up2 lo, skip): RefineUp2 into cat's first channels, then skip's at (x, y).
+struct RefineUp2Cat {
+    LearnedTensor lo, skip, cat;
+    ATROUS_HOST_DEVICE void operator()(int x, int y) const {
+        RefineUp2{lo, cat}(x, y);
+        memcpy(&cat(x, y, lo.channels), skip.at(x, y), sizeof(float) * size_t(skip.channels));
     }
 };
 
